@@ -1,0 +1,54 @@
+# Two commands on a fresh machine: `make sim` (the main job) and `make test`.
+# Both create .venv, install the pinned Python deps and make sure GHDL and Yosys exist.
+
+PYTHON   ?= python3
+VENV     := .venv
+BIN      := $(VENV)/bin
+STAMP    := $(VENV)/.installed-stamp
+BUILD    := build
+# The default design: the paper's 51-term FLANN trained on Table 1 (see README).
+DEFAULT_MODEL := data/default_model.json
+TRAIN_ARGS    := --terms 51 --method lstsq
+MODEL    ?=
+DEVICE   ?= xc2s200-pq208-5
+
+.PHONY: all venv tools test sim gen synth paper bench clean
+
+all: test
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+	$(BIN)/pip install -q -e '.[dev]'
+	touch $@
+
+venv: $(STAMP)
+
+tools:
+	@scripts/ensure_tools.sh
+
+test: venv tools
+	$(BIN)/python -m pytest -q
+
+# Main job: train (unless MODEL= is given), generate VHDL, co-simulate every bench, summarise.
+sim: venv tools
+	@mkdir -p $(BUILD)
+ifeq ($(strip $(MODEL)),)
+	$(BIN)/flann train data/paper_table1.csv $(TRAIN_ARGS) -o $(BUILD)/model.json
+	$(BIN)/flann sim $(BUILD)/model.json --plot $(BUILD)/sim.png
+else
+	$(BIN)/flann sim $(MODEL) --plot $(BUILD)/sim.png
+endif
+
+# Regenerate the checked-in hdl/ from the checked-in default model.
+gen: venv
+	$(BIN)/flann gen $(DEFAULT_MODEL) -o hdl --device $(DEVICE)
+
+synth: venv tools
+	$(BIN)/flann synth hdl --device $(DEVICE)
+
+paper: venv
+	$(BIN)/flann paper --plot $(BUILD)/paper
+
+clean:
+	rm -rf $(BUILD) sim_build .pytest_cache

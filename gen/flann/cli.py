@@ -1,0 +1,79 @@
+"""The ``flann`` console command.
+
+Subcommands live in :mod:`flann.commands` (one module each, exposing ``HELP``,
+``add_arguments(parser)`` and ``run(args) -> int``).  A module is imported only when its
+subcommand is used, so one command's heavy imports never slow down or break another.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import warnings
+
+from . import __version__
+from .errors import FlannError
+
+# name -> one-line help; the module is flann.commands.<name>
+COMMANDS: dict[str, str] = {
+    "train": "train a FLANN inverse model on recordings",
+    "predict": "apply a model to recordings",
+    "eval": "accuracy of a model on recordings",
+    "paper": "reproduce the seed paper's tables and figures",
+    "gen": "generate VHDL-93 for a model",
+    "sim": "co-simulate the generated VHDL under GHDL/cocotb",
+    "synth": "resource estimate via GHDL synthesis and Yosys",
+    "explore": "design-space table (lanes x multiplier x widths)",
+    "ise": "write an ISE 10.1 project for the generated VHDL",
+    "trace": "stage-by-stage error of hardware against the golden model",
+    "simulate": "LVDT physics simulator: write recordings from a sensor file",
+    "diagnose": "locate and name the physics missing between simulation and recordings",
+}
+
+
+def _load(name: str):
+    return importlib.import_module(f"flann.commands.{name.replace('-', '_')}")
+
+
+def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="flann", description="LVDT linearisation with a FLANN: model, VHDL, simulation, physics."
+    )
+    parser.add_argument("--version", action="version", version=f"flann {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, help_text in COMMANDS.items():
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        if name == selected:
+            _load(name).add_arguments(p)
+    return parser
+
+
+def _one_line_warnings() -> None:
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"warning: {message}", file=sys.stderr)
+
+    warnings.showwarning = show
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    selected = next((a for a in argv if a in COMMANDS), None)
+    parser = build_parser(selected)
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    _one_line_warnings()
+    try:
+        return int(_load(args.command).run(args) or 0)
+    except FlannError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

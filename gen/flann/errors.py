@@ -1,0 +1,25 @@
+"""User-facing errors.
+
+Every layer raises :class:`FlannError` (or a subclass) for bad input; the CLI turns it
+into one line on stderr and exit code 2.  Messages name the file/field and what is allowed.
+"""
+
+
+class FlannError(Exception):
+    """Bad input from the user: reported as one line, exit code 2."""
+
+
+class RecordingsError(FlannError):
+    """A recordings CSV that cannot be used."""
+
+
+class ModelFileError(FlannError):
+    """A model.json that cannot be read or is of another format."""
+
+
+class SpecError(FlannError):
+    """A fixed-point / generator option that cannot be honoured."""
+
+
+class SensorError(FlannError):
+    """A sensor description (TOML) that is invalid."""
