@@ -20,7 +20,7 @@ def test_paper_table_reads_with_provenance():
         ("displacement_mm,voltage_v\n1,abc\n", "not a number"),
         ("displacement_mm,voltage_v\n1,nan\n", "not finite"),
         ("displacement_mm,voltage_v\n1,inf\n", "not finite"),
-        ("displacement_mm,voltage_v,direction\n1,2,0\n", "not +1 or -1"),
+        ("displacement_mm,voltage_v,direction\n1,2,0\n", r"not \+1 or -1"),
         ("displacement_mm,voltage_v\n", "no data rows"),
         ("displacement_mm,voltage_v\n1,2,3\n", "cells"),
     ],
