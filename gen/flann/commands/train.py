@@ -1,0 +1,93 @@
+"""``flann train``: fit a FLANN inverse model to recordings and write model.json."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import FlannError
+from ..recordings import prepare_for_fit, read_recordings
+from ..train import NORMALISATIONS, PAPER_TERMS, check_fit_input, fit_auto, fit_lms, fit_lstsq
+
+HELP = "train a FLANN inverse model on recordings"
+
+
+def _terms(text: str):
+    if text == "auto":
+        return "auto"
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer or 'auto', got {text!r}")
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {n}")
+    return n
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...)")
+    p.add_argument("-o", "--output", required=True, help="model.json to write")
+    p.add_argument("--terms", type=_terms, default="auto",
+                   help="expansion terms N (paper: %s) or 'auto' (default): terms, "
+                        "normalisation and ridge chosen by cross-validation"
+                        % ", ".join(map(str, PAPER_TERMS)))
+    p.add_argument("--method", choices=("lstsq", "lms"), default="lstsq",
+                   help="closed-form least squares (default) or the paper's LMS")
+    p.add_argument("--eta", type=float, default=0.01, help="LMS learning rate (default 0.01)")
+    p.add_argument("--epochs", type=int, default=1000, help="LMS epochs (default 1000)")
+    p.add_argument("--ridge", type=float, default=0.0,
+                   help="lstsq ridge penalty on mean squared error (default 0)")
+    p.add_argument("--normalise", choices=NORMALISATIONS, default=None,
+                   help="input normalisation for explicit --terms: 'range' (default: the "
+                        "data's voltage range -> [-1, 1]) or 'none' (raw volts, as the paper)")
+    p.add_argument("--input-offset-v", type=float, default=None,
+                   help="explicit normalisation offset (V); needs --input-scale-v")
+    p.add_argument("--input-scale-v", type=float, default=None,
+                   help="explicit normalisation scale (V); needs --input-offset-v")
+    p.add_argument("--trim", action="store_true",
+                   help="keep only the monotonic span when the voltage folds back")
+
+
+def run(args) -> int:
+    rec = read_recordings(args.recordings)
+    rec = prepare_for_fit(rec, trim=args.trim)
+    explicit = None
+    if (args.input_offset_v is None) != (args.input_scale_v is None):
+        raise FlannError("--input-offset-v and --input-scale-v must be given together")
+    if args.input_scale_v is not None:
+        if args.input_scale_v == 0:
+            raise FlannError("--input-scale-v must not be 0")
+        if args.normalise is not None:
+            raise FlannError("give either --normalise or --input-offset-v/--input-scale-v")
+        explicit = (args.input_offset_v, args.input_scale_v)
+    provenance = {"data_file": args.recordings.replace("\\", "/").rsplit("/", 1)[-1],
+                  "data_sha256": rec.sha256}
+    if rec.comments:
+        provenance["data_provenance"] = rec.comments[0]
+    if args.terms == "auto":
+        if args.method != "lstsq" or explicit is not None or args.normalise or args.ridge:
+            raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
+                             "give --terms N to set --method/--normalise/--ridge")
+        check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
+        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance)
+        print(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
+              f"held-out error (cross-validation, {model.training['cv_folds']} folds): "
+              f"RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+    else:
+        norm = args.normalise or "range"
+        check_fit_input(rec.voltage_v, rec.displacement_mm, args.terms, rec.source)
+        if args.method == "lms":
+            model = fit_lms(rec.voltage_v, rec.displacement_mm, args.terms, eta=args.eta,
+                            epochs=args.epochs, norm=norm, offset_scale=explicit,
+                            training=provenance)
+            print(f"lms: {args.terms} terms, eta {args.eta:g}, {args.epochs} epochs, final "
+                  f"epoch MSE {model.training['mse_per_epoch'][-1]:.4g} mm^2 (training error)",
+                  file=sys.stderr)
+        else:
+            model = fit_lstsq(rec.voltage_v, rec.displacement_mm, args.terms, norm=norm,
+                              offset_scale=explicit, ridge=args.ridge, training=provenance)
+            print(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
+                  f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)",
+                  file=sys.stderr)
+    model.save(args.output)
+    return 0

@@ -1,0 +1,258 @@
+"""Training the FLANN inverse model: the paper's LMS, closed-form least squares, and ``auto``.
+
+All three return a :class:`flann.model.FlannModel` whose output is
+``y_mm = bias + sum_i w_i phi_i(v_n)`` with ``v_n = (v - input_offset_v) / input_scale_v``.
+
+* :func:`fit_lms` -- the paper's rule, sample by sample in file order:
+  ``w(k+1) = w(k) + eta * e(k) * s(k)``, ``e(k) = d(k) - y(k)``, every weight (and the bias,
+  whose input is the constant 1, the paper's phi_1 = 1) starting at 1.  The mean of e(k)^2
+  over each epoch (the a-priori errors seen while updating) is recorded as the epoch's MSE.
+* :func:`fit_lstsq` -- minimum-norm least squares (``numpy.linalg.lstsq``), optionally with a
+  ridge penalty: minimise ``mean(e^2) + ridge * |w|^2`` (the bias is not penalised).  With
+  more terms than points the problem is under-determined and the minimum-norm interpolant
+  is returned (the paper fits 51 and 61 terms to 13 points).
+* :func:`fit_auto` -- chooses terms, normalisation and ridge by K-fold cross-validation and
+  reports the held-out error (never the training error).
+
+Normalisation: ``"range"`` maps the data's voltage range to [-1, 1] (offset = midpoint,
+scale = half span); ``"none"`` uses raw volts (offset 0, scale 1) as the paper did.
+Everything here is deterministic: no random numbers, a fixed order of operations.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import FlannError, RecordingsError
+from .model import FlannModel, expand
+
+PAPER_TERMS = (11, 25, 51, 61)
+NORMALISATIONS = ("range", "none")
+MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
+AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
+AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
+AUTO_MAX_FOLDS = 10
+
+
+# -- normalisation -----------------------------------------------------------------------
+def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
+    """(input_offset_v, input_scale_v) for ``kind`` ('range' or 'none')."""
+    v = np.asarray(voltage_v, dtype=float)
+    if kind == "none":
+        return 0.0, 1.0
+    if kind == "range":
+        lo, hi = float(v.min()), float(v.max())
+        if not hi > lo:
+            raise RecordingsError(
+                f"voltage_v spans no range (all {lo:g} V): cannot normalise or fit"
+            )
+        return (lo + hi) / 2.0, (hi - lo) / 2.0
+    raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)}, got {kind!r}")
+
+
+def _design(v_n: np.ndarray, terms: int) -> np.ndarray:
+    """[1, phi_0 .. phi_{terms-1}]: the bias column first."""
+    return np.hstack([np.ones((v_n.size, 1)), expand(v_n, terms)])
+
+
+def check_fit_input(voltage_v, displacement_mm, terms: int, source: str = "recordings") -> None:
+    """Refuse what cannot be fitted at all; warn (as the paper did it) about terms > points."""
+    n = int(np.asarray(voltage_v).size)
+    if terms < 1:
+        raise FlannError(f"--terms must be >= 1, got {terms}")
+    distinct = np.unique(np.asarray(voltage_v, dtype=float)).size
+    if n < MIN_POINTS or distinct < 2:
+        raise RecordingsError(
+            f"{source}: {n} point(s) with {distinct} distinct voltage(s); need at least "
+            f"{MIN_POINTS} points with 2 distinct voltages to fit a model"
+        )
+    if terms + 1 > n:
+        warnings.warn(
+            f"{source}: {terms} terms + bias from {n} points: under-determined, the fit "
+            "interpolates the points (as in the paper); check between-point behaviour with "
+            "'flann eval' on denser data",
+            stacklevel=2,
+        )
+
+
+def _ranges(voltage_v, displacement_mm):
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    return (float(v.min()), float(v.max())), (float(x.min()), float(x.max()))
+
+
+# -- least squares -----------------------------------------------------------------------
+def solve_lstsq(design: np.ndarray, y: np.ndarray, ridge: float = 0.0) -> np.ndarray:
+    """Coefficients c (bias first) minimising mean((design c - y)^2) + ridge |c[1:]|^2.
+
+    ridge = 0: minimum-norm least squares.  ridge > 0: the augmented system
+    [design; sqrt(n ridge) [0 | I]] c = [y; 0], solved by the same routine.
+    """
+    if ridge < 0 or not math.isfinite(ridge):
+        raise FlannError(f"--ridge must be a finite number >= 0, got {ridge!r}")
+    if ridge > 0:
+        n, p = design.shape
+        reg = np.zeros((p - 1, p))
+        reg[:, 1:] = np.sqrt(n * ridge) * np.eye(p - 1)
+        design = np.vstack([design, reg])
+        y = np.concatenate([y, np.zeros(p - 1)])
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    return coef
+
+
+def fit_lstsq(voltage_v, displacement_mm, terms: int, *, norm: str = "range",
+              offset_scale: tuple[float, float] | None = None, ridge: float = 0.0,
+              training: dict | None = None) -> FlannModel:
+    """Closed-form least-squares model (see module docstring)."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
+    coef = solve_lstsq(_design((v - offset) / scale, terms), x, ridge)
+    resid = x - (_design((v - offset) / scale, terms) @ coef)
+    vr, xr = _ranges(v, x)
+    info = {"method": "lstsq", "ridge": float(ridge),
+            "normalisation": norm if offset_scale is None else "explicit",
+            "train_rms_error_mm": float(np.sqrt(np.mean(resid**2))), "points": int(v.size)}
+    info.update(training or {})
+    return FlannModel(weights=tuple(float(c) for c in coef[1:]), bias=float(coef[0]),
+                      input_offset_v=float(offset), input_scale_v=float(scale),
+                      voltage_range_v=vr, displacement_range_mm=xr, training=info)
+
+
+# -- LMS -----------------------------------------------------------------------------------
+def lms_epochs(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
+               w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's LMS on a design matrix ``S`` (one row per sample, bias column included).
+
+    Returns (weights, mse_per_epoch).  Samples are visited in row order every epoch.
+    """
+    if not (eta > 0 and math.isfinite(eta)):
+        raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
+    if epochs < 1:
+        raise FlannError(f"--epochs must be >= 1, got {epochs}")
+    w = np.ones(S.shape[1]) if w0 is None else np.array(w0, dtype=float)
+    mse = np.empty(epochs)
+    rows = [S[k] for k in range(S.shape[0])]
+    with np.errstate(over="ignore", invalid="ignore"):
+        for ep in range(epochs):
+            acc = 0.0
+            for s, dk in zip(rows, d):
+                e = dk - float(s @ w)
+                w += eta * e * s
+                acc += e * e
+            mse[ep] = acc / len(rows)
+            if not math.isfinite(mse[ep]):
+                raise FlannError(
+                    f"LMS diverged in epoch {ep + 1} with eta={eta:g}: use a smaller --eta "
+                    f"(stability needs eta < 2/|s|^2 = {2 / float(np.max(np.sum(S**2, 1))):.3g})"
+                )
+    return w, mse
+
+
+def fit_lms(voltage_v, displacement_mm, terms: int, *, eta: float, epochs: int,
+            norm: str = "range", offset_scale: tuple[float, float] | None = None,
+            training: dict | None = None) -> FlannModel:
+    """The paper's LMS (see module docstring).  MSE per epoch goes to training['mse_per_epoch']."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
+    S = _design((v - offset) / scale, terms)
+    w, mse = lms_epochs(S, x, eta, epochs)
+    resid = x - S @ w
+    vr, xr = _ranges(v, x)
+    info = {"method": "lms", "eta": float(eta), "epochs": int(epochs), "weights_start": 1.0,
+            "normalisation": norm if offset_scale is None else "explicit",
+            "train_rms_error_mm": float(np.sqrt(np.mean(resid**2))), "points": int(v.size),
+            "mse_per_epoch": [float(f"{m:.6g}") for m in mse]}
+    info.update(training or {})
+    return FlannModel(weights=tuple(float(c) for c in w[1:]), bias=float(w[0]),
+                      input_offset_v=float(offset), input_scale_v=float(scale),
+                      voltage_range_v=vr, displacement_range_mm=xr, training=info)
+
+
+# -- auto: cross-validation ---------------------------------------------------------------
+@dataclass(frozen=True)
+class CvResult:
+    terms: int
+    norm: str
+    ridge: float
+    rms_mm: float
+    max_mm: float
+
+
+def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
+    """Interleaved held-out folds over the points sorted by voltage.
+
+    The lowest- and highest-voltage points are never held out: cross-validation measures
+    error *inside* the calibrated voltage range (the model is not used beyond it).
+    """
+    v = np.asarray(voltage_v, dtype=float)
+    order = np.argsort(v, kind="stable")
+    inner = order[1:-1]
+    k = min(AUTO_MAX_FOLDS if k is None else k, inner.size)
+    if k < 2:
+        raise RecordingsError(
+            f"{v.size} points: too few for cross-validation (auto needs at least 4); "
+            "give --terms N explicitly"
+        )
+    return [np.sort(inner[i::k]) for i in range(k)]
+
+
+def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
+                   ridges=AUTO_RIDGES, k: int | None = None) -> list[CvResult]:
+    """Held-out RMS and max error (mm) for every (terms, norm, ridge) candidate."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    folds = cv_folds(v, k)
+    results = []
+    for norm in norms:
+        offset, scale = normalisation(v, norm)
+        full = _design((v - offset) / scale, max(terms_list))
+        errs = {(t, r): np.empty(v.size) * np.nan for t in terms_list for r in ridges}
+        for held in folds:
+            train = np.ones(v.size, bool)
+            train[held] = False
+            for t in terms_list:
+                A = full[train, : t + 1]
+                B = full[held, : t + 1]
+                for r in ridges:
+                    coef = solve_lstsq(A, x[train], r)
+                    errs[(t, r)][held] = B @ coef - x[held]
+        for (t, r), e in errs.items():
+            e = e[np.isfinite(e)]
+            results.append(CvResult(t, norm, r, float(np.sqrt(np.mean(e**2))),
+                                    float(np.max(np.abs(e)))))
+    return results
+
+
+def pick(results: list[CvResult]) -> CvResult:
+    """Smallest held-out RMS; within 2 % of it, prefer fewer terms, then larger ridge."""
+    best = min(r.rms_mm for r in results)
+    ok = [r for r in results if r.rms_mm <= best * 1.02 + 1e-12]
+    return min(ok, key=lambda r: (r.terms, -r.ridge, NORMALISATIONS.index(r.norm)))
+
+
+def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
+             ridges=AUTO_RIDGES, training: dict | None = None) -> tuple[FlannModel, CvResult]:
+    """Choose (terms, norm, ridge) by cross-validation, then fit on all points."""
+    v = np.asarray(voltage_v, dtype=float)
+    if v.size < 4:
+        raise RecordingsError(
+            f"{v.size} points: too few for cross-validation (auto needs at least 4); "
+            "give --terms N explicitly"
+        )
+    results = cross_validate(v, displacement_mm, terms_list, norms, ridges)
+    choice = pick(results)
+    info = {"selected_by": "cross-validation",
+            "cv_folds": len(cv_folds(v)),
+            "cv_heldout_rms_error_mm": choice.rms_mm,
+            "cv_heldout_max_error_mm": choice.max_mm,
+            "cv_candidates": len(results)}
+    info.update(training or {})
+    model = fit_lstsq(v, displacement_mm, choice.terms, norm=choice.norm, ridge=choice.ridge,
+                      training=info)
+    return model, choice
