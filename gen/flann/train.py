@@ -34,7 +34,7 @@ PAPER_TERMS = (11, 25, 51, 61)
 NORMALISATIONS = ("range", "none")
 MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
 AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
-AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
+AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0)
 AUTO_MAX_FOLDS = 10
 
 
@@ -151,6 +151,28 @@ def lms_epochs(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
                     f"(stability needs eta < 2/|s|^2 = {2 / float(np.max(np.sum(S**2, 1))):.3g})"
                 )
     return w, mse
+
+
+def lms_leave_one_out(S: np.ndarray, d: np.ndarray, eta: float, epochs: int) -> np.ndarray:
+    """Held-out predictions of LMS trained without each row in turn (all folds at once).
+
+    Fold i visits every row except row i, in row order, ``epochs`` times, starting from
+    weights of 1 -- exactly :func:`lms_epochs` on the other rows; returns S[i] @ w_i.
+    """
+    if not (eta > 0 and math.isfinite(eta)):
+        raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
+    n, p = S.shape
+    W = np.ones((n, p))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(epochs):
+            for k in range(n):
+                e = d[k] - W @ S[k]
+                e[k] = 0.0
+                W += eta * np.outer(e, S[k])
+    pred = np.einsum("ij,ij->i", W, S)
+    if not np.all(np.isfinite(pred)):
+        raise FlannError(f"LMS diverged in leave-one-out with eta={eta:g}: use a smaller --eta")
+    return pred
 
 
 def fit_lms(voltage_v, displacement_mm, terms: int, *, eta: float, epochs: int,

@@ -1,0 +1,67 @@
+"""``flann eval``: accuracy of a model on recordings (compensated vs the raw sensor)."""
+
+from __future__ import annotations
+
+import json
+
+from ..metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
+                       raw_output_mm)
+from ..errors import FlannError
+from ..model import load_model
+from ..recordings import read_recordings
+from .predict import warn_outside_range
+
+HELP = "accuracy of a model on recordings"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("model", help="model.json")
+    p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v")
+    p.add_argument("--json", action="store_true", help="print the figures as JSON")
+    p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
+                   help="linearity tolerance in %% of full scale (default %(default)g)")
+    p.add_argument("--band", type=float, default=DEFAULT_BAND_PCT_FS, metavar="PCT_FS",
+                   help="stroke-fraction band in %% of full scale (default %(default)g)")
+    p.add_argument("--full-scale-mm", type=float, default=None,
+                   help="full scale (mm); default half the recordings' displacement span")
+
+
+def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
+    """Metrics of the compensated output and of the raw sensor (its least-squares line)."""
+    if not (tol >= 0 and band >= 0):
+        raise FlannError("--tol and --band must be >= 0 (% of full scale)")
+    if fs_mm is not None and not fs_mm > 0:
+        raise FlannError(f"--full-scale-mm must be > 0, got {fs_mm:g}")
+    if len(rec) < 2:
+        raise FlannError(f"{rec.source}: need at least 2 rows to evaluate, got {len(rec)}")
+    fs = full_scale_mm(rec.displacement_mm) if fs_mm is None else float(fs_mm)
+    x = rec.displacement_mm
+    compensated = error_report(model.predict(rec.voltage_v), x, tol, band, fs, rec.direction)
+    raw = error_report(raw_output_mm(rec.voltage_v, x), x, tol, band, fs, rec.direction)
+    return {"points": len(rec), "full_scale_mm": fs, "tolerance_pct_fs": tol,
+            "band_pct_fs": band, "compensated": compensated, "raw": raw}
+
+
+def run(args) -> int:
+    model = load_model(args.model)
+    rec = read_recordings(args.recordings)
+    warn_outside_range(model, rec.voltage_v, rec.source)
+    res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
+    if args.json:
+        print(json.dumps(res, indent=2))
+        return 0
+    fs = res["full_scale_mm"]
+    print(f"{rec.source}: {res['points']} points, full scale {fs:g} mm "
+          f"(linearity tol +-{args.tol:g} % FS = {args.tol * fs / 100:g} mm, "
+          f"band +-{args.band:g} % FS = {args.band * fs / 100:g} mm)")
+    print(f"{'':28s}{'compensated':>14s}{'raw (LS line)':>16s}")
+    rows = [("max error (mm)", "max_error_mm", "{:.4g}"),
+            ("RMS error (mm)", "rms_error_mm", "{:.4g}"),
+            ("max error (% FS)", "max_error_pct_fs", "{:.4g}"),
+            ("RMS error (% FS)", "rms_error_pct_fs", "{:.4g}"),
+            ("% of linearity range", "linearity_pct", "{:.2f}"),
+            (f"stroke within +-{args.band:g} % FS", "stroke_fraction_within_band", "{:.2%}")]
+    for label, key, fmt in rows:
+        print(f"{label:28s}{fmt.format(res['compensated'][key]):>14s}"
+              f"{fmt.format(res['raw'][key]):>16s}")
+    return 0

@@ -1,0 +1,120 @@
+"""``flann paper``: the seed paper's Table 2 (and Fig. 5) reproduced, plus what it did not show."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..errors import FlannError
+from ..fileio import atomic_directory
+from ..metrics import DEFAULT_TOL_PCT_FS
+from ..recordings import read_recordings
+from ..train import fit_lstsq
+from .. import paper
+
+HELP = "reproduce the seed paper's tables and figures"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("--json", action="store_true",
+                   help="print {raw_linearity_pct, tolerance_pct_fs, rows: [...]} as JSON")
+    p.add_argument("--plot", metavar="DIR", default=None,
+                   help="write PNGs equivalent to the paper's Fig. 5 into DIR")
+    p.add_argument("--eta", type=float, default=paper.DEFAULT_ETA,
+                   help="LMS learning rate (the paper gives none; default %(default)g)")
+    p.add_argument("--epochs", type=int, default=paper.DEFAULT_EPOCHS,
+                   help="LMS epochs (the paper gives none; default %(default)d)")
+    p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
+                   help="linearity tolerance, %% of full scale (default %(default)g)")
+    p.add_argument("--data", default=None,
+                   help="recordings CSV instead of the paper's Table 1 (built in)")
+    p.add_argument("--normalise", choices=("none", "range"), default="none",
+                   help="input normalisation: 'none' = raw volts as the paper (default)")
+    p.add_argument("--sensitivity", action="store_true",
+                   help="also print Table 2 over a grid of eta and epochs")
+    p.add_argument("--dense", action="store_true",
+                   help="also run the tool's default (--terms auto) on dense physics-like "
+                        "data and print the stroke fraction within +-0.1 %% FS before/after")
+
+
+def run(args) -> int:
+    if not (args.eta > 0):
+        raise FlannError(f"--eta must be > 0, got {args.eta:g}")
+    if args.epochs < 1:
+        raise FlannError(f"--epochs must be >= 1, got {args.epochs}")
+    if not (args.tol >= 0):
+        raise FlannError(f"--tol must be >= 0 % FS, got {args.tol:g}")
+    rec = paper.table1() if args.data is None else read_recordings(args.data)
+    if len(rec) < 3:
+        raise FlannError(f"{rec.source}: need at least 3 points, got {len(rec)}")
+    if args.normalise == "range":
+        lo, hi = float(rec.voltage_v.min()), float(rec.voltage_v.max())
+        offset_scale = ((lo + hi) / 2, (hi - lo) / 2)
+    else:
+        offset_scale = (0.0, 1.0)
+    out, details = paper.reproduce(rec, args.eta, args.epochs, args.tol, offset_scale)
+    if args.plot:
+        with atomic_directory(args.plot) as tmp:
+            paper.plot_fig5(tmp, rec, details)
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    _print_report(rec, out, details, args, offset_scale)
+    return 0
+
+
+def _print_report(rec, out, details, args, offset_scale) -> None:
+    fs = details["fs_mm"]
+    norm = "raw volts" if offset_scale == (0.0, 1.0) else "range-normalised volts"
+    print(f"Table 2 reproduced on {rec.source}: LMS on {norm}, weights and bias start at 1, "
+          f"eta {args.eta:g}, {args.epochs} epochs (the paper gives neither)")
+    print(f"% of linearity range: points within +-{args.tol:g} % FS = +-{args.tol * fs / 100:g} mm "
+          f"of the ideal line (FS = {fs:g} mm)")
+    print(f"raw sensor vs its least-squares line: {out['raw_linearity_pct']:.2f} %  "
+          f"(paper {paper.PAPER_RAW_PCT:.2f} %)")
+    print(f"{'terms':>5s} {'linearity %':>12s} {'paper %':>8s} {'LOO max mm':>11s} "
+          f"{'LOO max interior mm':>20s} {'final MSE mm^2':>15s}")
+    interior = np.ones(len(rec), bool)
+    interior[[int(np.argmin(rec.voltage_v)), int(np.argmax(rec.voltage_v))]] = False
+    for row in out["rows"]:
+        t = row["terms"]
+        loo = details["loo"][t][interior]
+        print(f"{t:5d} {row['linearity_pct']:12.2f} {row['paper_pct']:8.2f} "
+              f"{row['loo_max_error_mm']:11.3g} {np.max(np.abs(loo)):20.3g} "
+              f"{details['models'][t].training['mse_per_epoch'][-1]:15.3g}")
+    print("LOO: each point held out in turn, same method; 'interior' leaves out the two end "
+          "points, whose held-out error is extrapolation.")
+    print(f"Between the {len(rec)} points (dense sweep of v, compared with the monotone PCHIP "
+          "interpolant of the points):")
+    default = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="range")
+    for label, model in (("51 terms, paper LMS", details["models"][51]),
+                         ("51 terms, lstsq range-normalised (default design)", default)):
+        b = paper.between_points(model, rec)
+        print(f"  {label}: max deviation {b['max_dev_from_pchip_mm']:.3g} mm "
+              f"({b['max_dev_from_pchip_pct_fs']:.3g} % FS) at {b['at_voltage_v']:.3f} V; "
+              f"{b['sweep_fraction_within_tol_of_pchip']:.1%} of the sweep within +-{args.tol:g} "
+              f"% FS of it; output spans {b['output_range_mm'][0]:.3g} .. "
+              f"{b['output_range_mm'][1]:.3g} mm; decreasing on {b['decreasing_fraction']:.1%}")
+    if args.sensitivity:
+        grid = paper.sensitivity(rec, tol_pct_fs=args.tol)
+        etas = sorted({k[1] for k in grid})
+        eps = sorted({k[2] for k in grid})
+        print("Sensitivity: % of linearity range by (eta, epochs); '-' = LMS diverged")
+        print(f"{'terms':>5s} {'eta':>6s} " + " ".join(f"{e:>7d}" for e in eps))
+        for t in (11, 25, 51, 61):
+            for eta in etas:
+                cells = [grid.get((t, eta, e)) for e in eps]
+                print(f"{t:5d} {eta:6g} " + " ".join(
+                    f"{c:7.2f}" if c is not None else f"{'-':>7s}" for c in cells))
+    if args.dense:
+        d = paper.dense_demo()
+        print(f"Tool default (--terms auto) on dense physics-like data (tanh S-curve, "
+              f"{d['noise_v'] * 1e3:g} mV noise; 601 training points, 600 held-out points "
+              f"between them): {d['terms']} terms, normalisation {d['normalisation']}, "
+              f"ridge {d['ridge']:g}")
+        for key, label in (("before", "before (raw, LS line)"), ("after", "after (FLANN)")):
+            r = d[key]
+            print(f"  {label:22s}: stroke within +-{d['band_pct_fs']:g} % FS "
+                  f"{r['stroke_fraction_within_band']:.1%}, max error {r['max_error_mm']:.3g} mm "
+                  f"({r['max_error_pct_fs']:.3g} % FS), RMS {r['rms_error_mm']:.3g} mm")
