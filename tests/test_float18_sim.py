@@ -13,7 +13,7 @@ from flann.float18 import FLOAT18
 from flann.float18_hdl import BLOCKS, render_blocks
 
 SIM_DIR = Path(__file__).resolve().parent.parent / "sim"
-N_RANDOM = {"mul": 30000, "add": 30000}
+N_RANDOM = {"mul": 15000, "add": 15000}
 
 
 def _write(tmp_path: Path) -> dict[str, Path]:
