@@ -1,0 +1,41 @@
+"""flann synth DIR: resource estimate of generated VHDL (GHDL synthesis + Yosys) for a Spartan-II."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+from .. import synth
+from ..devices import DEVICES
+
+HELP = "resource estimate via GHDL synthesis and Yosys"
+
+
+def add_arguments(p):
+    p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
+    p.add_argument(
+        "--device", default=synth.DEFAULT_DEVICE, metavar="PART",
+        help=f"target part DEVICE-PACKAGE-SPEED (default {synth.DEFAULT_DEVICE}; devices "
+        + ", ".join(d.name for d in DEVICES) + ")",
+    )
+    p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
+    p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
+    p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
+    p.add_argument("--work", metavar="DIR", help="keep GHDL/Yosys intermediate files (netlist, yosys.log) here")
+
+
+def run(args) -> int:
+    if not args.no_lint:
+        man = synth.read_manifest(args.directory)
+        synth.check_lint(man.files, args.vsg_config, start=args.directory)
+    report = synth.synthesize(args.directory, args.device, work=args.work, progress=not args.json)
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    else:
+        print(report.table())
+        for w in report.warnings:
+            print(f"warning: yosys: {w}", file=sys.stderr)
+    if not report.fits:
+        print(f"error: {synth.not_fit_message(report)}", file=sys.stderr)
+        return 2
+    return 0
