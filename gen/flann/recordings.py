@@ -221,11 +221,11 @@ def _span_one(x: np.ndarray, v: np.ndarray, noise_v: float | None, k_sigma: floa
     parts = []
     if i_hi < n - 1 and (u[i_hi] - u[i_hi + 1:].min()) > thr:
         j = int(np.argmin(u[i_hi + 1:])) + i_hi + 1
-        parts.append(f"beyond {x[i_hi]:g} mm (peak {v[i_hi]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
+        parts.append(f"beyond {x[i_hi]:g} mm (turning point {v[i_hi]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
         keep[i_hi + 1:] = False
     if i_lo > 0 and (u[:i_lo].max() - u[i_lo]) > thr:
         j = int(np.argmax(u[:i_lo]))
-        parts.append(f"below {x[i_lo]:g} mm (peak {v[i_lo]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
+        parts.append(f"below {x[i_lo]:g} mm (turning point {v[i_lo]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
         keep[:i_lo] = False
     if not parts:
         return np.ones(n, bool), None, "", noise, thr

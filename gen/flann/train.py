@@ -15,7 +15,9 @@ All three return a :class:`flann.model.FlannModel` whose output is
   reports the held-out error (never the training error).
 
 Normalisation: ``"range"`` maps the data's voltage range to [-1, 1] (offset = midpoint,
-scale = half span); ``"none"`` uses raw volts (offset 0, scale 1) as the paper did.
+scale = half span); ``"half"`` maps it to [-0.5, 0.5] (scale = span: the trigonometric terms,
+periodic over 2 units of v_n, then need not join the two ends of the curve, which avoids the
+Gibbs-like error near the ends); ``"none"`` uses raw volts (offset 0, scale 1) as the paper.
 Everything here is deterministic: no random numbers, a fixed order of operations.
 """
 
@@ -31,7 +33,7 @@ from .errors import FlannError, RecordingsError
 from .model import FlannModel, expand
 
 PAPER_TERMS = (11, 25, 51, 61)
-NORMALISATIONS = ("range", "none")
+NORMALISATIONS = ("range", "half", "none")
 MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
 AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
 AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0)
@@ -40,17 +42,17 @@ AUTO_MAX_FOLDS = 10
 
 # -- normalisation -----------------------------------------------------------------------
 def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
-    """(input_offset_v, input_scale_v) for ``kind`` ('range' or 'none')."""
+    """(input_offset_v, input_scale_v) for ``kind`` ('range', 'half' or 'none')."""
     v = np.asarray(voltage_v, dtype=float)
     if kind == "none":
         return 0.0, 1.0
-    if kind == "range":
+    if kind in ("range", "half"):
         lo, hi = float(v.min()), float(v.max())
         if not hi > lo:
             raise RecordingsError(
                 f"voltage_v spans no range (all {lo:g} V): cannot normalise or fit"
             )
-        return (lo + hi) / 2.0, (hi - lo) / 2.0
+        return (lo + hi) / 2.0, (hi - lo) / (2.0 if kind == "range" else 1.0)
     raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)}, got {kind!r}")
 
 

@@ -10,7 +10,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..train import fit_lstsq
+from ..train import NORMALISATIONS, fit_lstsq, normalisation
 from .. import paper
 
 HELP = "reproduce the seed paper's tables and figures"
@@ -29,7 +29,7 @@ def add_arguments(p) -> None:
                    help="linearity tolerance, %% of full scale (default %(default)g)")
     p.add_argument("--data", default=None,
                    help="recordings CSV instead of the paper's Table 1 (built in)")
-    p.add_argument("--normalise", choices=("none", "range"), default="none",
+    p.add_argument("--normalise", choices=NORMALISATIONS, default="none",
                    help="input normalisation: 'none' = raw volts as the paper (default)")
     p.add_argument("--sensitivity", action="store_true",
                    help="also print Table 2 over a grid of eta and epochs")
@@ -48,11 +48,7 @@ def run(args) -> int:
     rec = paper.table1() if args.data is None else read_recordings(args.data)
     if len(rec) < 3:
         raise FlannError(f"{rec.source}: need at least 3 points, got {len(rec)}")
-    if args.normalise == "range":
-        lo, hi = float(rec.voltage_v.min()), float(rec.voltage_v.max())
-        offset_scale = ((lo + hi) / 2, (hi - lo) / 2)
-    else:
-        offset_scale = (0.0, 1.0)
+    offset_scale = normalisation(rec.voltage_v, args.normalise)
     out, details = paper.reproduce(rec, args.eta, args.epochs, args.tol, offset_scale)
     if args.plot:
         with atomic_directory(args.plot) as tmp:
@@ -64,9 +60,11 @@ def run(args) -> int:
     return 0
 
 
-def _print_report(rec, out, details, args, offset_scale) -> None:
+def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
     fs = details["fs_mm"]
-    norm = "raw volts" if offset_scale == (0.0, 1.0) else "range-normalised volts"
+    norm = ("raw volts" if args.normalise == "none"
+            else f"volts normalised '{args.normalise}' (offset {offset_scale[0]:g} V, "
+                 f"scale {offset_scale[1]:g} V)")
     print(f"Table 2 reproduced on {rec.source}: LMS on {norm}, weights and bias start at 1, "
           f"eta {args.eta:g}, {args.epochs} epochs (the paper gives neither)")
     print(f"% of linearity range: points within +-{args.tol:g} % FS = +-{args.tol * fs / 100:g} mm "

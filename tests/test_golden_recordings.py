@@ -1,0 +1,67 @@
+"""Validation before fitting: duplicates, fold-back (and --trim), flat-end noise, too few points."""
+
+import numpy as np
+import pytest
+
+from flann.errors import RecordingsError
+from flann.paper import s_curve
+from flann.recordings import Recordings, monotonic_span, parse_recordings, prepare_for_fit
+
+
+def folding(x):
+    # x exp(-x^2 / 2a^2) peaks at x = a = 35 mm: beyond +-35 mm the voltage falls again,
+    # as when the core leaves the coils
+    return 6.0 * (x / 35.0) * np.exp(0.5 - 0.5 * (x / 35.0) ** 2)
+
+
+def test_duplicate_displacement_with_other_voltage_in_same_direction():
+    text = "displacement_mm,voltage_v\n0,0.0\n5,1.0\n5,1.2\n10,2.0\n"
+    with pytest.raises(RecordingsError, match=r"rows 2 and 3: displacement 5 mm appears twice"):
+        prepare_for_fit(parse_recordings(text, "d.csv"))
+
+
+def test_same_displacement_in_the_two_directions_is_fine():
+    text = ("displacement_mm,voltage_v,direction\n0,0.0,1\n5,1.0,1\n10,2.0,1\n"
+            "10,2.1,-1\n5,1.2,-1\n0,0.1,-1\n")
+    rec = parse_recordings(text, "h.csv")
+    assert prepare_for_fit(rec) is rec
+
+
+def test_fold_back_is_refused_and_located():
+    x = np.arange(-45.0, 45.5, 0.5)
+    rec = Recordings(x, folding(x), source="fold.csv")
+    with pytest.raises(RecordingsError, match=r"beyond 35 mm.*below -35 mm.*--trim"):
+        prepare_for_fit(rec)
+
+
+def test_trim_keeps_the_monotonic_span():
+    x = np.arange(-45.0, 45.5, 0.5)
+    rec = Recordings(x, folding(x), source="fold.csv")
+    with pytest.warns(UserWarning, match=r"-35 \.\. 35 mm"):
+        kept = prepare_for_fit(rec, trim=True)
+    assert kept.displacement_mm.min() == -35.0 and kept.displacement_mm.max() == 35.0
+    assert np.all(np.diff(kept.voltage_v) > 0)
+
+
+def test_fold_back_inside_the_span_cannot_be_trimmed():
+    x = np.linspace(-30.0, 30.0, 121)
+    v = s_curve(x)
+    v[60:70] -= np.linspace(0.0, 3.0, 10)       # falls ~0.17 V per step for 9 steps at the null
+    span = monotonic_span(Recordings(x, v, source="dip.csv"))
+    assert span.foldback and not span.trimmable
+    with pytest.raises(RecordingsError, match="cannot remove it"):
+        prepare_for_fit(Recordings(x, v, source="dip.csv"), trim=True)
+
+
+def test_noise_wiggles_on_flat_ends_are_not_a_fold_back():
+    x = np.linspace(-60.0, 60.0, 1201)         # far into saturation: ends nearly flat
+    v = s_curve(x, noise_v=2e-3, seed=3)
+    assert np.count_nonzero(np.diff(v) < 0) > 50  # the data do wiggle back point to point
+    rec = Recordings(x, v, source="flat.csv")
+    assert not monotonic_span(rec).foldback
+    assert prepare_for_fit(rec) is rec
+
+
+def test_too_few_points():
+    with pytest.raises(RecordingsError, match="need at least 3"):
+        prepare_for_fit(parse_recordings("displacement_mm,voltage_v\n0,0\n1,1\n", "two.csv"))

@@ -1,0 +1,119 @@
+"""Training: one LMS step, least squares and ridge by hand; auto, LOO, determinism."""
+
+import json
+
+import numpy as np
+import pytest
+
+from flann.errors import FlannError, RecordingsError
+from flann.paper import s_curve
+from flann.train import (_design, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
+                         lms_epochs, lms_leave_one_out, normalisation)
+
+
+def test_one_lms_step_by_hand():
+    # s = [1 (bias), v] = [1, 2], w = [1, 1] -> y = 3, e = 5 - 3 = 2
+    # w <- w + 0.1 * 2 * [1, 2] = [1.2, 1.4]; epoch MSE = e^2 = 4
+    m = fit_lms([2.0], [5.0], 1, eta=0.1, epochs=1, offset_scale=(0.0, 1.0))
+    assert m.bias == pytest.approx(1.2)
+    assert m.weights == pytest.approx((1.4,))
+    assert m.training["mse_per_epoch"] == pytest.approx([4.0])
+    assert m.training["weights_start"] == 1.0
+
+
+def test_two_lms_steps_in_file_order_by_hand():
+    # after step 1 w = [1.2, 1.4]; sample (v=1, d=0): y = 2.6, e = -2.6
+    # w <- [1.2, 1.4] - 0.26 * [1, 1] = [0.94, 1.14]; MSE = (4 + 6.76) / 2 = 5.38
+    m = fit_lms([2.0, 1.0], [5.0, 0.0], 1, eta=0.1, epochs=1, offset_scale=(0.0, 1.0))
+    assert (m.bias, *m.weights) == pytest.approx((0.94, 1.14))
+    assert m.training["mse_per_epoch"] == pytest.approx([5.38])
+
+
+def test_least_squares_line_by_hand():
+    # v = [0, 2, 4] -> range normalisation offset 2, scale 2, v_n = [-1, 0, 1]; x = [1, 3, 4]
+    # slope = sum(v_n (x - 8/3)) / sum(v_n^2) = (5/3 + 4/3) / 2 = 1.5; bias = mean x = 8/3
+    m = fit_lstsq([0.0, 2.0, 4.0], [1.0, 3.0, 4.0], 1)
+    assert (m.input_offset_v, m.input_scale_v) == (2.0, 2.0)
+    assert m.weights[0] == pytest.approx(1.5)
+    assert m.bias == pytest.approx(8 / 3)
+
+
+def test_ridge_by_hand():
+    # minimise mean(e^2) + lam w^2 with centred v_n = [-1, 0, 1]:
+    # w = sum(v_n x) / (sum v_n^2 + n lam) = 3 / (2 + 3 lam); lam = 1/3 -> w = 1; bias unpenalised
+    m = fit_lstsq([0.0, 2.0, 4.0], [1.0, 3.0, 4.0], 1, ridge=1 / 3)
+    assert m.weights[0] == pytest.approx(1.0)
+    assert m.bias == pytest.approx(8 / 3)
+
+
+def test_underdetermined_lstsq_is_minimum_norm_by_hand():
+    # one point, bias + v: b + w*1 = 2 with min b^2 + w^2 -> b = w = 1
+    m = fit_lstsq([1.0], [2.0], 1, offset_scale=(0.0, 1.0))
+    assert (m.bias, m.weights[0]) == pytest.approx((1.0, 1.0))
+
+
+def test_more_terms_than_points_warns_but_fits(recwarn):
+    with pytest.warns(UserWarning, match="under-determined"):
+        check_fit_input(np.arange(13.0), np.arange(13.0), 51)
+
+
+@pytest.mark.parametrize("v", [[1.0, 2.0], [1.0, 1.0, 1.0]])
+def test_too_few_points_to_fit(v):
+    with pytest.raises(RecordingsError, match="need at least"):
+        check_fit_input(np.array(v), np.arange(len(v), dtype=float), 1)
+
+
+def test_range_and_raw_normalisation():
+    assert normalisation([-5.185, 5.276], "range") == pytest.approx((0.0455, 5.2305))
+    assert normalisation([-5.185, 5.276], "half") == pytest.approx((0.0455, 10.461))
+    assert normalisation([-5.185, 5.276], "none") == (0.0, 1.0)
+
+
+def test_lms_diverges_with_a_clear_error():
+    with pytest.raises(FlannError, match="smaller --eta"):
+        fit_lms([5.0, -5.0, 4.0], [1.0, 2.0, 3.0], 11, eta=5.0, epochs=50,
+                offset_scale=(0.0, 1.0))
+
+
+def test_batched_leave_one_out_equals_separate_runs():
+    v = np.array([-2.0, -1.1, 0.2, 0.9, 2.3])
+    x = np.array([-3.0, -1.0, 0.5, 1.0, 3.5])
+    S = _design(v / 2.3, 5)
+    pred = lms_leave_one_out(S, x, 0.05, 40)
+    for i in range(v.size):
+        keep = np.arange(v.size) != i
+        w, _ = lms_epochs(S[keep], x[keep], 0.05, 40)
+        assert pred[i] == pytest.approx(S[i] @ w, abs=1e-12)
+
+
+def test_cv_never_holds_out_the_voltage_extremes():
+    v = np.array([3.0, -1.0, 0.0, 5.0, 1.0, 2.0])   # min at row 1, max at row 3
+    held = np.concatenate(cv_folds(v, 2))
+    assert sorted(held.tolist()) == [0, 2, 4, 5]
+
+
+def test_auto_on_a_straight_line_picks_the_linear_term_alone():
+    v = np.linspace(-4.0, 4.0, 21)
+    model, choice = fit_auto(v, 3.0 * v + 1.0)
+    assert choice.terms == 1
+    assert model.predict([2.5])[0] == pytest.approx(8.5, abs=1e-6)
+
+
+def test_auto_held_out_error_is_honest_on_new_points():
+    x = np.linspace(-30.0, 30.0, 121)
+    model, choice = fit_auto(s_curve(x, 1e-3, seed=5), x)
+    assert model.training["cv_heldout_rms_error_mm"] == choice.rms_mm
+    x_new = np.linspace(-29.75, 29.75, 120)
+    rms_new = np.sqrt(np.mean((model.predict(s_curve(x_new, 1e-3, seed=6)) - x_new) ** 2))
+    assert 0.33 * choice.rms_mm < rms_new < 3.0 * choice.rms_mm
+
+
+def test_training_is_deterministic():
+    x = np.linspace(-30.0, 30.0, 61)
+    v = s_curve(x, 1e-3, seed=7)
+    a = fit_lstsq(v, x, 25).to_json()
+    b = fit_lstsq(v, x, 25).to_json()
+    assert a == b
+    assert fit_lms(v, x, 5, eta=0.01, epochs=5).to_json() == \
+        fit_lms(v, x, 5, eta=0.01, epochs=5).to_json()
+    json.loads(a)
