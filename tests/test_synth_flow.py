@@ -1,0 +1,95 @@
+"""flann synth on the fixtures in tests/fixtures/synth (GHDL synthesis + Yosys xcv).
+
+Expected counts are derived by hand from the fixture sources (see their header comments)
+and from the DS001 capacities typed in below, not from the code under test.
+"""
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from flann.cli import main
+
+FIX = Path(__file__).parent / "fixtures" / "synth"
+ISSUE_KEYS = {"device", "luts", "ffs", "brams", "lut_pct", "ff_pct", "bram_pct", "fits", "smallest_device"}
+
+needs_tools = pytest.mark.skipif(
+    not (shutil.which("ghdl") and shutil.which("yosys")), reason="ghdl and yosys are required (scripts/ensure_tools.sh)"
+)
+
+
+def _run(capsys, *argv):
+    rc = main(["synth", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.mark.synth
+@needs_tools
+def test_good_design_fits_with_hand_counted_registers(capsys, tmp_path):
+    rc, out, err = _run(capsys, FIX / "good", "--device", "xc2s30-pq208-5", "--json", "--work", tmp_path)
+    assert rc == 0, err
+    rep = json.loads(out)
+    assert ISSUE_KEYS <= set(rep)
+    assert rep["device"] == "xc2s30-pq208-5"
+    assert rep["ffs"] == 18 + 1  # accumulator + valid
+    assert rep["brams"] == 1  # 256 x 16 ROM = 4096 bits = one 4 Kbit block RAM
+    assert 18 <= rep["luts"] < 400  # at least one LUT per accumulator bit
+    assert rep["lut_pct"] == pytest.approx(100 * rep["luts"] / 864, abs=0.05)  # XC2S30: 216 CLBs
+    assert rep["ff_pct"] == pytest.approx(100 * 19 / 864, abs=0.05)
+    assert rep["bram_pct"] == pytest.approx(100 / 6, abs=0.05)
+    assert rep["fits"] is True
+    assert rep["smallest_device"] == "xc2s30-pq208-5"  # XC2S15 comes in no PQ208
+    assert rep["io"] == 1 + 1 + 12 + 1 + 1 + 18 + 1  # every port but clk
+    assert (tmp_path / "flann_top.v").is_file() and (tmp_path / "yosys.log").is_file()
+
+
+@pytest.mark.synth
+@needs_tools
+def test_too_big_exits_2_and_names_smallest_device(capsys):
+    rc, out, err = _run(capsys, FIX / "too_big", "--device", "xc2s15-tq144-5", "--json")
+    assert rc == 2
+    rep = json.loads(out)
+    assert rep["ffs"] == 33 * 12 + 33  # hand count from the fixture
+    assert rep["fits"] is False
+    assert rep["ff_pct"] == pytest.approx(100 * 429 / 384, abs=0.05)
+    # 429 FF > 384 (XC2S15) but <= 864 (XC2S30), which is offered in TQ144
+    assert rep["smallest_device"] == "xc2s30-tq144-5"
+    assert "does not fit xc2s15-tq144-5" in err
+    assert "429 flip-flops > 384" in err and "xc2s30-tq144-5" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.synth
+@needs_tools
+def test_latch_is_refused_with_the_signal_named(capsys):
+    rc, out, err = _run(capsys, FIX / "latch", "--json")
+    assert rc == 2 and out == ""
+    assert 'latch inferred for "out_sat"' in err and "flann_top.vhd:" in err
+
+
+@pytest.mark.synth
+@needs_tools
+def test_multiple_drivers_are_refused(capsys):
+    rc, out, err = _run(capsys, FIX / "multidriver", "--json")
+    assert rc == 2 and out == ""
+    assert 'multiple drivers for "out_sat"' in err
+
+
+def test_missing_manifest_is_one_line(capsys, tmp_path):
+    rc, out, err = _run(capsys, tmp_path)
+    assert rc == 2
+    assert err.strip() == f"error: {tmp_path / 'manifest.json'} not found: generate the design first (flann gen MODEL -o {tmp_path})"
+
+
+def test_manifest_listing_a_missing_file(capsys, tmp_path):
+    (tmp_path / "manifest.json").write_text(json.dumps({"top": "flann_top", "files": ["nope.vhd"]}))
+    rc, out, err = _run(capsys, tmp_path)
+    assert rc == 2 and "'nope.vhd' does not exist" in err
+
+
+def test_bad_device_is_refused_before_synthesis(capsys):
+    rc, out, err = _run(capsys, FIX / "good", "--device", "xc2s15-pq208-5", "--no-lint")
+    assert rc == 2 and "not offered in pq208" in err
