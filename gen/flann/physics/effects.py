@@ -1,0 +1,247 @@
+"""Catalogue of non-ideal effects, each switched on in the sensor file with physical parameters.
+
+Public API (stable; ``flann diagnose`` uses the same catalogue):
+
+* :data:`EFFECTS` -- ordered ``name -> Effect``.  Names (exact): ``null_offset``,
+  ``quadrature_null``, ``zero_shift``, ``secondary_imbalance``, ``backlash``,
+  ``thermal_drift``, ``adc_clipping``, ``leadscrew_periodic``, ``secondary_loading``.
+* :class:`Effect`: ``name``, ``stage``, ``description`` (one line of physics), ``params``
+  (tuple of :class:`Param`: ``name`` with unit suffix, ``unit``, ``default`` (a typical
+  size), ``neutral`` (the value at which the effect does nothing), ``lower``/``upper``
+  bounds, ``description``), ``formula`` (text), ``defaults()``, ``neutral()``,
+  ``bounds()`` and ``apply(params, ctx, signal) -> signal`` (pure, vectorised).
+* :class:`Context` (inputs per sample: displacement_mm, direction, temperature_c, time_s,
+  sensor) and :class:`Signal` (state flowing through the stages).
+
+Stages, applied in this order by :func:`flann.physics.simulate.simulate_output_v`:
+
+1. ``position`` -- on the core position before the magnetics (zero_shift, backlash,
+   leadscrew_periodic): ``core_mm``.
+2. ``transformer`` -- on the primary drive and the secondaries (thermal_drift:
+   ``drive_scale``; secondary_imbalance: ``s1_scale``/``s2_scale``; secondary_loading:
+   ``load_ohm``; quadrature_null: ``quadrature_v``, output-referred, seen only by the
+   amplitude detector).
+3. the magnetics and the demodulator (:mod:`flann.physics.lvdt`) -> ``output_v``.
+4. ``output`` -- on the demodulated volts (null_offset, then adc_clipping last).
+
+Formulas (x = displacement, d = direction of travel +-1 (0 when unknown), T = temperature,
+y = output, y0(x) = ideal output, v1/v2 = secondary e.m.f.s, G = demodulator gain):
+
+* null_offset:        y += offset_v
+* quadrature_null:    amplitude detector: y = G |v_d + j quadrature_v/G| = sqrt(y0^2 + q^2)
+                      (phase-sensitive detector: rejected, no change)
+* zero_shift:         core = x - shift_mm            (null moves to x = +shift_mm)
+* secondary_imbalance v1 *= 1 + e/2, v2 *= 1 - e/2  -> y += G e (v1+v2)/2 (in phase)
+* backlash:           core = x - d * deadband_mm / 2 (core lags the actuator)
+* thermal_drift:      primary current *= 1 + k (T - reference_temperature_c)
+* adc_clipping:       y = clip(y, -rail_v, +rail_v)
+* leadscrew_periodic: core = x + a sin(2 pi x / period_mm + phase_rad)
+* secondary_loading:  v_d -> v_d R_L / (R_L + 2 R_s + j w L_loop(core))
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import numpy as np
+
+from ..errors import SensorError
+
+STAGES = ("position", "transformer", "output")
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str          # key in the sensor file, ends with its unit
+    unit: str
+    default: float     # a typical size (used by with_effect and examples)
+    neutral: float     # value at which the effect does nothing
+    lower: float
+    upper: float
+    description: str
+
+
+@dataclass(frozen=True)
+class Context:
+    """Per-sample inputs (arrays broadcast to the displacement's shape)."""
+
+    displacement_mm: np.ndarray
+    direction: np.ndarray        # +1 increasing, -1 decreasing, 0 unknown
+    temperature_c: np.ndarray | None   # None: at every effect's reference temperature
+    time_s: np.ndarray
+    sensor: object               # flann.physics.sensor.Sensor
+
+
+@dataclass(frozen=True)
+class Signal:
+    core_mm: np.ndarray
+    drive_scale: np.ndarray | float = 1.0
+    s1_scale: np.ndarray | float = 1.0
+    s2_scale: np.ndarray | float = 1.0
+    quadrature_v: np.ndarray | float = 0.0
+    load_ohm: float = math.inf
+    output_v: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Effect:
+    name: str
+    stage: str
+    description: str
+    formula: str
+    params: tuple[Param, ...]
+    apply: Callable[[Mapping[str, float], Context, Signal], Signal]
+
+    def defaults(self) -> dict[str, float]:
+        return {p.name: p.default for p in self.params}
+
+    def neutral(self) -> dict[str, float]:
+        return {p.name: p.neutral for p in self.params}
+
+    def bounds(self) -> dict[str, tuple[float, float]]:
+        return {p.name: (p.lower, p.upper) for p in self.params}
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.params)
+
+
+def _rep(sig: Signal, **kw) -> Signal:
+    return dataclasses.replace(sig, **kw)
+
+
+# -- position stage ---------------------------------------------------------------------
+
+def _zero_shift(p, ctx, sig):
+    return _rep(sig, core_mm=sig.core_mm - p["shift_mm"])
+
+
+def _backlash(p, ctx, sig):
+    return _rep(sig, core_mm=sig.core_mm - ctx.direction * (p["deadband_mm"] / 2.0))
+
+
+def _leadscrew(p, ctx, sig):
+    phase = 2 * math.pi * ctx.displacement_mm / p["period_mm"] + p["phase_rad"]
+    return _rep(sig, core_mm=sig.core_mm + p["amplitude_mm"] * np.sin(phase))
+
+
+# -- transformer stage -------------------------------------------------------------------
+
+def _thermal(p, ctx, sig):
+    if ctx.temperature_c is None:
+        return sig
+    scale = 1.0 + p["coefficient_per_c"] * (ctx.temperature_c - p["reference_temperature_c"])
+    return _rep(sig, drive_scale=sig.drive_scale * scale)
+
+
+def _imbalance(p, ctx, sig):
+    e = p["imbalance_fraction"]
+    return _rep(sig, s1_scale=sig.s1_scale * (1 + e / 2), s2_scale=sig.s2_scale * (1 - e / 2))
+
+
+def _quadrature(p, ctx, sig):
+    return _rep(sig, quadrature_v=sig.quadrature_v + p["quadrature_v"])
+
+
+def _loading(p, ctx, sig):
+    return _rep(sig, load_ohm=p["load_ohm"])
+
+
+# -- output stage ------------------------------------------------------------------------
+
+def _null_offset(p, ctx, sig):
+    return _rep(sig, output_v=sig.output_v + p["offset_v"])
+
+
+def _clipping(p, ctx, sig):
+    return _rep(sig, output_v=np.clip(sig.output_v, -p["rail_v"], p["rail_v"]))
+
+
+_I = math.inf
+EFFECTS: dict[str, Effect] = {
+    e.name: e for e in (
+        Effect("null_offset", "output",
+               "electrical offset at null: in-phase residual or amplifier/demodulator DC offset",
+               "y += offset_v",
+               (Param("offset_v", "V", 0.01, 0.0, -1e3, 1e3, "output offset"),),
+               _null_offset),
+        Effect("quadrature_null", "transformer",
+               "quadrature/harmonic null residual (capacitive coupling, phase mismatch) that an "
+               "amplitude detector adds in quadrature; a phase-sensitive detector rejects it",
+               "amplitude detector: y = sqrt(y0^2 + quadrature_v^2); phase-sensitive: y = y0",
+               (Param("quadrature_v", "V", 0.02, 0.0, 0.0, 1e3,
+                      "output-referred quadrature residual at null"),),
+               _quadrature),
+        Effect("zero_shift", "position",
+               "mechanical null not at zero displacement (core or actuator origin offset)",
+               "core = x - shift_mm",
+               (Param("shift_mm", "mm", 0.5, 0.0, -1e3, 1e3, "displacement at which the core is centred"),),
+               _zero_shift),
+        Effect("secondary_imbalance", "transformer",
+               "unequal secondary coupling (turns or position mismatch) leaves part of the "
+               "common-mode secondary voltage in the output",
+               "v1 *= 1 + e/2, v2 *= 1 - e/2",
+               (Param("imbalance_fraction", "1", 0.01, 0.0, -0.99, 0.99,
+                      "relative coupling mismatch e of secondary 1 over secondary 2"),),
+               _imbalance),
+        Effect("backlash", "position",
+               "lost motion of the actuator: the core lags behind the commanded position "
+               "against the direction of travel",
+               "core = x - direction * deadband_mm / 2",
+               (Param("deadband_mm", "mm", 0.2, 0.0, 0.0, 1e3, "full dead band"),),
+               _backlash),
+        Effect("thermal_drift", "transformer",
+               "sensitivity changes with temperature, e.g. the primary's copper resistance "
+               "(+0.39 %/degC) lowering the excitation current",
+               "primary current *= 1 + coefficient_per_c * (T - reference_temperature_c)",
+               (Param("coefficient_per_c", "1/degC", -0.001, 0.0, -0.5, 0.5,
+                      "relative sensitivity change per degC"),
+                Param("reference_temperature_c", "degC", 20.0, 20.0, -273.15, 1e3,
+                      "temperature at which the sensitivity is nominal")),
+               _thermal),
+        Effect("adc_clipping", "output",
+               "converter or amplifier rails: the output saturates at +-rail_v",
+               "y = clip(y, -rail_v, rail_v)",
+               (Param("rail_v", "V", 5.0, _I, 1e-9, _I, "rail (saturation) voltage"),),
+               _clipping),
+        Effect("leadscrew_periodic", "position",
+               "periodic position error of the actuator's lead screw (thread pitch, "
+               "eccentricity): the core is displaced sinusoidally in the commanded position",
+               "core = x + amplitude_mm * sin(2 pi x / period_mm + phase_rad)",
+               (Param("amplitude_mm", "mm", 0.05, 0.0, -1e3, 1e3, "position error amplitude"),
+                Param("period_mm", "mm", 2.0, 2.0, 1e-6, 1e6, "period (lead of the screw)"),
+                Param("phase_rad", "rad", 0.0, 0.0, -1e3, 1e3, "phase at x = 0")),
+               _leadscrew),
+        Effect("secondary_loading", "transformer",
+               "finite load resistance on the series-opposed secondaries: their "
+               "position-dependent inductance and resistance divide the e.m.f. (gain and phase)",
+               "v_d *= R_L / (R_L + 2 R_s + j w L_loop(core))",
+               (Param("load_ohm", "ohm", 100e3, _I, 1e-3, _I, "load resistance"),),
+               _loading),
+    )
+}
+
+
+def validate_effects(effects: Mapping[str, Mapping[str, float]], source: str = "<memory>") -> None:
+    """Raise SensorError for an unknown effect, a missing/unknown parameter or a value
+    outside the parameter's physical range."""
+    for name, params in effects.items():
+        if name not in EFFECTS:
+            raise SensorError(f"{source}: unknown effect '{name}' (known: {', '.join(EFFECTS)})")
+        eff = EFFECTS[name]
+        for key in params:
+            if key not in eff.param_names:
+                raise SensorError(f"{source}: effects.{name}.{key}: unknown parameter "
+                                  f"(allowed: {', '.join(eff.param_names)})")
+        for p in eff.params:
+            if p.name not in params:
+                raise SensorError(f"{source}: effects.{name}.{p.name} missing")
+            v = params[p.name]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v):
+                raise SensorError(f"{source}: effects.{name}.{p.name} must be a number, got {v!r}")
+            if not p.lower <= v <= p.upper:
+                raise SensorError(f"{source}: effects.{name}.{p.name} = {v:g} out of range "
+                                  f"[{p.lower:g}, {p.upper:g}] {p.unit}")

@@ -1,0 +1,201 @@
+"""Simulated output with every enabled effect, and simulated bench recordings.
+
+Public API (stable):
+
+* :func:`simulate_output_v` (sensor, displacement_mm, direction=None, temperature_c=None,
+  time_s=None) -> ndarray: noiseless analog output with all of ``sensor.effects`` applied
+  in stage order (position -> transformer -> magnetics/demodulator -> output, clipping last;
+  see :mod:`flann.physics.effects`).  ``direction`` None means unknown (backlash does
+  nothing); ``temperature_c`` None means every effect's reference temperature.
+* :func:`contributions_v` (same arguments) -> {effect name: output with only that effect
+  minus the ideal output}, plus ``"all"`` (all effects minus ideal).
+* :func:`adc_convert` (sensor, volts) -> volts: the sensor's converter (rails at its full
+  scale, rounding to its LSB); identity when the sensor has no ``[adc]``.
+* :func:`sweep_positions` and :func:`simulate_recordings` (sensor, sweeps=1, step_mm=1.0,
+  noise_v=0.0, seed=0, temperature_profile=None, travel_mm=None, step_time_s=1.0) ->
+  :class:`flann.recordings.Recordings` with direction, time_s and temperature_c columns,
+  reproducible from ``seed``.
+* :func:`parse_temperature_profile` ("20", "const:20", "ramp:20:45", "sine:25:5:600").
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from ..errors import FlannError
+from ..recordings import Recordings
+from .effects import EFFECTS, Context, Signal
+from .lvdt import demodulate_v, inductances_h, primary_current_a
+from .sensor import Sensor
+
+_ORDER = {name: i for i, name in enumerate(EFFECTS)}
+
+
+def _ordered(effects, stage: str):
+    names = [n for n in effects if EFFECTS[n].stage == stage]
+    names.sort(key=lambda n: (n == "adc_clipping", _ORDER[n]))  # clipping always last
+    return names
+
+
+def _broadcast(value, shape, fill) -> np.ndarray | None:
+    if value is None:
+        return None if fill is None else np.full(shape, fill, dtype=float)
+    return np.broadcast_to(np.asarray(value, dtype=float), shape)
+
+
+def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
+                      time_s=None) -> np.ndarray:
+    """Noiseless output (V) of ``s`` with all its enabled effects (see module docstring)."""
+    x = np.asarray(displacement_mm, dtype=float)
+    ctx = Context(
+        displacement_mm=x,
+        direction=_broadcast(direction, x.shape, 0.0),
+        temperature_c=_broadcast(temperature_c, x.shape, None),
+        time_s=_broadcast(time_s, x.shape, 0.0),
+        sensor=s,
+    )
+    sig = Signal(core_mm=x)
+    for stage in ("position", "transformer"):
+        for name in _ordered(s.effects, stage):
+            sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
+    sig = _transformer(s, sig)
+    for name in _ordered(s.effects, "output"):
+        sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
+    return np.asarray(sig.output_v, dtype=float)
+
+
+def _transformer(s: Sensor, sig: Signal) -> Signal:
+    """Magnetics, primary circuit, (loaded) secondaries and demodulator -> output_v."""
+    loaded = math.isfinite(sig.load_ohm)
+    m1, m2, lp, *rest = inductances_h(s, sig.core_mm, loop=loaded)
+    w = s.omega_rad_s
+    m_diff = sig.s1_scale * m1 - sig.s2_scale * m2
+    z_primary = s.primary_resistance_ohm + 1j * w * lp
+    if loaded:
+        z_loop = sig.load_ohm + 2 * s.secondary_resistance_ohm + 1j * w * rest[0]
+        # Secondary current reflects an impedance (w M)^2 / Z_loop into the primary.
+        z_primary = z_primary + (w * m_diff) ** 2 / z_loop
+    i_p = s.excitation_peak_v * sig.drive_scale / z_primary
+    v_diff = 1j * w * m_diff * i_p
+    if loaded:
+        v_diff = v_diff * (sig.load_ohm / z_loop)
+    out = demodulate_v(s, v_diff, quadrature_v=sig.quadrature_v)
+    return Signal(core_mm=sig.core_mm, drive_scale=sig.drive_scale, s1_scale=sig.s1_scale,
+                  s2_scale=sig.s2_scale, quadrature_v=sig.quadrature_v, load_ohm=sig.load_ohm,
+                  output_v=out)
+
+
+def contributions_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
+                    time_s=None) -> dict[str, np.ndarray]:
+    """Per enabled effect: output with only that effect on minus the ideal output; and
+    ``"all"``: output with every effect minus the ideal output."""
+    ideal = simulate_output_v(s.without_effects(), displacement_mm)
+    out = {}
+    for name, params in s.effects.items():
+        only = s.replace(effects={name: params})
+        out[name] = simulate_output_v(only, displacement_mm, direction, temperature_c, time_s) - ideal
+    out["all"] = simulate_output_v(s, displacement_mm, direction, temperature_c, time_s) - ideal
+    return out
+
+
+def adc_convert(s: Sensor, volts) -> np.ndarray:
+    """The sensor's converter: saturate at its bipolar full scale (never wrap) and round to
+    its LSB, ``2 full_scale / 2**bits``."""
+    v = np.asarray(volts, dtype=float)
+    if s.adc_bits is None:
+        return v
+    lsb = 2.0 * s.adc_full_scale_v / 2 ** int(s.adc_bits)
+    codes = np.clip(np.round(v / lsb), -(2 ** (int(s.adc_bits) - 1)), 2 ** (int(s.adc_bits) - 1) - 1)
+    return codes * lsb
+
+
+def parse_temperature_profile(spec: str | float | None) -> Callable[[np.ndarray, float], np.ndarray]:
+    """A function (time_s, duration_s) -> temperature_c from a text spec.
+
+    ``"25"`` or ``"const:25"``: constant; ``"ramp:20:45"``: linear from 20 to 45 degC over
+    the run; ``"sine:25:5:600"``: 25 + 5 sin(2 pi t / 600 s).
+    """
+    if spec is None:
+        spec = "const:20"
+    text = str(spec).strip()
+    kind, _, rest = text.partition(":")
+    if not rest:
+        kind, rest = "const", text
+    try:
+        nums = [float(v) for v in rest.split(":")]
+    except ValueError:
+        raise FlannError(f"--temperature-profile {text!r}: expected const:T, ramp:T0:T1 or "
+                         "sine:MEAN:AMPLITUDE:PERIOD_S (numbers)") from None
+    want = {"const": 1, "ramp": 2, "sine": 3}
+    if kind not in want or len(nums) != want[kind] or not all(map(math.isfinite, nums)):
+        raise FlannError(f"--temperature-profile {text!r}: expected const:T, ramp:T0:T1 or "
+                         "sine:MEAN:AMPLITUDE:PERIOD_S")
+    if any(t < -273.15 for t in nums[:2]) or (kind == "sine" and nums[2] <= 0):
+        raise FlannError(f"--temperature-profile {text!r}: temperatures must be >= -273.15 "
+                         "degC and the period > 0")
+    if kind == "const":
+        return lambda t, dur: np.full_like(t, nums[0])
+    if kind == "ramp":
+        return lambda t, dur: nums[0] + (nums[1] - nums[0]) * (t / dur if dur > 0 else 0 * t)
+    return lambda t, dur: nums[0] + nums[1] * np.sin(2 * math.pi * t / nums[2])
+
+
+def sweep_positions(travel_mm: tuple[float, float], step_mm: float,
+                    sweeps: int) -> tuple[np.ndarray, np.ndarray]:
+    """Commanded positions and directions of ``sweeps`` forward+reverse passes.
+
+    Forward: from..to (direction +1); reverse: to-step..from (direction -1); later forward
+    passes start at from+step: each turning point is sampled once, in the direction that
+    reached it.  The first forward
+    pass is assumed to be approached from below (dead band already taken up).
+    """
+    lo, hi = travel_mm
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+        raise FlannError(f"travel {lo:g}..{hi:g} mm: the end must be above the start")
+    if not math.isfinite(step_mm) or step_mm <= 0:
+        raise FlannError(f"--step-mm {step_mm:g}: must be > 0")
+    n = int(math.floor((hi - lo) / step_mm + 1e-9))
+    if n < 1:
+        raise FlannError(f"--step-mm {step_mm:g}: larger than the travel {hi - lo:g} mm")
+    if n > 1_000_000:
+        raise FlannError(f"--step-mm {step_mm:g}: {n} steps per pass is too many (max 1e6)")
+    if not 1 <= sweeps <= 1000:
+        raise FlannError(f"--sweeps {sweeps}: must be 1..1000")
+    fwd = lo + step_mm * np.arange(n + 1)
+    rev = fwd[-2::-1]
+    pos, dirs = [], []
+    for k in range(sweeps):
+        f = fwd if k == 0 else fwd[1:]   # the turning point at `from` was taken in reverse
+        pos += [f, rev]
+        dirs += [np.ones(f.size), -np.ones(rev.size)]
+    return np.concatenate(pos), np.concatenate(dirs)
+
+
+def simulate_recordings(s: Sensor, sweeps: int = 1, step_mm: float = 1.0, noise_v: float = 0.0,
+                        seed: int = 0, temperature_profile=None,
+                        travel_mm: tuple[float, float] | None = None,
+                        step_time_s: float = 1.0) -> Recordings:
+    """Bench recordings: forward and reverse sweeps over ``travel_mm`` (default the rated
+    stroke), every enabled effect, white Gaussian noise of ``noise_v`` (V rms) added before
+    the ADC, reproducible from ``seed``.  ``temperature_profile`` is a spec string (see
+    :func:`parse_temperature_profile`) or a function (time_s, duration_s) -> degC."""
+    if not math.isfinite(noise_v) or noise_v < 0:
+        raise FlannError(f"--noise-v {noise_v:g}: must be >= 0")
+    if not math.isfinite(step_time_s) or step_time_s <= 0:
+        raise FlannError(f"step time {step_time_s:g} s: must be > 0")
+    travel = travel_mm if travel_mm is not None else (-s.stroke_mm, s.stroke_mm)
+    x, d = sweep_positions(travel, step_mm, sweeps)
+    t = step_time_s * np.arange(x.size, dtype=float)
+    profile = (temperature_profile if callable(temperature_profile)
+               else parse_temperature_profile(temperature_profile))
+    temp = np.asarray(profile(t, float(t[-1])), dtype=float)
+    y = simulate_output_v(s, x, direction=d, temperature_c=temp, time_s=t)
+    rng = np.random.default_rng(seed)
+    if noise_v > 0:
+        y = y + rng.normal(0.0, noise_v, size=y.shape)
+    y = adc_convert(s, y)
+    return Recordings(displacement_mm=x, voltage_v=y, direction=d, time_s=t, temperature_c=temp,
+                      source=f"simulate:{s.name}")
