@@ -1,0 +1,137 @@
+"""``flann simulate``: LVDT physics simulator (recordings from a sensor file) and calibration.
+
+    flann simulate [SENSOR.toml] -o recordings.csv [--sweeps N] [--step-mm S] [--noise-v SIGMA]
+                   [--seed K] [--temperature-profile SPEC] [--from-mm A --to-mm B] [--plot P.png]
+    flann simulate --fit RECORDINGS.csv [SENSOR.toml] [--params a,b,...] [--write-sensor OUT.toml]
+                   [--json OUT.json] [--plot P.png]
+
+Without SENSOR.toml the seed paper's LVDT (data/sensors/paper_lvdt.toml) is used.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import FlannError
+from ..fileio import atomic_write_json, atomic_write_text
+from ..recordings import read_recordings, write_recordings
+
+HELP = "LVDT physics simulator: write recordings from a sensor file"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("sensor", nargs="?", default=None,
+                   help="sensor TOML (default: the seed paper's LVDT)")
+    p.add_argument("-o", "--output", help="recordings CSV to write (simulation mode)")
+    p.add_argument("--sweeps", type=int, default=1,
+                   help="forward+reverse passes (default 1)")
+    p.add_argument("--step-mm", type=float, default=1.0, help="actuator step (default 1 mm)")
+    p.add_argument("--from-mm", type=float, default=None,
+                   help="start of travel (default -stroke_mm of the sensor)")
+    p.add_argument("--to-mm", type=float, default=None,
+                   help="end of travel (default +stroke_mm of the sensor)")
+    p.add_argument("--step-time-s", type=float, default=1.0,
+                   help="time per step (default 1 s)")
+    p.add_argument("--noise-v", type=float, default=0.0,
+                   help="white Gaussian noise, V rms, before the ADC (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--temperature-profile", default="const:20",
+                   help="const:T | ramp:T0:T1 (over the run) | sine:MEAN:AMP:PERIOD_S "
+                        "(degC; default const:20)")
+    p.add_argument("--no-effects", action="store_true",
+                   help="ignore the sensor file's [effects] (ideal sensor)")
+    p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
+                                  "(with --fit: calibration and residuals)")
+    p.add_argument("--fit", metavar="RECORDINGS", default=None,
+                   help="calibrate the unknown geometry of the sensor to these recordings")
+    p.add_argument("--params", default=None,
+                   help="with --fit: comma-separated sensor fields to fit (default "
+                        "primary_length_mm,secondary_length_mm,secondary_gap_mm,"
+                        "demodulator_gain_ratio)")
+    p.add_argument("--write-sensor", help="with --fit: write the calibrated sensor TOML")
+    p.add_argument("--json", help="with --fit: write the fit report as JSON")
+
+
+def _sensor(args):
+    from ..physics.sensor import default_sensor, load_sensor
+
+    return load_sensor(args.sensor) if args.sensor else default_sensor()
+
+
+def run(args) -> int:
+    if args.fit:
+        return _run_fit(args)
+    if not args.output:
+        raise FlannError("simulate: give -o RECORDINGS.csv (or --fit RECORDINGS.csv)")
+    for opt in ("params", "write_sensor", "json"):
+        if getattr(args, opt):
+            raise FlannError(f"simulate: --{opt.replace('_', '-')} needs --fit")
+    from ..physics.simulate import simulate_recordings
+
+    s = _sensor(args)
+    if args.no_effects:
+        s = s.without_effects()
+    lo = -s.stroke_mm if args.from_mm is None else args.from_mm
+    hi = s.stroke_mm if args.to_mm is None else args.to_mm
+    rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
+                              seed=args.seed, temperature_profile=args.temperature_profile,
+                              travel_mm=(lo, hi), step_time_s=args.step_time_s)
+    effects = "; ".join(f"{n}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
+                        for n, p in s.effects.items()) or "none"
+    comments = (
+        f"simulated by flann simulate: sensor {s.name} ({args.sensor or 'default'})",
+        f"travel {lo:g}..{hi:g} mm, step {args.step_mm:g} mm, sweeps {args.sweeps}, "
+        f"step time {args.step_time_s:g} s, noise {args.noise_v:g} V rms, seed {args.seed}, "
+        f"temperature {args.temperature_profile}",
+        f"effects: {effects}",
+    )
+    if args.plot:
+        from ..physics.plots import plot_simulation
+
+        plot_simulation(s, rec, args.plot)
+    write_recordings(args.output, rec, comments=comments)
+    print(f"wrote {args.output}: {len(rec)} rows, effects: {effects}", file=sys.stderr)
+    return 0
+
+
+def _run_fit(args) -> int:
+    if args.output:
+        raise FlannError("simulate --fit: -o is for simulation; use --write-sensor OUT.toml")
+    from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
+    from ..physics.sensor import format_sensor
+
+    s = _sensor(args)
+    rec = read_recordings(args.fit)
+    params = DEFAULT_FIT_PARAMS
+    if args.params:
+        params = tuple(p.strip() for p in args.params.split(",") if p.strip())
+    fit = fit_sensor(rec, sensor=s, params=params)
+    print(f"calibrated {s.name} to {args.fit} ({len(rec)} points, ideal model, no effects):")
+    for line in fit.summary_lines():
+        print(f"  {line}")
+    for row in fit.excluded_rows:
+        print(f"  excluded row {row}: {rec.displacement_mm[row]:g} mm, {rec.voltage_v[row]:g} V "
+              f"is {fit.residual_v[row]:+.3f} V off the curve "
+              f"({abs(fit.residual_v[row]) / fit.noise_v:.0f} x the robust noise "
+              f"{fit.noise_v * 1e3:.0f} mV): outlier, not fitted")
+    if args.write_sensor:
+        atomic_write_text(args.write_sensor, format_sensor(
+            fit.sensor, comments=(f"calibrated by: flann simulate --fit {args.fit}",
+                                  f"rms residual {fit.rms_v * 1e3:.1f} mV")))
+    if args.json:
+        atomic_write_json(args.json, {
+            "recordings": str(args.fit),
+            "params": fit.values,
+            "stderr": fit.stderr,
+            "rms_v": fit.rms_v,
+            "noise_v": fit.noise_v,
+            "points_used": int(fit.used.sum()),
+            "excluded": [{"row": r, "displacement_mm": float(rec.displacement_mm[r]),
+                          "voltage_v": float(rec.voltage_v[r]),
+                          "residual_v": float(fit.residual_v[r])} for r in fit.excluded_rows],
+        })
+    if args.plot:
+        from ..physics.plots import plot_fit
+
+        plot_fit(rec, fit, args.plot)
+    return 0

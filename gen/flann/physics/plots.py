@@ -1,0 +1,101 @@
+"""PNG plots of the physics: simulated curve with each effect's contribution; a calibration."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..recordings import Recordings  # noqa: E402
+from .fit import FitResult  # noqa: E402
+from .lvdt import ideal_output_v  # noqa: E402
+from .sensor import Sensor  # noqa: E402
+from .simulate import contributions_v  # noqa: E402
+
+
+def _save(fig, path: str | Path) -> None:
+    """Write the PNG atomically (no half-written file on error)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=110)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    finally:
+        plt.close(fig)
+
+
+def plot_simulation(s: Sensor, rec: Recordings, path: str | Path) -> None:
+    """Top: recordings, ideal and simulated curves; bottom: each enabled effect's
+    contribution (output with only that effect minus ideal) along the recorded run."""
+    x = rec.displacement_mm
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
+    xf = np.linspace(x.min(), x.max(), 600)
+    ax1.plot(xf, ideal_output_v(s, xf), "k-", lw=1, label="ideal (no effects)")
+    for sign, style, label in ((1, "C0.", "recorded, forward"), (-1, "C1.", "recorded, reverse")):
+        m = rec.direction == sign if rec.direction is not None else np.ones(x.size, bool)
+        if m.any():
+            ax1.plot(x[m], rec.voltage_v[m], style, ms=3, label=label)
+    ax1.set_ylabel("output (V)")
+    ax1.set_title(f"{s.name}: simulated LVDT output")
+    ax1.grid(alpha=0.3)
+    ax1.legend(fontsize=8)
+    contrib = contributions_v(s, x, rec.direction, rec.temperature_c, rec.time_s)
+    if len(contrib) == 1:
+        ax2.text(0.5, 0.5, "no effects enabled", ha="center", va="center",
+                 transform=ax2.transAxes)
+    if len(contrib) == 1:
+        contrib = {}
+    # One line per pass in run order (not sorted): direction- and time-dependent effects
+    # (backlash, drift) then show as separate forward/reverse branches.
+    if rec.direction is not None:
+        breaks = np.flatnonzero(np.diff(rec.direction) != 0) + 1
+    else:
+        breaks = np.array([], dtype=int)
+    passes = np.split(np.arange(x.size), breaks)
+    for i, (name, dv) in enumerate(contrib.items()):
+        style = "k--" if name == "all" else f"C{i % 10}-"
+        for k, idx in enumerate(passes):
+            ax2.plot(x[idx], 1e3 * dv[idx], style, lw=1, label=name if k == 0 else None)
+    ax2.set_xlabel("displacement (mm)")
+    ax2.set_ylabel("contribution (mV)")
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8, ncol=2)
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def plot_fit(rec: Recordings, fit: FitResult, path: str | Path) -> None:
+    """Recordings with the calibrated ideal model, excluded points marked; residuals."""
+    x, y = rec.displacement_mm, rec.voltage_v
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
+    xf = np.linspace(x.min(), x.max(), 600)
+    ax1.plot(xf, ideal_output_v(fit.sensor, xf), "k-", lw=1, label="calibrated ideal model")
+    ax1.plot(x[fit.used], y[fit.used], "C0o", ms=4, label="recordings (fitted)")
+    if (~fit.used).any():
+        ax1.plot(x[~fit.used], y[~fit.used], "rx", ms=9, mew=2, label="excluded outlier")
+    ax1.set_ylabel("output (V)")
+    ax1.set_title(f"calibration to {Path(rec.source).name}: rms {fit.rms_v * 1e3:.1f} mV")
+    ax1.grid(alpha=0.3)
+    ax1.legend(fontsize=8)
+    ax2.plot(x[fit.used], 1e3 * fit.residual_v[fit.used], "C0o-", ms=4, lw=0.8)
+    if (~fit.used).any():
+        ax2.plot(x[~fit.used], 1e3 * fit.residual_v[~fit.used], "rx", ms=9, mew=2)
+    ax2.axhline(0, color="k", lw=0.8)
+    ax2.set_xlabel("displacement (mm)")
+    ax2.set_ylabel("data - model (mV)")
+    ax2.grid(alpha=0.3)
+    fig.tight_layout()
+    _save(fig, path)
