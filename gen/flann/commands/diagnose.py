@@ -1,0 +1,82 @@
+"""``flann diagnose``: locate and name the physics missing between simulation and recordings."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+HELP = "locate and name the physics missing between simulation and recordings"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("recordings", nargs="?", help="recordings CSV (displacement_mm, voltage_v, "
+                   "optional direction, time_s, temperature_c)")
+    p.add_argument("--sensor", metavar="SENSOR.toml",
+                   help="sensor description (flann-sensor/1); its geometry is then taken as "
+                        "known and only gain and origin are calibrated (default: the paper's "
+                        "LVDT with geometry calibrated to the recordings)")
+    p.add_argument("--json", nargs="?", const="-", metavar="OUT.json",
+                   help="write the diagnosis as JSON (to stdout when no file is given)")
+    p.add_argument("--plot", metavar="OUT.png", help="residuals before/after, mismatch shaded")
+    p.add_argument("--demo", action="store_true",
+                   help="run the concealed-effect demonstration (simulated recordings) and "
+                        "print the table")
+    p.add_argument("--limits", action="store_true",
+                   help="with --demo: also measure detection limits (slow: many simulations)")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+
+
+def _progress(quiet: bool):
+    if quiet:
+        return None
+
+    def show(msg: str) -> None:
+        print(f"  {msg}", file=sys.stderr, flush=True)
+
+    return show
+
+
+def run(args) -> int:
+    from ..errors import FlannError
+    from ..fileio import atomic_write_json
+
+    if args.demo:
+        if args.recordings or args.sensor or args.plot:
+            raise FlannError("--demo takes no recordings, --sensor or --plot (it simulates its own)")
+        from ..diagnose.demo import demo_table, run_demo
+
+        results = run_demo(progress=_progress(args.quiet), limits=args.limits)
+        if args.json:
+            obj = [r.to_json() for r in results.cases]
+            if results.limits:
+                obj = {"cases": obj, "detection_limits": results.limits}
+            if args.json == "-":
+                print(json.dumps(obj, indent=2))
+            else:
+                atomic_write_json(args.json, obj)
+        if args.json != "-":
+            print(demo_table(results), end="")
+        return 0 if results.all_right else 1
+
+    if not args.recordings:
+        raise FlannError("diagnose needs a recordings CSV (or --demo)")
+    from ..diagnose import diagnose
+    from ..diagnose.report import format_text, plot, to_json
+    from ..recordings import read_recordings
+
+    rec = read_recordings(args.recordings)
+    sensor = None
+    if args.sensor:
+        from ..physics.sensor import load_sensor
+
+        sensor = load_sensor(args.sensor)
+    dg = diagnose(rec, sensor=sensor, progress=_progress(args.quiet))
+    if args.plot:
+        plot(dg, args.plot)
+    if args.json == "-":
+        print(json.dumps(to_json(dg), indent=2))
+    else:
+        if args.json:
+            atomic_write_json(args.json, to_json(dg))
+        print(format_text(dg), end="")
+    return 0

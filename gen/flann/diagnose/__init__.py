@@ -1,0 +1,253 @@
+"""``flann diagnose``: where simulation and recordings differ, and which physics is missing.
+
+Layers (one way): :mod:`.data` (model-free checks, passes, noise, outliers, regions) ->
+:mod:`.calibrate` (ideal simulation: gain, origin, geometry) -> :mod:`.model` (calibrated
+simulation + catalogue effects as one least-squares family) -> :mod:`.select` (forward
+selection by BIC and cross-validation) -> :mod:`.explain` / :mod:`.report` (sentences,
+JSON, text, plot).  :mod:`.demo` proves it on simulated recordings with concealed effects.
+
+Public API: :func:`diagnose` (Recordings, sensor=None) -> :class:`Diagnosis`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RecordingsError
+from ..recordings import Recordings, monotonic_span
+from . import data as D
+from .calibrate import calibrate, initial_origin
+from .explain import explain
+from .model import Data, PhysicsFamily
+from .select import Fit, forward_select
+
+
+@dataclass
+class EffectReport:
+    name: str
+    explanation: str
+    params: dict
+    rms_v_after: float
+    delta_bic: float
+    cv_t: float
+    alternatives: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Diagnosis:
+    source: str
+    n: int
+    n_used: int
+    passes_text: str
+    calibration_text: str
+    notes: list[str]
+    baseline_rms: float
+    baseline_params: dict
+    noise_v: float
+    regions: list[dict]
+    time_spans: list[tuple[float, float, float]]
+    time_unit: str
+    outliers: list[dict]
+    effects: list[EffectReport]
+    final_rms: float
+    untestable: dict[str, str]
+    # for the plot (kept points only)
+    x: np.ndarray = field(repr=False, default=None)
+    direction: np.ndarray | None = field(repr=False, default=None)
+    resid_before: np.ndarray = field(repr=False, default=None)
+    resid_after: np.ndarray = field(repr=False, default=None)
+    outlier_mask: np.ndarray = field(repr=False, default=None)
+    trials: list = field(repr=False, default_factory=list)
+    final_fit: Fit | None = field(repr=False, default=None)
+
+    @property
+    def named(self) -> list[str]:
+        return [e.name for e in self.effects]
+
+    @property
+    def improvement(self) -> float:
+        return self.baseline_rms / self.final_rms if self.final_rms > 0 else math.inf
+
+
+def _param(value, stderr, unit) -> dict:
+    se = float(stderr)
+    return {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
+
+
+def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
+    """Calibrate the ideal simulation to ``rec``, locate the mismatch, name missing physics.
+
+    ``sensor`` (a :class:`flann.physics.sensor.Sensor`) makes geometry and origin known;
+    without it the paper's LVDT is the starting point and geometry, gain and origin are
+    calibrated.
+    """
+    from ..physics.sensor import default_sensor
+
+    x_all = np.asarray(rec.displacement_mm, dtype=float)
+    y_all = np.asarray(rec.voltage_v, dtype=float)
+    d_given = None if rec.direction is None else np.asarray(rec.direction, dtype=float)
+    D.check_inputs(x_all, y_all, d_given, rec.source)
+    notes: list[str] = []
+    known = sensor is not None
+    sensor = (sensor or default_sensor()).replace(effects={})
+
+    # -- shape: rectified output, fold-back beyond the stroke ---------------------------
+    passes_all = D.find_passes(x_all, d_given)
+    raw_noise = D.estimate_noise(x_all, y_all, passes_all)
+    tip = D.detect_v_shape(x_all, y_all, raw_noise)
+    keep = np.ones(x_all.size, bool)
+    if tip is not None:
+        msg = (f"the output is rectified (unsigned, V-shaped through the null at about "
+               f"{tip:.3g} mm): an amplitude demodulator without phase sensitivity; "
+               "diagnosing against an amplitude-demodulated simulation")
+        notes.append(msg)
+        if sensor.demodulator_kind != "amplitude":
+            warnings.warn(f"{rec.source}: {msg}", stacklevel=2)
+            sensor = sensor.replace(demodulator_kind="amplitude")
+    elif sensor.demodulator_kind == "amplitude":
+        notes.append("the sensor file says amplitude demodulator but the output changes sign; "
+                     "diagnosing it as phase-sensitive")
+        sensor = sensor.replace(demodulator_kind="phase_sensitive")
+    if tip is None:
+        span = monotonic_span(rec)
+        if span.foldback:
+            if not span.trimmable:
+                raise RecordingsError(f"{span.message}; diagnose cannot judge a curve that "
+                                      "turns back inside its stroke")
+            keep = span.mask.copy()
+            if keep.sum() < D.MIN_POINTS or np.unique(x_all[keep]).size < 4:
+                raise RecordingsError(f"{span.message}; the monotonic span leaves only "
+                                      f"{int(keep.sum())} points, too few to diagnose")
+            msg = (f"{span.message}; trimmed to the monotonic span "
+                   f"{x_all[keep].min():g}..{x_all[keep].max():g} mm "
+                   f"({int((~keep).sum())} points dropped)")
+            warnings.warn(msg, stacklevel=2)
+            notes.append(msg.split(": ", 1)[-1])
+    rows = np.flatnonzero(keep)
+    x = x_all[keep]
+    y = y_all[keep]
+    passes = D.find_passes(x, None if d_given is None else d_given[keep])
+    direction = passes.direction
+    temp = None if rec.temperature_c is None else np.asarray(rec.temperature_c, float)[keep]
+    time = None if rec.time_s is None else np.asarray(rec.time_s, float)[keep]
+
+    # -- calibrate the ideal simulation --------------------------------------------------
+    if progress:
+        progress("calibrating the ideal simulation")
+    origin0 = initial_origin(x, y, tip)
+    cal = calibrate(sensor, x, y, origin_known=known, geometry_known=known, origin0=origin0,
+                    progress=progress)
+    noise = D.estimate_noise(x, cal.resid, passes)
+    out_mask = D.find_outliers(x, cal.resid, passes, noise)
+    if out_mask.sum() > max(1, 0.02 * x.size):
+        # many "glitches" are not glitches: keep them (they are structure or noise)
+        out_mask[:] = False
+    noise = D.estimate_noise(x, cal.resid, passes, exclude=out_mask)
+    fit_idx = np.flatnonzero(~out_mask)
+    data = Data(x=x, y=y, direction=direction, temperature_c=temp, time_s=time)
+    family = PhysicsFamily(cal.sensor, data, origin_known=known, shape=cal.shape,
+                           gain0=cal.gain, origin0=cal.origin_mm)
+
+    # -- name the missing physics --------------------------------------------------------
+    sel = forward_select(family, family.candidates, fit_idx, progress=progress)
+    all_idx = np.arange(x.size)
+    before = y - family.predict(sel.baseline, all_idx)
+    after = y - family.predict(sel.final, all_idx)
+
+    order = [s.name for s in sel.steps]
+    cumulative: list[Fit] = [s.fit for s in sel.steps]
+    deltas = [s.delta_bic for s in sel.steps]
+    cvts = [s.cv_t for s in sel.steps]
+    alts = {s.name: s.alternatives for s in sel.steps}
+    if sel.dropped:  # recompute the cumulative chain in the surviving order
+        cumulative, deltas = [], []
+        prev = sel.baseline
+        for k in range(len(order)):
+            f = family.fit(order[:k + 1], fit_idx, start=prev)
+            cumulative.append(f)
+            deltas.append(f.bic - prev.bic)
+            prev = f
+        cumulative[-1] = sel.final
+    final = sel.final
+    effects = []
+    slope = _slope(family, final, all_idx)
+    for k, name in enumerate(order):
+        params = {}
+        for n, v, se in zip(final.names, final.theta, final.stderr):
+            if n.startswith(name + "."):
+                pname = n.split(".", 1)[1]
+                params[pname] = _param(v, se, family.specs_by_name(final.effects)[n].unit)
+        if name == "thermal_drift":
+            params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
+        contrib = family.predict(final, all_idx) - _without(family, final, name, all_idx)
+        sentence = explain(name, params, contrib, x, direction, temp, y, slope,
+                           final.value("baseline.origin_mm") if not known else 0.0)
+        effects.append(EffectReport(name, sentence, params, cumulative[k].rms, deltas[k],
+                                    cvts[k] if k < len(cvts) else math.nan,
+                                    alternatives=alts.get(name, [])))
+
+    # -- locate the mismatch (residual of the calibrated ideal simulation) ----------------
+    regions = D.locate_regions(x, before, passes, noise, exclude=out_mask)
+    t_axis, t_unit = (time, "s") if time is not None else (rows.astype(float), "rows")
+    time_spans = D.locate_time_spans(t_axis, before, noise, exclude=out_mask) if regions else []
+    outliers = [{"row": int(rows[i]), "displacement_mm": float(x[i]),
+                 "residual_v": float(after[i])} for i in np.flatnonzero(out_mask)]
+
+    base_params = {"gain_ratio": _param(final.value("baseline.gain_ratio"),
+                                        _se(final, "baseline.gain_ratio"), "")}
+    if not known:
+        base_params["origin_mm"] = _param(final.value("baseline.origin_mm"),
+                                          _se(final, "baseline.origin_mm"), "mm")
+        for f, v in cal.geometry.items():
+            base_params[f] = _param(v, cal.geometry_stderr.get(f, math.nan), "mm")
+    n_dir = "" if direction is None else (
+        "directions " + "/".join(sorted({"+" if v > 0 else "-" for v in np.unique(direction)}))
+        + (" (inferred from the order)" if passes.inferred else ""))
+    passes_text = f"{len(passes.runs)} pass(es)" + (f", {n_dir}" if n_dir else "")
+    cal_text = ("sensor file: geometry and origin known; gain fitted" if known else
+                "paper LVDT as start; geometry, gain and origin fitted") + \
+        f", {sensor.demodulator_kind.replace('_', '-')} detector"
+    untestable = dict(family.untestable)
+    return Diagnosis(
+        source=rec.source, n=int(x_all.size), n_used=int(fit_idx.size), passes_text=passes_text,
+        calibration_text=cal_text, notes=notes,
+        baseline_rms=float(np.sqrt(np.mean(before[fit_idx] ** 2))),
+        baseline_params=base_params, noise_v=float(noise), regions=regions,
+        time_spans=time_spans, time_unit=t_unit, outliers=outliers, effects=effects,
+        final_rms=float(np.sqrt(np.mean(after[fit_idx] ** 2))), untestable=untestable,
+        x=x, direction=direction, resid_before=before, resid_after=after,
+        outlier_mask=out_mask, trials=sel.trials, final_fit=final)
+
+
+def _se(fit: Fit, name: str) -> float:
+    return float(fit.stderr[fit.names.index(name)])
+
+
+def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
+    """The fitted model's output with ``effect`` switched off (its parameters neutral)."""
+    from ..physics.effects import EFFECTS
+
+    theta = fit.theta.copy()
+    neutral = EFFECTS[effect].neutral()
+    for i, n in enumerate(fit.names):
+        if n.startswith(effect + "."):
+            theta[i] = neutral[n.split(".", 1)[1]]
+    return family.evaluate(theta, fit.names, idx)
+
+
+def _slope(family: PhysicsFamily, fit: Fit, idx) -> np.ndarray:
+    h = 0.01
+    x = family.data.x
+    orig = family.data
+    try:
+        family.data = Data(x + h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
+        up = family.evaluate(fit.theta, fit.names, idx)
+        family.data = Data(x - h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
+        dn = family.evaluate(fit.theta, fit.names, idx)
+    finally:
+        family.data = orig
+    return (up - dn) / (2 * h)

@@ -1,0 +1,364 @@
+"""Model-free look at recordings: checks, passes, noise, outliers, mismatch regions.
+
+Nothing here knows the physics.  Functions take the displacement, voltage and (when
+known) direction of every point and return plain numpy arrays or small dataclasses, so
+the same code serves the ideal-simulation residuals and raw voltages alike.
+
+Noise is estimated with the Gasser-Sargent-Buckley-Jennings pseudo-residuals: inside a
+pass sorted by displacement, each point is compared with the straight line through its
+two neighbours.  A smooth curve (the S-curve, or any physics left out of a model) has
+almost no second difference, so what remains is the per-point scatter; a median
+absolute deviation makes the estimate insensitive to the odd glitch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import RecordingsError
+
+MIN_POINTS = 6
+# |pseudo-residual| / sigma above which a lone point is a glitch (false alarm ~1e-6/point)
+OUTLIER_Z = 5.0
+# a running mean of w residuals is "off" when it exceeds REGION_Z * sigma / sqrt(w)
+REGION_Z = 4.5
+
+
+@dataclass(frozen=True)
+class Passes:
+    """How the recording was taken: per-point direction (+1/-1, or None) and the runs.
+
+    ``runs`` are index arrays in recording order, each a monotonic sweep of the core
+    (one run holding everything, sorted by displacement, when the order carries no
+    sweep information).  ``inferred`` says the direction came from the recording order.
+    """
+
+    direction: np.ndarray | None
+    runs: tuple[np.ndarray, ...]
+    inferred: bool
+    ordered: bool
+
+
+def check_inputs(x: np.ndarray, y: np.ndarray, direction: np.ndarray | None, source: str) -> None:
+    """Refuse what cannot be diagnosed, in one line naming the problem."""
+    n = x.size
+    if n < MIN_POINTS:
+        raise RecordingsError(f"{source}: {n} data rows; diagnose needs at least {MIN_POINTS}")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        raise RecordingsError(f"{source}: displacement_mm/voltage_v contain non-finite values")
+    x_flat = np.ptp(x) == 0
+    y_flat = np.ptp(y) == 0
+    if x_flat and y_flat:
+        raise RecordingsError(
+            f"{source}: all {n} points are identical (displacement {x[0]:g} mm, "
+            f"voltage {y[0]:g} V): nothing to compare with a simulation")
+    if x_flat:
+        raise RecordingsError(
+            f"{source}: column 'displacement_mm' does not vary (all {x[0]:g} mm): "
+            "diagnose needs a sweep over the stroke")
+    if y_flat:
+        raise RecordingsError(
+            f"{source}: column 'voltage_v' does not vary (all {y[0]:g} V) although the "
+            "displacement does: no sensor signal recorded")
+    if np.unique(x).size < 4:
+        raise RecordingsError(
+            f"{source}: only {np.unique(x).size} distinct displacements; diagnose needs "
+            "at least 4 to calibrate a curve")
+    if direction is not None:
+        bad = ~np.isin(direction, (-1.0, 1.0))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise RecordingsError(
+                f"{source}: row {i + 1}, column 'direction': {direction[i]:g} is not +1 or -1")
+
+
+def find_passes(x: np.ndarray, direction: np.ndarray | None) -> Passes:
+    """Split the recording (in row order) into monotonic sweeps.
+
+    With a direction column the runs follow it.  Without one, the sign of each step
+    from the previous row gives the direction; if that flips so often that runs are
+    shorter than 4 points, the rows are taken as unordered (no direction information).
+    """
+    n = x.size
+    if direction is not None:
+        d = np.asarray(direction, dtype=float)
+        cuts = np.flatnonzero(np.diff(d) != 0) + 1
+        runs = tuple(np.split(np.arange(n), cuts))
+        return Passes(direction=d, runs=runs, inferred=False, ordered=True)
+    step = np.sign(np.diff(x))
+    # zero steps (repeated readings) carry the previous direction
+    for i in range(step.size):
+        if step[i] == 0:
+            step[i] = step[i - 1] if i else 0
+    if np.all(step == 0):
+        return Passes(None, (np.argsort(x, kind="stable"),), inferred=True, ordered=False)
+    first = step[np.flatnonzero(step)[0]]
+    step[step == 0] = first
+    d = np.concatenate([[step[0]], step])
+    cuts = np.flatnonzero(np.diff(d) != 0) + 1
+    runs = tuple(np.split(np.arange(n), cuts))
+    lengths = np.array([r.size for r in runs])
+    if len(runs) > 1 and np.median(lengths) < 4:
+        return Passes(None, (np.argsort(x, kind="stable"),), inferred=True, ordered=False)
+    return Passes(direction=d, runs=runs, inferred=True, ordered=True)
+
+
+def _sorted_groups(x: np.ndarray, passes: Passes, min_size: int = 3) -> list[np.ndarray]:
+    groups = [r[np.argsort(x[r], kind="stable")] for r in passes.runs if r.size >= min_size]
+    if not groups:
+        groups = [np.argsort(x, kind="stable")]
+    return groups
+
+
+def pseudo_residuals(x: np.ndarray, r: np.ndarray, order: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Standardised GSJ pseudo-residuals along ``order`` (indices sorted by displacement).
+
+    Returns (index, e/c): for each point, its residual minus the straight line through
+    its two neighbours (one-sided extrapolation at the ends), divided by the factor that
+    makes its variance equal to the per-point noise variance.
+    """
+    m = order.size
+    if m < 3:
+        return np.empty(0, dtype=int), np.empty(0)
+    xs, rs = x[order], r[order]
+    idx, val = [], []
+    # interior: e_i = a r_{i-1} + b r_{i+1} - r_i
+    x0, x1, x2 = xs[:-2], xs[1:-1], xs[2:]
+    span = x2 - x0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a = np.where(span > 0, (x2 - x1) / span, 0.5)
+        b = 1.0 - a
+    e = a * rs[:-2] + b * rs[2:] - rs[1:-1]
+    c = np.sqrt(a * a + b * b + 1.0)
+    idx.append(order[1:-1])
+    val.append(e / c)
+    # ends: r_0 against the line through r_1, r_2 (extrapolated)
+    for end, n1, n2 in ((0, 1, 2), (m - 1, m - 2, m - 3)):
+        d12 = xs[n2] - xs[n1]
+        t = (xs[end] - xs[n1]) / d12 if d12 != 0 else -1.0
+        t = float(np.clip(t, -3.0, 3.0))
+        pred = rs[n1] + t * (rs[n2] - rs[n1])
+        cc = math.sqrt((1 - t) ** 2 + t ** 2 + 1.0)
+        idx.append(np.array([order[end]]))
+        val.append(np.array([(pred - rs[end]) / cc]))
+    return np.concatenate(idx), np.concatenate(val)
+
+
+def estimate_noise(x: np.ndarray, r: np.ndarray, passes: Passes,
+                   exclude: np.ndarray | None = None) -> float:
+    """Per-point noise (V, one sigma) of residuals ``r``, robust to smooth structure."""
+    keep = np.ones(x.size, bool) if exclude is None else ~exclude
+    vals = []
+    for g in _sorted_groups(x, passes):
+        g = g[keep[g]]
+        _, v = pseudo_residuals(x, r, g)
+        vals.append(v)
+    v = np.concatenate(vals) if vals else np.empty(0)
+    if v.size < 5:
+        g = np.argsort(x, kind="stable")
+        _, v = pseudo_residuals(x, r, g[keep[g]])
+    if v.size == 0:
+        return float(np.std(r))
+    return float(1.4826 * np.median(np.abs(v)))
+
+
+def find_outliers(x: np.ndarray, r: np.ndarray, passes: Passes, sigma: float,
+                  z: float = OUTLIER_Z) -> np.ndarray:
+    """Boolean mask of isolated glitches: one point far off the line through its neighbours.
+
+    A glitch of size g at point i gives pseudo-residual g at i and about -g/2 at its
+    neighbours, so only the local maximum of |e| is flagged; a smooth excursion (physics)
+    has no second difference and is never flagged.
+    """
+    mask = np.zeros(x.size, bool)
+    if sigma <= 0:
+        return mask
+    n = x.size
+    # at small n be stricter than the normal tail would need, never looser than z
+    zz = max(z, float(_norm_isf(0.001 / max(n, 1))))
+    for g in _sorted_groups(x, passes):
+        idx, v = pseudo_residuals(x, r, g)
+        if idx.size == 0:
+            continue
+        pos = {int(i): k for k, i in enumerate(idx)}
+        score = np.zeros(g.size)
+        for k, i in enumerate(g):
+            score[k] = abs(v[pos[int(i)]]) if int(i) in pos else 0.0
+        for k in range(g.size):
+            if score[k] <= zz * sigma:
+                continue
+            left = score[k - 1] if k > 0 else 0.0
+            right = score[k + 1] if k + 1 < g.size else 0.0
+            if score[k] >= left and score[k] >= right:
+                mask[g[k]] = True
+    return mask
+
+
+def _norm_isf(p: float) -> float:
+    from scipy.stats import norm
+    return float(norm.isf(p))
+
+
+def running_mean(v: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centred running mean of ``v`` over ``w`` points (shrinking at the ends) and the count."""
+    w = max(1, int(w))
+    h = w // 2
+    c = np.concatenate([[0.0], np.cumsum(v)])
+    i = np.arange(v.size)
+    lo = np.clip(i - h, 0, v.size)
+    hi = np.clip(i + h + 1, 0, v.size)
+    cnt = hi - lo
+    return (c[hi] - c[lo]) / cnt, cnt
+
+
+def window_size(m: int) -> int:
+    """Points averaged when locating a mismatch: about 1/12 of a pass, 3..101."""
+    return int(np.clip(m // 12, 3, 101)) | 1
+
+
+@dataclass(frozen=True)
+class Span:
+    lo: int        # first and last position in the sorted group
+    hi: int
+    peak: float    # signed running-mean residual of largest magnitude
+
+
+def significant_spans(v: np.ndarray, sigma: float, w: int, z: float = REGION_Z) -> list[Span]:
+    """Spans of a sorted residual sequence whose running mean exceeds the noise."""
+    if v.size == 0 or sigma <= 0:
+        return []
+    m, cnt = running_mean(v, w)
+    # also flag single points far beyond the noise (large effects over a short stretch)
+    sig = (np.abs(m) > z * sigma / np.sqrt(cnt))
+    sig &= cnt >= min(w, v.size)  # ignore the shrunk end windows unless large
+    sig |= (np.abs(m) > z * sigma / np.sqrt(np.maximum(cnt, 1))) & (np.abs(v) > 3 * sigma)
+    spans = []
+    k = 0
+    while k < v.size:
+        if not sig[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < v.size and sig[j + 1]:
+            j += 1
+        seg = m[k:j + 1]
+        spans.append(Span(k, j, float(seg[np.argmax(np.abs(seg))])))
+        k = j + 1
+    # merge spans separated by less than a window
+    merged: list[Span] = []
+    for s in spans:
+        if merged and s.lo - merged[-1].hi <= w:
+            p = merged[-1]
+            peak = p.peak if abs(p.peak) >= abs(s.peak) else s.peak
+            merged[-1] = Span(p.lo, s.hi, peak)
+        else:
+            merged.append(s)
+    # a span must hold at least half a window (or be a large single excursion)
+    return [s for s in merged if (s.hi - s.lo + 1) >= max(2, w // 2) or abs(s.peak) > 6 * sigma]
+
+
+def locate_regions(x: np.ndarray, r: np.ndarray, passes: Passes, sigma: float,
+                   exclude: np.ndarray | None = None) -> list[dict]:
+    """Displacement spans (per direction of travel) where residuals exceed the noise.
+
+    Returns dicts with the JSON keys (from_mm, to_mm, direction, peak_residual_v); a
+    span seen in both directions of travel is reported once with direction "both".
+    """
+    keep = np.ones(x.size, bool) if exclude is None else ~exclude
+    groups: dict[str, np.ndarray] = {}
+    if passes.direction is not None and passes.ordered:
+        for sign, label in ((1.0, "+"), (-1.0, "-")):
+            idx = np.flatnonzero((passes.direction == sign) & keep)
+            if idx.size >= 3:
+                groups[label] = idx[np.argsort(x[idx], kind="stable")]
+    if not groups:
+        idx = np.flatnonzero(keep)
+        groups["both"] = idx[np.argsort(x[idx], kind="stable")]
+    found: dict[str, list[tuple[float, float, float]]] = {}
+    for label, g in groups.items():
+        w = window_size(g.size)
+        spans = significant_spans(r[g], sigma, w)
+        found[label] = [(float(x[g[s.lo]]), float(x[g[s.hi]]), s.peak) for s in spans]
+    regions = []
+    if set(found) == {"+", "-"}:
+        plus, minus = list(found["+"]), list(found["-"])
+        used = set()
+        for a in plus:
+            best = None
+            for j, b in enumerate(minus):
+                if j in used:
+                    continue
+                overlap = min(a[1], b[1]) - max(a[0], b[0])
+                shorter = max(min(a[1] - a[0], b[1] - b[0]), 1e-12)
+                if overlap / shorter > 0.5:
+                    best = j
+                    break
+            if best is None:
+                regions.append(_region(a, "+"))
+            else:
+                used.add(best)
+                b = minus[best]
+                peak = a[2] if abs(a[2]) >= abs(b[2]) else b[2]
+                regions.append(_region((min(a[0], b[0]), max(a[1], b[1]), peak), "both"))
+        regions += [_region(b, "-") for j, b in enumerate(minus) if j not in used]
+    else:
+        for label, spans in found.items():
+            regions += [_region(s, label) for s in spans]
+    regions.sort(key=lambda d: (d["from_mm"], d["direction"]))
+    return regions
+
+
+def _region(s: tuple[float, float, float], direction: str) -> dict:
+    return {"from_mm": s[0], "to_mm": s[1], "direction": direction, "peak_residual_v": s[2]}
+
+
+def locate_time_spans(t: np.ndarray, r: np.ndarray, sigma: float,
+                      exclude: np.ndarray | None = None) -> list[tuple[float, float, float]]:
+    """Spans of recording time (or row number) where the residual, taken in time order, is off."""
+    keep = np.ones(t.size, bool) if exclude is None else ~exclude
+    idx = np.flatnonzero(keep)
+    idx = idx[np.argsort(t[idx], kind="stable")]
+    w = window_size(idx.size)
+    return [(float(t[idx[s.lo]]), float(t[idx[s.hi]]), s.peak)
+            for s in significant_spans(r[idx], sigma, w)]
+
+
+# --------------------------------------------------------------------------- shape checks
+
+def _smooth_sorted(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(x, kind="stable")
+    xs, ys = x[order], y[order]
+    w = max(1, min(len(xs) // 15, 15)) | 1
+    if w > 1:
+        # running median: robust to glitches, keeps plateaus flat
+        h = w // 2
+        pad = np.pad(ys, h, mode="edge")
+        win = np.lib.stride_tricks.sliding_window_view(pad, w)
+        ys = np.median(win, axis=1)
+    return xs, ys
+
+
+def detect_v_shape(x: np.ndarray, y: np.ndarray, sigma_raw: float) -> float | None:
+    """Displacement of the tip when the output is rectified (a V through the null), else None.
+
+    A signed LVDT output crosses zero once and rises (or falls) through the stroke; an
+    amplitude-demodulated one never changes sign: it falls to a minimum near zero at the
+    null and rises again on both sides.  Flagged when the smoothed curve has an interior
+    minimum within 15 % of the span from zero, both ends are at least 30 % of the span
+    above it, and (almost) no point lies below it by more than the noise.
+    """
+    xs, ys = _smooth_sorted(x, y)
+    rng = float(np.ptp(ys)) or float(np.ptp(y))
+    tol = max(6.0 * sigma_raw, 0.03 * rng)
+    for sgn in (1.0, -1.0):
+        v = sgn * ys
+        k = int(np.argmin(v))
+        if 0 < k < len(v) - 1:
+            rise_l, rise_r = v[0] - v[k], v[-1] - v[k]
+            if (min(rise_l, rise_r) > 0.3 * rng and abs(v[k]) < 0.15 * rng
+                    and np.mean(sgn * y >= -tol) > 0.97):
+                return float(xs[k])
+    return None

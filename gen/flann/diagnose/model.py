@@ -1,0 +1,372 @@
+"""The calibrated ideal simulation plus candidate effects, as one least-squares family.
+
+Every candidate effect is the physics simulator's own (:data:`flann.physics.effects.EFFECTS`,
+applied by :func:`flann.physics.simulate.simulate_output_v`): this module only decides which
+parameters are free, where the fit starts, and which effects the recordings can test.
+
+Free parameters of the baseline (the ideal simulation):
+
+* ``gain_ratio`` -- the demodulator gain (its sign is the output's sign convention);
+* ``origin_mm`` -- the displacement at which the core is centred, unless the origin is
+  known (a sensor file was given): recordings may start at 0 mm with the null mid-way;
+* ``shape_1..K`` -- when the geometry is unknown, the leading K modes of how the output's
+  shape changes with the winding/core geometry (derivatives of the simulated output with
+  respect to the geometry fields, at the calibrated geometry, made orthogonal to gain and
+  origin).  They let the geometry re-adjust, to first order, together with every
+  candidate effect, so a geometry the nonlinear calibration got slightly wrong is never
+  mistaken for missing physics, and an effect is not blamed on geometry either.
+
+Geometry itself (winding lengths, core length, bore) is calibrated once, nonlinearly, by
+:mod:`flann.diagnose.calibrate`: rebuilding the magnetics table costs ~0.1 s, too slow to
+repeat inside every candidate fit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..physics.effects import EFFECTS, Context, Signal
+from ..physics.simulate import simulate_output_v
+from .select import Fit
+
+# Effects the diagnosis tries, in catalogue order (secondary_loading is left out: with
+# unknown geometry its position-dependent gain is a shape change, not a signature).
+CANDIDATES = ("null_offset", "quadrature_null", "zero_shift", "secondary_imbalance",
+              "backlash", "thermal_drift", "adc_clipping", "leadscrew_periodic")
+
+
+@dataclass(frozen=True)
+class Data:
+    """The points being diagnosed (outliers and fold-back already removed by the caller)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    direction: np.ndarray | None        # +-1, given or inferred from the sweep order
+    temperature_c: np.ndarray | None
+    time_s: np.ndarray | None
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    name: str          # "baseline.gain_ratio", "backlash.deadband_mm", ...
+    lower: float
+    upper: float
+    unit: str
+
+
+class ShapeModes:
+    """K functions of the core position: first-order geometry corrections (unit gain)."""
+
+    def __init__(self, grid_mm: np.ndarray, modes: np.ndarray, fields: tuple[str, ...],
+                 slope: np.ndarray):
+        self.grid_mm = grid_mm
+        self.modes = modes            # (K, grid) per unit of the demodulator gain
+        self.fields = fields
+        self.slope = slope            # d(ideal output)/dx per unit gain on the grid
+
+    @property
+    def k(self) -> int:
+        return int(self.modes.shape[0])
+
+    def evaluate(self, core_mm: np.ndarray) -> np.ndarray:
+        return np.stack([np.interp(core_mm, self.grid_mm, m) for m in self.modes])
+
+
+class PhysicsFamily:
+    """Least-squares fits of the calibrated ideal simulation + any set of catalogue effects."""
+
+    def __init__(self, sensor, data: Data, origin_known: bool, shape: ShapeModes | None,
+                 gain0: float, origin0: float):
+        self.sensor = sensor.replace(effects={})
+        self.data = data
+        self.origin_known = origin_known
+        self.shape = shape
+        self.gain0 = float(gain0)
+        self.origin0 = float(origin0)
+        y = data.y
+        self.v_range = float(np.ptp(y)) or 1.0
+        self.t_ref = (float(np.mean(data.temperature_c))
+                      if data.temperature_c is not None else 20.0)
+        self.untestable = self._untestable()
+        self.candidates = tuple(c for c in CANDIDATES if c not in self.untestable)
+        self._shape_cache: dict = {}
+        self.nfev = 0
+
+    # -- which effects these recordings can reveal ----------------------------------
+    def _untestable(self) -> dict[str, str]:
+        d = self.data
+        out = {}
+        if self.sensor.demodulator_kind == "phase_sensitive":
+            out["quadrature_null"] = "a phase-sensitive detector rejects quadrature"
+        if not self.origin_known:
+            out["zero_shift"] = ("the origin is calibrated (no sensor file), so a shifted null "
+                                 "is the fitted origin_mm")
+        if d.direction is None or np.unique(d.direction).size < 2:
+            out["backlash"] = "needs travel in both directions"
+        if d.temperature_c is None or np.ptp(d.temperature_c) == 0:
+            out["thermal_drift"] = "needs a temperature_c column that varies"
+        if np.unique(d.x).size < 12:
+            out["leadscrew_periodic"] = "needs at least 12 distinct displacements"
+        return out
+
+    # -- parameters ------------------------------------------------------------------
+    def specs(self, effects) -> list[ParamSpec]:
+        g = abs(self.gain0)
+        span = float(np.ptp(self.data.x))
+        out = [ParamSpec("baseline.gain_ratio", *sorted((self.gain0 * 0.2, self.gain0 * 5.0)), "")]
+        if not self.origin_known:
+            out.append(ParamSpec("baseline.origin_mm", self.origin0 - span, self.origin0 + span, "mm"))
+        if self.shape is not None:
+            out += [ParamSpec(f"baseline.shape_{k + 1}", -2.0, 2.0, "") for k in range(self.shape.k)]
+        ymax = float(np.max(np.abs(self.data.y)))
+        for e in effects:
+            if e == "null_offset":
+                out.append(ParamSpec("null_offset.offset_v", -self.v_range, self.v_range, "V"))
+            elif e == "quadrature_null":
+                out.append(ParamSpec("quadrature_null.quadrature_v", 0.0, self.v_range, "V"))
+            elif e == "zero_shift":
+                out.append(ParamSpec("zero_shift.shift_mm", -span / 2, span / 2, "mm"))
+            elif e == "secondary_imbalance":
+                out.append(ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""))
+            elif e == "backlash":
+                out.append(ParamSpec("backlash.deadband_mm", 0.0, span / 10, "mm"))
+            elif e == "thermal_drift":
+                out.append(ParamSpec("thermal_drift.coefficient_per_c", -0.05, 0.05, "1/degC"))
+            elif e == "adc_clipping":
+                out.append(ParamSpec("adc_clipping.rail_v", 0.3 * ymax, 3.0 * ymax, "V"))
+            elif e == "leadscrew_periodic":
+                step = self._typical_step()
+                out += [ParamSpec("leadscrew_periodic.amplitude_mm", -span / 20, span / 20, "mm"),
+                        ParamSpec("leadscrew_periodic.period_mm", 2.05 * step, span / 3, "mm"),
+                        ParamSpec("leadscrew_periodic.phase_rad", -4 * math.pi, 4 * math.pi, "rad")]
+            else:
+                raise ValueError(f"unknown candidate {e}")
+        return out
+
+    def _typical_step(self) -> float:
+        u = np.unique(self.data.x)
+        return float(np.median(np.diff(u))) if u.size > 1 else 1.0
+
+    # -- the model -------------------------------------------------------------------
+    def _unpack(self, theta: np.ndarray, names: list[str]):
+        gain = theta[0]
+        pos = 1
+        origin = self.origin0
+        if not self.origin_known:
+            origin = theta[pos]
+            pos += 1
+        shape = None
+        if self.shape is not None:
+            shape = theta[pos:pos + self.shape.k]
+            pos += self.shape.k
+        eff: dict[str, dict[str, float]] = {}
+        for name, v in zip(names[pos:], theta[pos:]):
+            e, p = name.split(".", 1)
+            eff.setdefault(e, {})[p] = float(v)
+        for e, params in eff.items():
+            full = EFFECTS[e].neutral()
+            if e == "thermal_drift":
+                full["reference_temperature_c"] = self.t_ref
+            full.update(params)
+            eff[e] = full
+        return float(gain), float(origin), shape, eff
+
+    _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm", "adc_clipping.rail_v",
+                  "leadscrew_periodic.period_mm")
+    _CLIPPED = {"secondary_imbalance.imbalance_fraction": 0.9,
+                "thermal_drift.coefficient_per_c": 0.2}
+
+    def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
+        """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
+        th = np.array(theta, dtype=float)
+        for i, n in enumerate(names):
+            if n in self._ONE_SIDED:
+                th[i] = abs(th[i])
+            elif n in self._CLIPPED:
+                th[i] = float(np.clip(th[i], -self._CLIPPED[n], self._CLIPPED[n]))
+        return th
+
+    def evaluate(self, theta: np.ndarray, names: list[str], idx: np.ndarray) -> np.ndarray:
+        self.nfev += 1
+        gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
+        d = self.data
+        inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
+        s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
+        core = d.x[idx] - self.origin0
+        direction = None if d.direction is None else d.direction[idx]
+        temp = None if d.temperature_c is None else d.temperature_c[idx]
+        time = None if d.time_s is None else d.time_s[idx]
+        # The core positions use the calibrated origin, so the simulator's magnetics cache
+        # is hit whenever no position effect is on; a change of origin enters to first
+        # order through the slope (it is ~1e-3 mm inside the effect fits).
+        y = simulate_output_v(s, core, direction=direction, temperature_c=temp, time_s=time)
+        if self.shape is not None:
+            modes = self._modes_at(idx, core)
+            if origin != self.origin0:
+                y = y - gain * (origin - self.origin0) * modes[0]
+            if shape is not None:
+                y = y + gain * (shape @ modes[1:])
+        elif origin != self.origin0:
+            y = y - gain * (origin - self.origin0) * self._slope_at(idx, core)
+        outer = [k for k in EFFECTS if k in eff and EFFECTS[k].stage == "output"]
+        if outer:
+            ctx = Context(displacement_mm=core,
+                          direction=np.zeros_like(core) if direction is None else direction,
+                          temperature_c=temp, time_s=np.zeros_like(core) if time is None else time,
+                          sensor=s)
+            sig = Signal(core_mm=core, output_v=y)
+            # catalogue order keeps clipping last, as the simulator does
+            for k in outer:
+                sig = EFFECTS[k].apply(eff[k], ctx, sig)
+            y = sig.output_v
+        return y
+
+    def _modes_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """[slope, shape_1..K] at the points idx (per unit gain), cached per index set."""
+        key = (idx.size, int(idx[0]) if idx.size else -1, int(idx[-1]) if idx.size else -1,
+               hash(idx.tobytes()))
+        hit = self._shape_cache.get(key)
+        if hit is None:
+            slope = np.interp(core, self.shape.grid_mm, self.shape.slope)
+            hit = np.vstack([slope[None, :], self.shape.evaluate(core)])
+            self._shape_cache[key] = hit
+        return hit
+
+    def _slope_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+        key = ("slope", idx.size, hash(idx.tobytes()))
+        hit = self._shape_cache.get(key)
+        if hit is None:
+            h = 0.01
+            s1 = self.sensor.replace(demodulator_gain_ratio=1.0)
+            hit = (simulate_output_v(s1, core + h) - simulate_output_v(s1, core - h)) / (2 * h)
+            self._shape_cache[key] = hit
+        return hit
+
+    def data_y(self, idx: np.ndarray) -> np.ndarray:
+        return self.data.y[idx]
+
+    # -- starting values ---------------------------------------------------------------
+    def _start(self, effects, names, idx, start: Fit | None) -> np.ndarray:
+        theta = np.empty(len(names))
+        known = dict(zip(start.names, start.theta)) if start is not None else {}
+        base = {"baseline.gain_ratio": self.gain0, "baseline.origin_mm": self.origin0}
+        resid = None
+        for i, n in enumerate(names):
+            if n in known:
+                theta[i] = known[n]
+            elif n in base:
+                theta[i] = base[n]
+            elif n.startswith("baseline.shape_"):
+                theta[i] = 0.0
+            else:
+                theta[i] = np.nan
+        missing = [i for i in range(len(names)) if np.isnan(theta[i])]
+        if missing:
+            if start is not None:
+                resid = self.data_y(idx) - self.evaluate(start.theta, start.names, idx)
+                base_theta, base_names = start.theta, start.names
+            else:
+                base_names = [n for n in names if n.startswith("baseline.")]
+                base_theta = theta[:len(base_names)]
+                resid = self.data_y(idx) - self.evaluate(base_theta, base_names, idx)
+            guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)))
+            for i in missing:
+                theta[i] = guesses.get(names[i], 0.0)
+        return theta
+
+    def _guess(self, resid: np.ndarray, idx: np.ndarray, base: dict) -> dict[str, float]:
+        """Effect-specific starting values from the residual of the model without them."""
+        d = self.data
+        gain = base.get("baseline.gain_ratio", self.gain0)
+        origin = base.get("baseline.origin_mm", self.origin0)
+        x = d.x[idx] - origin
+        h = 0.01
+        s0 = self.sensor.replace(demodulator_gain_ratio=gain)
+        slope = (simulate_output_v(s0, x + h) - simulate_output_v(s0, x - h)) / (2 * h)
+        g = {}
+        g["null_offset.offset_v"] = float(np.mean(resid))
+        g["quadrature_null.quadrature_v"] = max(float(np.min(np.abs(d.y[idx]))), 1e-4 * self.v_range)
+        denom = float(np.dot(slope, slope)) or 1.0
+        g["zero_shift.shift_mm"] = float(-np.dot(resid, slope) / denom)
+        if d.direction is not None:
+            dd = d.direction[idx]
+            g["backlash.deadband_mm"] = max(float(-2 * np.dot(resid * dd, slope) / denom), 1e-4)
+        ymax = float(np.max(np.abs(d.y[idx])))
+        g["adc_clipping.rail_v"] = ymax
+        g["secondary_imbalance.imbalance_fraction"] = 0.0
+        g["thermal_drift.coefficient_per_c"] = 0.0
+        g.update(self._guess_leadscrew(x, resid, slope))
+        return g
+
+    def _guess_leadscrew(self, x, resid, slope) -> dict[str, float]:
+        """Period, amplitude and phase from a periodogram of the position error resid/slope."""
+        w = np.abs(slope) > 0.3 * np.max(np.abs(slope))
+        if w.sum() < 12:
+            return {}
+        xe = x[w]
+        e = -resid[w] / slope[w]  # core error estimate: resid = slope * (core - x)
+        lo = max(2.05 * self._typical_step(), 1e-3)
+        hi = max(float(np.ptp(xe)) / 3, lo * 1.01)
+        periods = np.geomspace(lo, hi, 400)
+        e = e - np.mean(e)
+        ph = 2 * np.pi * xe[None, :] / periods[:, None]
+        c, sn = np.cos(ph), np.sin(ph)
+        cc, ss = np.sum(c * c, 1), np.sum(sn * sn, 1)
+        a_c = (c @ e) / cc
+        a_s = (sn @ e) / ss
+        k = int(np.argmax(a_c ** 2 + a_s ** 2))
+        best = (0.0, float(periods[k]), float(a_s[k]), float(a_c[k]))
+        _, p, a_s, a_c = best
+        # a_s sin + a_c cos = amp sin(2 pi x/p + phase)
+        return {"leadscrew_periodic.amplitude_mm": float(math.hypot(a_s, a_c)),
+                "leadscrew_periodic.period_mm": float(p),
+                "leadscrew_periodic.phase_rad": float(math.atan2(a_c, a_s))}
+
+    # -- fitting -----------------------------------------------------------------------
+    def fit(self, effects, idx: np.ndarray, start: Fit | None = None) -> Fit:
+        """Levenberg-Marquardt (MINPACK: no threaded BLAS, fast on a busy machine); bounds
+        are enforced by :meth:`_physical` (|.| for one-sided, clipping for two-sided)."""
+        effects = tuple(effects)
+        specs = self.specs(effects)
+        names = [p.name for p in specs]
+        lo = np.array([p.lower for p in specs])
+        hi = np.array([p.upper for p in specs])
+        theta0 = np.clip(self._start(effects, names, idx, start), lo, hi)
+        y = self.data_y(idx)
+
+        def fun(th):
+            return self.evaluate(th, names, idx) - y
+
+        try:
+            res = least_squares(fun, theta0, method="lm", x_scale="jac",
+                                max_nfev=40 * (len(names) + 1), xtol=1e-9, ftol=1e-9)
+        except (ValueError, FloatingPointError):
+            return Fit(effects, names, theta0, np.full(len(names), np.nan), -fun(theta0), idx,
+                       ok=False)
+        theta = self._physical(res.x, names)
+        resid = -res.fun
+        stderr = _stderr(res.jac, resid, len(names))
+        return Fit(effects, names, theta, stderr, resid, idx, ok=bool(np.all(np.isfinite(resid))))
+
+    def predict(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
+        return self.evaluate(fit.theta, fit.names, idx)
+
+    def specs_by_name(self, effects) -> dict[str, ParamSpec]:
+        return {p.name: p for p in self.specs(effects)}
+
+
+def _stderr(jac, resid: np.ndarray, k: int) -> np.ndarray:
+    n = resid.size
+    if n <= k:
+        return np.full(k, np.nan)
+    jac = np.asarray(jac, dtype=float)
+    s2 = float(np.dot(resid, resid)) / (n - k)
+    try:
+        cov = np.linalg.pinv(jac.T @ jac) * s2
+    except np.linalg.LinAlgError:
+        return np.full(k, np.nan)
+    return np.sqrt(np.clip(np.diag(cov), 0.0, None))

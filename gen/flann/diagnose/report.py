@@ -1,0 +1,153 @@
+"""Reporting a :class:`~flann.diagnose.core.Diagnosis`: JSON, text and the residual plot."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _num(v: float) -> float:
+    v = float(v)
+    return v if math.isfinite(v) else None  # JSON has no inf/nan
+
+
+def to_json(dg) -> dict:
+    """The issue's JSON, keys exactly as specified (params as {"value", "stderr", "unit"})."""
+    return {
+        "baseline": {"rms_v": _num(dg.baseline_rms), "params": dg.baseline_params},
+        "noise_v": _num(dg.noise_v),
+        "regions": [{"from_mm": _num(r["from_mm"]), "to_mm": _num(r["to_mm"]),
+                     "direction": r["direction"], "peak_residual_v": _num(r["peak_residual_v"])}
+                    for r in dg.regions],
+        "outliers": [{"row": int(o["row"]), "displacement_mm": _num(o["displacement_mm"]),
+                      "residual_v": _num(o["residual_v"])} for o in dg.outliers],
+        "effects": [{"name": e.name, "explanation": e.explanation, "params": e.params,
+                     "rms_v_after": _num(e.rms_v_after), "delta_bic": _num(e.delta_bic)}
+                    for e in dg.effects],
+        "final": {"rms_v": _num(dg.final_rms)},
+        "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
+    }
+
+
+def _fmt_param(name: str, p: dict) -> str:
+    unit = f" {p['unit']}" if p.get("unit") else ""
+    se = p.get("stderr")
+    if isinstance(p.get("value"), str):
+        return f"{name} = {p['value']}"
+    if se is None or not math.isfinite(se):
+        return f"{name} = {p['value']:.6g}{unit}"
+    return f"{name} = {p['value']:.6g} ± {se:.2g}{unit}"
+
+
+def _mv(v: float) -> str:
+    return f"{v * 1e3:.3g} mV"
+
+
+def format_text(dg) -> str:
+    lines = [f"{dg.source}: {dg.n_used} of {dg.n} points, {dg.passes_text}"]
+    for note in dg.notes:
+        lines.append(f"note: {note}")
+    lines.append(f"calibrated ideal simulation ({dg.calibration_text}): RMS residual "
+                 f"{_mv(dg.baseline_rms)}")
+    lines.append("  " + "; ".join(_fmt_param(k, v) for k, v in dg.baseline_params.items()))
+    lines.append(f"noise estimated from point-to-point scatter: {_mv(dg.noise_v)} (1 sigma)")
+    if dg.outliers:
+        lines.append(f"isolated outliers ({len(dg.outliers)}, measurement glitches, left out of "
+                     "the fits):")
+        for o in dg.outliers:
+            lines.append(f"  row {o['row']} at {o['displacement_mm']:g} mm: {_mv(o['residual_v'])} "
+                         f"off the curve ({abs(o['residual_v']) / dg.noise_v:.0f} x noise)")
+    if dg.regions:
+        lines.append("where the ideal simulation and the recordings differ beyond the noise:")
+        for r in dg.regions:
+            lines.append(f"  {r['from_mm']:g} .. {r['to_mm']:g} mm, direction {r['direction']}: "
+                         f"residual up to {_mv(r['peak_residual_v'])}")
+        if dg.time_spans:
+            unit = "s" if dg.time_unit == "s" else "rows"
+            spans = ", ".join(f"{a:g}..{b:g} {unit}" for a, b, _ in dg.time_spans)
+            lines.append(f"  in recording time: {spans}")
+    if not dg.effects:
+        lines.append(f"nothing missing: the residual ({_mv(dg.final_rms)} RMS) is noise; "
+                     "no effect of the catalogue earns its keep")
+    else:
+        lines.append("physics missing from the ideal simulation (most important first):")
+        prev = dg.baseline_rms
+        for i, e in enumerate(dg.effects, 1):
+            lines.append(f"  {i}. {e.name}: {e.explanation}")
+            lines.append("     " + "; ".join(_fmt_param(k, v) for k, v in e.params.items()))
+            lines.append(f"     RMS {_mv(prev)} -> {_mv(e.rms_v_after)}, delta BIC "
+                         f"{e.delta_bic:.1f}, cross-validation t = {e.cv_t:.1f}")
+            if e.alternatives:
+                lines.append(f"     fits these recordings equally well (BIC within 2): "
+                             f"{', '.join(e.alternatives)}; named the simplest")
+            prev = e.rms_v_after
+        lines.append(f"final RMS {_mv(dg.final_rms)} (noise {_mv(dg.noise_v)}), improvement "
+                     f"x{dg.baseline_rms / dg.final_rms:.3g}")
+    if dg.untestable:
+        lines.append("not testable on these recordings: " + "; ".join(
+            f"{k} ({v})" for k, v in dg.untestable.items()))
+    return "\n".join(lines) + "\n"
+
+
+def plot(dg, path) -> None:
+    """Residuals against displacement before and after the added effects, spans shaded."""
+    import io
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    x, d = dg.x, dg.direction
+    keep = ~dg.outlier_mask
+    title_after = ("after " + " + ".join(e.name for e in dg.effects)) if dg.effects \
+        else "no effect added (nothing missing)"
+    for ax, r, title in ((axes[0], dg.resid_before, "ideal simulation, calibrated"),
+                         (axes[1], dg.resid_after, title_after)):
+        for reg in dg.regions:
+            color = {"+": "tab:red", "-": "tab:blue", "both": "tab:purple"}[reg["direction"]]
+            ax.axvspan(reg["from_mm"], reg["to_mm"], color=color, alpha=0.12, lw=0)
+        if d is not None:
+            for sign, color, label in ((1, "tab:red", "moving +"), (-1, "tab:blue", "moving -")):
+                m = keep & (d == sign)
+                if m.any():
+                    ax.plot(x[m], r[m] * 1e3, ".", ms=2.5, color=color, label=label)
+        else:
+            ax.plot(x[keep], r[keep] * 1e3, ".", ms=2.5, color="k", label="points")
+        if dg.outlier_mask.any():
+            ax.plot(x[~keep], r[~keep] * 1e3, "x", color="tab:orange", ms=7, label="outlier")
+        for k in (-2, 2):
+            ax.axhline(k * dg.noise_v * 1e3, color="0.5", lw=0.7, ls="--")
+        ax.axhline(0, color="0.3", lw=0.7)
+        rms = math.sqrt(np.mean(r[keep] ** 2))
+        ax.set_title(f"{title}: RMS {rms * 1e3:.3g} mV", fontsize=10)
+        ax.set_ylabel("residual (mV)")
+        ax.legend(fontsize=8, loc="best")
+    axes[1].set_xlabel("displacement (mm)")
+    fig.suptitle(f"flann diagnose: {dg.source} (shaded: located mismatch, dashed: ±2 noise)",
+                 fontsize=10)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    _atomic_write_bytes(path, buf.getvalue())
+
+
+def _atomic_write_bytes(path, data: bytes) -> None:
+    import contextlib
+    import os
+    import tempfile
+    from pathlib import Path
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
