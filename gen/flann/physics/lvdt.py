@@ -280,12 +280,13 @@ def flux_profile(s: Sensor, core_position_mm: float, z_mm) -> np.ndarray:
             continue
         z0 = math.sqrt(r[i] / g)
         k = math.sqrt(r[i] * g)
-        # Phi(b_i) from the matched potentials: u' = s - R' Phi at the segment start.
-        phi_p = src[i] / r[i]
         length = b[i + 1] - b[i]
-        # Solve Phi_a from u_b = C u_a - Z0 S (Phi_a - phi_p)
-        ch, sh = math.cosh(k * length), math.sinh(k * length)
-        phi_a = phi_p + (ch * u[i] - u[i + 1]) / (z0 * sh) if sh > 0 else phi_p
+        # u = alpha e^{-k d} + beta e^{-k (L - d)} from both ends (no growing exponentials);
+        # Phi = s/R' - u'/R' = phi_p + (alpha e^{-k d} - beta e^{-k (L - d)}) / Z0.
+        e = math.exp(-k * length)
+        det = 1.0 - e * e
+        alpha = (u[i] - e * u[i + 1]) / det
+        beta = (u[i + 1] - e * u[i]) / det
         d = z[m] - b[i]
-        out[m] = phi_p + (phi_a - phi_p) * np.cosh(k * d) - u[i] / z0 * np.sinh(k * d)
+        out[m] = (src[i] / r[i] + (alpha * np.exp(-k * d) - beta * np.exp(-k * (length - d))) / z0)
     return out

@@ -1,0 +1,129 @@
+"""Simulated recordings (sweeps, seed, noise, ADC, temperature), the CLI, and calibration."""
+
+import json
+
+import numpy as np
+import pytest
+
+from flann.cli import main
+from flann.errors import FlannError
+from flann.physics.fit import fit_sensor
+from flann.physics.lvdt import ideal_output_v
+from flann.physics.sensor import default_sensor
+from flann.physics.simulate import (
+    adc_convert, parse_temperature_profile, simulate_output_v, simulate_recordings, sweep_positions,
+)
+from flann.recordings import Recordings, read_recordings
+
+
+def test_sweep_positions_forward_reverse():
+    x, d = sweep_positions((-2.0, 2.0), 1.0, 2)
+    np.testing.assert_array_equal(x, [-2, -1, 0, 1, 2, 1, 0, -1, -2, -1, 0, 1, 2, 1, 0, -1, -2])
+    np.testing.assert_array_equal(d, [1] * 5 + [-1] * 4 + [1] * 4 + [-1] * 4)
+
+
+def test_recordings_columns_seed_and_noise():
+    s = default_sensor().replace(adc_bits=None, adc_full_scale_v=None)
+    a = simulate_recordings(s, sweeps=3, step_mm=0.5, noise_v=0.01, seed=7)
+    b = simulate_recordings(s, sweeps=3, step_mm=0.5, noise_v=0.01, seed=7)
+    c = simulate_recordings(s, sweeps=3, step_mm=0.5, noise_v=0.01, seed=8)
+    np.testing.assert_array_equal(a.voltage_v, b.voltage_v)
+    assert not np.array_equal(a.voltage_v, c.voltage_v)
+    for col in ("direction", "time_s", "temperature_c"):
+        assert getattr(a, col) is not None and getattr(a, col).size == len(a)
+    assert set(np.unique(a.direction)) == {-1.0, 1.0}
+    assert np.all(np.diff(a.time_s) == 1.0)
+    resid = a.voltage_v - ideal_output_v(s, a.displacement_mm)
+    assert np.std(resid) == pytest.approx(0.01, rel=0.1)
+    assert abs(np.mean(resid)) < 3 * 0.01 / np.sqrt(len(a))
+
+
+def test_adc_quantises_and_saturates():
+    s = default_sensor()        # 16 bits, +-10 V: LSB = 20 V / 65536
+    lsb = 20.0 / 65536
+    y = adc_convert(s, np.array([0.3 * lsb, 0.7 * lsb, 12.0, -12.0]))
+    np.testing.assert_allclose(y, [0.0, lsb, 10.0 - lsb, -10.0])
+    r = simulate_recordings(s, step_mm=5.0)
+    codes = r.voltage_v / lsb
+    np.testing.assert_allclose(codes, np.round(codes), atol=1e-6)
+
+
+def test_temperature_profile_ramp_drives_thermal_drift():
+    s = default_sensor().with_effect("thermal_drift", coefficient_per_c=-0.004,
+                                     reference_temperature_c=20.0)
+    r = simulate_recordings(s, sweeps=1, step_mm=1.0, temperature_profile="ramp:20:40")
+    assert r.temperature_c[0] == 20.0 and r.temperature_c[-1] == 40.0
+    ratio = r.voltage_v[-1] / ideal_output_v(s, r.displacement_mm[-1:])[0]
+    assert ratio == pytest.approx(1 - 0.004 * 20, abs=2e-3)   # ADC LSB on ~5 V
+
+
+@pytest.mark.parametrize("spec", ["ramp:20", "sine:1:2", "warm", "const:-300", "sine:20:1:0"])
+def test_bad_temperature_profiles(spec):
+    with pytest.raises(FlannError, match="temperature-profile"):
+        parse_temperature_profile(spec)
+
+
+def test_cli_simulate_writes_readable_recordings(tmp_path, capsys):
+    out = tmp_path / "rec.csv"
+    png = tmp_path / "rec.png"
+    rc = main(["simulate", "data/sensors/paper_lvdt_effects.toml", "-o", str(out), "--sweeps", "2",
+               "--step-mm", "2", "--noise-v", "0.002", "--seed", "3",
+               "--temperature-profile", "ramp:20:30", "--plot", str(png)])
+    assert rc == 0
+    rec = read_recordings(out)
+    assert len(rec) == 31 + 30 + 30 + 30   # -30..30 step 2, back to -30, forth, back
+    assert rec.direction is not None and rec.temperature_c[-1] == pytest.approx(30.0)
+    assert any("effects: null_offset" in c for c in rec.comments)
+    assert png.stat().st_size > 10_000
+    again = tmp_path / "again.csv"
+    main(["simulate", "data/sensors/paper_lvdt_effects.toml", "-o", str(again), "--sweeps", "2",
+          "--step-mm", "2", "--noise-v", "0.002", "--seed", "3", "--temperature-profile", "ramp:20:30"])
+    assert again.read_text() == out.read_text()
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--step-mm", "0"], "--step-mm"),
+    (["--sweeps", "0"], "--sweeps"),
+    (["--noise-v", "-1"], "--noise-v"),
+    (["--from-mm", "5", "--to-mm", "1"], "travel"),
+    (["--temperature-profile", "hot"], "temperature-profile"),
+])
+def test_cli_bad_options_exit_2(tmp_path, capsys, args, fragment):
+    out = tmp_path / "r.csv"
+    assert main(["simulate", "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_fit_recovers_known_geometry():
+    truth = default_sensor().replace(primary_length_mm=6.0, secondary_length_mm=24.0,
+                                     secondary_gap_mm=8.0, demodulator_gain_ratio=1.3)
+    x = np.arange(-30.0, 30.5, 1.0)
+    rec = Recordings(displacement_mm=x, voltage_v=ideal_output_v(truth, x))
+    fit = fit_sensor(rec, starts=2)
+    assert fit.rms_v < 1e-4
+    assert fit.values["primary_length_mm"] == pytest.approx(6.0, rel=1e-2)
+    assert fit.values["secondary_length_mm"] == pytest.approx(24.0, rel=1e-2)
+    assert fit.values["secondary_gap_mm"] == pytest.approx(8.0, rel=1e-2)
+    assert fit.values["demodulator_gain_ratio"] == pytest.approx(1.3, rel=1e-2)
+    assert fit.excluded_rows == ()
+
+
+def test_fit_table1_excludes_the_10mm_point(tmp_path, capsys):
+    js = tmp_path / "fit.json"
+    rc = main(["simulate", "--fit", "data/paper_table1.csv", "--json", str(js),
+               "--write-sensor", str(tmp_path / "fitted.toml")])
+    assert rc == 0
+    rep = json.loads(js.read_text())
+    assert [e["displacement_mm"] for e in rep["excluded"]] == [10.0]
+    assert rep["excluded"][0]["residual_v"] < -0.8          # 1.810 V vs ~2.9 V expected
+    assert rep["points_used"] == 12
+    assert rep["rms_v"] < 0.1                               # docs/physics.md states the figure
+    assert "excluded row 8" in capsys.readouterr().out
+
+
+def test_simulate_output_matches_ideal_without_effects():
+    s = default_sensor()
+    x = np.linspace(-40, 40, 81)
+    np.testing.assert_allclose(simulate_output_v(s, x), ideal_output_v(s, x), rtol=1e-12, atol=1e-12)
