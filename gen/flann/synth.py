@@ -251,6 +251,31 @@ def _ghdl_errors(stderr: str, top: str) -> FlannError:
     return FlannError(f"ghdl --synth of {top} failed: {first}")
 
 
+_PMUX_RE = re.compile(
+    r"(always @\*\n\s*case \([^\n]*\)\n)((?:[ \t]+[^\n]*:\s*(\S+)\s*<=[^\n]*\n)+)([ \t]*)endcase"
+)
+
+
+def complete_pmux_cases(verilog: str) -> tuple[str, int]:
+    """Give GHDL's one-hot ``always @* case`` blocks a ``default: x <= 'bx``.
+
+    GHDL writes the parallel mux of a VHDL ``case`` (all choices covered, one-hot select)
+    as a combinational Verilog ``case`` without ``default``; Yosys cannot prove the select
+    one-hot and infers a latch for the impossible remaining values.  GHDL has already
+    checked the VHDL for real latches (it refuses them), so the missing selections are
+    don't-cares.  Returns (text, number of such case blocks).
+    """
+
+    def fix(m: re.Match) -> str:
+        body = m.group(2)
+        if re.search(r"^\s*default\s*:", body, re.M):
+            return m.group(0)
+        indent = re.match(r"[ \t]*", body).group(0)
+        return f"{m.group(1)}{body}{indent}default: {m.group(3)} <= 'bx;\n{m.group(4)}endcase"
+
+    return _PMUX_RE.subn(fix, verilog)
+
+
 def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
     """Analyse and synthesise the manifest's files with GHDL; return the Verilog netlist."""
     ghdl = _need_tool("ghdl")
@@ -270,7 +295,8 @@ def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
     if s.returncode != 0:
         raise _ghdl_errors(s.stderr, man.top)
     out = work / f"{man.top}.v"
-    out.write_text(s.stdout)
+    text, _ = complete_pmux_cases(s.stdout)
+    out.write_text(text)
     return out
 
 

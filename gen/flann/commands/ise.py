@@ -1,0 +1,21 @@
+"""flann ise DIR: ISE 10.1 project (xtclsh script, UCF with pin map, FuseSoC core) for a generated design."""
+
+from __future__ import annotations
+
+from .. import ise
+
+HELP = "write an ISE 10.1 project for the generated VHDL"
+
+
+def add_arguments(p):
+    p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
+    p.add_argument("--device", default="xc2s200-pq208-5", metavar="PART",
+                   help="Spartan-II part DEVICE-PQ208-SPEED (default xc2s200-pq208-5)")
+    p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
+    p.add_argument("--clock-mhz", type=float, default=50.0, help="clock frequency for the PERIOD constraint (default 50)")
+
+
+def run(args) -> int:
+    files = ise.write_ise(args.directory, args.device, args.output, args.clock_mhz)
+    print(ise.summary(files, args.output, args.device))
+    return 0
