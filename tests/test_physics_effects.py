@@ -158,3 +158,16 @@ def test_contributions_isolate_each_effect(s):
     np.testing.assert_allclose(c["zero_shift"], ideal_output_v(s, X - 0.5) - ideal_output_v(s, X), atol=1e-12)
     # these two act on different stages and add exactly
     np.testing.assert_allclose(c["all"], c["null_offset"] + c["zero_shift"], atol=1e-12)
+
+
+def test_copper_thermal_coefficient_matches_primary_current(s):
+    # Independent: heat the primary's copper by 1 degC (R * (1 + 0.00393)) and compare the
+    # ideal output's change with the predicted coefficient.
+    from flann.physics.effects import thermal_coefficient_from_copper
+
+    k = thermal_coefficient_from_copper(s)
+    hot = s.replace(primary_resistance_ohm=s.primary_resistance_ohm * (1 + 0.00393))
+    x = np.array([2.0])
+    ratio = ideal_output_v(hot, x)[0] / ideal_output_v(s, x)[0] - 1
+    assert k < 0
+    assert ratio == pytest.approx(k, rel=0.01)

@@ -125,6 +125,8 @@ def _run_fit(args) -> int:
             "stderr": fit.stderr,
             "rms_v": fit.rms_v,
             "noise_v": fit.noise_v,
+            "even_part_rms_v": None if fit.asymmetry_floor_v != fit.asymmetry_floor_v
+            else fit.asymmetry_floor_v,
             "points_used": int(fit.used.sum()),
             "excluded": [{"row": r, "displacement_mm": float(rec.displacement_mm[r]),
                           "voltage_v": float(rec.voltage_v[r]),

@@ -10,6 +10,8 @@ Public API (stable; ``flann diagnose`` uses the same catalogue):
   size), ``neutral`` (the value at which the effect does nothing), ``lower``/``upper``
   bounds, ``description``), ``formula`` (text), ``defaults()``, ``neutral()``,
   ``bounds()`` and ``apply(params, ctx, signal) -> signal`` (pure, vectorised).
+* :func:`thermal_coefficient_from_copper` (sensor) -> the thermal_drift coefficient the
+  primary's copper resistance alone would cause.
 * :class:`Context` (inputs per sample: displacement_mm, direction, temperature_c, time_s,
   sensor) and :class:`Signal` (state flowing through the stages).
 
@@ -224,6 +226,21 @@ EFFECTS: dict[str, Effect] = {
                _loading),
     )
 }
+
+
+COPPER_TEMPCO_PER_C = 0.00393   # resistance temperature coefficient of copper at 20 degC
+
+
+def thermal_coefficient_from_copper(sensor, alpha_per_c: float = COPPER_TEMPCO_PER_C) -> float:
+    """Sensitivity coefficient (1/degC) that the primary's copper alone causes at null:
+    with ``Ip = V / (R_p + j w Lp)`` and ``R_p(T) = R_p (1 + alpha dT)``,
+    ``d ln|Ip| / dT = -alpha R_p^2 / (R_p^2 + (w Lp)^2)``.  A physical starting value for
+    ``thermal_drift.coefficient_per_c`` (core permeability and secondary loading add more)."""
+    from .lvdt import inductances_h
+
+    lp = float(inductances_h(sensor, [0.0])[2][0])
+    r = sensor.primary_resistance_ohm
+    return -alpha_per_c * r * r / (r * r + (sensor.omega_rad_s * lp) ** 2)
 
 
 def validate_effects(effects: Mapping[str, Mapping[str, float]], source: str = "<memory>") -> None:

@@ -62,12 +62,26 @@ class FitResult:
     used: np.ndarray                     # bool mask of the points used
     excluded_rows: tuple[int, ...]       # 0-based data rows flagged as outliers
     noise_v: float                       # robust noise estimate of the first pass
+    asymmetry_floor_v: float             # rms of the data's even part (nan: no mirrored pairs)
+    bounds: dict[str, tuple[float, float]] = None  # search range of each fitted parameter
+
+    def at_bound(self, name: str) -> bool:
+        lo, hi = self.bounds[name]
+        v = self.values[name]
+        return abs(v - lo) <= 1e-6 * max(1.0, abs(lo)) or abs(v - hi) <= 1e-6 * max(1.0, abs(hi))
 
     def summary_lines(self) -> list[str]:
         lines = []
         for n in self.names:
-            lines.append(f"{n} = {self.values[n]:.4g} +- {self.stderr[n]:.2g}")
+            note = ""
+            if self.bounds and self.at_bound(n):
+                note = (f"  (at its search bound {self.bounds[n][0]:g}..{self.bounds[n][1]:g}: "
+                        "the data push it there; the uncertainty is not meaningful)")
+            lines.append(f"{n} = {self.values[n]:.4g} +- {self.stderr[n]:.2g}{note}")
         lines.append(f"rms residual = {self.rms_v * 1e3:.1f} mV over {int(self.used.sum())} points")
+        if math.isfinite(self.asymmetry_floor_v):
+            lines.append(f"even part of the data (y(x) + y(-x))/2: rms {self.asymmetry_floor_v * 1e3:.1f} mV "
+                         "-- no symmetric sensor can fit it")
         return lines
 
 
@@ -132,7 +146,26 @@ def fit_sensor(rec: Recordings, sensor: Sensor | None = None,
         used=mask,
         excluded_rows=tuple(int(i) for i in np.flatnonzero(~mask)),
         noise_v=noise,
+        asymmetry_floor_v=_even_part_rms(x, y, mask),
+        bounds={n: (float(a), float(b)) for n, a, b in zip(names, lo, hi)},
     )
+
+
+def _even_part_rms(x, y, mask) -> float:
+    """rms over the used points of (y(x) + y(-x))/2, taking 0 for points without a used
+    mirror point: the floor below which no odd (symmetric-sensor) model can go."""
+    xu, yu = x[mask], y[mask]
+    lookup = {}
+    for xi, yi in zip(np.round(xu, 9), yu):
+        lookup.setdefault(xi, []).append(yi)
+    if not any(-xi in lookup and xi != 0 for xi in lookup):
+        return math.nan
+    even = np.zeros(xu.size)
+    for i, (xi, yi) in enumerate(zip(np.round(xu, 9), yu)):
+        mirror = lookup.get(-xi if xi != 0 else 0.0)
+        if mirror is not None:
+            even[i] = (yi + float(np.mean(mirror))) / 2 if xi != 0 else yi
+    return float(np.sqrt(np.mean(even ** 2)))
 
 
 def _starting_points(base, names, x, y, lo, hi, gain_i, keep):

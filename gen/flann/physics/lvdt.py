@@ -99,23 +99,25 @@ def magnetics(s: Sensor) -> Magnetics:
 
 @dataclass(frozen=True)
 class _Segments:
-    """Axial segments between sorted breakpoints, one row per core position."""
+    """Axial segments between sorted breakpoints; column j is core position j (arrays are
+    (breakpoints, positions) so each sweep step reads contiguous rows)."""
 
-    b: np.ndarray        # breakpoints (n, 8), sorted
-    r: np.ndarray        # series reluctance per metre of each finite segment (n, 7)
-    n_p: np.ndarray      # turn densities of the windings in each segment (n, 7)
+    b: np.ndarray        # breakpoints (8, n), sorted along axis 0
+    r: np.ndarray        # series reluctance per metre of each finite segment (7, n)
+    n_p: np.ndarray      # turn densities of the windings in each segment (7, n)
     n_s1: np.ndarray
     n_s2: np.ndarray
 
 
 def _segments(mg: Magnetics, pos_m: np.ndarray) -> _Segments:
-    fixed = np.array([-mg.a3, -mg.a2, -mg.a1, mg.a1, mg.a2, mg.a3])
-    b = np.concatenate([np.broadcast_to(fixed, (pos_m.size, 6)),
-                        (pos_m - mg.half_core)[:, None], (pos_m + mg.half_core)[:, None]], axis=1)
-    b.sort(axis=1)
-    mid = 0.5 * (b[:, 1:] + b[:, :-1])
-    in_core = np.abs(mid - pos_m[:, None]) < mg.half_core
-    r = np.where(in_core, mg.r_core, mg.r_air)
+    n = pos_m.size
+    b = np.empty((8, n))
+    b[:6] = np.array([-mg.a3, -mg.a2, -mg.a1, mg.a1, mg.a2, mg.a3])[:, None]
+    b[6] = pos_m - mg.half_core
+    b[7] = pos_m + mg.half_core
+    b.sort(axis=0)
+    mid = 0.5 * (b[1:] + b[:-1])
+    r = np.where(np.abs(mid - pos_m) < mg.half_core, mg.r_core, mg.r_air)
     n_p = np.where(np.abs(mid) < mg.a1, mg.n_p, 0.0)
     n_s1 = np.where((mid > mg.a2) & (mid < mg.a3), mg.n_s, 0.0)
     n_s2 = np.where((mid < -mg.a2) & (mid > -mg.a3), mg.n_s, 0.0)
@@ -125,45 +127,44 @@ def _segments(mg: Magnetics, pos_m: np.ndarray) -> _Segments:
 def _solve(mg: Magnetics, seg: _Segments, sources: tuple[np.ndarray, ...]):
     """Exact solution of the line for each source (m.m.f. per metre at 1 A, per segment).
 
-    Returns, per source, the breakpoint potentials ``u`` (n, 8) and the flux integrals
-    ``int Phi dz`` over every finite segment (n, 7).  Both ends are semi-infinite air lines
+    Returns, per source, the breakpoint potentials ``u`` (8, n) and the flux integrals
+    ``int Phi dz`` over every finite segment (7, n).  Both ends are semi-infinite air lines
     (``Phi = -u/Z0`` on the left, ``+u/Z0`` on the right): no truncated domain.  The sweeps
     carry the affine relation ``Phi = Y u + J`` from each end (a Moebius map with |tanh| < 1,
     numerically stable for any segment length), then match them at every breakpoint.
     """
     g = mg.g_leak
     z0 = np.sqrt(seg.r / g)                      # characteristic "impedance" (1/H)
-    length = np.diff(seg.b, axis=1)
+    length = np.diff(seg.b, axis=0)
     kl = np.sqrt(seg.r * g) * length
-    t = np.tanh(kl)
-    e2 = np.exp(-2.0 * kl)
-    sech = 2.0 * np.exp(-kl) / (1.0 + e2)       # 1/cosh without overflow
+    ekl = np.exp(-kl)
+    t = (1.0 - ekl * ekl) / (1.0 + ekl * ekl)    # tanh(kl)
+    sech = 2.0 * ekl / (1.0 + ekl * ekl)         # 1/cosh(kl), no overflow
+    zt = z0 * t
+    tz = t / z0
     z0_air = math.sqrt(mg.r_air / g)
-    n_seg = length.shape[1]
-    shape = seg.b.shape
-    y_l = np.empty(shape)
-    y_r = np.empty(shape)
-    y_l[:, 0] = -1.0 / z0_air
+    n_seg = length.shape[0]
+    y_l = np.empty(seg.b.shape)
+    y_r = np.empty(seg.b.shape)
+    y_l[0] = -1.0 / z0_air
     for i in range(n_seg):
-        y = y_l[:, i]
-        y_l[:, i + 1] = (y - t[:, i] / z0[:, i]) / (1.0 - z0[:, i] * t[:, i] * y)
-    y_r[:, -1] = 1.0 / z0_air
+        y_l[i + 1] = (y_l[i] - tz[i]) / (1.0 - zt[i] * y_l[i])
+    y_r[-1] = 1.0 / z0_air
     for i in range(n_seg - 1, -1, -1):
-        y = y_r[:, i + 1]
-        y_r[:, i] = (y + t[:, i] / z0[:, i]) / (1.0 + z0[:, i] * t[:, i] * y)
+        y_r[i] = (y_r[i + 1] + tz[i]) / (1.0 + zt[i] * y_r[i + 1])
+    gain_l = sech / (1.0 - zt * y_l[:-1])
+    gain_r = sech / (1.0 + zt * y_r[1:])
     out = []
     for src in sources:
         phi_p = src / seg.r                      # particular flux of a uniform winding
-        j_l = np.zeros(shape)
-        j_r = np.zeros(shape)
+        j_l = np.zeros(seg.b.shape)
+        j_r = np.zeros(seg.b.shape)
         for i in range(n_seg):
-            jp = j_l[:, i] - phi_p[:, i]
-            j_l[:, i + 1] = jp * sech[:, i] / (1.0 - z0[:, i] * t[:, i] * y_l[:, i]) + phi_p[:, i]
+            j_l[i + 1] = (j_l[i] - phi_p[i]) * gain_l[i] + phi_p[i]
         for i in range(n_seg - 1, -1, -1):
-            jp = j_r[:, i + 1] - phi_p[:, i]
-            j_r[:, i] = jp * sech[:, i] / (1.0 + z0[:, i] * t[:, i] * y_r[:, i + 1]) + phi_p[:, i]
+            j_r[i] = (j_r[i + 1] - phi_p[i]) * gain_r[i] + phi_p[i]
         u = (j_r - j_l) / (y_l - y_r)
-        flux_integral = (src * length - np.diff(u, axis=1)) / seg.r
+        flux_integral = (src * length - np.diff(u, axis=0)) / seg.r
         out.append((u, flux_integral))
     return out
 
@@ -189,10 +190,11 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
         sources.append(seg.n_s1 - seg.n_s2)
     solved = _solve(mg, seg, tuple(sources))
     _u, fi = solved[0]
-    res = [np.sum(fi * seg.n_s1, axis=1), np.sum(fi * seg.n_s2, axis=1), np.sum(fi * seg.n_p, axis=1)]
+    res = [np.einsum("ij,ij->j", fi, seg.n_s1), np.einsum("ij,ij->j", fi, seg.n_s2),
+           np.einsum("ij,ij->j", fi, seg.n_p)]
     if loop:
         _u, fl = solved[1]
-        res.append(np.sum(fl * (seg.n_s1 - seg.n_s2), axis=1))
+        res.append(np.einsum("ij,ij->j", fl, seg.n_s1 - seg.n_s2))
     out = tuple(r[inverse].reshape(x.shape) for r in res)
     for arr in out:
         arr.setflags(write=False)
@@ -265,7 +267,7 @@ def flux_profile(s: Sensor, core_position_mm: float, z_mm) -> np.ndarray:
     mg = magnetics(s)
     seg = _segments(mg, np.array([core_position_mm * 1e-3]))
     (u, _fi), = _solve(mg, seg, (seg.n_p,))
-    b, r, src, u = seg.b[0], seg.r[0], seg.n_p[0], u[0]
+    b, r, src, u = seg.b[:, 0], seg.r[:, 0], seg.n_p[:, 0], u[:, 0]
     g = mg.g_leak
     z = np.asarray(z_mm, dtype=float) * 1e-3
     z0_air = math.sqrt(mg.r_air / g)
