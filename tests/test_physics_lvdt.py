@@ -163,3 +163,14 @@ def test_ideal_output_fast_path_is_cached_per_geometry():
     y2 = lvdt.ideal_output_v(s.replace(secondary_gap_mm=s.secondary_gap_mm + 1.0), x)
     assert np.abs(y2 - y1).max() > 0.01
     np.testing.assert_array_equal(lvdt.ideal_output_v(s, x), y1)
+
+
+def test_coupling_table_reciprocity_and_passivity():
+    s = default_sensor()
+    t = lvdt.coupling_table(s, half_range_mm=60.0, n=121)
+    assert t.position_mm[0] == -60.0 and t.position_mm[-1] == 60.0
+    # mirror symmetry of the construction: M1(x) = M2(-x)
+    np.testing.assert_allclose(t.m1_h, t.m2_h[::-1], rtol=1e-10)
+    # self-inductances positive; the loop of two secondaries has |M1 - M2|^2 <= Lp L_loop
+    assert np.all(t.lp_h > 0) and np.all(t.lloop_h > 0)
+    assert np.all((t.m1_h - t.m2_h) ** 2 <= t.lp_h * t.lloop_h * (1 + 1e-9))

@@ -18,11 +18,9 @@ inductance ``Lp(x)``.  End-of-stroke roll-off is not fitted: it appears when the
 leaves a secondary, at a place set by core length, winding lengths and gap, with a shape
 set by ``lambda``.
 
-The equations are discretised on a fixed axial grid (node spacing ~0.25 mm for the paper's
-sensor), the core enters each branch by its exact overlap length (so the result is smooth in
-the core position), and all core positions of a table are solved at once as one banded
-system (LAPACK gtsv).  The table (``M1, M2, Lp`` vs core position) depends only on the
-geometry and is cached; electrical quantities are then cheap::
+R', G' and the turn densities are piecewise constant between 8 breakpoints (winding ends and
+core ends), so the line is solved exactly, segment by segment, with semi-infinite air lines
+at both ends (no grid, no truncated domain), for all core positions at once (vectorised).  Then::
 
     Ip = V_peak / (R_p + j w Lp(x)),    v1 = j w M1(x) Ip,    v2 = j w M2(x) Ip
     v_d = v1 - v2                       (secondaries in series opposition)
@@ -35,12 +33,13 @@ saturation and inter-winding capacitance are left out of the ideal model.
 Public API (stable):
 
 * :func:`ideal_output_v` (sensor, displacement_mm) -> ndarray: demodulated output, no effects.
-  Vectorised; ~0.1 ms for 2000 points once the table of the geometry is cached, ~30 ms
-  to build a table for a new geometry (``bench/physics_speed.py``).
+  Vectorised and exact; a few ms for 2000 new positions, ~0.2 ms when geometry and
+  positions repeat (cached; ``bench/physics_speed.py``).
 * :func:`secondary_emf_v` (sensor, core_position_mm, drive_scale=1) -> (v1, v2): complex
   peak e.m.f.s of the two secondaries (V).
 * :func:`demodulate_v` (sensor, v_diff, quadrature_v=0) -> output volts.
-* :func:`coupling_table` (sensor) -> :class:`CouplingTable`, :func:`inductances_h`,
+* :func:`inductances_h` (sensor, core_position_mm, loop=False) -> (M1, M2, Lp[, L_loop]) in H,
+  :func:`coupling_table` (sensor) -> :class:`CouplingTable`,
   :func:`primary_current_a`, :func:`flux_profile` (for plots), :func:`null_slope_v_per_mm`.
 """
 
@@ -51,14 +50,23 @@ from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_banded
-from scipy.linalg.lapack import dptsv
 
 from .sensor import Sensor
 
 MU0 = 4e-7 * math.pi  # H/m
 
 _CACHE_SIZE = 32
+
+
+@dataclass(frozen=True)
+class CouplingTable:
+    """Inductances vs core-centre position (position grid in mm, inductances in H)."""
+
+    position_mm: np.ndarray
+    m1_h: np.ndarray     # primary -> secondary 1 (+z side)
+    m2_h: np.ndarray     # primary -> secondary 2 (-z side)
+    lp_h: np.ndarray     # primary self-inductance (bore flux only)
+    lloop_h: np.ndarray  # self-inductance of the two secondaries in series opposition
 
 
 @dataclass(frozen=True)

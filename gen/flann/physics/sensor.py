@@ -34,13 +34,13 @@ File format ``flann-sensor/1`` (every numeric key carries its unit as a suffix: 
 
     [primary]                            # centred on z = 0
     turns = 1500
-    length_mm = 20.0
+    length_mm = 2.0
     resistance_ohm = 60.0
 
     [secondary]                          # two identical windings, series opposition
     turns = 3300
-    length_mm = 30.0
-    gap_mm = 2.0                         # axial spacing primary end -> secondary start
+    length_mm = 18.16
+    gap_mm = 13.52                       # axial spacing primary end -> secondary start
     resistance_ohm = 200.0
 
     [excitation]
@@ -49,7 +49,7 @@ File format ``flann-sensor/1`` (every numeric key carries its unit as a suffix: 
 
     [demodulator]
     kind = "phase_sensitive"             # or "amplitude" (rectifier: unsigned output)
-    gain_ratio = 0.5                     # V out per V peak differential (negative: reversed)
+    gain_ratio = 2.022                   # V out per V peak differential (negative: reversed)
 
     [adc]
     bits = 16
