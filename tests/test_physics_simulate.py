@@ -127,3 +127,19 @@ def test_simulate_output_matches_ideal_without_effects():
     s = default_sensor()
     x = np.linspace(-40, 40, 81)
     np.testing.assert_allclose(simulate_output_v(s, x), ideal_output_v(s, x), rtol=1e-12, atol=1e-12)
+
+
+def test_fit_scales_to_a_miniature_sensor():
+    from flann.physics.sensor import load_sensor
+
+    truth = load_sensor("data/sensors/miniature_reversed.toml")
+    start = truth.replace(primary_length_mm=4.0, secondary_length_mm=3.0, secondary_gap_mm=1.0,
+                          demodulator_gain_ratio=-1.0)
+    # past the rated stroke, through the output peaks (inside +-2.5 mm only the slope and a
+    # little curvature are seen: the geometry would not be identifiable)
+    x = np.linspace(-7.0, 7.0, 57)
+    rec = Recordings(displacement_mm=x, voltage_v=ideal_output_v(truth, x))
+    fit = fit_sensor(rec, sensor=start, starts=2)
+    assert fit.rms_v < 1e-3
+    assert fit.values["demodulator_gain_ratio"] < 0
+    assert fit.values["secondary_gap_mm"] == pytest.approx(0.5, abs=0.1)

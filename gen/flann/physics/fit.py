@@ -33,7 +33,8 @@ from .sensor import Sensor, default_sensor
 DEFAULT_FIT_PARAMS = ("primary_length_mm", "secondary_length_mm", "secondary_gap_mm",
                       "demodulator_gain_ratio")
 
-# Physically sensible search ranges (relative to nothing the paper gives).
+# Search ranges.  Lengths scale with the sensor being calibrated (a miniature LVDT is not
+# searched in centimetres): (min(floor, 0.2 v), max(ceiling, 5 v)) around its current value v.
 DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "primary_length_mm": (2.0, 150.0),
     "secondary_length_mm": (2.0, 150.0),
@@ -43,12 +44,40 @@ DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "core_length_mm": (5.0, 300.0),
     "demodulator_gain_ratio": (-1e3, 1e3),
 }
+_SCALED = ("primary_length_mm", "secondary_length_mm", "secondary_gap_mm", "core_length_mm")
+# Starting grid, as multiples of the sensor's current value (gain: solved in closed form).
 _GRID: dict[str, tuple[float, ...]] = {
-    "primary_length_mm": (2.0, 5.0, 15.0, 30.0, 50.0),
-    "secondary_length_mm": (8.0, 16.0, 30.0, 50.0),
-    "secondary_gap_mm": (1.0, 5.0, 12.0, 20.0),
-    "core_permeability_ratio": (30.0, 200.0, 2000.0),
+    "primary_length_mm": (0.3, 1.0, 3.0, 8.0),
+    "secondary_length_mm": (0.5, 1.0, 2.0),
+    "secondary_gap_mm": (0.2, 1.0, 3.0),
+    "core_permeability_ratio": (0.2, 1.0, 5.0),
 }
+
+
+FINEST_WIRE_MM = 0.05   # AWG 44 magnet wire: the finest in practical use
+
+
+def min_winding_length_mm(turns: float, sensor: Sensor) -> float:
+    """Shortest winding that can hold ``turns`` in the radial build of the former, with the
+    finest practical wire at 100 % fill: turns * d_w^2 / build."""
+    build = (sensor.coil_outer_diameter_mm - sensor.coil_inner_diameter_mm) / 2
+    return turns * FINEST_WIRE_MM ** 2 / build
+
+
+def default_bounds(sensor: Sensor, name: str) -> tuple[float, float]:
+    """Search range of a fittable field for this sensor (winding lengths: from the
+    winding-space limit up to max(150 mm, 5 x the current value))."""
+    lo, hi = DEFAULT_BOUNDS[name]
+    if name in _SCALED:
+        v = getattr(sensor, name)
+        lo, hi = min(lo, 0.2 * v), max(hi, 5.0 * v)
+    if name == "primary_length_mm":
+        lo = min_winding_length_mm(sensor.primary_turns, sensor)
+    if name == "secondary_length_mm":
+        lo = min_winding_length_mm(sensor.secondary_turns, sensor)
+    if name == "housing_inner_diameter_mm":
+        lo = max(sensor.coil_outer_diameter_mm * 1.01, min(lo, sensor.housing_inner_diameter_mm))
+    return lo, hi
 
 
 @dataclass(frozen=True)
@@ -109,7 +138,8 @@ def fit_sensor(rec: Recordings, sensor: Sensor | None = None,
                          f"(need at least {len(names) + 2})")
     if np.ptp(x) == 0:
         raise FlannError(f"{rec.source}: no displacement variation")
-    bnd = {**DEFAULT_BOUNDS, **(bounds or {})}
+    bnd = {n: default_bounds(base, n) for n in names if n in DEFAULT_BOUNDS}
+    bnd.update(bounds or {})
     lo = np.array([bnd[n][0] for n in names])
     hi = np.array([bnd[n][1] for n in names])
     gain_i = names.index("demodulator_gain_ratio") if "demodulator_gain_ratio" in names else None
@@ -176,8 +206,9 @@ def _starting_points(base, names, x, y, lo, hi, gain_i, keep):
         if i == gain_i:
             axes.append((None,))
         else:
-            grid = _GRID.get(n, (getattr(base, n),))
-            axes.append(tuple(float(np.clip(v, lo[i], hi[i])) for v in grid))
+            v0 = getattr(base, n)
+            grid = tuple(f * v0 for f in _GRID.get(n, (1.0,))) if v0 > 0 else (lo[i], hi[i])
+            axes.append(tuple(sorted({float(np.clip(v, lo[i], hi[i])) for v in grid})))
     scored = []
     for combo in itertools.product(*axes):
         theta = np.array([getattr(base, n) if v is None else v for n, v in zip(names, combo)],

@@ -34,13 +34,13 @@ File format ``flann-sensor/1`` (every numeric key carries its unit as a suffix: 
 
     [primary]                            # centred on z = 0
     turns = 1500
-    length_mm = 2.0
+    length_mm = 0.9375
     resistance_ohm = 60.0
 
     [secondary]                          # two identical windings, series opposition
     turns = 3300
-    length_mm = 18.16
-    gap_mm = 13.52                       # axial spacing primary end -> secondary start
+    length_mm = 23.25
+    gap_mm = 13.14                       # axial spacing primary end -> secondary start
     resistance_ohm = 200.0
 
     [excitation]
@@ -49,7 +49,7 @@ File format ``flann-sensor/1`` (every numeric key carries its unit as a suffix: 
 
     [demodulator]
     kind = "phase_sensitive"             # or "amplitude" (rectifier: unsigned output)
-    gain_ratio = 2.022                   # V out per V peak differential (negative: reversed)
+    gain_ratio = 2.272                   # V out per V peak differential (negative: reversed)
 
     [adc]
     bits = 16
@@ -368,10 +368,10 @@ PAPER_LVDT: dict[str, Any] = {
              "permeability_ratio": 220.0},
     "coil": {"inner_diameter_mm": 6.0, "outer_diameter_mm": 14.0,
              "housing_inner_diameter_mm": 20.0},
-    "primary": {"turns": 1500, "length_mm": 2.0, "resistance_ohm": 60.0},
-    "secondary": {"turns": 3300, "length_mm": 18.16, "gap_mm": 13.52, "resistance_ohm": 200.0},
+    "primary": {"turns": 1500, "length_mm": 0.9375, "resistance_ohm": 60.0},
+    "secondary": {"turns": 3300, "length_mm": 23.25, "gap_mm": 13.14, "resistance_ohm": 200.0},
     "excitation": {"amplitude_vpp": 10.0, "frequency_hz": 5000.0},
-    "demodulator": {"kind": "phase_sensitive", "gain_ratio": 2.022},
+    "demodulator": {"kind": "phase_sensitive", "gain_ratio": 2.272},
     "adc": {"bits": 16, "full_scale_v": 10.0},
 }
 
