@@ -126,7 +126,7 @@ class Bench:
         self.scoreboard = Scoreboard(dut._log)
 
     async def start(self):
-        cocotb.start_soon(Clock(self.dut.clk, 10, unit="ns").start())
+        cocotb.start_soon(Clock(self.dut.clk, 10, unit="ns", impl="gpi").start())
         self.driver.idle()
         self.dut.rst.value = 1
         for _ in range(3):

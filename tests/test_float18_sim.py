@@ -34,6 +34,19 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
         r = subprocess.run(["ghdl", "-a", "--std=93c", f"--workdir={tmp_path}", str(p)],
                            capture_output=True, text=True, cwd=tmp_path)
         assert r.returncode == 0, r.stderr
+    # the whole float18 design (shared front end, converter, blocks, top) analyses in order
+    from flann.float18_hdl import generate
+    from flann.model import load_model
+
+    man = generate(load_model(Path(__file__).resolve().parent.parent / "data" / "default_model.json"),
+                   tmp_path / "design")
+    assert man["top"] == "flann_f18_top" and man["files"][-1] == "flann_f18_top.vhd"
+    work = tmp_path / "design_work"
+    work.mkdir()
+    r = subprocess.run(["ghdl", "-a", "--std=93c", f"--workdir={work}",
+                        *[str(tmp_path / "design" / f) for f in man["files"]]],
+                       capture_output=True, text=True, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
     text = files["flann_f18_add.vhd"].read_text()
     assert "entity flann_f18_add is" in text and "constant bias_c" not in text
     assert "constant bias_c : integer := 31;" in files["flann_f18_mul.vhd"].read_text()
@@ -52,3 +65,45 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
         vhdl_sources=[str(files[f"{entity}.vhd"])], python_search=[str(SIM_DIR)],
         compile_args=["--std=93c"], sim_build=str(tmp_path / "sim_build"),
         extra_env={"FLANN_F18_SPEC": json.dumps(spec)})
+
+
+# -- top level: every input code ------------------------------------------------------------
+def _run_top(tmp_path, model, step: int, seed: int, **options):
+    from cocotb_test.simulator import run
+
+    from flann.float18_hdl import generate
+    from flann.float18_top import F18Top, derive_f18_spec
+
+    man = generate(model, tmp_path / "hdl", **options)
+    top = F18Top(derive_f18_spec(model, **options))
+    codes = top.all_codes()[::step]
+    out, sat = top.process(codes)
+    exp = tmp_path / "expected.json"
+    exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
+                               "latency": man["latency_cycles"], "in_bits": man["input_bits"], "seed": seed}))
+    run(simulator="ghdl", toplevel=man["top"], toplevel_lang="vhdl", module="test_f18_top",
+        vhdl_sources=[str(tmp_path / "hdl" / f) for f in man["files"]], python_search=[str(SIM_DIR)],
+        compile_args=["--std=93c"], sim_build=str(tmp_path / "sim_build"),
+        extra_env={"FLANN_F18_TOP": str(exp)})
+    return codes
+
+
+@pytest.mark.sim
+def test_top_every_input_code_matches_twin(tmp_path):
+    """Default model, default 12-bit input: all 4096 codes, 0 mismatches (and the latency)."""
+    from flann.model import load_model
+
+    model = load_model(Path(__file__).resolve().parent.parent / "data" / "default_model.json")
+    codes = _run_top(tmp_path, model, step=1, seed=11)
+    assert codes.size == 4096
+
+
+@pytest.mark.sim
+def test_top_other_widths_match_twin(tmp_path):
+    """The paper's raw-volt model, 10-bit input, coarser table: every 8th code."""
+    from flann.recordings import read_recordings
+    from flann.train import fit_lstsq
+
+    rec = read_recordings(Path(__file__).resolve().parent.parent / "data" / "paper_table1.csv")
+    model = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="none")
+    _run_top(tmp_path, model, step=8, seed=12, input_bits=10, table_addr_bits=6)

@@ -46,7 +46,7 @@ class F18Spec:
     fmt: FloatFormat
     weight_codes: tuple[int, ...]   # model term order; [0] is the code term's weight
     start_code: int                 # bias + w0 * (-offset / scale)
-    adv_period: int                 # cycles per term: adder latency + 1 (sequential sum)
+    adv_period: int                 # cycles per term: the adder's latency (result forwarded)
 
     number_format = "float18"
 
@@ -84,14 +84,6 @@ class F18Spec:
     def float_reference(self, codes) -> np.ndarray:
         return self.base.float_reference(codes)
 
-    @property
-    def latency_cycles(self) -> int:
-        """Accepting edge -> out_valid edge (see flann_f18_top)."""
-        b = self.base
-        # norm (input_bits + 1 edges) ... then steps + 3 advances of adv_period cycles, then
-        # the last term's convert (1) + multiply (2) + add (3) + output register (1)
-        return b.input_bits + 2 + (b.steps + 3) * self.adv_period + 1 + F18Mul.latency + F18Add.latency + 1
-
     def to_dict(self) -> dict:
         d = self.base.to_dict()
         for k in ("weight", "product", "linear", "acc", "output", "output_lsb_mm"):
@@ -122,8 +114,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
                         "cannot share the term converter")
     if Tf > fmt.bias - 1:
         raise SpecError(f"term_frac_bits = {Tf}: float18 cannot hold 2^-{Tf} (min normal 2^{1 - fmt.bias})")
-    spec = F18Spec(base=base, fmt=fmt, weight_codes=(), start_code=0,
-                   adv_period=F18Add.latency + 1)
+    spec = F18Spec(base=base, fmt=fmt, weight_codes=(), start_code=0, adv_period=F18Add.latency)
     w = spec.golden_weights()
     for i, x in enumerate(w):
         if abs(x) > float(fmt.max_value):
@@ -132,7 +123,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     if not math.isfinite(start) or abs(start) > float(fmt.max_value):
         raise SpecError(f"bias {start:.4g} exceeds float18's range")
     return F18Spec(base=base, fmt=fmt, weight_codes=tuple(int(c) for c in fmt.encode_array(w)),
-                   start_code=int(fmt.encode_array([start])[0]), adv_period=F18Add.latency + 1)
+                   start_code=int(fmt.encode_array([start])[0]), adv_period=F18Add.latency)
 
 
 # -- twins ---------------------------------------------------------------------------------
