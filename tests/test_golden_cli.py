@@ -141,7 +141,7 @@ def test_paper_json_and_plots(tmp_path, capsys):
     assert [rows[t]["paper_pct"] for t in (11, 25, 51, 61)] == [38.46, 84.62, 100.0, 100.0]
     assert all(r["loo_max_error_mm"] > 0 for r in d["rows"])
     pngs = sorted(p.name for p in (tmp_path / "fig").glob("*.png"))
-    assert len(pngs) == 10 and "fig5h_mse_51.png" in pngs
+    assert pngs == ["between_points_51.png", "fig5.png"]
     assert all((tmp_path / "fig" / p).read_bytes()[:4] == b"\x89PNG" for p in pngs)
 
 

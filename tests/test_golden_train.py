@@ -8,7 +8,8 @@ import pytest
 from flann.errors import FlannError, RecordingsError
 from flann.paper import s_curve
 from flann.train import (_design, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
-                         lms_epochs, lms_leave_one_out, normalisation)
+                         lms_epochs, lms_leave_one_out, lms_sequential,
+                         normalisation)
 
 
 def test_one_lms_step_by_hand():
@@ -75,6 +76,16 @@ def test_lms_diverges_with_a_clear_error():
                 offset_scale=(0.0, 1.0))
 
 
+def test_fast_lms_equals_the_literal_sample_by_sample_loop():
+    v = np.array([-5.185, -2.896, 0.001, 1.810, 4.799, 5.276])
+    x = np.array([-30.0, -10.0, 0.0, 10.0, 20.0, 30.0])
+    S = _design(v, 11)
+    w_fast, mse_fast = lms_epochs(S, x, 0.02, 200)
+    w_ref, mse_ref = lms_sequential(S, x, 0.02, 200)
+    np.testing.assert_allclose(w_fast, w_ref, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(mse_fast, mse_ref, rtol=1e-9, atol=1e-12)
+
+
 def test_batched_leave_one_out_equals_separate_runs():
     v = np.array([-2.0, -1.1, 0.2, 0.9, 2.3])
     x = np.array([-3.0, -1.0, 0.5, 1.0, 3.5])
@@ -82,7 +93,7 @@ def test_batched_leave_one_out_equals_separate_runs():
     pred = lms_leave_one_out(S, x, 0.05, 40)
     for i in range(v.size):
         keep = np.arange(v.size) != i
-        w, _ = lms_epochs(S[keep], x[keep], 0.05, 40)
+        w, _ = lms_sequential(S[keep], x[keep], 0.05, 40)
         assert pred[i] == pytest.approx(S[i] @ w, abs=1e-12)
 
 

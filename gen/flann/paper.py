@@ -54,6 +54,25 @@ def loo_errors(rec: Recordings, terms: int, eta: float = DEFAULT_ETA,
     return lms_leave_one_out(S, rec.displacement_mm, eta, epochs) - rec.displacement_mm
 
 
+def lstsq_loo_errors(rec: Recordings, terms: int, norm: str = "range",
+                     ridge: float = 0.0) -> np.ndarray:
+    """Leave-one-out error (mm) of ``flann train --terms N --method lstsq`` (normalisation
+    recomputed from the remaining points, as training on them would)."""
+    import warnings
+
+    from .train import fit_lstsq
+
+    err = np.empty(len(rec))
+    for i in range(len(rec)):
+        keep = np.arange(len(rec)) != i
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = fit_lstsq(rec.voltage_v[keep], rec.displacement_mm[keep], terms, norm=norm,
+                          ridge=ridge)
+        err[i] = m.predict(rec.voltage_v[i:i + 1])[0] - rec.displacement_mm[i]
+    return err
+
+
 def between_points(model: FlannModel, rec: Recordings, n: int = SWEEP_POINTS) -> dict:
     """The model on a dense sweep of v between the recorded voltages.
 
@@ -148,7 +167,8 @@ def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS
 
 # -- Fig. 5 ----------------------------------------------------------------------------
 def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
-    """PNGs equivalent to the paper's Fig. 5 (a)-(i), plus the between-points sweep."""
+    """``fig5.png``: the paper's Fig. 5 panel for panel (3 x 3, (a)-(i)), and
+    ``between_points_51.png``: the 51-term model between the table's points (beyond it)."""
     from pathlib import Path
 
     import matplotlib
@@ -158,55 +178,50 @@ def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     outdir = Path(outdir)
     v, x = rec.voltage_v, rec.displacement_mm
     models = details["models"]
-    written = []
-
-    def save(fig, name):
-        fig.tight_layout()
-        fig.savefig(outdir / name, dpi=100)
-        plt.close(fig)
-        written.append(name)
-
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot(x, v, "o-", label="Table 1")
-    a, b = raw_line(v, x)
-    ax.plot(x, (x - b) / a, "--", label="least-squares line")
-    ax.set(xlabel="displacement (mm)", ylabel="LVDT output (V)", title="(a) LVDT (nonlinear)")
-    ax.legend(); ax.grid(True)
-    save(fig, "fig5a_lvdt_response.png")
-
     sweep = between_points(models[51], rec)
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot(sweep["v"], sweep["y"], "-", lw=0.8, label="51-term FLANN (dense sweep)")
-    ax.plot(v, models[51].predict(v), "o", label="at Table 1 voltages")
-    ax.set(xlabel="LVDT output (V)", ylabel="FLANN output (mm)", title="(b) FLANN (inverse model)")
-    ax.legend(); ax.grid(True)
-    save(fig, "fig5b_inverse_model.png")
+    fig, axes = plt.subplots(3, 3, figsize=(13, 11))
+    (a, b, c), (d, e, f), (g, h, i) = axes
 
-    for tag, terms in (("c", 51), ("d", 25), ("e", 51), ("f", 61)):
-        fig, ax = plt.subplots(figsize=(5, 4))
+    slope, icpt = raw_line(v, x)
+    a.plot(x, v, "o-", label="Table 1")
+    a.plot(x, (x - icpt) / slope, "--", label="least-squares line")
+    a.set(xlabel="displacement (mm)", ylabel="LVDT output (V)", title="(a) LVDT (nonlinear)")
+    a.legend()
+
+    b.plot(sweep["v"], sweep["y"], "-", lw=0.6, label="51 terms, dense sweep")
+    b.plot(v, models[51].predict(v), "o", label="at Table 1 voltages")
+    b.set(xlabel="LVDT output (V)", ylabel="FLANN output (mm)",
+          title="(b) FLANN (inverse model), 51 terms")
+    b.legend()
+
+    for ax, terms, title in ((c, 51, "(c) overall response (51)"), (d, 25, "(d) FE: 25"),
+                             (e, 51, "(e) FE: 51"), (f, 61, "(f) FE: 61")):
         ax.plot(x, x, "k--", lw=0.8, label="ideal y = x")
         ax.plot(x, models[terms].predict(v), "o-", label=f"LVDT + FLANN, {terms} terms")
-        title = "(c) overall response" if tag == "c" else f"({tag}) FE: {terms}"
         ax.set(xlabel="displacement (mm)", ylabel="compensated output (mm)", title=title)
-        ax.legend(); ax.grid(True)
-        save(fig, f"fig5{tag}_cascade_{terms}.png")
+        ax.legend()
 
-    for tag, terms in (("g", 25), ("h", 51), ("i", 61)):
+    for ax, terms, tag in ((g, 25, "g"), (h, 51, "h"), (i, 61, "i")):
         mse = models[terms].training["mse_per_epoch"]
-        fig, ax = plt.subplots(figsize=(5, 4))
         ax.semilogy(np.arange(1, len(mse) + 1), mse)
         ax.set(xlabel="epoch", ylabel="MSE (mm$^2$)", title=f"({tag}) CR: {terms}")
-        ax.grid(True, which="both")
-        save(fig, f"fig5{tag}_mse_{terms}.png")
+    for ax in axes.flat:
+        ax.grid(True)
+    fig.tight_layout()
+    fig.savefig(outdir / "fig5.png", dpi=80)
+    plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(sweep["v"], sweep["y"] - sweep["ref"], lw=0.8, label="51 terms (paper LMS)")
     ax.plot(v, np.zeros_like(v), "ko", ms=3, label="Table 1 voltages")
     ax.set(xlabel="LVDT output (V)", ylabel="model - PCHIP of table (mm)",
-           title="between the 13 points (beyond the paper)")
-    ax.legend(); ax.grid(True)
-    save(fig, "between_points_51.png")
-    return written
+           title="51-term model between the 13 points (beyond the paper)")
+    ax.legend()
+    ax.grid(True)
+    fig.tight_layout()
+    fig.savefig(outdir / "between_points_51.png", dpi=80)
+    plt.close(fig)
+    return ["fig5.png", "between_points_51.png"]
 
 
 def sensitivity(rec: Recordings | None = None, etas=(0.005, 0.01, 0.02, 0.03),

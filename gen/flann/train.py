@@ -3,7 +3,8 @@
 All three return a :class:`flann.model.FlannModel` whose output is
 ``y_mm = bias + sum_i w_i phi_i(v_n)`` with ``v_n = (v - input_offset_v) / input_scale_v``.
 
-* :func:`fit_lms` -- the paper's rule, sample by sample in file order:
+* :func:`fit_lms` -- the paper's rule, sample by sample in file order (computed epoch-wise
+  as an affine map, see :func:`lms_epochs`; :func:`lms_sequential` is the literal loop):
   ``w(k+1) = w(k) + eta * e(k) * s(k)``, ``e(k) = d(k) - y(k)``, every weight (and the bias,
   whose input is the constant 1, the paper's phi_1 = 1) starting at 1.  The mean of e(k)^2
   over each epoch (the a-priori errors seen while updating) is recorded as the epoch's MSE.
@@ -88,16 +89,19 @@ def _ranges(voltage_v, displacement_mm):
 
 
 # -- least squares -----------------------------------------------------------------------
-def solve_lstsq(design: np.ndarray, y: np.ndarray, ridge: float = 0.0) -> np.ndarray:
+def solve_lstsq(design: np.ndarray, y: np.ndarray, ridge: float = 0.0,
+                samples: int | None = None) -> np.ndarray:
     """Coefficients c (bias first) minimising mean((design c - y)^2) + ridge |c[1:]|^2.
 
     ridge = 0: minimum-norm least squares.  ridge > 0: the augmented system
-    [design; sqrt(n ridge) [0 | I]] c = [y; 0], solved by the same routine.
+    [design; sqrt(n ridge) [0 | I]] c = [y; 0], solved by the same routine.  ``samples``
+    is n when ``design`` is a QR-reduced stand-in for an n-row system (cross-validation).
     """
     if ridge < 0 or not math.isfinite(ridge):
         raise FlannError(f"--ridge must be a finite number >= 0, got {ridge!r}")
     if ridge > 0:
         n, p = design.shape
+        n = n if samples is None else samples
         reg = np.zeros((p - 1, p))
         reg[:, 1:] = np.sqrt(n * ridge) * np.eye(p - 1)
         design = np.vstack([design, reg])
@@ -126,54 +130,101 @@ def fit_lstsq(voltage_v, displacement_mm, terms: int, *, norm: str = "range",
 
 
 # -- LMS -----------------------------------------------------------------------------------
-def lms_epochs(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
-               w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The paper's LMS on a design matrix ``S`` (one row per sample, bias column included).
-
-    Returns (weights, mse_per_epoch).  Samples are visited in row order every epoch.
-    """
+def _check_lms(eta: float, epochs: int) -> None:
     if not (eta > 0 and math.isfinite(eta)):
         raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
     if epochs < 1:
         raise FlannError(f"--epochs must be >= 1, got {epochs}")
+
+
+def _diverged(S: np.ndarray, eta: float, where: str) -> FlannError:
+    bound = 2 / float(np.max(np.sum(S**2, 1)))
+    return FlannError(f"LMS diverged {where} with eta={eta:g}: use a smaller --eta "
+                      f"(stability needs roughly eta < 2/|s|^2 = {bound:.3g})")
+
+
+def lms_sequential(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
+                   w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's LMS written literally, one sample at a time (the reference).
+
+    ``S`` has one row per sample (bias column included); samples are visited in row order
+    every epoch: e = d_k - s_k.w, w += eta e s_k.  Returns (weights, mse_per_epoch) with the
+    epoch's MSE the mean of the a-priori e^2.
+    """
+    _check_lms(eta, epochs)
     w = np.ones(S.shape[1]) if w0 is None else np.array(w0, dtype=float)
     mse = np.empty(epochs)
-    rows = [S[k] for k in range(S.shape[0])]
     with np.errstate(over="ignore", invalid="ignore"):
         for ep in range(epochs):
             acc = 0.0
-            for s, dk in zip(rows, d):
+            for s, dk in zip(S, d):
                 e = dk - float(s @ w)
                 w += eta * e * s
                 acc += e * e
-            mse[ep] = acc / len(rows)
+            mse[ep] = acc / S.shape[0]
             if not math.isfinite(mse[ep]):
-                raise FlannError(
-                    f"LMS diverged in epoch {ep + 1} with eta={eta:g}: use a smaller --eta "
-                    f"(stability needs eta < 2/|s|^2 = {2 / float(np.max(np.sum(S**2, 1))):.3g})"
-                )
+                raise _diverged(S, eta, f"in epoch {ep + 1}")
+    return w, mse
+
+
+def _epoch_map(S: np.ndarray, d: np.ndarray, eta: float, skip: int | None = None):
+    """One LMS epoch as an affine map: w_after = A w + c; a-priori errors e = f - E w.
+
+    Step k is w <- (I - eta s_k s_k^T) w + eta d_k s_k; composing the steps in row order
+    (``skip`` leaves one row out) gives A, c; E, f give each step's a-priori error.
+    """
+    p = S.shape[1]
+    A, c = np.eye(p), np.zeros(p)
+    E, f = np.zeros_like(S), np.zeros(S.shape[0])
+    for k, (s, dk) in enumerate(zip(S, d)):
+        if k == skip:
+            continue
+        sA = s @ A
+        E[k], f[k] = sA, dk - s @ c
+        A = A - eta * np.outer(s, sA)
+        c = c + (eta * (dk - s @ c)) * s
+    return A, c, E, f
+
+
+def lms_epochs(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
+               w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's LMS, same result as :func:`lms_sequential` (to rounding), much faster.
+
+    The sample-by-sample rule is linear in w, so one epoch is an affine map computed once
+    (:func:`_epoch_map`); the epochs then cost one small matrix-vector product each.
+    """
+    _check_lms(eta, epochs)
+    w = np.ones(S.shape[1]) if w0 is None else np.array(w0, dtype=float)
+    mse = np.empty(epochs)
+    with np.errstate(over="ignore", invalid="ignore"):
+        A, c, E, f = _epoch_map(S, d, eta)
+        for ep in range(epochs):
+            e = f - E @ w
+            mse[ep] = float(e @ e) / S.shape[0]
+            if not math.isfinite(mse[ep]):
+                raise _diverged(S, eta, f"in epoch {ep + 1}")
+            w = A @ w + c
     return w, mse
 
 
 def lms_leave_one_out(S: np.ndarray, d: np.ndarray, eta: float, epochs: int) -> np.ndarray:
-    """Held-out predictions of LMS trained without each row in turn (all folds at once).
+    """Held-out predictions of LMS trained without each row in turn.
 
     Fold i visits every row except row i, in row order, ``epochs`` times, starting from
-    weights of 1 -- exactly :func:`lms_epochs` on the other rows; returns S[i] @ w_i.
+    weights of 1 -- :func:`lms_epochs` on the other rows; returns S[i] @ w_i.
     """
-    if not (eta > 0 and math.isfinite(eta)):
-        raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
+    _check_lms(eta, epochs)
     n, p = S.shape
+    maps = [_epoch_map(S, d, eta, skip=i) for i in range(n)]
+    A = np.stack([m[0] for m in maps])
+    C = np.stack([m[1] for m in maps])
     W = np.ones((n, p))
     with np.errstate(over="ignore", invalid="ignore"):
         for _ in range(epochs):
-            for k in range(n):
-                e = d[k] - W @ S[k]
-                e[k] = 0.0
-                W += eta * np.outer(e, S[k])
+            W = np.einsum("ipq,iq->ip", A, W) + C
     pred = np.einsum("ij,ij->i", W, S)
     if not np.all(np.isfinite(pred)):
-        raise FlannError(f"LMS diverged in leave-one-out with eta={eta:g}: use a smaller --eta")
+        raise _diverged(S, eta, "in leave-one-out")
     return pred
 
 
@@ -228,7 +279,12 @@ def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
 
 def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
                    ridges=AUTO_RIDGES, k: int | None = None) -> list[CvResult]:
-    """Held-out RMS and max error (mm) for every (terms, norm, ridge) candidate."""
+    """Held-out RMS and max error (mm) for every (terms, norm, ridge) candidate.
+
+    Per fold one QR factorisation of the largest design, A = Q R; the first k columns of A
+    are Q R[:, :k], so every smaller candidate is the small problem R[:, :k] c = Q^T y
+    (same minimiser, same minimum-norm solution, ridge included) -- exact, and fast.
+    """
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     folds = cv_folds(v, k)
@@ -240,11 +296,13 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORM
         for held in folds:
             train = np.ones(v.size, bool)
             train[held] = False
+            Q, R = np.linalg.qr(full[train])
+            z = Q.T @ x[train]
+            n_train = int(train.sum())
             for t in terms_list:
-                A = full[train, : t + 1]
                 B = full[held, : t + 1]
                 for r in ridges:
-                    coef = solve_lstsq(A, x[train], r)
+                    coef = solve_lstsq(R[:, : t + 1], z, r, samples=n_train)
                     errs[(t, r)][held] = B @ coef - x[held]
         for (t, r), e in errs.items():
             e = e[np.isfinite(e)]

@@ -10,7 +10,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..train import NORMALISATIONS, fit_lstsq, normalisation
+from ..train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
 from .. import paper
 
 HELP = "reproduce the seed paper's tables and figures"
@@ -83,13 +83,20 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
               f"{details['models'][t].training['mse_per_epoch'][-1]:15.3g}")
     print("LOO: each point held out in turn, same method; 'interior' leaves out the two end "
           "points, whose held-out error is extrapolation.")
-    print(f"Between the {len(rec)} points (dense sweep of v, compared with the monotone PCHIP "
-          "interpolant of the points):")
+    print(f"Between the {len(rec)} points: leave-one-out, and a dense sweep of v compared with "
+          "the monotone PCHIP interpolant of the points:")
     default = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="range")
-    for label, model in (("51 terms, paper LMS", details["models"][51]),
-                         ("51 terms, lstsq range-normalised (default design)", default)):
+    auto, choice = fit_auto(rec.voltage_v, rec.displacement_mm)
+    designs = (("51 terms, paper LMS", details["models"][51], details["loo"][51]),
+               ("51 terms, lstsq, range (default design)", default,
+                paper.lstsq_loo_errors(rec, 51, "range")),
+               (f"auto: {choice.terms} terms, {choice.norm}, ridge {choice.ridge:g}", auto,
+                paper.lstsq_loo_errors(rec, choice.terms, choice.norm, choice.ridge)))
+    for label, model, loo in designs:
         b = paper.between_points(model, rec)
-        print(f"  {label}: max deviation {b['max_dev_from_pchip_mm']:.3g} mm "
+        print(f"  {label}:\n    LOO max {np.max(np.abs(loo)):.3g} mm (interior "
+              f"{np.max(np.abs(loo[interior])):.3g} mm); max deviation "
+              f"{b['max_dev_from_pchip_mm']:.3g} mm "
               f"({b['max_dev_from_pchip_pct_fs']:.3g} % FS) at {b['at_voltage_v']:.3f} V; "
               f"{b['sweep_fraction_within_tol_of_pchip']:.1%} of the sweep within +-{args.tol:g} "
               f"% FS of it; output spans {b['output_range_mm'][0]:.3g} .. "
