@@ -73,7 +73,8 @@ def contexts(spec: Spec) -> dict[str, dict]:
         code_bits=B, phase_bits=P, lin_bits=lin_bits, acc_v_bits=NV, acc_l_bits=s.lin_width,
         guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
-        ka=bits_literal(s.ka, NV, False),
+        ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
+        nk1=bits_literal(-s.k1, s.lin_width),
         kb=bits_literal((s.kb + (1 << (s.norm_guard - 1))) % (1 << NV), NV, False),
         k1=bits_literal(s.k1, s.lin_width), k0=bits_literal(s.k0 + (1 << (s.lin_guard - 1)), s.lin_width),
     )

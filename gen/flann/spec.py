@@ -132,6 +132,7 @@ class Spec:
     slope_rom: tuple = field(repr=False)
     weight_rom: tuple = field(repr=False)  # [lane][step]
     analysis: dict = field(repr=False, compare=False, default_factory=dict)
+    term_bound: int = 0  # largest |term| the expansion can produce (sizes products and acc)
 
     # -- derived ------------------------------------------------------------------------
     @property
@@ -417,7 +418,7 @@ def derive_spec(
         weight_fmt=weight_fmt, product_fmt=product_fmt, product_shift=shift, acc_fmt=acc_fmt,
         out_fmt=out_fmt, output_lsb_mm=q, steps=S, adv_period=adv_period,
         value_rom=tuple(int(x) for x in value_rom), slope_rom=tuple(int(x) for x in slope_rom),
-        weight_rom=weight_rom,
+        weight_rom=weight_rom, term_bound=int(term_max),
     )
     analysis = error_analysis(spec, Sw=Sw, Swm=Swm, N=N)
     spec = replace(spec, analysis=analysis)
