@@ -174,3 +174,41 @@ def test_coupling_table_reciprocity_and_passivity():
     # self-inductances positive; the loop of two secondaries has |M1 - M2|^2 <= Lp L_loop
     assert np.all(t.lp_h > 0) and np.all(t.lloop_h > 0)
     assert np.all((t.m1_h - t.m2_h) ** 2 <= t.lp_h * t.lloop_h * (1 + 1e-9))
+
+
+def test_eddy_current_permeability_limits():
+    # skin depth delta = sqrt(2 / (w mu0 mu_r sigma)); deep in the skin-effect regime the
+    # flux penetrates ~delta/sqrt(2) (|1/(1+j)| delta) from each exposed face, so the
+    # section-averaged permeability tends to mu_r * sqrt(2) * delta / thickness for a wall
+    # open on both faces (tube, full wall thickness) and mu_r * sqrt(2) * delta / radius for a
+    # rod (surface / area = 2 / radius), at a phase lag of 45 deg.
+    s = default_sensor().replace(core_conductivity_s_per_m=2e6)
+    for f in (2e5, 1e6):
+        t = s.replace(excitation_frequency_hz=f)
+        delta = math.sqrt(2 / (2 * math.pi * f * MU0 * t.core_permeability_ratio * 2e6))
+        wall = (5.0 - 4.4) / 2 * 1e-3
+        mu = lvdt.core_permeability_eff(t)
+        assert abs(mu) == pytest.approx(t.core_permeability_ratio * math.sqrt(2) * delta / wall, rel=0.02)
+        assert math.degrees(-np.angle(mu)) == pytest.approx(45.0, abs=1.0)
+    rod = s.replace(core_inner_diameter_mm=0.0, excitation_frequency_hz=1e6)
+    delta = math.sqrt(2 / (2 * math.pi * 1e6 * MU0 * rod.core_permeability_ratio * 2e6))
+    assert abs(lvdt.core_permeability_eff(rod)) == pytest.approx(
+        rod.core_permeability_ratio * math.sqrt(2) * delta / 2.5e-3, rel=0.05)
+    slow = rod.replace(excitation_frequency_hz=0.01)
+    assert lvdt.core_permeability_eff(slow) == pytest.approx(rod.core_permeability_ratio, rel=1e-4)
+
+
+def test_eddy_currents_lower_sensitivity_with_frequency():
+    # With R_p = 0, Ip = V/(jw Lp) and v = (M/Lp) V: without eddy currents the output does
+    # not depend on frequency at all; a conducting core loses coupling as f rises.
+    base = default_sensor().replace(primary_resistance_ohm=0.0)
+    x = np.array([10.0])
+    ref = lvdt.ideal_output_v(base, x)[0]
+    assert lvdt.ideal_output_v(base.replace(excitation_frequency_hz=50e3), x)[0] == pytest.approx(ref, rel=1e-12)
+    cond = base.replace(core_conductivity_s_per_m=2e6)
+    assert lvdt.ideal_output_v(cond.replace(excitation_frequency_hz=1.0), x)[0] == pytest.approx(ref, rel=1e-5)
+    ys = [lvdt.ideal_output_v(cond.replace(excitation_frequency_hz=f), x)[0] for f in (1e3, 5e3, 20e3, 100e3)]
+    assert ref > ys[0] > ys[1] > ys[2] > ys[3] > 0
+    # still odd and zero at null, and the detector is trimmed to the rotated phase
+    y = lvdt.ideal_output_v(cond, np.array([-7.0, 0.0, 7.0]))
+    assert y[1] == pytest.approx(0, abs=1e-12) and y[0] == pytest.approx(-y[2], rel=1e-9)

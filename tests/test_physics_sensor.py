@@ -108,3 +108,12 @@ def test_console_script_reports_one_line(tmp_path):
                        capture_output=True, text=True)
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+
+
+def test_optional_core_conductivity():
+    text = BASE.replace("permeability_ratio = 220.0", "permeability_ratio = 220.0\nconductivity_s_per_m = 1.7e6")
+    s = parse_sensor(text)
+    assert s.core_conductivity_s_per_m == 1.7e6 and default_sensor().core_conductivity_s_per_m == 0.0
+    assert parse_sensor(format_sensor(s)) == s
+    with pytest.raises(SensorError, match="core.conductivity_s_per_m = -1"):
+        parse_sensor(text.replace("1.7e6", "-1.0"))

@@ -69,11 +69,16 @@ class CouplingTable:
     lloop_h: np.ndarray  # self-inductance of the two secondaries in series opposition
 
 
+def _real_if_real(z: complex):
+    return z.real if z.imag == 0 else z
+
+
 @dataclass(frozen=True)
 class Magnetics:
     """Per-unit-length constants of the transmission line and the winding layout (SI)."""
 
-    r_core: float      # series reluctance per metre, core-filled bore (1/(H m))
+    r_core: complex    # series reluctance per metre, core-filled bore (1/(H m)); complex
+                       # (a loss part) when eddy currents flow in the core
     r_air: float       # series reluctance per metre, air-filled bore
     g_leak: float      # leakage permeance per metre to the housing (H/m per m)
     half_core: float   # core half length (m)
@@ -82,6 +87,33 @@ class Magnetics:
     a3: float          # outer end of a secondary (m)
     n_p: float         # primary turns per metre
     n_s: float         # secondary turns per metre
+
+
+def core_permeability_eff(s: Sensor) -> complex:
+    """Effective (complex) relative permeability of the core at the excitation frequency.
+
+    Eddy currents confine the a.c. flux to a skin depth ``delta = sqrt(2 / (w mu0 mu_r
+    sigma))``.  Averaged over the section (e^{jwt} convention, Neubert; any text on eddy
+    currents in laminations/rods):
+
+    * tube of wall w (treated as a plate): ``mu_r tanh(g w/2) / (g w/2)``, ``g = (1+j)/delta``
+    * solid rod of radius a: ``mu_r 2 J1(k a) / (k a J0(k a))``, ``k = (1-j)/delta``
+
+    ``sigma = 0`` gives ``mu_r`` (real)."""
+    mu_r = s.core_permeability_ratio
+    sigma = s.core_conductivity_s_per_m
+    if sigma <= 0:
+        return complex(mu_r)
+    delta = math.sqrt(2.0 / (s.omega_rad_s * MU0 * mu_r * sigma))
+    mm = 1e-3
+    if s.core_inner_diameter_mm > 0:
+        half_wall = (s.core_outer_diameter_mm - s.core_inner_diameter_mm) / 4 * mm
+        g = (1 + 1j) / delta * half_wall
+        return complex(mu_r * np.tanh(g) / g)
+    from scipy.special import jv
+
+    ka = (1 - 1j) / delta * (s.core_outer_diameter_mm / 2 * mm)
+    return complex(mu_r * 2 * jv(1, ka) / (ka * jv(0, ka)))
 
 
 def magnetics(s: Sensor) -> Magnetics:
@@ -95,7 +127,7 @@ def magnetics(s: Sensor) -> Magnetics:
     a2 = a1 + s.secondary_gap_mm * mm
     a3 = a2 + s.secondary_length_mm * mm
     return Magnetics(
-        r_core=1.0 / (MU0 * (s.core_permeability_ratio * a_core + (a_air - a_core))),
+        r_core=_real_if_real(1.0 / (MU0 * (core_permeability_eff(s) * a_core + (a_air - a_core)))),
         r_air=1.0 / (MU0 * a_air),
         g_leak=2 * math.pi * MU0 / math.log(r_housing / r_core),
         half_core=s.core_length_mm / 2 * mm,
@@ -152,8 +184,9 @@ def _solve(mg: Magnetics, seg: _Segments, sources: tuple[np.ndarray, ...]):
     tz = t / z0
     z0_air = math.sqrt(mg.r_air / g)
     n_seg = length.shape[0]
-    y_l = np.empty(seg.b.shape)
-    y_r = np.empty(seg.b.shape)
+    dtype = np.result_type(seg.r, float)
+    y_l = np.empty(seg.b.shape, dtype=dtype)
+    y_r = np.empty(seg.b.shape, dtype=dtype)
     y_l[0] = -1.0 / z0_air
     for i in range(n_seg):
         y_l[i + 1] = (y_l[i] - tz[i]) / (1.0 - zt[i] * y_l[i])
@@ -165,8 +198,8 @@ def _solve(mg: Magnetics, seg: _Segments, sources: tuple[np.ndarray, ...]):
     out = []
     for src in sources:
         phi_p = src / seg.r                      # particular flux of a uniform winding
-        j_l = np.zeros(seg.b.shape)
-        j_r = np.zeros(seg.b.shape)
+        j_l = np.zeros(seg.b.shape, dtype=dtype)
+        j_r = np.zeros(seg.b.shape, dtype=dtype)
         for i in range(n_seg):
             j_l[i + 1] = (j_l[i] - phi_p[i]) * gain_l[i] + phi_p[i]
         for i in range(n_seg - 1, -1, -1):
@@ -228,10 +261,13 @@ def primary_current_a(s: Sensor, lp_h) -> np.ndarray:
 
 
 def reference_phase_rad(s: Sensor) -> float:
-    """Phase-sensitive detector reference: the phase of the secondary e.m.f. at null
-    (``arg(j w Ip(0))``; the detector's phase is trimmed there, as in practice)."""
-    lp0 = inductances_h(s, np.zeros(1))[2][0]
-    return float(np.angle(1j * s.omega_rad_s * primary_current_a(s, lp0)))
+    """Phase-sensitive detector reference, trimmed at null as in practice: the phase of
+    the differential e.m.f. for a small core movement, ``arg(j w Ip(0) dM_d/dx(0))``
+    (``arg(j w Ip(0))`` when the inductances are real, i.e. without eddy currents)."""
+    m1, m2, lp = inductances_h(s, np.array([-1e-3, 0.0, 1e-3]))
+    slope = (m1[2] - m2[2]) - (m1[0] - m2[0])
+    slope_phase = float(np.angle(slope)) if np.iscomplexobj(slope) and slope != 0 else 0.0
+    return float(np.angle(1j * s.omega_rad_s * primary_current_a(s, lp[1]))) + slope_phase
 
 
 def secondary_emf_v(s: Sensor, core_position_mm, drive_scale=1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -280,7 +316,7 @@ def flux_profile(s: Sensor, core_position_mm: float, z_mm) -> np.ndarray:
     z = np.asarray(z_mm, dtype=float) * 1e-3
     z0_air = math.sqrt(mg.r_air / g)
     k_air = math.sqrt(mg.r_air * g)
-    out = np.empty_like(z)
+    out = np.empty(z.shape, dtype=np.result_type(seg.r, float))
     left, right = z < b[0], z >= b[-1]
     out[left] = -u[0] / z0_air * np.exp(k_air * (z[left] - b[0]))
     out[right] = u[-1] / z0_air * np.exp(-k_air * (z[right] - b[-1]))
@@ -288,12 +324,12 @@ def flux_profile(s: Sensor, core_position_mm: float, z_mm) -> np.ndarray:
         m = (z >= b[i]) & (z < b[i + 1])
         if not m.any():
             continue
-        z0 = math.sqrt(r[i] / g)
-        k = math.sqrt(r[i] * g)
+        z0 = np.sqrt(r[i] / g)
+        k = np.sqrt(r[i] * g)
         length = b[i + 1] - b[i]
         # u = alpha e^{-k d} + beta e^{-k (L - d)} from both ends (no growing exponentials);
         # Phi = s/R' - u'/R' = phi_p + (alpha e^{-k d} - beta e^{-k (L - d)}) / Z0.
-        e = math.exp(-k * length)
+        e = np.exp(-k * length)
         det = 1.0 - e * e
         alpha = (u[i] - e * u[i + 1]) / det
         beta = (u[i + 1] - e * u[i]) / det

@@ -26,6 +26,7 @@ File format ``flann-sensor/1`` (every numeric key carries its unit as a suffix: 
     outer_diameter_mm = 5.0
     length_mm = 60.0
     permeability_ratio = 220.0           # relative permeability of the core material
+    # conductivity_s_per_m = 1.7e6       # optional: eddy currents (default 0 = none)
 
     [coil]                               # winding former and magnetic return (housing)
     inner_diameter_mm = 6.0
@@ -79,7 +80,7 @@ FORMAT = "flann-sensor/1"
 DEMODULATORS = ("phase_sensitive", "amplitude")
 
 # Recognised unit suffixes (dimensionless quantities say so: _ratio, _fraction).
-UNIT_SUFFIXES = ("_mm", "_hz", "_vpp", "_v", "_ohm", "_c", "_per_c", "_rad", "_deg",
+UNIT_SUFFIXES = ("_mm", "_hz", "_vpp", "_v", "_ohm", "_c", "_per_c", "_rad", "_deg", "_s_per_m",
                  "_ratio", "_fraction", "_s")
 UNIT_WORDS = ("turns", "bits")
 
@@ -93,6 +94,7 @@ _SCHEMA: dict[str, dict[str, tuple[str, float, bool, float]]] = {
         "outer_diameter_mm": ("core_outer_diameter_mm", 0.0, False, 1e3),
         "length_mm": ("core_length_mm", 0.0, False, 1e4),
         "permeability_ratio": ("core_permeability_ratio", 1.0, True, 1e6),
+        "conductivity_s_per_m": ("core_conductivity_s_per_m", 0.0, True, 1e9),
     },
     "coil": {
         "inner_diameter_mm": ("coil_inner_diameter_mm", 0.0, False, 1e3),
@@ -124,6 +126,8 @@ _SCHEMA: dict[str, dict[str, tuple[str, float, bool, float]]] = {
 }
 _STRING_KEYS = {("", "format"), ("", "name"), ("", "description"), ("demodulator", "kind")}
 _OPTIONAL_SECTIONS = ("adc",)
+# Keys that may be omitted, with the value they then take.
+_OPTIONAL_KEYS = {("core", "conductivity_s_per_m"): 0.0}
 
 
 @dataclass(frozen=True)
@@ -153,6 +157,7 @@ class Sensor:
     adc_bits: int | None = None          # None: no converter (analog output recorded)
     adc_full_scale_v: float | None = None
     effects: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    core_conductivity_s_per_m: float = 0.0   # 0: no eddy currents in the core
     description: str = field(default="", compare=False)
     source: str = field(default="<memory>", compare=False)
 
@@ -196,14 +201,17 @@ class Sensor:
         return self.primary_length_mm + 2.0 * (self.secondary_gap_mm + self.secondary_length_mm)
 
     def magnetics_key(self) -> tuple:
-        """The fields the coupling (mutual inductance) table depends on (cache key)."""
-        return tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
+        """The fields the inductances depend on (cache key); the frequency only matters
+        when the core conducts (eddy currents)."""
+        key = tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
+        return key + (self.excitation_frequency_hz,) if self.core_conductivity_s_per_m > 0 else key
 
 
 _FIELD_NAMES = {f.name for f in dataclasses.fields(Sensor)}
 _MAGNETIC_FIELDS = (
     "core_inner_diameter_mm", "core_outer_diameter_mm", "core_length_mm",
-    "core_permeability_ratio", "coil_inner_diameter_mm", "coil_outer_diameter_mm",
+    "core_permeability_ratio", "core_conductivity_s_per_m",
+    "coil_inner_diameter_mm", "coil_outer_diameter_mm",
     "housing_inner_diameter_mm", "primary_turns", "primary_length_mm",
     "secondary_turns", "secondary_length_mm", "secondary_gap_mm",
 )
@@ -291,6 +299,9 @@ def sensor_from_dict(doc: Mapping[str, Any], source: str = "<memory>") -> Sensor
                 if key not in keys:
                     raise _bad(source, _unknown_key_msg(section, key))
         for key, (fname, *_rest) in keys.items():
+            if key not in table and (section, key) in _OPTIONAL_KEYS:
+                values[fname] = _OPTIONAL_KEYS[(section, key)]
+                continue
             if key not in table:
                 raise _bad(source, f"missing key {section + '.' if section else ''}{key}")
             values[fname] = table[key]
@@ -408,6 +419,8 @@ def format_sensor(s: Sensor, comments: tuple[str, ...] = ()) -> str:
             lines.append(f"kind = {_fmt_value(s.demodulator_kind)}")
         for key, (fname, *_r) in keys.items():
             v = getattr(s, fname)
+            if (section, key) in _OPTIONAL_KEYS and v == _OPTIONAL_KEYS[(section, key)]:
+                continue
             if key in ("turns", "bits"):
                 v = int(v) if float(v).is_integer() else v
             lines.append(f"{key} = {_fmt_value(v)}")
