@@ -104,6 +104,14 @@ def test_predict_writes_every_row(tmp_path, capsys):
     assert [float(r["predicted_mm"]) for r in rows] == [-3.5, 0.5, 2.5]
 
 
+def test_predict_without_displacement_column(tmp_path, capsys):
+    data = tmp_path / "v.csv"
+    data.write_text("voltage_v\n-2\n1\n")
+    out = tmp_path / "p.csv"
+    assert run(["predict", hand_model(tmp_path), data, "-o", out], capsys)[0] == 0
+    assert out.read_text() == "voltage_v,predicted_mm\n-2,-3.5\n1,2.5\n"
+
+
 def test_eval_json_by_hand(tmp_path, capsys):
     # y = 0.5 + 2 v at v = -2, 0, 1, 2 -> -3.5, 0.5, 2.5, 4.5 vs x = -4, 0, 2, 4:
     # errors 0.5 each; FS = 4 mm; max = RMS = 0.5 mm = 12.5 % FS

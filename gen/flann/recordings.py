@@ -65,7 +65,10 @@ def _parse_float(text: str, column: str, row: int, source: str) -> float:
     return value
 
 
-def parse_recordings(text: str, source: str = "<memory>") -> Recordings:
+def parse_recordings(text: str, source: str = "<memory>",
+                     required: tuple[str, ...] = REQUIRED) -> Recordings:
+    """Parse CSV text.  ``required=("voltage_v",)`` lets ``displacement_mm`` be absent
+    (then ``None``): only for commands that do not need it (``flann predict``)."""
     comments = []
     lines = []
     for line in text.splitlines():
@@ -80,7 +83,7 @@ def parse_recordings(text: str, source: str = "<memory>") -> Recordings:
         raise RecordingsError(f"{source}: no header line (expected columns {', '.join(REQUIRED)})")
     reader = csv.reader(io.StringIO("\n".join(lines)))
     header = [h.strip() for h in next(reader)]
-    missing = [c for c in REQUIRED if c not in header]
+    missing = [c for c in required if c not in header]
     if missing:
         raise RecordingsError(
             f"{source}: missing column(s) {', '.join(missing)} (header has: {', '.join(header)})"
@@ -115,10 +118,11 @@ def parse_recordings(text: str, source: str = "<memory>") -> Recordings:
                 "is not +1 or -1"
             )
     sha = hashlib.sha256(text.encode()).hexdigest()
+    arrays.setdefault("displacement_mm", None)
     return Recordings(**arrays, source=source, sha256=sha, comments=tuple(comments))
 
 
-def read_recordings(path: str | Path) -> Recordings:
+def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED) -> Recordings:
     path = Path(path)
     try:
         text = path.read_text()
@@ -128,7 +132,7 @@ def read_recordings(path: str | Path) -> Recordings:
         raise RecordingsError(f"{path}: is a directory, expected a CSV file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise RecordingsError(f"{path}: cannot read ({exc.__class__.__name__})") from None
-    return parse_recordings(text, source=str(path))
+    return parse_recordings(text, source=str(path), required=required)
 
 
 def format_recordings(rec: Recordings, comments: tuple[str, ...] | list[str] = (),

@@ -15,7 +15,7 @@ HELP = "apply a model to recordings"
 
 def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
-    p.add_argument("recordings", help="recordings CSV (voltage_v required as usual)")
+    p.add_argument("recordings", help="CSV with voltage_v (displacement_mm copied when given)")
     p.add_argument("-o", "--output", required=True, help="CSV to write")
 
 
@@ -29,13 +29,16 @@ def warn_outside_range(model, voltage_v, source: str) -> None:
 
 def run(args) -> int:
     model = load_model(args.model)
-    rec = read_recordings(args.recordings)
+    rec = read_recordings(args.recordings, required=("voltage_v",))
     warn_outside_range(model, rec.voltage_v, rec.source)
-    y = model.predict(rec.voltage_v)
+    cols = {"voltage_v": rec.voltage_v}
+    if rec.displacement_mm is not None:
+        cols["displacement_mm"] = rec.displacement_mm
+    cols["predicted_mm"] = model.predict(rec.voltage_v)
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
-    w.writerow(["voltage_v", "displacement_mm", "predicted_mm"])
-    for v, x, p in zip(rec.voltage_v, rec.displacement_mm, y):
-        w.writerow([f"{v:.9g}", f"{x:.9g}", f"{p:.9g}"])
+    w.writerow(list(cols))
+    for row in zip(*cols.values()):
+        w.writerow([f"{c:.9g}" for c in row])
     atomic_write_text(args.output, out.getvalue())
     return 0
