@@ -33,8 +33,9 @@ saturation and inter-winding capacitance are left out of the ideal model.
 Public API (stable):
 
 * :func:`ideal_output_v` (sensor, displacement_mm) -> ndarray: demodulated output, no effects.
-  Vectorised and exact; a few ms for 2000 new positions, ~0.2 ms when geometry and
-  positions repeat (cached; ``bench/physics_speed.py``).
+  Vectorised; exact below TABLE_MIN_POINTS distinct positions, else interpolated from a
+  per-geometry table of exact solutions (~1e-7 of full scale); ~1-2 ms for 2000 new
+  positions, ~0.3 ms when geometry and positions repeat (``bench/physics_speed.py``).
 * :func:`secondary_emf_v` (sensor, core_position_mm, drive_scale=1) -> (v1, v2): complex
   peak e.m.f.s of the two secondaries (V).
 * :func:`demodulate_v` (sensor, v_diff, quadrature_v=0) -> output volts.
@@ -211,21 +212,20 @@ def _solve(mg: Magnetics, seg: _Segments, sources: tuple[np.ndarray, ...]):
 
 
 _INDUCTANCES: "OrderedDict[tuple, tuple[np.ndarray, ...]]" = OrderedDict()
+_TABLES: "OrderedDict[tuple, tuple]" = OrderedDict()
+
+# Calls with at least TABLE_MIN_POINTS distinct positions interpolate a per-geometry table
+# of TABLE_POINTS exact solutions (cubic Hermite, 4th-order slopes; error ~1e-7 of full
+# scale for the paper's sensor, tests/test_physics_lvdt.py).  The choice depends only on the
+# number of positions, never on call history, so a least-squares fit (fixed positions) sees
+# one consistent, C1-smooth function for its finite-difference Jacobians.
+TABLE_MIN_POINTS = 400
+TABLE_POINTS = 1601
 
 
-def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.ndarray, ...]:
-    """(M1, M2, Lp) in henry at the core-centre positions (mm); with ``loop=True`` also the
-    self-inductance of the two secondaries in series opposition.  Cached on the geometry
-    and the positions, so a fit that varies only electrical parameters pays once."""
-    x = np.asarray(core_position_mm, dtype=float)
-    key = (s.magnetics_key(), loop, x.shape, x.tobytes())
-    hit = _INDUCTANCES.get(key)
-    if hit is not None:
-        _INDUCTANCES.move_to_end(key)
-        return hit
-    flat, inverse = np.unique(x.ravel(), return_inverse=True)
+def _exact(s: Sensor, pos_mm: np.ndarray, loop: bool) -> list[np.ndarray]:
     mg = magnetics(s)
-    seg = _segments(mg, flat * 1e-3)
+    seg = _segments(mg, pos_mm * 1e-3)
     sources = [seg.n_p]
     if loop:
         sources.append(seg.n_s1 - seg.n_s2)
@@ -236,6 +236,77 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
     if loop:
         _u, fl = solved[1]
         res.append(np.einsum("ij,ij->j", fl, seg.n_s1 - seg.n_s2))
+    return res
+
+
+def table_half_range_mm(s: Sensor) -> float:
+    """Core positions covered by the interpolation table: until the core has left."""
+    return s.coil_span_mm / 2 + s.core_length_mm / 2 + 0.1 * s.coil_span_mm
+
+
+def _table(s: Sensor, loop: bool):
+    key = (s.magnetics_key(), loop)
+    hit = _TABLES.get(key)
+    if hit is not None:
+        _TABLES.move_to_end(key)
+        return hit
+    half = table_half_range_mm(s)
+    pos = np.linspace(-half, half, TABLE_POINTS)
+    values = _exact(s, pos, loop)
+    slopes = []
+    for y in values:
+        d = np.gradient(y)
+        d[2:-2] = (-y[4:] + 8 * y[3:-1] - 8 * y[1:-3] + y[:-4]) / 12
+        slopes.append(d)
+    hit = (pos, values, slopes)
+    _TABLES[key] = hit
+    if len(_TABLES) > _CACHE_SIZE:
+        _TABLES.popitem(last=False)
+    return hit
+
+
+def _interpolate(table, xq: np.ndarray) -> list[np.ndarray]:
+    pos, values, slopes = table
+    t = (xq - pos[0]) / (pos[1] - pos[0])
+    i = np.minimum(np.floor(t).astype(np.intp), pos.size - 2)
+    t -= i
+    t2 = t * t
+    t3 = t2 * t
+    h00 = 2 * t3 - 3 * t2 + 1
+    h10 = t3 - 2 * t2 + t
+    h01 = 3 * t2 - 2 * t3
+    h11 = t3 - t2
+    return [h00 * y[i] + h10 * d[i] + h01 * y[i + 1] + h11 * d[i + 1]
+            for y, d in zip(values, slopes)]
+
+
+def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.ndarray, ...]:
+    """(M1, M2, Lp) in henry at the core-centre positions (mm); with ``loop=True`` also the
+    self-inductance of the two secondaries in series opposition.  Exact line solution for
+    fewer than TABLE_MIN_POINTS distinct positions, otherwise a cached per-geometry table
+    (see above).  Results are cached on geometry and positions, so a fit that varies only
+    electrical parameters pays once."""
+    x = np.asarray(core_position_mm, dtype=float)
+    key = (s.magnetics_key(), loop, x.shape, x.tobytes())
+    hit = _INDUCTANCES.get(key)
+    if hit is not None:
+        _INDUCTANCES.move_to_end(key)
+        return hit
+    flat, inverse = np.unique(x.ravel(), return_inverse=True)
+    if flat.size >= TABLE_MIN_POINTS:
+        half = table_half_range_mm(s)
+        inside = np.abs(flat) <= half
+        res = [np.empty(flat.size, dtype=complex) for _ in range(4 if loop else 3)]
+        interp = _interpolate(_table(s, loop), flat[inside])
+        exact = _exact(s, flat[~inside], loop) if (~inside).any() else None
+        for k in range(len(res)):
+            res[k][inside] = interp[k]
+            if exact is not None:
+                res[k][~inside] = exact[k]
+        if not any(np.iscomplexobj(v) for v in interp):
+            res = [r.real.copy() for r in res]
+    else:
+        res = _exact(s, flat, loop)
     out = tuple(r[inverse].reshape(x.shape) for r in res)
     for arr in out:
         arr.setflags(write=False)
@@ -294,7 +365,7 @@ def demodulate_v(s: Sensor, v_diff, quadrature_v=0.0) -> np.ndarray:
 
 def ideal_output_v(s: Sensor, displacement_mm) -> np.ndarray:
     """Demodulated output (V) of the ideal sensor (no effects) with the core centre at
-    ``displacement_mm``.  Vectorised and exact (no interpolation)."""
+    ``displacement_mm``.  Vectorised (see :func:`inductances_h` for exact vs table)."""
     v1, v2 = secondary_emf_v(s, displacement_mm)
     return demodulate_v(s, v1 - v2)
 
