@@ -110,3 +110,24 @@ def test_cli_json_plot_and_errors(tmp_path, capsys):
     assert main(["trace", str(DEFAULT), "--format", "float18", "--lanes", "3"]) == 2
     assert "lanes" in capsys.readouterr().err
     assert main(["trace", str(tmp_path / "missing.json")]) == 2
+
+
+def test_cli_compare_at_table_points(tmp_path, capsys):
+    png = tmp_path / "fig6b.png"
+    table = ROOT / "data" / "paper_table1.csv"
+    assert main(["trace", str(DEFAULT), "--format", "float18", "--compare", "--at", str(table),
+                 "--json", "--plot", str(png)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert set(d["trace"]) == {"float18", "fixed"} and set(d["at"]) == {"float18", "fixed"}
+    rec = read_recordings(table)
+    model = load_model(DEFAULT)
+    for fmt, rows in d["at"].items():
+        assert len(rows) == len(rec.voltage_v)
+        for row in rows:
+            # golden at the clamped nearest code, recomputed here from the model file
+            v = row["code"] * derive_spec(model).input_lsb_v
+            assert abs(row["golden_mm"] - float(model.predict([v])[0])) < 1e-9
+            assert abs(row["error_mm"] - (row["hardware_mm"] - row["golden_mm"])) < 1e-12
+    # float18 (12-bit significand) is coarser than the fixed design sized for 1 output LSB
+    assert d["trace"]["float18"]["total"]["rms_mm"] > d["trace"]["fixed"]["total"]["rms_mm"]
+    assert png.read_bytes()[:4] == b"\x89PNG"

@@ -120,7 +120,7 @@ def stages_fixed(spec, codes=None) -> Stages:
         step_cols=step_cols, h_out=t.adder["out"].astype(float) * q, start_stage="linear",
         info=dict(table_addr_bits=spec.table_addr_bits, interp=spec.interp, phase_bits=spec.phase_bits,
                   term_frac_bits=Tf, weight_frac_bits=Wf, product_frac_bits=Pf, output_lsb_mm=q,
-                  lanes=L),
+                  lanes=L, input_lsb_v=spec.input_lsb_v),
     )
 
 
@@ -149,7 +149,8 @@ def stages_float18(fspec, codes=None) -> Stages:
         h_start=np.full(codes.size, float(fmt.decode(fspec.start_code))), h_running=dec(t.running),
         step_cols=[[i] for i in range(N)], h_out=dec(t.out), start_stage="weights",
         info=dict(table_addr_bits=base.table_addr_bits, interp=base.interp, phase_bits=base.phase_bits,
-                  term_frac_bits=Tf, sig_bits=fmt.sig_bits, format=fmt.describe()),
+                  term_frac_bits=Tf, sig_bits=fmt.sig_bits, format=fmt.describe(),
+                  input_lsb_v=base.input_lsb_v),
     )
 
 
@@ -225,7 +226,24 @@ class TraceResult:
     dominant: dict               # {stage, term, label, span, reason}
     curves: dict = field(repr=False, default_factory=dict)   # for plotting
     volts: np.ndarray = field(repr=False, default=None)
+    codes: np.ndarray = field(repr=False, default=None)
+    golden_mm: np.ndarray = field(repr=False, default=None)
+    hardware_mm: np.ndarray = field(repr=False, default=None)
     identity_residual_mm: float = 0.0
+    input_lsb_v: float = 0.0
+
+    def at_voltages(self, voltages) -> list[dict]:
+        """Golden, hardware and error at the (clamped) input codes nearest to ``voltages``."""
+        rows = []
+        pos = {int(c): k for k, c in enumerate(self.codes)}
+        for v in np.asarray(voltages, dtype=float):
+            # the nearest code, clamped as the hardware clamps its input
+            c = int(np.clip(np.rint(v / self.input_lsb_v), self.codes.min(), self.codes.max()))
+            k = pos[c]
+            rows.append({"voltage_v": float(v), "code": c, "golden_mm": float(self.golden_mm[k]),
+                         "hardware_mm": float(self.hardware_mm[k]),
+                         "error_mm": float(self.hardware_mm[k] - self.golden_mm[k])})
+        return rows
 
     def to_dict(self) -> dict:
         return {"format": self.fmt, "codes": self.n_codes, "total": self.total,
@@ -289,7 +307,9 @@ def trace(st: Stages, top_n: int = 10) -> TraceResult:
     total = {"max_mm": float(e_abs.max()), "rms_mm": _rms(err), "peak_v": float(volts[int(np.argmax(e_abs))]),
              "span": _span(volts, err)}
     return TraceResult(fmt=st.fmt, n_codes=int(ok.sum()), total=total, stages=stages, terms=terms,
-                       dominant=dom_d, curves=curves, volts=volts, identity_residual_mm=resid)
+                       dominant=dom_d, curves=curves, volts=volts, codes=st.codes[ok],
+                       golden_mm=st.g_out[ok], hardware_mm=st.h_out[ok], identity_residual_mm=resid,
+                       input_lsb_v=float(st.info["input_lsb_v"]))
 
 
 def _reason(st: Stages, src: Source, ok: np.ndarray) -> str:
@@ -411,6 +431,33 @@ def plot_trace(result: TraceResult, path, title: str = "") -> None:
     plt.close(fig)
 
 
+def plot_compare(results: dict, path, points: dict | None = None, title: str = "") -> None:
+    """Total error (hardware - golden) of several formats on the same axes, as the seed's
+    Fig. 6(b); ``points``: {fmt: at_voltages() rows} drawn as markers."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colours = {"float18": "tab:red", "fixed": "tab:blue"}
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for fmt, r in results.items():
+        o = np.argsort(r.volts)
+        ax.plot(r.volts[o], r.curves["total"][o], lw=0.6, color=colours.get(fmt), alpha=0.8,
+                label=f"{fmt}: every input code (max {r.total['max_mm']:.3g} mm, rms {r.total['rms_mm']:.2g} mm)")
+    for fmt, rows in (points or {}).items():
+        ax.plot([p["voltage_v"] for p in rows], [p["error_mm"] for p in rows], "o", ms=5,
+                color=colours.get(fmt), markeredgecolor="k", label=f"{fmt}: Table 1 inputs")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xlabel("input (V)")
+    ax.set_ylabel("hardware − golden model (mm)")
+    ax.set_title(title or "error between hardware and golden model")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center")
+    fig.tight_layout()
+    _save_fig(fig, path)
+    plt.close(fig)
+
+
 def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options) -> TraceResult:
     if fmt == "fixed":
         from .spec import derive_spec
@@ -424,4 +471,4 @@ def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options)
 
 
 __all__ = ["Stages", "Source", "TraceResult", "STAGES", "attribute", "trace", "stages_fixed",
-           "stages_float18", "plot_trace", "run_trace", "term_label"]
+           "stages_float18", "plot_trace", "plot_compare", "run_trace", "term_label"]

@@ -2,6 +2,8 @@
 
 Stage-by-stage error of the bit-true hardware against the float64 golden model over every
 input code: which block and which term contribute most, over which input span, and why.
+``--compare`` adds the other format (errors of both on the same axes, as the seed's
+Fig. 6(b)); ``--at CSV`` also lists the error at the recordings' input voltages.
 """
 
 from __future__ import annotations
@@ -9,35 +11,72 @@ from __future__ import annotations
 import json
 
 from ..model import load_model
-from ..trace import plot_trace, run_trace
+from ..recordings import read_recordings
+from ..trace import plot_compare, plot_trace, run_trace
 from .gen import add_spec_arguments, spec_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
+FORMATS = ("fixed", "float18")
+_FIXED_ONLY = ("output_bits", "output_lsb_mm", "weight_frac_bits", "product_frac_bits", "mult_style", "lanes")
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("model", help="model.json (flann-model/1)")
-    parser.add_argument("--format", choices=("fixed", "float18"), default="fixed",
+    parser.add_argument("--format", choices=FORMATS, default="fixed",
                         help="number format of the datapath (default %(default)s)")
+    parser.add_argument("--compare", action="store_true",
+                        help="also trace the other format; --plot then shows both errors on one axis")
+    parser.add_argument("--at", metavar="CSV", help="also report the error at these recordings' voltages")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--plot", metavar="OUT.png", help="plot error per stage vs input voltage")
     add_spec_arguments(parser)
 
 
+def _options(args, fmt: str) -> dict:
+    opts = spec_options(args)
+    if fmt == "float18":
+        # fixed-only options are an error when given explicitly for float18 alone
+        defaults = {"mult_style": "lut", "lanes": 1}
+        drop = args.compare and args.format == "fixed"
+        opts = {k: v for k, v in opts.items()
+                if k not in _FIXED_ONLY or (v not in (None, defaults.get(k)) and not drop)}
+    return opts
+
+
 def run(args) -> int:
     model = load_model(args.model)
-    opts = spec_options(args)
-    if args.format == "float18":
-        opts = {k: v for k, v in opts.items()
-                if k not in ("output_bits", "output_lsb_mm", "weight_frac_bits", "product_frac_bits",
-                             "mult_style") or v not in (None, "lut")}
-    result = run_trace(model, args.format, **opts)
+    fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
+    results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
+    points = None
+    if args.at:
+        rec = read_recordings(args.at)
+        points = {f: r.at_voltages(rec.voltage_v) for f, r in results.items()}
     if args.plot:
-        plot_trace(result, args.plot, title=f"flann trace {args.model} ({args.format})")
+        if args.compare:
+            plot_compare(results, args.plot, points, title=f"hardware − golden: {args.model}")
+        else:
+            plot_trace(results[args.format], args.plot, title=f"flann trace {args.model} ({args.format})")
     if args.json:
-        print(json.dumps(result.to_dict(), indent=2))
-    else:
-        print(result.text())
-        if args.plot:
-            print(f"plot: {args.plot}")
+        out = {f: r.to_dict() for f, r in results.items()} if args.compare else results[args.format].to_dict()
+        if points:
+            out = {"trace": out, "at": points}
+        print(json.dumps(out, indent=2))
+        return 0
+    for f, r in results.items():
+        print(r.text())
+        print()
+    if points:
+        print(f"at the input voltages of {args.at} (nearest input code):")
+        head = f"{'V':>8} {'code':>6} {'golden mm':>10}" + "".join(f" {f + ' err mm':>16}" for f in points)
+        print(head)
+        first = next(iter(points.values()))
+        for k, row in enumerate(first):
+            line = f"{row['voltage_v']:>8.3f} {row['code']:>6d} {row['golden_mm']:>10.4f}"
+            line += "".join(f" {points[f][k]['error_mm']:>16.4f}" for f in points)
+            print(line)
+        for f, rows in points.items():
+            m = max(abs(r["error_mm"]) for r in rows)
+            print(f"  {f}: max |error| at these points {m:.4f} mm")
+    if args.plot:
+        print(f"plot: {args.plot}")
     return 0
