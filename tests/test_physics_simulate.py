@@ -143,3 +143,17 @@ def test_fit_scales_to_a_miniature_sensor():
     assert fit.rms_v < 1e-3
     assert fit.values["demodulator_gain_ratio"] < 0
     assert fit.values["secondary_gap_mm"] == pytest.approx(0.5, abs=0.1)
+
+
+def test_fold_back_warning_beyond_the_output_peak(tmp_path, capsys):
+    from flann.physics.simulate import fold_back_mm
+
+    s = default_sensor()
+    x = np.linspace(0, 60, 6001)
+    peak = x[np.argmax(ideal_output_v(s, x))]          # independent: the output maximum
+    assert fold_back_mm(s, (-60.0, 60.0)) == pytest.approx(peak, abs=0.1)
+    assert fold_back_mm(s, (-0.8 * peak, 0.8 * peak)) is None
+    out = tmp_path / "r.csv"
+    assert main(["simulate", "-o", str(out), "--from-mm", "-60", "--to-mm", "60"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: travel -60..60 mm goes past" in err and out.exists()

@@ -66,7 +66,9 @@ def run(args) -> int:
     for opt in ("params", "write_sensor", "json"):
         if getattr(args, opt):
             raise FlannError(f"simulate: --{opt.replace('_', '-')} needs --fit")
-    from ..physics.simulate import simulate_recordings
+    import warnings
+
+    from ..physics.simulate import fold_back_mm, simulate_recordings
 
     s = _sensor(args)
     if args.no_effects:
@@ -75,7 +77,11 @@ def run(args) -> int:
     hi = s.stroke_mm if args.to_mm is None else args.to_mm
     rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
                               seed=args.seed, temperature_profile=args.temperature_profile,
-                              travel_mm=(lo, hi), step_time_s=args.step_time_s)
+                              travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=True)
+    fold = fold_back_mm(s, (lo, hi))
+    if fold is not None:
+        warnings.warn(f"travel {lo:g}..{hi:g} mm goes past |x| = {fold:.1f} mm where the output "
+                      "folds back (core end leaving a secondary)")
     effects = "; ".join(f"{n}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
                         for n, p in s.effects.items()) or "none"
     comments = (

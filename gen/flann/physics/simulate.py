@@ -16,11 +16,14 @@ Public API (stable):
   :class:`flann.recordings.Recordings` with direction, time_s and temperature_c columns,
   reproducible from ``seed``.
 * :func:`parse_temperature_profile` ("20", "const:20", "ramp:20:45", "sine:25:5:600").
+* :func:`fold_back_mm` (sensor, travel) -> the first |displacement| in the travel beyond which
+  the ideal output stops rising (the core leaving the secondaries), or None.
 """
 
 from __future__ import annotations
 
 import math
+import sys
 from typing import Callable
 
 import numpy as np
@@ -174,10 +177,14 @@ def sweep_positions(travel_mm: tuple[float, float], step_mm: float,
     return np.concatenate(pos), np.concatenate(dirs)
 
 
+MAX_SAMPLES = 10_000_000
+_CHUNK = 200_000
+
+
 def simulate_recordings(s: Sensor, sweeps: int = 1, step_mm: float = 1.0, noise_v: float = 0.0,
                         seed: int = 0, temperature_profile=None,
                         travel_mm: tuple[float, float] | None = None,
-                        step_time_s: float = 1.0) -> Recordings:
+                        step_time_s: float = 1.0, progress: bool = False) -> Recordings:
     """Bench recordings: forward and reverse sweeps over ``travel_mm`` (default the rated
     stroke), every enabled effect, white Gaussian noise of ``noise_v`` (V rms) added before
     the ADC, reproducible from ``seed``.  ``temperature_profile`` is a spec string (see
@@ -187,15 +194,37 @@ def simulate_recordings(s: Sensor, sweeps: int = 1, step_mm: float = 1.0, noise_
     if not math.isfinite(step_time_s) or step_time_s <= 0:
         raise FlannError(f"step time {step_time_s:g} s: must be > 0")
     travel = travel_mm if travel_mm is not None else (-s.stroke_mm, s.stroke_mm)
+    per_pass = math.floor((travel[1] - travel[0]) / step_mm + 1e-9) + 1 if step_mm > 0 else 0
+    if per_pass * 2 * sweeps > MAX_SAMPLES:
+        raise FlannError(f"{sweeps} sweeps of {per_pass} steps is more than {MAX_SAMPLES} samples")
     x, d = sweep_positions(travel, step_mm, sweeps)
     t = step_time_s * np.arange(x.size, dtype=float)
     profile = (temperature_profile if callable(temperature_profile)
                else parse_temperature_profile(temperature_profile))
     temp = np.asarray(profile(t, float(t[-1])), dtype=float)
-    y = simulate_output_v(s, x, direction=d, temperature_c=temp, time_s=t)
+    y = np.empty(x.size)
+    for start in range(0, x.size, _CHUNK):
+        sl = slice(start, start + _CHUNK)
+        y[sl] = simulate_output_v(s, x[sl], direction=d[sl], temperature_c=temp[sl], time_s=t[sl])
+        if progress and x.size > _CHUNK:
+            print(f"simulate: {min(start + _CHUNK, x.size)}/{x.size} samples", file=sys.stderr)
     rng = np.random.default_rng(seed)
     if noise_v > 0:
         y = y + rng.normal(0.0, noise_v, size=y.shape)
     y = adc_convert(s, y)
     return Recordings(displacement_mm=x, voltage_v=y, direction=d, time_s=t, temperature_c=temp,
                       source=f"simulate:{s.name}")
+
+
+def fold_back_mm(s: Sensor, travel_mm: tuple[float, float], n: int = 2001) -> float | None:
+    """Smallest |x| in the travel where the ideal output stops being monotonic (its slope
+    changes sign relative to the null slope), or None if it is monotonic throughout."""
+    x = np.linspace(travel_mm[0], travel_mm[1], n)
+    y = simulate_output_v(s.without_effects(), x)
+    slope = np.diff(y)
+    sign = np.sign(np.median(slope)) or 1.0
+    bad = slope * sign <= 0
+    if not bad.any():
+        return None
+    mids = 0.5 * (x[1:] + x[:-1])
+    return float(np.min(np.abs(mids[bad])))
