@@ -7,7 +7,7 @@ import pytest
 
 from flann.errors import FlannError, RecordingsError
 from flann.paper import s_curve
-from flann.train import (_design, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
+from flann.train import (design_matrix, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
                          lms_epochs, lms_leave_one_out, lms_sequential,
                          normalisation)
 
@@ -79,7 +79,7 @@ def test_lms_diverges_with_a_clear_error():
 def test_fast_lms_equals_the_literal_sample_by_sample_loop():
     v = np.array([-5.185, -2.896, 0.001, 1.810, 4.799, 5.276])
     x = np.array([-30.0, -10.0, 0.0, 10.0, 20.0, 30.0])
-    S = _design(v, 11)
+    S = design_matrix(v, 11)
     w_fast, mse_fast = lms_epochs(S, x, 0.02, 200)
     w_ref, mse_ref = lms_sequential(S, x, 0.02, 200)
     np.testing.assert_allclose(w_fast, w_ref, rtol=1e-9, atol=1e-9)
@@ -89,7 +89,7 @@ def test_fast_lms_equals_the_literal_sample_by_sample_loop():
 def test_batched_leave_one_out_equals_separate_runs():
     v = np.array([-2.0, -1.1, 0.2, 0.9, 2.3])
     x = np.array([-3.0, -1.0, 0.5, 1.0, 3.5])
-    S = _design(v / 2.3, 5)
+    S = design_matrix(v / 2.3, 5)
     pred = lms_leave_one_out(S, x, 0.05, 40)
     for i in range(v.size):
         keep = np.arange(v.size) != i

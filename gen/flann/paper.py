@@ -20,7 +20,7 @@ from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, ful
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
 from .recordings import Recordings
-from .train import _design, fit_auto, fit_lms, lms_leave_one_out
+from .train import design_matrix, fit_auto, fit_lms, lms_leave_one_out
 
 # The paper's Table 1 (also in data/paper_table1.csv, checked equal by the tests).
 TABLE1_DISPLACEMENT_MM = np.arange(-30.0, 30.0 + 1, 5.0)
@@ -50,7 +50,7 @@ def loo_errors(rec: Recordings, terms: int, eta: float = DEFAULT_ETA,
                epochs: int = DEFAULT_EPOCHS, offset_scale=(0.0, 1.0)) -> np.ndarray:
     """Leave-one-out error (mm) at every point, same method as :func:`paper_model`."""
     off, scale = offset_scale
-    S = _design((rec.voltage_v - off) / scale, terms)
+    S = design_matrix((rec.voltage_v - off) / scale, terms)
     return lms_leave_one_out(S, rec.displacement_mm, eta, epochs) - rec.displacement_mm
 
 
@@ -237,7 +237,7 @@ def sensitivity(rec: Recordings | None = None, etas=(0.005, 0.01, 0.02, 0.03),
     fs = full_scale_mm(x)
     out = {}
     for terms in terms_list:
-        S = _design(v, terms)
+        S = design_matrix(v, terms)
         for eta in etas:
             w, done = None, 0
             for ep in sorted(epochs_list):

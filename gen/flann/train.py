@@ -57,7 +57,7 @@ def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
     raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)}, got {kind!r}")
 
 
-def _design(v_n: np.ndarray, terms: int) -> np.ndarray:
+def design_matrix(v_n: np.ndarray, terms: int) -> np.ndarray:
     """[1, phi_0 .. phi_{terms-1}]: the bias column first."""
     return np.hstack([np.ones((v_n.size, 1)), expand(v_n, terms)])
 
@@ -117,8 +117,8 @@ def fit_lstsq(voltage_v, displacement_mm, terms: int, *, norm: str = "range",
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
-    coef = solve_lstsq(_design((v - offset) / scale, terms), x, ridge)
-    resid = x - (_design((v - offset) / scale, terms) @ coef)
+    coef = solve_lstsq(design_matrix((v - offset) / scale, terms), x, ridge)
+    resid = x - (design_matrix((v - offset) / scale, terms) @ coef)
     vr, xr = _ranges(v, x)
     info = {"method": "lstsq", "ridge": float(ridge),
             "normalisation": norm if offset_scale is None else "explicit",
@@ -235,7 +235,7 @@ def fit_lms(voltage_v, displacement_mm, terms: int, *, eta: float, epochs: int,
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
-    S = _design((v - offset) / scale, terms)
+    S = design_matrix((v - offset) / scale, terms)
     w, mse = lms_epochs(S, x, eta, epochs)
     resid = x - S @ w
     vr, xr = _ranges(v, x)
@@ -291,7 +291,7 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORM
     results = []
     for norm in norms:
         offset, scale = normalisation(v, norm)
-        full = _design((v - offset) / scale, max(terms_list))
+        full = design_matrix((v - offset) / scale, max(terms_list))
         errs = {(t, r): np.empty(v.size) * np.nan for t in terms_list for r in ridges}
         for held in folds:
             train = np.ones(v.size, bool)

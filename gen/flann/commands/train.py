@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
@@ -60,7 +61,7 @@ def run(args) -> int:
         if args.normalise is not None:
             raise FlannError("give either --normalise or --input-offset-v/--input-scale-v")
         explicit = (args.input_offset_v, args.input_scale_v)
-    provenance = {"data_file": args.recordings.replace("\\", "/").rsplit("/", 1)[-1],
+    provenance = {"data_file": Path(args.recordings).name,
                   "data_sha256": rec.sha256}
     if rec.comments:
         provenance["data_provenance"] = rec.comments[0]
