@@ -157,3 +157,19 @@ def test_fold_back_warning_beyond_the_output_peak(tmp_path, capsys):
     assert main(["simulate", "-o", str(out), "--from-mm", "-60", "--to-mm", "60"]) == 0
     err = capsys.readouterr().err
     assert "warning: travel -60..60 mm goes past" in err and out.exists()
+
+
+def test_cli_lists_effects(capsys):
+    from flann.physics.effects import EFFECTS
+
+    assert main(["simulate", "--list-effects"]) == 0
+    out = capsys.readouterr().out
+    for name, e in EFFECTS.items():
+        assert f"[effects.{name}]" in out
+        for p in e.params:
+            assert f"{p.name} = " in out
+
+
+def test_sensor_hashable_and_effects_distinguish():
+    s = default_sensor()
+    assert len({s, s.replace(), s.with_effect("backlash"), s.with_effect("backlash", deadband_mm=0.3)}) == 3

@@ -42,6 +42,8 @@ def add_arguments(p) -> None:
                    help="ignore the sensor file's [effects] (ideal sensor)")
     p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
                                   "(with --fit: calibration and residuals)")
+    p.add_argument("--list-effects", action="store_true",
+                   help="print the catalogue of non-ideal effects ([effects.NAME] tables) and exit")
     p.add_argument("--fit", metavar="RECORDINGS", default=None,
                    help="calibrate the unknown geometry of the sensor to these recordings")
     p.add_argument("--params", default=None,
@@ -58,7 +60,21 @@ def _sensor(args):
     return load_sensor(args.sensor) if args.sensor else default_sensor()
 
 
+def _list_effects() -> int:
+    from ..physics.effects import EFFECTS
+
+    for e in EFFECTS.values():
+        print(f"[effects.{e.name}]  ({e.stage} stage) {e.description}")
+        print(f"    {e.formula}")
+        for p in e.params:
+            print(f"    {p.name} = {p.default:g}   # {p.description}; {p.unit}, "
+                  f"range {p.lower:g}..{p.upper:g}, no effect at {p.neutral:g}")
+    return 0
+
+
 def run(args) -> int:
+    if args.list_effects:
+        return _list_effects()
     if args.fit:
         return _run_fit(args)
     if not args.output:

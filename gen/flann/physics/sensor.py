@@ -167,6 +167,12 @@ class Sensor:
                                    for k, v in dict(self.effects).items()})
         object.__setattr__(self, "effects", frozen)
 
+    def __hash__(self) -> int:  # effects is a mapping: hash its items
+        fields = tuple(getattr(self, f.name) for f in dataclasses.fields(self)
+                       if f.compare and f.name != "effects")
+        effects = tuple((k, tuple(sorted(v.items()))) for k, v in sorted(self.effects.items()))
+        return hash((fields, effects))
+
     # -- convenience -----------------------------------------------------------------
     def replace(self, **changes: Any) -> "Sensor":
         """Copy with ``changes`` applied (validated; raises SensorError on bad values)."""
