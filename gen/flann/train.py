@@ -288,11 +288,12 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORM
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     folds = cv_folds(v, k)
+    held_all = np.sort(np.concatenate(folds))
     results = []
     for norm in norms:
         offset, scale = normalisation(v, norm)
         full = design_matrix((v - offset) / scale, max(terms_list))
-        errs = {(t, r): np.empty(v.size) * np.nan for t in terms_list for r in ridges}
+        errs = {(t, r): np.full(v.size, np.nan) for t in terms_list for r in ridges}
         for held in folds:
             train = np.ones(v.size, bool)
             train[held] = False
@@ -305,7 +306,10 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORM
                     coef = solve_lstsq(R[:, : t + 1], z, r, samples=n_train)
                     errs[(t, r)][held] = B @ coef - x[held]
         for (t, r), e in errs.items():
-            e = e[np.isfinite(e)]
+            e = e[held_all]
+            if not np.all(np.isfinite(e)):   # numerically broken candidate: never chosen
+                results.append(CvResult(t, norm, r, math.inf, math.inf))
+                continue
             results.append(CvResult(t, norm, r, float(np.sqrt(np.mean(e**2))),
                                     float(np.max(np.abs(e)))))
     return results
