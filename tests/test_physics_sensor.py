@@ -117,3 +117,10 @@ def test_optional_core_conductivity():
     assert parse_sensor(format_sensor(s)) == s
     with pytest.raises(SensorError, match="core.conductivity_s_per_m = -1"):
         parse_sensor(text.replace("1.7e6", "-1.0"))
+
+
+def test_section_given_as_value_is_refused(tmp_path, capsys):
+    path = tmp_path / "flat.toml"
+    path.write_text('format = "flann-sensor/1"\nstroke_mm = 30.0\ncore = 5\n')
+    assert main(["simulate", str(path), "-o", str(tmp_path / "r.csv")]) == 2
+    assert "core must be a table" in capsys.readouterr().err

@@ -290,6 +290,8 @@ def sensor_from_dict(doc: Mapping[str, Any], source: str = "<memory>") -> Sensor
             continue
         if ("", key) in _STRING_KEYS:
             continue
+        if key in known_sections:
+            raise _bad(source, f"{key} must be a table ([{key}] ...), got {val!r}")
         if key not in _SCHEMA[""]:
             raise _bad(source, _unknown_key_msg("", key))
     for section, keys in _SCHEMA.items():
