@@ -8,7 +8,8 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
-from ..train import NORMALISATIONS, PAPER_TERMS, check_fit_input, fit_auto, fit_lms, fit_lstsq
+from ..train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+                     fit_lms, fit_lstsq)
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -47,6 +48,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="explicit normalisation scale (V); needs --input-offset-v")
     p.add_argument("--trim", action="store_true",
                    help="keep only the monotonic span when the voltage folds back")
+
+
+def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
+    """'; held-out ...' from the same cross-validation as auto (printed, not stored)."""
+    if explicit is not None or len(rec) < 4:
+        return ""
+    (res,) = cross_validate(rec.voltage_v, rec.displacement_mm, (terms,), (norm,), (ridge,))
+    return (f"; held-out (cross-validation): RMS {res.rms_mm:.4g} mm, "
+            f"max {res.max_mm:.4g} mm")
 
 
 def run(args) -> int:
@@ -88,7 +98,7 @@ def run(args) -> int:
             model = fit_lstsq(rec.voltage_v, rec.displacement_mm, args.terms, norm=norm,
                               offset_scale=explicit, ridge=args.ridge, training=provenance)
             print(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
-                  f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)",
-                  file=sys.stderr)
+                  f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
+                  + _heldout_text(rec, args.terms, norm, args.ridge, explicit), file=sys.stderr)
     model.save(args.output)
     return 0
