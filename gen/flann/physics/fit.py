@@ -110,7 +110,7 @@ class FitResult:
         lines.append(f"rms residual = {self.rms_v * 1e3:.1f} mV over {int(self.used.sum())} points")
         if math.isfinite(self.asymmetry_floor_v):
             lines.append(f"even part of the data (y(x) + y(-x))/2: rms {self.asymmetry_floor_v * 1e3:.1f} mV "
-                         "-- no symmetric sensor can fit it")
+                         "(asymmetry and noise: the floor for any symmetric sensor model)")
         return lines
 
 
