@@ -173,3 +173,26 @@ def test_cli_lists_effects(capsys):
 def test_sensor_hashable_and_effects_distinguish():
     s = default_sensor()
     assert len({s, s.replace(), s.with_effect("backlash"), s.with_effect("backlash", deadband_mm=0.3)}) == 3
+
+
+def test_describe_figures(capsys):
+    import math as m
+
+    from flann.physics.lvdt import describe, inductances_h
+
+    s = default_sensor()
+    d = describe(s)
+    lp = inductances_h(s, [0.0])[2][0]
+    w = 2 * m.pi * s.excitation_frequency_hz
+    assert d["primary_current_ma_peak"] == pytest.approx(
+        1e3 * 5.0 / m.hypot(s.primary_resistance_ohm, w * lp), rel=1e-9)
+    assert 0 < d["core_peak_flux_density_mt"] < 1000            # far from saturation
+    # decay length from the per-unit-length constants written out by hand
+    mu0 = 4e-7 * m.pi
+    a_core = m.pi / 4 * (5.0**2 - 4.4**2) * 1e-6
+    a_air = m.pi * ((6.0 + 14.0) / 4 * 1e-3) ** 2
+    r = 1 / (mu0 * (220 * a_core + a_air - a_core))
+    g = 2 * m.pi * mu0 / m.log(20.0 / 5.0)
+    assert d["core_decay_length_mm"] == pytest.approx(1e3 / m.sqrt(r * g), rel=1e-9)
+    assert main(["simulate", "--describe"]) == 0
+    assert "output_fold_back_mm = 30" in capsys.readouterr().out

@@ -42,6 +42,9 @@ def add_arguments(p) -> None:
                    help="ignore the sensor file's [effects] (ideal sensor)")
     p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
                                   "(with --fit: calibration and residuals)")
+    p.add_argument("--describe", action="store_true",
+                   help="print derived quantities of the sensor (slope, currents, flux density, "
+                        "fold-back, copper thermal coefficient) and exit")
     p.add_argument("--list-effects", action="store_true",
                    help="print the catalogue of non-ideal effects ([effects.NAME] tables) and exit")
     p.add_argument("--fit", metavar="RECORDINGS", default=None,
@@ -72,9 +75,27 @@ def _list_effects() -> int:
     return 0
 
 
+def _describe(args) -> int:
+    from ..physics.effects import thermal_coefficient_from_copper
+    from ..physics.lvdt import describe
+    from ..physics.simulate import fold_back_mm
+
+    s = _sensor(args)
+    print(f"{s.name}: {s.description}" if s.description else s.name)
+    for k, v in describe(s).items():
+        print(f"  {k} = {v:.4g}")
+    fold = fold_back_mm(s, (-3 * s.stroke_mm, 3 * s.stroke_mm), n=4001)
+    print(f"  output_fold_back_mm = {fold:.4g}" if fold is not None else
+          "  output_fold_back_mm = none within 3 x stroke")
+    print(f"  copper_thermal_coefficient_per_c = {thermal_coefficient_from_copper(s):.3g}")
+    return 0
+
+
 def run(args) -> int:
     if args.list_effects:
         return _list_effects()
+    if args.describe:
+        return _describe(args)
     if args.fit:
         return _run_fit(args)
     if not args.output:

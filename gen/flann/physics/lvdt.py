@@ -407,3 +407,25 @@ def flux_profile(s: Sensor, core_position_mm: float, z_mm) -> np.ndarray:
         d = z[m] - b[i]
         out[m] = (src[i] / r[i] + (alpha * np.exp(-k * d) - beta * np.exp(-k * (length - d))) / z0)
     return out
+
+
+def describe(s: Sensor) -> dict[str, float]:
+    """Derived quantities of the ideal sensor at null (for ``flann simulate --describe``)."""
+    mg = magnetics(s)
+    m1, _m2, lp = (v[0] for v in inductances_h(s, np.zeros(1)))
+    ip = primary_current_a(s, lp)
+    half = s.coil_span_mm / 2 + s.core_length_mm
+    z = np.linspace(-half, half, 2001)
+    phi = np.abs(flux_profile(s, 0.0, z))
+    a_core = math.pi / 4 * (s.core_outer_diameter_mm ** 2 - s.core_inner_diameter_mm ** 2) * 1e-6
+    mu = core_permeability_eff(s)
+    return {
+        "null_slope_v_per_mm": null_slope_v_per_mm(s),
+        "primary_inductance_h": float(abs(lp)),
+        "primary_current_ma_peak": float(abs(ip) * 1e3),
+        "secondary_emf_v_peak_at_null": float(abs(s.omega_rad_s * m1 * ip)),
+        "core_peak_flux_density_mt": float(phi.max() * abs(ip) / a_core * 1e3),
+        "core_decay_length_mm": float(1e3 / np.abs(np.sqrt(complex(mg.r_core) * mg.g_leak))),
+        "core_permeability_eff_abs": float(abs(mu)),
+        "core_permeability_eff_phase_deg": float(np.degrees(np.angle(mu))),
+    }

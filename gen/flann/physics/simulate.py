@@ -222,7 +222,8 @@ def fold_back_mm(s: Sensor, travel_mm: tuple[float, float], n: int = 2001) -> fl
     x = np.linspace(travel_mm[0], travel_mm[1], n)
     y = simulate_output_v(s.without_effects(), x)
     slope = np.diff(y)
-    sign = np.sign(np.median(slope)) or 1.0
+    centre = int(np.argmin(np.abs(0.5 * (x[1:] + x[:-1]))))   # the slope nearest the null
+    sign = np.sign(slope[centre]) or 1.0
     bad = slope * sign <= 0
     if not bad.any():
         return None
