@@ -48,8 +48,9 @@ def run(args) -> int:
         results = run_demo(progress=_progress(args.quiet), limits=args.limits)
         if args.json:
             obj = [r.to_json() for r in results.cases]
-            if results.limits:
-                obj = {"cases": obj, "detection_limits": results.limits}
+            if results.limits or results.alarms:
+                obj = {"cases": obj, "false_alarms": results.alarms,
+                       "detection_limits": results.limits}
             if args.json == "-":
                 print(json.dumps(obj, indent=2))
             else:

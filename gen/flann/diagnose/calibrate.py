@@ -113,67 +113,18 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
     shape = None
     if not geometry_known:
         fields = GEOMETRY_FIELDS
-        g = np.array([getattr(s, f) for f in fields], dtype=float)
-        lam = 1e-2
-        for it in range(MAX_ITER):
-            base = s.replace(demodulator_gain_ratio=gain)
-            u = x - origin
-            f0 = ideal_output_v(base, u)
-            r = y - f0
-            w = _huber_weights(r)
-            cost = float(np.sum(w * r * r))
-            h = 0.01
-            dfdx = (ideal_output_v(base, u + h) - ideal_output_v(base, u - h)) / (2 * h)
-            cols = [f0 / gain, -dfdx] if origin_free else [f0 / gain]
-            steps = []
-            for j, name in enumerate(fields):
-                d = _STEP[name] * g[j]
-                trial = _with_geometry(base, fields, g + d * np.eye(len(fields))[j])
-                tables += 1
-                if trial is None:
-                    cols.append(np.zeros_like(f0))
-                else:
-                    cols.append((ideal_output_v(trial, u) - f0) / d)
-                steps.append(d)
-            J = np.stack(cols, 1)
-            sw = np.sqrt(w)
-            Jw, rw = J * sw[:, None], r * sw
-            A = Jw.T @ Jw
-            b = Jw.T @ rw
-            improved = False
-            for _attempt in range(4):
-                M = A + lam * np.diag(np.diag(A) + 1e-30)
-                try:
-                    delta = np.linalg.solve(M, b)
-                except np.linalg.LinAlgError:
-                    lam *= 10
-                    continue
-                dg = delta[-len(fields):]
-                # keep each geometry step within 30 % of the current value
-                scale = min(1.0, float(np.min(0.3 * g / np.maximum(np.abs(dg), 1e-30))))
-                g_new = np.clip(g + scale * dg, [_BOUNDS[f][0] for f in fields],
-                                [_BOUNDS[f][1] for f in fields])
-                trial = _with_geometry(s, fields, g_new)
-                if trial is None:
-                    lam *= 10
-                    continue
-                tables += 1
-                gn, on, _ = _solve_gain_origin(trial, x, y, w, gain, origin, origin_free,
-                                               origin_range)
-                rn = y - ideal_output_v(trial.replace(demodulator_gain_ratio=gn), x - on)
-                cost_new = float(np.sum(w * rn * rn))
-                if cost_new < cost:
-                    rel = (cost - cost_new) / max(cost, 1e-300)
-                    s, g, gain, origin = trial, g_new, gn, on
-                    lam = max(lam / 5, 1e-6)
-                    improved = True
-                    break
-                lam *= 8
-            if progress:
-                progress(f"calibrating geometry: iteration {it + 1}, "
-                         f"rms {math.sqrt(np.mean(r * r)) * 1e3:.3g} mV")
-            if not improved or rel < 1e-5:
-                break
+        best = None
+        for g_start in _grid_starts(s, x, y, origin, fields):
+            trial = _with_geometry(s, fields, g_start)
+            if trial is None:
+                continue
+            gn, on, _ = _solve_gain_origin(trial, x, y, np.ones_like(y), gain, origin,
+                                           origin_free, origin_range)
+            out = _gauss_newton(trial, fields, x, y, gn, on, origin_free, origin_range, progress)
+            if best is None or out[-1] < best[-1]:
+                best = out
+        s, g, gain, origin, tables_gn, _cost = best
+        tables += tables_gn
         # derivatives at the solution -> shape modes and geometry uncertainty
         base = s.replace(demodulator_gain_ratio=gain)
         u = x - origin
@@ -198,6 +149,111 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
     return Calibration(sensor=s.replace(demodulator_gain_ratio=gain), gain=gain,
                        origin_mm=origin, geometry=geometry, geometry_stderr=geo_err,
                        shape=shape, resid=resid, tables=tables)
+
+
+def _grid_starts(s, x, y, origin, fields, keep: int = 2):
+    """Coarse grid over the geometry (all lengths scaled to the recorded span, then each
+    varied), gain solved in closed form on <= 200 points; the ``keep`` best start the
+    Gauss-Newton refinement, together with the sensor's own geometry."""
+    order = np.argsort(x, kind="stable")
+    sub = order[np.unique(np.linspace(0, x.size - 1, min(x.size, 200)).astype(int))]
+    xs, ys = x[sub] - origin, y[sub]
+    g0 = np.array([getattr(s, f) for f in fields], dtype=float)
+    half = max(float(np.max(np.abs(xs))), 1e-3)
+    k0 = half / max(s.stroke_mm, 1e-3)
+    factors = {"primary_length_mm": (0.5, 1.0, 3.0, 8.0), "secondary_length_mm": (0.6, 1.0, 1.6),
+               "secondary_gap_mm": (0.3, 1.0, 2.5), "core_length_mm": (0.8, 1.0, 1.25)}
+    scored = []
+    s1 = s.replace(demodulator_gain_ratio=1.0)
+    for k in (0.7 * k0, k0, 1.5 * k0):
+        for fp in factors["primary_length_mm"]:
+            for fs in factors["secondary_length_mm"]:
+                for fg in factors["secondary_gap_mm"]:
+                    for fc in factors["core_length_mm"]:
+                        g = g0 * k * np.array([fp, fs, fg, fc])
+                        trial = _with_geometry(s1, fields, g)
+                        if trial is None:
+                            continue
+                        f = ideal_output_v(trial, xs)
+                        den = float(f @ f)
+                        if den <= 0:
+                            continue
+                        r = ys - f * float(f @ ys) / den
+                        scored.append((float(r @ r), tuple(g)))
+    scored.sort(key=lambda t: t[0])
+    starts = [np.array(g) for _c, g in scored[:keep]]
+    return [g0] + starts
+
+
+def _gauss_newton(s, fields, x, y, gain, origin, origin_free, origin_range, progress):
+    """Damped Gauss-Newton over the geometry fields (gain, origin solved at each trial)."""
+    g = np.array([getattr(s, f) for f in fields], dtype=float)
+    lam = 1e-2
+    tables = 0
+    rel = 1.0
+    cost = math.inf
+    for it in range(MAX_ITER):
+        base = s.replace(demodulator_gain_ratio=gain)
+        u = x - origin
+        f0 = ideal_output_v(base, u)
+        r = y - f0
+        w = _huber_weights(r)
+        cost = float(np.sum(w * r * r))
+        h = 0.01
+        dfdx = (ideal_output_v(base, u + h) - ideal_output_v(base, u - h)) / (2 * h)
+        cols = [f0 / gain, -dfdx] if origin_free else [f0 / gain]
+        steps = []
+        for j, name in enumerate(fields):
+            d = _STEP[name] * g[j]
+            trial = _with_geometry(base, fields, g + d * np.eye(len(fields))[j])
+            tables += 1
+            if trial is None:
+                cols.append(np.zeros_like(f0))
+            else:
+                cols.append((ideal_output_v(trial, u) - f0) / d)
+            steps.append(d)
+        J = np.stack(cols, 1)
+        sw = np.sqrt(w)
+        Jw, rw = J * sw[:, None], r * sw
+        A = Jw.T @ Jw
+        b = Jw.T @ rw
+        improved = False
+        for _attempt in range(4):
+            M = A + lam * np.diag(np.diag(A) + 1e-30)
+            try:
+                delta = np.linalg.solve(M, b)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            dg = delta[-len(fields):]
+            # keep each geometry step within 30 % of the current value
+            scale = min(1.0, float(np.min(0.3 * g / np.maximum(np.abs(dg), 1e-30))))
+            g_new = np.clip(g + scale * dg, [_BOUNDS[f][0] for f in fields],
+                            [_BOUNDS[f][1] for f in fields])
+            trial = _with_geometry(s, fields, g_new)
+            if trial is None:
+                lam *= 10
+                continue
+            tables += 1
+            gn, on, _ = _solve_gain_origin(trial, x, y, w, gain, origin, origin_free,
+                                           origin_range)
+            rn = y - ideal_output_v(trial.replace(demodulator_gain_ratio=gn), x - on)
+            cost_new = float(np.sum(w * rn * rn))
+            if cost_new < cost:
+                rel = (cost - cost_new) / max(cost, 1e-300)
+                s, g, gain, origin = trial, g_new, gn, on
+                lam = max(lam / 5, 1e-6)
+                improved = True
+                break
+            lam *= 8
+        if progress:
+            progress(f"calibrating geometry: iteration {it + 1}, "
+                     f"rms {math.sqrt(np.mean(r * r)) * 1e3:.3g} mV")
+        if not improved or rel < 1e-5:
+            break
+    base = s.replace(demodulator_gain_ratio=gain)
+    r = y - ideal_output_v(base, x - origin)
+    return s, g, gain, origin, tables, float(np.sum(_huber_weights(r) * r * r))
 
 
 def _with_geometry(s, fields, values):

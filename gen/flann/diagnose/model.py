@@ -190,6 +190,20 @@ class PhysicsFamily:
                 th[i] = float(np.clip(th[i], -self._CLIPPED[n], self._CLIPPED[n]))
         return th
 
+    @staticmethod
+    def _canonical(theta: np.ndarray, names: list[str]) -> np.ndarray:
+        """Same model, conventional parameters: a positive lead-screw amplitude, its phase
+        in (-pi, pi]."""
+        th = np.array(theta, dtype=float)
+        if "leadscrew_periodic.amplitude_mm" in names:
+            ia = names.index("leadscrew_periodic.amplitude_mm")
+            ip = names.index("leadscrew_periodic.phase_rad")
+            if th[ia] < 0:
+                th[ia] = -th[ia]
+                th[ip] += math.pi
+            th[ip] = math.pi - (math.pi - th[ip]) % (2 * math.pi)
+        return th
+
     def evaluate(self, theta: np.ndarray, names: list[str], idx: np.ndarray) -> np.ndarray:
         self.nfev += 1
         gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
@@ -273,12 +287,14 @@ class PhysicsFamily:
                 base_names = [n for n in names if n.startswith("baseline.")]
                 base_theta = theta[:len(base_names)]
                 resid = self.data_y(idx) - self.evaluate(base_theta, base_names, idx)
-            guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)))
+            want = {names[i].split(".", 1)[0] for i in missing}
+            guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)), want)
             for i in missing:
                 theta[i] = guesses.get(names[i], 0.0)
         return theta
 
-    def _guess(self, resid: np.ndarray, idx: np.ndarray, base: dict) -> dict[str, float]:
+    def _guess(self, resid: np.ndarray, idx: np.ndarray, base: dict,
+               want: set[str]) -> dict[str, float]:
         """Effect-specific starting values from the residual of the model without them."""
         d = self.data
         gain = base.get("baseline.gain_ratio", self.gain0)
@@ -299,7 +315,8 @@ class PhysicsFamily:
         g["adc_clipping.rail_v"] = ymax
         g["secondary_imbalance.imbalance_fraction"] = 0.0
         g["thermal_drift.coefficient_per_c"] = 0.0
-        g.update(self._guess_leadscrew(x, resid, slope))
+        if "leadscrew_periodic" in want:
+            g.update(self._guess_leadscrew(x, resid, slope))
         return g
 
     def _guess_leadscrew(self, x, resid, slope) -> dict[str, float]:
@@ -311,7 +328,10 @@ class PhysicsFamily:
         e = -resid[w] / slope[w]  # core error estimate: resid = slope * (core - x)
         lo = max(2.05 * self._typical_step(), 1e-3)
         hi = max(float(np.ptp(xe)) / 3, lo * 1.01)
-        periods = np.geomspace(lo, hi, 400)
+        # uniform frequency grid, 3x oversampled against the resolution 1/span
+        f_hi, f_lo = 1.0 / lo, 1.0 / hi
+        n_f = int(np.clip(3 * (f_hi - f_lo) * float(np.ptp(xe)), 50, 3000))
+        periods = 1.0 / np.linspace(f_lo, f_hi, n_f)
         e = e - np.mean(e)
         ph = 2 * np.pi * xe[None, :] / periods[:, None]
         c, sn = np.cos(ph), np.sin(ph)
@@ -347,7 +367,7 @@ class PhysicsFamily:
         except (ValueError, FloatingPointError):
             return Fit(effects, names, theta0, np.full(len(names), np.nan), -fun(theta0), idx,
                        ok=False)
-        theta = self._physical(res.x, names)
+        theta = self._canonical(self._physical(res.x, names), names)
         resid = -res.fun
         stderr = _stderr(res.jac, resid, len(names))
         return Fit(effects, names, theta, stderr, resid, idx, ok=bool(np.all(np.isfinite(resid))))

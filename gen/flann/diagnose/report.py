@@ -67,9 +67,20 @@ def format_text(dg) -> str:
             unit = "s" if dg.time_unit == "s" else "rows"
             spans = ", ".join(f"{a:g}..{b:g} {unit}" for a, b, _ in dg.time_spans)
             lines.append(f"  in recording time: {spans}")
-    if not dg.effects:
+    if not dg.effects and not dg.regions:
         lines.append(f"nothing missing: the residual ({_mv(dg.final_rms)} RMS) is noise; "
                      "no effect of the catalogue earns its keep")
+    elif not dg.effects:
+        lines.append("no effect of the catalogue explains the mismatch located above: it is "
+                     "physics the catalogue lacks, or a shape the simulated geometry cannot take")
+    if dg.trials and dg.trials[-1]:
+        last = [t for t in dg.trials[-1] if not t.accepted]
+        if last:
+            lines.append("  closest candidates not earning their keep (delta BIC must be < -10 and "
+                         "cross-validation t > 2): " + ", ".join(
+                             f"{t.name} {t.delta_bic:+.1f}" + (f" (CV t {t.cv_t:.1f})"
+                                                               if t.cv_t is not None else "")
+                             for t in last[:3]))
     else:
         lines.append("physics missing from the ideal simulation (most important first):")
         prev = dg.baseline_rms
@@ -108,15 +119,24 @@ def plot(dg, path) -> None:
         for reg in dg.regions:
             color = {"+": "tab:red", "-": "tab:blue", "both": "tab:purple"}[reg["direction"]]
             ax.axvspan(reg["from_mm"], reg["to_mm"], color=color, alpha=0.12, lw=0)
+        ms = 2.5 if x.size > 300 else 5
         if d is not None:
             for sign, color, label in ((1, "tab:red", "moving +"), (-1, "tab:blue", "moving -")):
                 m = keep & (d == sign)
                 if m.any():
-                    ax.plot(x[m], r[m] * 1e3, ".", ms=2.5, color=color, label=label)
+                    ax.plot(x[m], r[m] * 1e3, ".", ms=ms, color=color, label=label)
         else:
-            ax.plot(x[keep], r[keep] * 1e3, ".", ms=2.5, color="k", label="points")
+            ax.plot(x[keep], r[keep] * 1e3, ".", ms=ms, color="k", label="points")
+        inl = r[keep] * 1e3
+        lim = max(float(np.max(np.abs(inl))) if inl.size else 1.0, 3 * dg.noise_v * 1e3) * 1.25
+        ax.set_ylim(-lim, lim)
         if dg.outlier_mask.any():
-            ax.plot(x[~keep], r[~keep] * 1e3, "x", color="tab:orange", ms=7, label="outlier")
+            # outliers drawn at the edge of the axis, their value written next to them
+            ro = np.clip(r[~keep] * 1e3, -0.95 * lim, 0.95 * lim)
+            ax.plot(x[~keep], ro, "x", color="tab:orange", ms=8, label="outlier (value noted)")
+            for xo, yo, v in zip(x[~keep], ro, r[~keep]):
+                ax.annotate(f"{v * 1e3:.0f} mV", (xo, yo), textcoords="offset points",
+                            xytext=(5, -10 if yo < 0 else 4), fontsize=7, color="tab:orange")
         for k in (-2, 2):
             ax.axhline(k * dg.noise_v * 1e3, color="0.5", lw=0.7, ls="--")
         ax.axhline(0, color="0.3", lw=0.7)
