@@ -264,3 +264,135 @@ def seed_for(model_path, **spec_options) -> SeedParallel:
         model=load_model(path), input_bits=spec.input_bits, input_lsb_v=spec.input_lsb_v,
         clamp_lo=spec.clamp_lo, clamp_hi=spec.clamp_hi, model_sha256=model_sha256(path),
     )
+
+
+# ----------------------------------------------------------------------------- design space
+WIDTH_PRESETS = ("budget", "narrow")
+NARROW_BITS = 4  # fraction bits taken off terms and weights in the "narrow" preset
+
+
+@dataclass
+class Row:
+    design: str
+    lanes: int | None
+    mult_style: str
+    widths: str
+    luts: int | None = None
+    ffs: int | None = None
+    brams: int | None = None
+    cycles_per_sample: int | None = None
+    samples_per_s: float | None = None
+    max_err_lsb: float | None = None
+    max_err_mm: float | None = None
+    output_lsb_mm: float | None = None
+    fits: bool | None = None
+    smallest_device: str | None = None
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def _width_options(model_path, preset: str, base: dict) -> dict:
+    if preset == "budget":
+        return {}
+    if preset == "narrow":
+        from . import hdlgen
+
+        ref = hdlgen.load(model_path, check_device=False, **base)
+        return {
+            "term_frac_bits": max(4, ref.term_fmt.frac_bits - NARROW_BITS),
+            "weight_frac_bits": max(0, ref.weight_fmt.frac_bits - NARROW_BITS),
+        }
+    raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
+
+
+def _measure(row: Row, design_dir: Path, device: str, work: Path | None) -> None:
+    from .synth import synthesize
+
+    rep = synthesize(design_dir, device, work=work)
+    d = rep.to_dict()
+    row.luts, row.ffs, row.brams = d["luts"], d["ffs"], d["brams"]
+    row.fits, row.smallest_device = d["fits"], d["smallest_device"]
+    if d["warnings"]:
+        row.note = (row.note + "; " if row.note else "") + f"{len(d['warnings'])} yosys warning(s)"
+
+
+def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles=("lut", "shiftadd"),
+            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True) -> list[Row]:
+    """Generate, synthesise and score each candidate; the seed architecture last."""
+    import warnings as _w
+
+    from . import hdlgen
+    from .devices import parse_part
+    from .spec import CLOCK_HZ as SPEC_CLOCK
+    from .twin import FlannTop
+
+    parse_part(device)
+    rows: list[Row] = []
+    combos = [(l, s, w) for w in widths for s in styles for l in lanes]
+    with tempfile.TemporaryDirectory(prefix="flann-explore-") as tmp:
+        for k, (lane, style, preset) in enumerate(combos, 1):
+            row = Row("ours", lane, style, preset)
+            rows.append(row)
+            if progress:
+                print(f"explore [{k}/{len(combos) + int(seed)}] lanes={lane} mult={style} widths={preset}",
+                      file=sys.stderr)
+            try:
+                base = dict(lanes=lane, mult_style=style)
+                with _w.catch_warnings(record=True) as caught:
+                    _w.simplefilter("always")
+                    opts = {**base, **_width_options(model_path, preset, base)}
+                    spec = hdlgen.load(model_path, check_device=False, device=device, **opts)
+                if caught:
+                    row.note = "error bound > 1 LSB"
+                err = FlannTop(spec).error_vs_float()
+                row.cycles_per_sample = spec.cycles_per_sample
+                row.samples_per_s = SPEC_CLOCK / spec.cycles_per_sample
+                row.max_err_lsb, row.max_err_mm = err["max_err_lsb"], err["max_err_mm"]
+                row.output_lsb_mm = spec.output_lsb_mm
+                ddir = Path(tmp) / f"d{k}"
+                hdlgen.write(spec, ddir)
+                _measure(row, ddir, device, None)
+            except FlannError as exc:
+                row.note = (row.note + "; " if row.note else "") + str(exc)
+        if seed:
+            if progress:
+                print(f"explore [{len(combos) + 1}/{len(combos) + 1}] seed architecture (fully parallel; slow)",
+                      file=sys.stderr)
+            s = seed_for(model_path)
+            row = Row("seed (paper, parallel)", None, "constant", f"fixed{s.word}")
+            rows.append(row)
+            try:
+                err = s.error_vs_float()
+                row.cycles_per_sample, row.samples_per_s = 1, CLOCK_HZ
+                row.max_err_lsb, row.max_err_mm, row.output_lsb_mm = err["max_err_lsb"], err["max_err_mm"], s.output_lsb_mm
+                ddir = Path(tmp) / "seed"
+                s.write(ddir)
+                _measure(row, ddir, device, None)
+            except FlannError as exc:
+                row.note = (row.note + "; " if row.note else "") + str(exc)
+    return rows
+
+
+def _fmt(x, spec: str = "") -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    return format(x, spec)
+
+
+def markdown(rows: list[Row], device: str) -> str:
+    head = ("| design | lanes | multiplier | widths | LUT4 | FF | BRAM | cycles/sample | samples/s @ 50 MHz "
+            f"| max err (LSB) | max err (mm) | fits {device} | smallest Spartan-II | note |")
+    sep = "|" + "---|" * 14
+    lines = [head, sep]
+    for r in rows:
+        lines.append(
+            f"| {r.design} | {_fmt(r.lanes)} | {r.mult_style} | {r.widths} | {_fmt(r.luts)} | {_fmt(r.ffs)} "
+            f"| {_fmt(r.brams)} | {_fmt(r.cycles_per_sample)} | {_fmt(r.samples_per_s, ',.0f')} "
+            f"| {_fmt(r.max_err_lsb, '.3f')} | {_fmt(r.max_err_mm, '.4f')} | {_fmt(r.fits)} "
+            f"| {_fmt(r.smallest_device)} | {r.note} |"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,41 @@
+"""flann explore MODEL: design-space table (lanes x multiplier x widths) plus the seed architecture."""
+
+from __future__ import annotations
+
+import json
+
+from .. import explore
+from ..errors import FlannError
+
+HELP = "design-space table (lanes x multiplier x widths)"
+
+
+def _ints(text: str) -> tuple[int, ...]:
+    try:
+        vals = tuple(int(x) for x in text.split(","))
+    except ValueError:
+        raise FlannError(f"--lanes {text!r}: expected a comma-separated list of integers such as 1,2,4") from None
+    return vals
+
+
+def add_arguments(p):
+    p.add_argument("model", help="model.json")
+    p.add_argument("--device", default="xc2s200-pq208-5", metavar="PART", help="target part (default xc2s200-pq208-5)")
+    p.add_argument("--lanes", default="1,2,4", help="lane counts to try (default 1,2,4)")
+    p.add_argument("--mult", default="lut,shiftadd", help="multiplier styles (default lut,shiftadd)")
+    p.add_argument("--widths", default=",".join(explore.WIDTH_PRESETS),
+                   help="width presets: budget (error budget <= 1 LSB), narrow (4 fraction bits fewer)")
+    p.add_argument("--no-seed", action="store_true", help="leave out the seed architecture (its synthesis is slow)")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+
+
+def run(args) -> int:
+    rows = explore.explore(
+        args.model, args.device, lanes=_ints(args.lanes), styles=tuple(args.mult.split(",")),
+        widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=True,
+    )
+    if args.json:
+        print(json.dumps([r.to_dict() for r in rows], indent=2))
+    else:
+        print(explore.markdown(rows, args.device))
+    return 0

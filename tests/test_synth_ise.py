@@ -1,0 +1,78 @@
+"""flann ise: xtclsh project, UCF with a LOC for every port bit, FuseSoC core."""
+
+import re
+import warnings
+from pathlib import Path
+
+import pytest
+import yaml
+
+from flann.cli import main
+from flann.errors import FlannError
+from flann.ise import write_ise
+
+FIX = Path(__file__).parent / "fixtures" / "synth" / "good"
+# flann_top ports of the fixture, by hand: clk rst in_valid in_ready in_data(12) out_valid out_data(18) out_sat
+NETS = (["clk", "rst", "in_valid", "in_ready", "out_valid", "out_sat"]
+        + [f"in_data<{i}>" for i in range(12)] + [f"out_data<{i}>" for i in range(18)])
+
+
+def test_cli_writes_the_handoff(tmp_path, capsys):
+    out = tmp_path / "ise"
+    assert main(["ise", str(FIX), "--device", "xc2s200-pq208-5", "-o", str(out)]) == 0
+    assert "xtclsh flann_top.tcl" in capsys.readouterr().out
+    for name in ("flann_top.tcl", "flann_top.ucf", "flann_top.core", "README.txt", "src/flann_top.vhd"):
+        assert (out / name).is_file(), name
+    assert (out / "src/flann_top.vhd").read_bytes() == (FIX / "flann_top.vhd").read_bytes()
+
+
+def test_ucf_pins_every_port_bit_once(tmp_path):
+    write_ise(FIX, "xc2s200-pq208-5", tmp_path, clock_mhz=50)
+    ucf = (tmp_path / "flann_top.ucf").read_text()
+    locs = dict(re.findall(r'^NET "([^"]+)" LOC = "(P\d+)";', ucf, re.M))
+    assert sorted(locs) == sorted(NETS)
+    assert len(set(locs.values())) == len(locs)  # no pin used twice
+    assert all(1 <= int(p[1:]) <= 208 for p in locs.values())
+    assert locs["clk"] == "P77"  # GCK1 on PQ208
+    assert 'PERIOD "clk" 20 ns' in ucf  # 1 / 50 MHz
+    assert "EXAMPLE ASSIGNMENT" in ucf
+
+
+def test_tcl_targets_the_part_and_lists_sources_in_order(tmp_path):
+    write_ise(FIX, "xc2s100-pq208-6", tmp_path)
+    tcl = (tmp_path / "flann_top.tcl").read_text()
+    for line in ('project set family "Spartan2"', 'project set device "xc2s100"', 'project set package "pq208"',
+                 'project set speed "-6"', 'xfile add "src/flann_top.vhd"', 'xfile add "flann_top.ucf"',
+                 '"ROM Style" "Block"', 'process run "Generate Programming File"'):
+        assert line in tcl, line
+    assert "project new flann_top.ise" in tcl  # ISE 10.1 project file, not .xise
+
+
+def test_core_file_is_capi2_yaml(tmp_path):
+    write_ise(FIX, "xc2s200-pq208-5", tmp_path)
+    text = (tmp_path / "flann_top.core").read_text()
+    assert text.startswith("CAPI=2:")
+    core = yaml.safe_load(text)
+    assert core["filesets"]["rtl"]["files"] == ["src/flann_top.vhd"]
+    assert core["targets"]["synth"]["tools"]["ise"]["device"] == "xc2s200"
+    assert core["targets"]["default"]["toplevel"] == "flann_top"
+
+
+def test_period_follows_clock(tmp_path):
+    write_ise(FIX, "xc2s200-pq208-5", tmp_path, clock_mhz=40)
+    assert 'PERIOD "clk" 25 ns' in (tmp_path / "flann_top.ucf").read_text()
+
+
+def test_non_pq208_and_small_device(tmp_path):
+    with pytest.raises(FlannError, match="PQ208 package only"):
+        write_ise(FIX, "xc2s200-fg256-5", tmp_path / "a")
+    assert not (tmp_path / "a").exists()
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        write_ise(FIX, "xc2s30-pq208-5", tmp_path / "b")
+    assert any("132 user I/O" in str(x.message) for x in w)
+
+
+def test_missing_manifest(tmp_path, capsys):
+    assert main(["ise", str(tmp_path), "-o", str(tmp_path / "o")]) == 2
+    assert "manifest.json not found" in capsys.readouterr().err
