@@ -171,3 +171,14 @@ def test_copper_thermal_coefficient_matches_primary_current(s):
     ratio = ideal_output_v(hot, x)[0] / ideal_output_v(s, x)[0] - 1
     assert k < 0
     assert ratio == pytest.approx(k, rel=0.01)
+
+
+def test_copper_thermal_coefficient_with_lossy_core(s):
+    from flann.physics.effects import thermal_coefficient_from_copper
+
+    lossy = s.replace(core_conductivity_s_per_m=1e7, primary_resistance_ohm=600.0)
+    k = thermal_coefficient_from_copper(lossy)
+    hot = lossy.replace(primary_resistance_ohm=600.0 * (1 + 0.00393))
+    x = np.array([2.0])
+    ratio = abs(ideal_output_v(hot, x)[0] / ideal_output_v(lossy, x)[0]) - 1
+    assert ratio == pytest.approx(k, rel=0.02)

@@ -233,14 +233,16 @@ COPPER_TEMPCO_PER_C = 0.00393   # resistance temperature coefficient of copper a
 
 def thermal_coefficient_from_copper(sensor, alpha_per_c: float = COPPER_TEMPCO_PER_C) -> float:
     """Sensitivity coefficient (1/degC) that the primary's copper alone causes at null:
-    with ``Ip = V / (R_p + j w Lp)`` and ``R_p(T) = R_p (1 + alpha dT)``,
-    ``d ln|Ip| / dT = -alpha R_p^2 / (R_p^2 + (w Lp)^2)``.  A physical starting value for
+    with ``Ip = V / Z``, ``Z = R_p + j w Lp`` and ``R_p(T) = R_p (1 + alpha dT)``,
+    ``d ln|Ip| / dT = -alpha R_p Re(Z) / |Z|^2`` (= ``-alpha R_p^2 / |Z|^2`` for a lossless core).  A physical starting value for
     ``thermal_drift.coefficient_per_c`` (core permeability and secondary loading add more)."""
     from .lvdt import inductances_h
 
-    lp = float(inductances_h(sensor, [0.0])[2][0])
+    lp = complex(inductances_h(sensor, [0.0])[2][0])   # complex with core eddy losses
     r = sensor.primary_resistance_ohm
-    return -alpha_per_c * r * r / (r * r + (sensor.omega_rad_s * lp) ** 2)
+    z = r + 1j * sensor.omega_rad_s * lp
+    # d|Z|/dR = Re(Z)/|Z|, so d ln|Ip| / dT = -alpha R Re(Z) / |Z|^2
+    return float(-alpha_per_c * r * z.real / abs(z) ** 2)
 
 
 def validate_effects(effects: Mapping[str, Mapping[str, float]], source: str = "<memory>") -> None:
