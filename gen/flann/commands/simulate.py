@@ -171,6 +171,10 @@ def _run_fit(args) -> int:
             "even_part_rms_v": None if fit.asymmetry_floor_v != fit.asymmetry_floor_v
             else fit.asymmetry_floor_v,
             "points_used": int(fit.used.sum()),
+            "residuals": [{"row": i, "displacement_mm": float(x), "residual_v": float(r),
+                           "used": bool(u)}
+                          for i, (x, r, u) in enumerate(zip(rec.displacement_mm, fit.residual_v,
+                                                            fit.used))],
             "excluded": [{"row": r, "displacement_mm": float(rec.displacement_mm[r]),
                           "voltage_v": float(rec.voltage_v[r]),
                           "residual_v": float(fit.residual_v[r])} for r in fit.excluded_rows],
