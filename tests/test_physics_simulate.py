@@ -196,3 +196,9 @@ def test_describe_figures(capsys):
     assert d["core_decay_length_mm"] == pytest.approx(1e3 / m.sqrt(r * g), rel=1e-9)
     assert main(["simulate", "--describe"]) == 0
     assert "output_fold_back_mm = 30" in capsys.readouterr().out
+
+
+def test_describe_plot(tmp_path):
+    png = tmp_path / "anatomy.png"
+    assert main(["simulate", "data/sensors/miniature_reversed.toml", "--describe", "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000

@@ -41,7 +41,8 @@ def add_arguments(p) -> None:
     p.add_argument("--no-effects", action="store_true",
                    help="ignore the sensor file's [effects] (ideal sensor)")
     p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
-                                  "(with --fit: calibration and residuals)")
+                                  "(with --fit: calibration and residuals; with --describe: "
+                                  "flux along the bore and inductances)")
     p.add_argument("--describe", action="store_true",
                    help="print derived quantities of the sensor (slope, currents, flux density, "
                         "fold-back, copper thermal coefficient) and exit")
@@ -88,6 +89,10 @@ def _describe(args) -> int:
     print(f"  output_fold_back_mm = {fold:.4g}" if fold is not None else
           "  output_fold_back_mm = none within 3 x stroke")
     print(f"  copper_thermal_coefficient_per_c = {thermal_coefficient_from_copper(s):.3g}")
+    if args.plot:
+        from ..physics.plots import plot_anatomy
+
+        plot_anatomy(s, args.plot)
     return 0
 
 

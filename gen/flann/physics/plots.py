@@ -99,3 +99,46 @@ def plot_fit(rec: Recordings, fit: FitResult, path: str | Path) -> None:
     ax2.grid(alpha=0.3)
     fig.tight_layout()
     _save(fig, path)
+
+
+def plot_anatomy(s: Sensor, path: str | Path) -> None:
+    """Top: axial flux along the bore for a few core positions, windings shaded.
+    Bottom: mutual inductances and the ideal output versus core position."""
+    from .lvdt import coupling_table, flux_profile
+
+    a1 = s.primary_length_mm / 2
+    a2 = a1 + s.secondary_gap_mm
+    a3 = a2 + s.secondary_length_mm
+    half = a3 + s.core_length_mm / 2 + s.stroke_mm
+    z = np.linspace(-half, half, 1201)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 7))
+    for lo, hi, label, colour in ((-a1, a1, "primary", "0.85"), (a2, a3, "S1", "#cde"),
+                                  (-a3, -a2, "S2", "#ecd")):
+        ax1.axvspan(lo, hi, color=colour, zorder=0)
+        ax1.text((lo + hi) / 2, 0.02, label, ha="center", transform=ax1.get_xaxis_transform(),
+                 fontsize=8)
+    for i, p in enumerate((0.0, 0.5 * s.stroke_mm, s.stroke_mm)):
+        phi = np.abs(flux_profile(s, p, z)) * 1e6
+        ax1.plot(z, phi, f"C{i}-", lw=1.2, label=f"core at {p:g} mm")
+        ax1.axvspan(p - s.core_length_mm / 2, p + s.core_length_mm / 2, ymin=0.97 - 0.03 * i,
+                    ymax=1.0 - 0.03 * i, color=f"C{i}", alpha=0.8)
+    ax1.set_xlabel("z along the axis (mm); bars at the top: core extent")
+    ax1.set_ylabel("|axial flux| (uWb per A)")
+    ax1.set_title(f"{s.name}: flux along the bore (transmission-line model)")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+    t = coupling_table(s, half_range_mm=a3 + s.core_length_mm / 2, n=401)
+    ax2.axvspan(-s.stroke_mm, s.stroke_mm, color="0.92", zorder=0)
+    ax2.plot(t.position_mm, np.abs(t.m1_h) * 1e3, "C0-", label="|M1| (mH)")
+    ax2.plot(t.position_mm, np.abs(t.m2_h) * 1e3, "C1-", label="|M2| (mH)")
+    ax2.set_xlabel("core position (mm)")
+    ax2.set_ylabel("mutual inductance (mH)")
+    ax2.grid(alpha=0.3)
+    ax3 = ax2.twinx()
+    ax3.plot(t.position_mm, ideal_output_v(s, t.position_mm), "k--", lw=1, label="output (V)")
+    ax3.set_ylabel("ideal output (V); shaded: rated stroke")
+    lines = ax2.get_legend_handles_labels()
+    more = ax3.get_legend_handles_labels()
+    ax2.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper left")
+    fig.tight_layout()
+    _save(fig, path)
