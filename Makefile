@@ -12,6 +12,10 @@ TRAIN_ARGS    := --terms 51 --method lstsq
 MODEL    ?=
 DEVICE   ?= xc2s200-pq208-5
 
+# Small matrices only: BLAS threads buy nothing and oversubscribe the 2 cores.
+export OPENBLAS_NUM_THREADS := 1
+export OMP_NUM_THREADS := 1
+
 .PHONY: all venv tools test sim gen synth paper bench clean
 
 all: test

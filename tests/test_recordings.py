@@ -35,3 +35,32 @@ def test_unknown_column_warns_and_is_ignored():
         rec = parse_recordings("displacement_mm,voltage_v,humidity\n1,2,3\n")
     assert set(rec.columns()) == {"displacement_mm", "voltage_v"}
     np.testing.assert_array_equal(rec.voltage_v, [2.0])
+
+
+def _sweeps_text(second_pass_offset_v: float, with_time: bool) -> str:
+    """Two forward passes over a smooth curve; the second shifted by an offset."""
+    x = np.arange(-10, 11, 1.0)
+    v = np.tanh(x / 8.0)
+    rows = ["displacement_mm,voltage_v,direction" + (",time_s" if with_time else "")]
+    t = 0
+    for off in (0.0, second_pass_offset_v):
+        for xi, vi in zip(x, v + off):
+            rows.append(f"{xi},{vi:.6f},1" + (f",{t}" if with_time else ""))
+            t += 1
+    return "\n".join(rows) + "\n"
+
+
+def test_repeated_sweeps_within_noise_are_accepted_with_time_column():
+    from flann.recordings import prepare_for_fit
+
+    rec = parse_recordings(_sweeps_text(0.0005, with_time=True))
+    assert len(prepare_for_fit(rec)) == 42
+
+
+@pytest.mark.parametrize("offset, with_time", [(0.0005, False), (0.3, True)])
+def test_repeats_are_refused_without_time_or_beyond_noise(offset, with_time):
+    from flann.recordings import prepare_for_fit
+
+    rec = parse_recordings(_sweeps_text(offset, with_time=with_time), source="r.csv")
+    with pytest.raises(RecordingsError, match="appears twice"):
+        prepare_for_fit(rec)

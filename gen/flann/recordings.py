@@ -279,19 +279,34 @@ def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float
                          message=msg, noise_v=noise, threshold_v=thr)
 
 
-def check_duplicates(rec: Recordings) -> None:
-    """One voltage per displacement per direction: a repeat with another voltage is refused."""
+def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01) -> None:
+    """One voltage per displacement per direction: a repeat with another voltage is refused.
+
+    Recordings with a ``time_s`` column may hold repeated sweeps: there a repeat is refused
+    only when it differs by more than the noise allows, ``max(k_sigma * noise, floor_frac *
+    voltage span)`` with the noise estimated on the first pass; without ``time_s`` any
+    differing repeat is refused.
+    """
     direction = rec.direction if rec.direction is not None else np.zeros(len(rec))
+    tol = 0.0
+    if rec.time_s is not None:
+        keys = np.stack([direction, rec.displacement_mm], axis=1)
+        first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
+        sub = rec.subset(first)
+        order = np.lexsort((sub.displacement_mm, direction[first]))
+        tol = max(k_sigma * estimate_noise_v(sub.voltage_v[order]),
+                  floor_frac * float(np.ptp(rec.voltage_v)))
     seen: dict[tuple[float, float], int] = {}
     for i, (d, x, v) in enumerate(zip(direction, rec.displacement_mm, rec.voltage_v)):
         key = (float(d), float(x))
         j = seen.setdefault(key, i)
-        if j != i and rec.voltage_v[j] != v:
+        if j != i and abs(rec.voltage_v[j] - v) > tol:
             where = "" if rec.direction is None else f" in direction {int(d):+d}"
             raise RecordingsError(
                 f"{rec.source}: rows {j + 1} and {i + 1}: displacement {x:g} mm appears twice"
                 f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
                 "average repeats or give each sweep its direction (+1/-1)"
+                + (f" (repeats may differ by {tol:.3g} V)" if tol else "")
             )
 
 
