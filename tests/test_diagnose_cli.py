@@ -101,3 +101,16 @@ def test_foldback_trimmed_with_warning(tmp_path, capsys):
 def test_interior_foldback_refused(tmp_path, capsys):
     x = np.linspace(-30, 30, 200)
     _bad(["diagnose", _write(tmp_path / "r.csv", x, np.sin(x / 4.0))], capsys, "no inverse")
+
+
+def test_text_report_names_effect(tmp_path, capsys):
+    s = default_sensor().replace(adc_bits=None, adc_full_scale_v=None)
+    s = s.with_effect("backlash", deadband_mm=0.06)
+    rec = simulate_recordings(s, step_mm=0.2, noise_v=0.005, seed=8)
+    p = tmp_path / "bl.csv"
+    write_recordings(p, rec)
+    assert main(["diagnose", str(p), "--plot", str(tmp_path / "bl.png"), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "1. backlash: the residual changes sign with the direction of travel" in out
+    assert "deadband_mm = " in out and "RMS " in out and "improvement" in out
+    assert "nothing missing" not in out

@@ -63,6 +63,8 @@ class Diagnosis:
     outlier_mask: np.ndarray = field(repr=False, default=None)
     trials: list = field(repr=False, default_factory=list)
     final_fit: Fit | None = field(repr=False, default=None)
+    family: PhysicsFamily | None = field(repr=False, default=None)
+    fit_idx: np.ndarray | None = field(repr=False, default=None)
 
     @property
     def named(self) -> list[str]:
@@ -220,7 +222,8 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
         time_spans=time_spans, time_unit=t_unit, outliers=outliers, effects=effects,
         final_rms=float(np.sqrt(np.mean(after[fit_idx] ** 2))), untestable=untestable,
         x=x, direction=direction, resid_before=before, resid_after=after,
-        outlier_mask=out_mask, trials=sel.trials, final_fit=final)
+        outlier_mask=out_mask, trials=sel.trials, final_fit=final, family=family,
+        fit_idx=fit_idx)
 
 
 def _se(fit: Fit, name: str) -> float:

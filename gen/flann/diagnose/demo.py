@@ -258,7 +258,7 @@ def false_alarm_rate(case: Case, reps: int = 20, progress=None) -> dict:
 
 
 # effects whose detection limit the demo measures (--limits)
-LIMIT_EFFECTS = ("quadrature_null", "backlash", "null_offset", "leadscrew_periodic")
+LIMIT_EFFECTS = ("quadrature_null", "backlash", "leadscrew_periodic")
 
 
 def detection_limit(case: Case, scales=(0.25, 0.5, 1.0, 2.0), reps: int = 20,

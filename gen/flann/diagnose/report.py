@@ -73,15 +73,7 @@ def format_text(dg) -> str:
     elif not dg.effects:
         lines.append("no effect of the catalogue explains the mismatch located above: it is "
                      "physics the catalogue lacks, or a shape the simulated geometry cannot take")
-    if dg.trials and dg.trials[-1]:
-        last = [t for t in dg.trials[-1] if not t.accepted]
-        if last:
-            lines.append("  closest candidates not earning their keep (delta BIC must be < -10 and "
-                         "cross-validation t > 2): " + ", ".join(
-                             f"{t.name} {t.delta_bic:+.1f}" + (f" (CV t {t.cv_t:.1f})"
-                                                               if t.cv_t is not None else "")
-                             for t in last[:3]))
-    else:
+    if dg.effects:
         lines.append("physics missing from the ideal simulation (most important first):")
         prev = dg.baseline_rms
         for i, e in enumerate(dg.effects, 1):
@@ -95,6 +87,14 @@ def format_text(dg) -> str:
             prev = e.rms_v_after
         lines.append(f"final RMS {_mv(dg.final_rms)} (noise {_mv(dg.noise_v)}), improvement "
                      f"x{dg.baseline_rms / dg.final_rms:.3g}")
+    if dg.trials and dg.trials[-1]:
+        last = [t for t in dg.trials[-1] if not t.accepted]
+        if last:
+            lines.append("  closest candidates not earning their keep (delta BIC must be < -10 and "
+                         "cross-validation t > 2): " + ", ".join(
+                             f"{t.name} {t.delta_bic:+.1f}" + (f" (CV t {t.cv_t:.1f})"
+                                                               if t.cv_t is not None else "")
+                             for t in last[:3]))
     if dg.untestable:
         lines.append("not testable on these recordings: " + "; ".join(
             f"{k} ({v})" for k, v in dg.untestable.items()))
@@ -127,6 +127,15 @@ def plot(dg, path) -> None:
                     ax.plot(x[m], r[m] * 1e3, ".", ms=ms, color=color, label=label)
         else:
             ax.plot(x[keep], r[keep] * 1e3, ".", ms=ms, color="k", label="points")
+        # running means make a pattern below the per-point noise visible
+        from .data import running_mean, window_size
+        groups = ([(d == sign) & keep for sign in (1, -1)] if d is not None else [keep])
+        for m, color in zip(groups, ("darkred", "navy") if d is not None else ("k",)):
+            if m.sum() >= 5:
+                o = np.flatnonzero(m)
+                o = o[np.argsort(x[o], kind="stable")]
+                rm, _ = running_mean(r[o], window_size(o.size))
+                ax.plot(x[o], rm * 1e3, "-", color=color, lw=1.6)
         inl = r[keep] * 1e3
         lim = max(float(np.max(np.abs(inl))) if inl.size else 1.0, 3 * dg.noise_v * 1e3) * 1.25
         ax.set_ylim(-lim, lim)
