@@ -47,6 +47,10 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
                         *[str(tmp_path / "design" / f) for f in man["files"]]],
                        capture_output=True, text=True, cwd=tmp_path)
     assert r.returncode == 0, r.stderr
+    # VSG with the repository's configuration: no style violations in the float18 files
+    from flann.synth import lint_vhdl
+
+    assert lint_vhdl(sorted((tmp_path / "design").glob("flann_f18_*.vhd"))) == []
     text = files["flann_f18_add.vhd"].read_text()
     assert "entity flann_f18_add is" in text and "constant bias_c" not in text
     assert "constant bias_c : integer := 31;" in files["flann_f18_mul.vhd"].read_text()

@@ -392,6 +392,9 @@ def _save_fig(fig, path) -> None:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(buf.getvalue())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)      # mkstemp's 0600 is not meant for a figure
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
