@@ -2,7 +2,8 @@
 
 The expected outputs come from the twin, computed by the pytest side and passed as a JSON
 file named in FLANN_F18_TOP (GHDL's VPI cannot read generics):
-{"codes": [...], "out": [...], "sat": [...], "latency": N, "in_bits": B, "seed": S}
+{"codes": [...], "out": [...], "sat": [...], "latency": N, "in_bits": B, "seed": S,
+ "records": optional path where the HDL's outputs are written as JSON}
 """
 
 import json
@@ -24,6 +25,7 @@ class TopBench:
         self.mask = (1 << self.spec["in_bits"]) - 1
         self.errors = []
         self.latencies = set()
+        self.record = []                     # (code, out_data, out_sat) as the HDL gave them
 
     async def reset(self):
         cocotb.start_soon(Clock(self.dut.clk, 10, unit="ns", impl="gpi").start())
@@ -50,6 +52,7 @@ class TopBench:
         self.latencies.add(round((cocotb.utils.get_sim_time(unit="ns") - t0) / 10))
         got = self.dut.out_data.value.to_unsigned()
         sat = str(self.dut.out_sat.value) == "1"
+        self.record.append((code, got, sat))
         if got != want_out or sat != want_sat:
             self.errors.append(f"code {code}: out {got:#07x} sat {sat}, twin {want_out:#07x} sat {want_sat}")
         await FallingEdge(self.dut.clk)
@@ -64,6 +67,11 @@ async def every_code(dut):
     tb.rng.shuffle(order)                # independent of the previous sample's state
     for k in order:
         await tb.one(s["codes"][k], s["out"][k], s["sat"][k])
+    if s.get("records"):
+        # the HDL's own outputs, for `flann trace --hdl` and the runner's summary
+        with open(s["records"], "w") as fh:
+            json.dump({"codes": [r[0] for r in tb.record], "out": [r[1] for r in tb.record],
+                       "sat": [r[2] for r in tb.record], "latency": sorted(tb.latencies)}, fh)
     for e in tb.errors[:20]:
         dut._log.error(e)
     dut._log.info(f"{len(order) - len(tb.errors)} of {len(order)} codes bit-exact; latency {sorted(tb.latencies)}")

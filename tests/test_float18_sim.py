@@ -73,23 +73,15 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
 
 # -- top level: every input code ------------------------------------------------------------
 def _run_top(tmp_path, model, step: int, seed: int, **options):
-    from cocotb_test.simulator import run
-
-    from flann.float18_hdl import generate
+    from flann.float18_sim import run_top
     from flann.float18_top import F18Top, derive_f18_spec
 
-    man = generate(model, tmp_path / "hdl", **options)
-    top = F18Top(derive_f18_spec(model, **options))
-    codes = top.all_codes()[::step]
-    out, sat = top.process(codes)
-    exp = tmp_path / "expected.json"
-    exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
-                               "latency": man["latency_cycles"], "in_bits": man["input_bits"], "seed": seed}))
-    run(simulator="ghdl", toplevel=man["top"], toplevel_lang="vhdl", module="test_f18_top",
-        vhdl_sources=[str(tmp_path / "hdl" / f) for f in man["files"]], python_search=[str(SIM_DIR)],
-        compile_args=["--std=93c"], sim_build=str(tmp_path / "sim_build"),
-        extra_env={"FLANN_F18_TOP": str(exp)})
-    return codes
+    codes = F18Top(derive_f18_spec(model, **options)).all_codes()[::step]
+    r = run_top(model, tmp_path, codes=codes, seed=seed, **options)
+    assert not r["bench_failed"], "cocotb reported a failure (see sim.log)"
+    assert r["mismatches"] == 0 and r["codes"].size == codes.size
+    assert r["latency"] == [r["manifest"]["latency_cycles"]]
+    return r["codes"]
 
 
 @pytest.mark.sim

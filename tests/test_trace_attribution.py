@@ -131,3 +131,13 @@ def test_cli_compare_at_table_points(tmp_path, capsys):
     # float18 (12-bit significand) is coarser than the fixed design sized for 1 output LSB
     assert d["trace"]["float18"]["total"]["rms_mm"] > d["trace"]["fixed"]["total"]["rms_mm"]
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.sim
+def test_cli_hdl_outputs_compared(capsys):
+    """--hdl simulates the float18 top over every code of an 8-bit input and compares the
+    HDL's own outputs: equal to the twin, so HDL - golden is the twin's error."""
+    assert main(["trace", str(DEFAULT), "--format", "float18", "--input-bits", "8", "--hdl", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["hdl"]["codes"] == 256 and d["hdl"]["mismatches"] == 0
+    assert abs(d["hdl"]["max_err_mm"] - d["total"]["max_mm"]) < 1e-12

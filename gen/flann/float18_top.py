@@ -96,8 +96,9 @@ class F18Spec:
 def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     """Float18 spec: the fixed spec's input stage and expansion, float18 constants."""
     for k in _FIXED_ONLY:
-        if options.get(k) not in (None, "lut"):
-            raise SpecError(f"{k.replace('_', '-')}: applies to the fixed format only, not float18")
+        if options.get(k) is not None:
+            raise SpecError(f"{k.replace('_', '-')}: applies to the fixed format only, not float18 "
+                            "(which has its own multiplier and adder)")
     options = {k: v for k, v in options.items() if k not in _FIXED_ONLY}
     if options.get("lanes", 1) != 1:
         raise SpecError("lanes: the float18 datapath has one lane (sequential float sum), got "

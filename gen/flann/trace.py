@@ -231,6 +231,7 @@ class TraceResult:
     hardware_mm: np.ndarray = field(repr=False, default=None)
     identity_residual_mm: float = 0.0
     input_lsb_v: float = 0.0
+    hdl: dict | None = None        # set by check_hdl(): the simulated HDL's own outputs
 
     def at_voltages(self, voltages) -> list[dict]:
         """Golden, hardware and error at the (clamped) input codes nearest to ``voltages``."""
@@ -246,9 +247,12 @@ class TraceResult:
         return rows
 
     def to_dict(self) -> dict:
-        return {"format": self.fmt, "codes": self.n_codes, "total": self.total,
-                "stages": self.stages, "top_sources": self.terms, "dominant": self.dominant,
-                "identity_residual_mm": self.identity_residual_mm}
+        d = {"format": self.fmt, "codes": self.n_codes, "total": self.total,
+             "stages": self.stages, "top_sources": self.terms, "dominant": self.dominant,
+             "identity_residual_mm": self.identity_residual_mm}
+        if self.hdl is not None:
+            d["hdl"] = self.hdl
+        return d
 
     def text(self) -> str:
         t = self.total
@@ -270,6 +274,10 @@ class TraceResult:
                   f"where: {_fmt_intervals(sp)} ({sp['share']:.0%} of codes; rms {sp['rms_inside_mm']:.3g} mm "
                   f"there vs {sp['rms_outside_mm']:.3g} mm elsewhere; peak at {sp['peak_v']:+.3f} V)",
                   f"why: {d['reason']}"]
+        if self.hdl is not None:
+            h = self.hdl
+            lines.append(f"HDL (GHDL, {h['top']}): {h['codes']} codes simulated, {h['mismatches']} mismatches "
+                         f"vs the twin; max |HDL - golden| {h['max_err_mm']:.3g} mm over the trained range")
         return "\n".join(lines)
 
 
@@ -461,6 +469,43 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     plt.close(fig)
 
 
+def check_hdl(result: TraceResult, model_path, options: dict, build_dir) -> dict:
+    """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
+    HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``."""
+    from pathlib import Path
+
+    build_dir = Path(build_dir)
+    if result.fmt == "float18":
+        from .float18_sim import run_top
+
+        r = run_top(model_path, build_dir, **options)
+        from .float18 import FLOAT18
+        codes, hdl_mm, mism, top = r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"]
+    else:
+        from .hdlgen import generate, load
+        from .simrun import run_bench
+        from .twin import FlannTop
+
+        generate(model_path, build_dir / "hdl", **options)
+        br = run_bench(build_dir / "hdl", "top", model=model_path, options=options, build_dir=build_dir)
+        rec = br.records.get("top_every_code")
+        if rec is None:
+            raise FlannError(f"fixed-point simulation produced no records (see {build_dir})")
+        spec = load(model_path, **options)
+        codes = np.asarray(rec["codes"], dtype=np.int64)
+        data = np.asarray(rec["data"], dtype=np.int64)
+        mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
+        hdl_mm, top = data * spec.output_lsb_mm, "flann_top"
+    pos = {int(c): k for k, c in enumerate(result.codes)}
+    sel = np.array([int(c) in pos for c in codes])
+    idx = np.array([pos[int(c)] for c in codes[sel]], dtype=np.int64)
+    err = hdl_mm[sel] - result.golden_mm[idx]
+    result.hdl = {"top": top, "codes": int(codes.size), "mismatches": mism,
+                  "max_err_mm": float(np.abs(err).max()) if err.size else 0.0,
+                  "equals_twin": bool(mism == 0)}
+    return result.hdl
+
+
 def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options) -> TraceResult:
     if fmt == "fixed":
         from .spec import derive_spec
@@ -474,4 +519,4 @@ def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options)
 
 
 __all__ = ["Stages", "Source", "TraceResult", "STAGES", "attribute", "trace", "stages_fixed",
-           "stages_float18", "plot_trace", "plot_compare", "run_trace", "term_label"]
+           "stages_float18", "plot_trace", "plot_compare", "run_trace", "check_hdl", "term_label"]

@@ -2,7 +2,8 @@
 
 Stage-by-stage error of the bit-true hardware against the float64 golden model over every
 input code: which block and which term contribute most, over which input span, and why.
-``--compare`` adds the other format (errors of both on the same axes, as the seed's
+``--hdl`` also simulates the generated VHDL over every input code and compares its own
+outputs; ``--compare`` adds the other format (errors of both on the same axes, as the seed's
 Fig. 6(b)); ``--at CSV`` also lists the error at the recordings' input voltages.
 """
 
@@ -27,19 +28,33 @@ def add_arguments(parser) -> None:
     parser.add_argument("--compare", action="store_true",
                         help="also trace the other format; --plot then shows both errors on one axis")
     parser.add_argument("--at", metavar="CSV", help="also report the error at these recordings' voltages")
+    parser.add_argument("--hdl", action="store_true",
+                        help="also simulate the generated VHDL over every input code (GHDL + cocotb, "
+                             "about a minute) and compare its outputs with the twin and the golden model")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--plot", metavar="OUT.png", help="plot error per stage vs input voltage")
     add_spec_arguments(parser)
 
 
+def _spec_defaults() -> dict:
+    """The generator options' values when not given on the command line."""
+    import argparse
+
+    p = argparse.ArgumentParser()
+    add_spec_arguments(p)
+    return spec_options(p.parse_args([]))
+
+
 def _options(args, fmt: str) -> dict:
+    """Generator options for one format.  For float18, fixed-only options left at their
+    defaults are dropped; given explicitly they are an error (unless --compare, where they
+    are meant for the fixed design)."""
     opts = spec_options(args)
     if fmt == "float18":
-        # fixed-only options are an error when given explicitly for float18 alone
-        defaults = {"mult_style": "lut", "lanes": 1}
-        drop = args.compare and args.format == "fixed"
-        opts = {k: v for k, v in opts.items()
-                if k not in _FIXED_ONLY or (v not in (None, defaults.get(k)) and not drop)}
+        defaults = _spec_defaults()
+        for k in _FIXED_ONLY:
+            if k in opts and (opts[k] == defaults.get(k) or (args.compare and args.format == "fixed")):
+                del opts[k]
     return opts
 
 
@@ -47,6 +62,16 @@ def run(args) -> int:
     model = load_model(args.model)
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
+    if args.hdl:
+        import sys
+        import tempfile
+
+        from ..trace import check_hdl
+
+        for f, r in results.items():
+            print(f"simulating the {f} design over every input code ...", file=sys.stderr)
+            with tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:
+                check_hdl(r, args.model, _options(args, f), tmp)
     points = None
     if args.at:
         rec = read_recordings(args.at)

@@ -1,0 +1,86 @@
+"""Run the float18 top-level cocotb bench (``sim/test_f18_top.py``) under GHDL.
+
+``run_top(model, build_dir, codes=None, **options)`` generates the float18 design,
+computes the twin's outputs, simulates the given input codes (default: every code) and
+returns what the HDL produced with the comparison; pass/fail comes from cocotb's results
+file, the outputs from the bench's records.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FlannError
+from .float18_hdl import generate
+from .float18_top import F18Top, derive_f18_spec
+from .model import FlannModel, load_model, model_sha256
+
+
+def sim_dir() -> Path:
+    d = Path(__file__).resolve().parents[2] / "sim"
+    if not (d / "test_f18_top.py").is_file():
+        raise FlannError(f"{d}: cocotb benches not found (run from the flann repository checkout)")
+    return d
+
+
+def run_top(model, build_dir, codes=None, seed: int = 1, **options) -> dict:
+    """Simulate flann_f18_top; returns codes, HDL out/sat, twin out/sat, mismatches, latency."""
+    import shutil
+
+    if shutil.which("ghdl") is None:
+        raise FlannError("ghdl not found on PATH (install GHDL 2.x, mcode backend: `make tools`)")
+    from cocotb_test.simulator import run as cocotb_run
+
+    build_dir = Path(build_dir)
+    if isinstance(model, FlannModel):
+        fmodel, sha = model, ""
+    else:
+        fmodel, sha = load_model(model), model_sha256(model)
+    fspec = derive_f18_spec(fmodel, model_sha256=sha, **options)
+    man = generate(model, build_dir / "hdl", **options)
+    top = F18Top(fspec)
+    codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
+    out, sat = top.process(codes)
+    exp = build_dir / "expected.json"
+    rec = build_dir / "hdl_outputs.json"
+    if rec.exists():
+        rec.unlink()
+    exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
+                               "latency": man["latency_cycles"], "in_bits": man["input_bits"],
+                               "seed": seed, "records": str(rec.resolve())}))
+    logger = logging.getLogger("cocotb")
+    saved = logger.handlers[:], logger.propagate
+    handler = logging.FileHandler(build_dir / "sim.log")
+    logger.handlers, logger.propagate = [handler], False
+    failed = False
+    try:
+        cocotb_run(simulator="ghdl", toplevel=man["top"], toplevel_lang="vhdl", module="test_f18_top",
+                   vhdl_sources=[str(build_dir / "hdl" / f) for f in man["files"]],
+                   python_search=[str(sim_dir())], compile_args=["--std=93c"],
+                   sim_build=str(build_dir / "sim_build"),
+                   extra_env={"FLANN_F18_TOP": str(exp.resolve())})
+    except SystemExit:
+        failed = True                      # mismatches are counted from the records below
+    finally:
+        logger.handlers, logger.propagate = saved
+        handler.close()
+    if not rec.is_file():
+        raise FlannError(f"float18 simulation produced no outputs (see {build_dir / 'sim.log'})")
+    got = json.loads(rec.read_text())
+    hcodes = np.asarray(got["codes"], dtype=np.int64)
+    order = np.argsort(hcodes)
+    hcodes = hcodes[order]
+    hout = np.asarray(got["out"], dtype=np.int64)[order]
+    hsat = np.asarray(got["sat"], dtype=bool)[order]
+    k = np.argsort(codes)
+    mism = int(np.count_nonzero((hout != out[k]) | (hsat != sat[k]))) if hcodes.size == codes.size else None
+    return {"codes": hcodes, "out": hout, "sat": hsat, "twin_out": out[k], "twin_sat": sat[k],
+            "mismatches": mism, "latency": got["latency"], "bench_failed": failed,
+            "manifest": man, "spec": fspec}
+
+
+__all__ = ["run_top", "sim_dir"]
