@@ -34,8 +34,11 @@ from .model import FlannModel
 from .spec import Spec, derive_spec
 from .twin import FlannExpansion, FlannNorm
 
-# options of the fixed-point spec that mean nothing to the float18 datapath
-_FIXED_ONLY = ("output_bits", "output_lsb_mm", "weight_frac_bits", "product_frac_bits", "mult_style")
+# options of the fixed-point spec that the float18 datapath shares (input stage, expansion);
+# every other generator option (widths of weights/products/output, multiplier style, ...)
+# belongs to the fixed datapath only
+FRONT_END_OPTIONS = ("device", "input_bits", "input_lsb_v", "clamp", "phase_bits", "table_addr_bits",
+                     "interp", "term_frac_bits", "model_sha256", "check_device", "lanes")
 
 
 @dataclass(frozen=True)
@@ -95,14 +98,15 @@ class F18Spec:
 
 def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     """Float18 spec: the fixed spec's input stage and expansion, float18 constants."""
-    for k in _FIXED_ONLY:
-        if options.get(k) is not None:
+    options = {k: v for k, v in options.items() if v is not None and k != "number_format"}
+    for k in options:
+        if k not in FRONT_END_OPTIONS:
             raise SpecError(f"{k.replace('_', '-')}: applies to the fixed format only, not float18 "
                             "(which has its own multiplier and adder)")
-    options = {k: v for k, v in options.items() if k not in _FIXED_ONLY}
     if options.get("lanes", 1) != 1:
         raise SpecError("lanes: the float18 datapath has one lane (sequential float sum), got "
                         f"{options['lanes']}")
+    options.pop("lanes", None)
     options.pop("number_format", None)
     base = derive_spec(model, **options)
     fmt = FLOAT18

@@ -13,12 +13,12 @@ import json
 
 from ..model import load_model
 from ..recordings import read_recordings
+from ..float18_top import FRONT_END_OPTIONS
 from ..trace import plot_compare, plot_trace, run_trace
 from .gen import add_spec_arguments, spec_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
 FORMATS = ("fixed", "float18")
-_FIXED_ONLY = ("output_bits", "output_lsb_mm", "weight_frac_bits", "product_frac_bits", "mult_style", "lanes")
 
 
 def add_arguments(parser) -> None:
@@ -48,12 +48,12 @@ def _spec_defaults() -> dict:
 def _options(args, fmt: str) -> dict:
     """Generator options for one format.  For float18, fixed-only options left at their
     defaults are dropped; given explicitly they are an error (unless --compare, where they
-    are meant for the fixed design)."""
+    are meant for the fixed design of the comparison)."""
     opts = spec_options(args)
     if fmt == "float18":
         defaults = _spec_defaults()
-        for k in _FIXED_ONLY:
-            if k in opts and (opts[k] == defaults.get(k) or (args.compare and args.format == "fixed")):
+        for k in list(opts):
+            if k not in FRONT_END_OPTIONS and (opts[k] == defaults.get(k) or args.compare):
                 del opts[k]
     return opts
 
