@@ -13,8 +13,8 @@ import json
 
 from ..model import load_model
 from ..recordings import read_recordings
-from ..float18_top import FRONT_END_OPTIONS
 from ..trace import plot_compare, plot_trace, run_trace
+from ._float18 import float18_options
 from .gen import add_spec_arguments, spec_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
@@ -36,26 +36,10 @@ def add_arguments(parser) -> None:
     add_spec_arguments(parser)
 
 
-def _spec_defaults() -> dict:
-    """The generator options' values when not given on the command line."""
-    import argparse
-
-    p = argparse.ArgumentParser()
-    add_spec_arguments(p)
-    return spec_options(p.parse_args([]))
-
-
 def _options(args, fmt: str) -> dict:
-    """Generator options for one format.  For float18, fixed-only options left at their
-    defaults are dropped; given explicitly they are an error (unless --compare, where they
-    are meant for the fixed design of the comparison)."""
-    opts = spec_options(args)
     if fmt == "float18":
-        defaults = _spec_defaults()
-        for k in list(opts):
-            if k not in FRONT_END_OPTIONS and (opts[k] == defaults.get(k) or args.compare):
-                del opts[k]
-    return opts
+        return float18_options(args, fixed_too=args.compare)
+    return spec_options(args)
 
 
 def run(args) -> int:
