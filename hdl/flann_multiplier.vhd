@@ -5,7 +5,8 @@
 --   number_format = "fixed"
 --   device = "xc2s200-pq208-5"
 --   lanes = 1
---   mult_style = "lut"
+--   mult_style = "shiftadd"
+--   mult_digit_bits = 2
 --   terms = 51
 --   input_bits = 12
 --   input_lsb_v = 0.00284
@@ -27,14 +28,14 @@
 --   output = "sfix<16,16,rnd,sat>"
 --   output_lsb_mm = 0.002
 --   steps = 50
---   adv_period = 1
+--   adv_period = 11
 
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
 
 -- term x weight for 1 lane(s); weights (output LSB x 2^9) in one ROM per lane,
--- addressed by the step counter.  Style "lut": inferred `*` (LUT array multiplier), one product per lane and cycle
+-- addressed by the step counter.  Style "shiftadd": serial shift-add, 2 weight bit(s) per cycle (10 cycles per product)
 -- Two advances from term to product: operands (ROM read) -> product (rounded by 2^17).
 entity flann_multiplier is
   port (
@@ -124,7 +125,7 @@ architecture rtl of flann_multiplier is
 
   type term_t    is array (0 to 0) of signed(19 downto 0);
   type weight_t  is array (0 to 0) of signed(19 downto 0);
-  type full_t    is array (0 to 0) of signed(39 downto 0);
+  type hi_t      is array (0 to 0) of signed(20 downto 0);
   type product_t is array (0 to 0) of signed(20 downto 0);
 
   signal step     : unsigned(5 downto 0);
@@ -133,15 +134,20 @@ architecture rtl of flann_multiplier is
   signal op_valid : std_logic;
   signal prod     : product_t;
   signal p_valid  : std_logic;
+  signal hi       : hi_t;
+  signal cnt      : unsigned(3 downto 0);
 
   -- product rounded to nearest (half added, then floor)
-  function round_product(x : signed(39 downto 0)) return signed is
+  function round_product(x : signed(40 downto 0)) return signed is
   begin
     return resize(shift_right(x + 65536, 17), 21);
   end function round_product;
 begin
 
   p_mult : process (clk)
+    variable a  : signed(21 downto 0);
+    variable hv : signed(20 downto 0);
+    variable wv : signed(19 downto 0);
   begin
     if rising_edge(clk) then
       if in_start = '1' then
@@ -149,19 +155,45 @@ begin
       end if;
       if in_adv = '1' then
         for l in 0 to lanes_c - 1 loop
-          prod(l)    <= round_product(op_term(l) * op_w(l));
+          prod(l)    <= round_product(hi(l) & op_w(l));
+          hi(l)      <= (others => '0');
           op_term(l) <= signed(in_terms((l + 1) * 20 - 1 downto l * 20));
-          op_w(l)    <= signed(weight_rom_c(l)(to_integer(step)));
+          op_w(l)    <= resize(signed(weight_rom_c(l)(to_integer(step))), 20);
         end loop;
         p_valid  <= op_valid;
         op_valid <= in_valid;
         if in_valid = '1' and in_start = '0' then
           step <= step + 1;
         end if;
+        cnt <= "1010";
+      elsif cnt /= 0 then
+        -- 2 weight bit(s) per cycle, LSB first: hi = (hi +- term) / 2, the dropped
+        -- bit shifts into the weight register, so each adder is only 22 bits wide;
+        -- the last bit (the sign of the sign-extended weight) weighs negative
+        for l in 0 to lanes_c - 1 loop
+          hv := hi(l);
+          wv := op_w(l);
+          for d in 0 to 1 loop
+            a := resize(hv, 22);
+            if wv(0) = '1' then
+              if cnt = 1 and d = 1 then
+                a := a - op_term(l);
+              else
+                a := a + op_term(l);
+              end if;
+            end if;
+            hv := a(21 downto 1);
+            wv := a(0) & wv(19 downto 1);
+          end loop;
+          hi(l)   <= hv;
+          op_w(l) <= wv;
+        end loop;
+        cnt <= cnt - 1;
       end if;
       if rst = '1' then
         op_valid <= '0';
         p_valid  <= '0';
+        cnt      <= (others => '0');
       end if;
     end if;
   end process p_mult;

@@ -5,7 +5,8 @@
 --   number_format = "fixed"
 --   device = "xc2s200-pq208-5"
 --   lanes = 1
---   mult_style = "lut"
+--   mult_style = "shiftadd"
+--   mult_digit_bits = 2
 --   terms = 51
 --   input_bits = 12
 --   input_lsb_v = 0.00284
@@ -27,7 +28,7 @@
 --   output = "sfix<16,16,rnd,sat>"
 --   output_lsb_mm = 0.002
 --   steps = 50
---   adv_period = 1
+--   adv_period = 11
 
 library ieee;
 use ieee.std_logic_1164.all;

@@ -5,7 +5,8 @@
 --   number_format = "fixed"
 --   device = "xc2s200-pq208-5"
 --   lanes = 1
---   mult_style = "lut"
+--   mult_style = "shiftadd"
+--   mult_digit_bits = 2
 --   terms = 51
 --   input_bits = 12
 --   input_lsb_v = 0.00284
@@ -27,7 +28,7 @@
 --   output = "sfix<16,16,rnd,sat>"
 --   output_lsb_mm = 0.002
 --   steps = 50
---   adv_period = 1
+--   adv_period = 11
 
 library ieee;
 use ieee.std_logic_1164.all;
@@ -38,8 +39,8 @@ use ieee.numeric_std.all;
 --   out_data : mm    = code x 0.002 mm (16 bits)
 --   out_sat  : input outside the trained range (clamped) or output saturated
 -- One sample at a time: accepted when in_valid and in_ready; out_valid pulses once per sample,
--- 70 clock edges after the accepting edge; in_ready returns one cycle later.
--- Sequencer: norm (12 + 1 cycles) -> 55 pipeline advances, one every 1 cycle(s)
+-- 610 clock edges after the accepting edge; in_ready returns one cycle later.
+-- Sequencer: norm (12 + 1 cycles) -> 55 pipeline advances, one every 11 cycle(s)
 -- (50 steps of 1 term(s) + pipeline drain) -> finish.
 entity flann_top is
   port (
@@ -58,10 +59,10 @@ architecture rtl of flann_top is
   type state_t is (st_idle, st_norm, st_run, st_fin);
   constant steps_c  : natural := 50;
   constant n_advs_c : natural := 55;
-  constant period_c : natural := 1;
+  constant period_c : natural := 11;
 
   signal state      : state_t;
-  signal timer      : unsigned(0 downto 0);
+  signal timer      : unsigned(3 downto 0);
   signal adv_cnt    : unsigned(5 downto 0);
   signal ready      : std_logic;
   signal accept     : std_logic;
@@ -100,7 +101,7 @@ begin
           end if;
         when st_run =>
           if timer = 0 then
-            timer   <= to_unsigned(period_c - 1, 1);
+            timer   <= to_unsigned(period_c - 1, 4);
             adv_cnt <= adv_cnt + 1;
             if adv_cnt = n_advs_c - 1 then
               state <= st_fin;

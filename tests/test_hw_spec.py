@@ -82,7 +82,9 @@ def test_default_spec_covers_trained_range_and_bounds_error(spec, model):
     assert (spec.clamp_lo - 1) * spec.input_lsb_v < lo <= spec.clamp_lo * spec.input_lsb_v
     assert spec.clamp_hi * spec.input_lsb_v <= hi < (spec.clamp_hi + 1) * spec.input_lsb_v
     assert spec.analysis["bound_total_lsb"] <= 1.0
-    assert spec.steps == 50 and spec.latency_cycles == 12 + 4 + (50 + 5 - 1)
+    # shift-add, 2 weight bits per cycle: ceil(W/2) cycles per product + the handing-on advance
+    assert spec.mult_style == "shiftadd" and spec.adv_period == -(-spec.weight_fmt.width // 2) + 1
+    assert spec.steps == 50 and spec.latency_cycles == 12 + 4 + (50 + 5 - 1) * spec.adv_period
 
 
 def test_bad_options_raise_spec_error_naming_the_field(model):

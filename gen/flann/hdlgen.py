@@ -97,15 +97,18 @@ def contexts(spec: Spec) -> dict[str, dict]:
     depth = 1 << step_bits
     words = [[bits_literal(w, W) for w in lane] + [bits_literal(0, W)] * (depth - len(lane))
              for lane in s.weight_rom]
-    cnt_bits = _ubits(W)
+    K = s.mult_digit_bits if s.mult_style == "shiftadd" else 1
+    WX = -(-W // K) * K  # weight register, sign-extended to whole digits
+    cnt_bits = _ubits(WX // K)
     multiplier = dict(
         common, style=s.mult_style, weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
-        full_bits=T + W, shift=s.product_shift, half=1 << (s.product_shift - 1),
+        full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
-        cnt_bits=cnt_bits, cnt_init=bits_literal(W, cnt_bits, False), cnt_init_int=W,
+        cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
+        shift_bits=WX if s.mult_style == "shiftadd" else W,
         style_note=("inferred `*` (LUT array multiplier), one product per lane and cycle"
                     if s.mult_style == "lut" else
-                    f"serial shift-add, one weight bit per cycle ({W} cycles per product)"),
+                    f"serial shift-add, {K} weight bit(s) per cycle ({WX // K} cycles per product)"),
     )
     AB = s.acc_fmt.width
     Pf = s.product_fmt.frac_bits

@@ -92,6 +92,7 @@ class Spec:
     # architecture
     lanes: int
     mult_style: str
+    mult_digit_bits: int  # shift-add: weight bits per cycle
     interp: bool
     # input
     input_bits: int
@@ -195,6 +196,7 @@ class Spec:
             "device": self.device,
             "lanes": self.lanes,
             "mult_style": self.mult_style,
+            "mult_digit_bits": self.mult_digit_bits,
             "terms": self.model.terms,
             "input_bits": self.input_bits,
             "input_lsb_v": self.input_lsb_v,
@@ -249,7 +251,8 @@ def derive_spec(
     output_bits: int | None = None,
     output_lsb_mm: float | None = None,
     lanes: int = 1,
-    mult_style: str = "lut",
+    mult_style: str = "shiftadd",
+    mult_digit_bits: int = 2,
     interp: bool = True,
     phase_bits: int | None = None,
     table_addr_bits: int | None = None,
@@ -407,10 +410,12 @@ def derive_spec(
         if width > 62:
             raise SpecError(f"{name} would need {width} bits (> 62): reduce the requested widths")
 
-    adv_period = 1 if mult_style == "lut" else weight_fmt.width + 1
+    K = _check_int("mult_digit_bits", mult_digit_bits, 1, weight_fmt.width)
+    # shift-add: ceil(W/K) cycles per product, then the advance that hands it on
+    adv_period = 1 if mult_style == "lut" else -(-weight_fmt.width // K) + 1
     spec = Spec(
         model=model, model_sha256=model_sha256, generator_version=__version__, device=device.lower(),
-        number_format=number_format, lanes=L, mult_style=mult_style, interp=bool(interp),
+        number_format=number_format, lanes=L, mult_style=mult_style, mult_digit_bits=K, interp=bool(interp),
         input_bits=B, input_lsb_v=lsb, clamp_lo=int(clo), clamp_hi=int(chi),
         phase_bits=P, norm_guard=Gn, ka=ka, kb=kb, lin_guard=Gl, k1=k1, k0=k0,
         lin_width=lin_width, lin_fmt=lin_fmt, table_addr_bits=A, value_fmt=value_fmt,
@@ -479,23 +484,25 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
 def estimate_resources(spec: Spec) -> dict:
     """Rough pre-synthesis estimate (LUT4, FF, block RAM) used to reject hopeless requests.
 
-    ``flann synth`` gives the measured figures; this only has to be the right order.
+    Coefficients calibrated on `flann synth` (GHDL + yosys synth_xilinx -family xcv) of the
+    51-term default in both multiplier styles; ``flann synth`` gives the measured figures.
     """
     L = spec.lanes
     T, W = spec.term_fmt.width, spec.weight_fmt.width
     P, A = spec.phase_bits, spec.table_addr_bits
-    if spec.mult_style == "lut":
-        mult_luts = T * W
-    else:
-        mult_luts = 2 * (T + W) + 8
-    interp_luts = (spec.dq_bits * (spec.slope_fmt.width + 1)) if spec.interp else 0
-    per_lane = mult_luts + interp_luts + 2 * P + T + spec.product_fmt.width
-    norm = 2 * (P + spec.norm_guard) + spec.lin_width + spec.input_bits * 2
-    luts = L * per_lane + norm + spec.acc_fmt.width * (1 + max(0, L - 1)) + spec.out_fmt.width + 40
+    mult = 5.1 * T * W if spec.mult_style == "lut" else 6.2 * (T + W) + 3 * T * (spec.mult_digit_bits - 1)
+    interp = 2.5 * spec.dq_bits * (spec.slope_fmt.width + 1) if spec.interp else 0
+    expansion = interp + 14.6 * P
+    norm = 1.5 * (P + spec.norm_guard + spec.lin_width)
+    adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
+    luts = L * (mult + expansion) + norm + adder + 60
     ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
-    tab_bits = (1 << A) * (spec.value_fmt.width + (spec.slope_fmt.width if spec.interp else 0))
-    # one dual-ported table serves two lanes
-    brams = math.ceil(L / 2) * math.ceil(tab_bits / BRAM_BITS) + L * math.ceil(spec.steps * W / BRAM_BITS)
+    # a 4-Kbit block is 4096/depth bits wide (at most 16); one dual-ported table serves two lanes
+    per_block = min(16, max(1, BRAM_BITS >> A))
+    tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp else [])
+    brams = math.ceil(L / 2) * sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in tables)
+    if spec.steps * W > 2048:  # small weight ROMs go to LUTs
+        brams += L * math.ceil(spec.steps * W / BRAM_BITS)
     return {"luts": int(luts), "ffs": int(ffs), "brams": int(brams)}
 
 

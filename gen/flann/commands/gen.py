@@ -20,7 +20,8 @@ def add_spec_arguments(parser) -> None:
     g.add_argument("--output-bits", type=int, default=None, help="signed output width")
     g.add_argument("--output-lsb-mm", type=float, default=None, help="mm per output code")
     g.add_argument("--lanes", type=int, default=1, help="parallel term lanes (default %(default)s)")
-    g.add_argument("--mult-style", choices=MULT_STYLES, default="lut", help="multiplier style (default %(default)s)")
+    g.add_argument("--mult-style", choices=MULT_STYLES, default="shiftadd", help="multiplier style (default %(default)s)")
+    g.add_argument("--mult-digit-bits", type=int, default=2, help="shift-add: weight bits per cycle (default %(default)s)")
     g.add_argument("--no-interp", action="store_true", help="plain table lookup, no slope correction")
     g.add_argument("--phase-bits", type=int, default=None, help="phase width (units of pi, mod 2)")
     g.add_argument("--table-addr-bits", type=int, default=None, help="quarter-wave table address bits")
@@ -33,7 +34,8 @@ def spec_options(args) -> dict:
     return dict(
         device=args.device, input_bits=args.input_bits, input_lsb_v=args.input_lsb_v,
         clamp=not args.no_clamp, output_bits=args.output_bits, output_lsb_mm=args.output_lsb_mm,
-        lanes=args.lanes, mult_style=args.mult_style, interp=not args.no_interp,
+        lanes=args.lanes, mult_style=args.mult_style, mult_digit_bits=args.mult_digit_bits,
+        interp=not args.no_interp,
         phase_bits=args.phase_bits, table_addr_bits=args.table_addr_bits,
         term_frac_bits=args.term_frac_bits, weight_frac_bits=args.weight_frac_bits,
         product_frac_bits=args.product_frac_bits,
