@@ -141,3 +141,6 @@ def test_cli_hdl_outputs_compared(capsys):
     d = json.loads(capsys.readouterr().out)
     assert d["hdl"]["codes"] == 256 and d["hdl"]["mismatches"] == 0
     assert abs(d["hdl"]["max_err_mm"] - d["total"]["max_mm"]) < 1e-12
+    # the internal stages captured by cocotb equal the twin's, stage by stage
+    st = d["hdl"]["stages"]
+    assert st["codes"] == 64 and st["all_equal"] and st["missing"] == 0

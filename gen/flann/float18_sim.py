@@ -27,8 +27,9 @@ def sim_dir() -> Path:
     return d
 
 
-def run_top(model, build_dir, codes=None, seed: int = 1, **options) -> dict:
-    """Simulate flann_f18_top; returns codes, HDL out/sat, twin out/sat, mismatches, latency."""
+def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **options) -> dict:
+    """Simulate flann_f18_top; returns codes, HDL out/sat, twin out/sat, mismatches, latency,
+    and for ``stage_codes`` the internal stages captured by cocotb compared with the twin's."""
     import shutil
 
     if shutil.which("ghdl") is None:
@@ -51,7 +52,8 @@ def run_top(model, build_dir, codes=None, seed: int = 1, **options) -> dict:
         rec.unlink()
     exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
                                "latency": man["latency_cycles"], "in_bits": man["input_bits"],
-                               "seed": seed, "records": str(rec.resolve())}))
+                               "seed": seed, "records": str(rec.resolve()),
+                               "stage_codes": [int(c) for c in stage_codes]}))
     logger = logging.getLogger("cocotb")
     saved = logger.handlers[:], logger.propagate
     handler = logging.FileHandler(build_dir / "sim.log")
@@ -78,9 +80,23 @@ def run_top(model, build_dir, codes=None, seed: int = 1, **options) -> dict:
     hsat = np.asarray(got["sat"], dtype=bool)[order]
     k = np.argsort(codes)
     mism = int(np.count_nonzero((hout != out[k]) | (hsat != sat[k]))) if hcodes.size == codes.size else None
+    stages = None
+    if len(stage_codes):
+        sc = np.asarray(list(stage_codes), dtype=np.int64)
+        tw = top.trace(sc)
+        stages = {"codes": int(sc.size), "terms": 0, "products": 0, "sums": 0, "missing": 0}
+        for n, c in enumerate(sc):
+            h = got["stages"].get(str(int(c)))
+            if h is None:
+                stages["missing"] += 1
+                continue
+            for key, arr in (("terms", tw.terms), ("products", tw.products), ("sums", tw.running)):
+                want = [int(x) for x in arr[n]]
+                stages[key] += int(sum(a != b for a, b in zip(h[key], want)) + abs(len(h[key]) - len(want)))
+        stages["all_equal"] = stages["missing"] == 0 and not any(stages[k] for k in ("terms", "products", "sums"))
     return {"codes": hcodes, "out": hout, "sat": hsat, "twin_out": out[k], "twin_sat": sat[k],
             "mismatches": mism, "latency": got["latency"], "bench_failed": failed,
-            "manifest": man, "spec": fspec}
+            "manifest": man, "spec": fspec, "stages": stages}
 
 
 __all__ = ["run_top", "sim_dir"]

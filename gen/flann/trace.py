@@ -278,6 +278,11 @@ class TraceResult:
             h = self.hdl
             lines.append(f"HDL (GHDL, {h['top']}): {h['codes']} codes simulated, {h['mismatches']} mismatches "
                          f"vs the twin; max |HDL - golden| {h['max_err_mm']:.3g} mm over the trained range")
+            st = h.get("stages")
+            if st:
+                lines.append(f"HDL stages captured by cocotb at {st['codes']} codes: "
+                             f"{st['terms']} term, {st['products']} product, {st['sums']} running-sum "
+                             f"mismatches vs the twin" + ("" if not st["missing"] else f", {st['missing']} codes missing"))
         return "\n".join(lines)
 
 
@@ -469,7 +474,7 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     plt.close(fig)
 
 
-def check_hdl(result: TraceResult, model_path, options: dict, build_dir) -> dict:
+def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64) -> dict:
     """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
     HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``."""
     from pathlib import Path
@@ -478,9 +483,13 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir) -> dict
     if result.fmt == "float18":
         from .float18_sim import run_top
 
-        r = run_top(model_path, build_dir, **options)
         from .float18 import FLOAT18
+
+        # internal stages (terms, products, running sums) captured at a spread of codes
+        stage_codes = result.codes[np.linspace(0, result.codes.size - 1, stage_samples).astype(int)]
+        r = run_top(model_path, build_dir, stage_codes=stage_codes, **options)
         codes, hdl_mm, mism, top = r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"]
+        stages = r["stages"]
     else:
         from .hdlgen import generate, load
         from .simrun import run_bench
@@ -496,13 +505,14 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir) -> dict
         data = np.asarray(rec["data"], dtype=np.int64)
         mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
         hdl_mm, top = data * spec.output_lsb_mm, "flann_top"
+        stages = None       # the fixed design's blocks are checked by its own block benches
     pos = {int(c): k for k, c in enumerate(result.codes)}
     sel = np.array([int(c) in pos for c in codes])
     idx = np.array([pos[int(c)] for c in codes[sel]], dtype=np.int64)
     err = hdl_mm[sel] - result.golden_mm[idx]
     result.hdl = {"top": top, "codes": int(codes.size), "mismatches": mism,
                   "max_err_mm": float(np.abs(err).max()) if err.size else 0.0,
-                  "equals_twin": bool(mism == 0)}
+                  "equals_twin": bool(mism == 0), "stages": stages}
     return result.hdl
 
 
