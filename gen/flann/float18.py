@@ -306,7 +306,7 @@ class _PipelinedTwin:
         """One rising edge: returns (out_valid, out_y) after the edge."""
         self._pipe.append((bool(in_valid), self.compute(a, b) if in_valid else None))
         self._pipe.popleft()
-        return self._pipe[-1] if self.latency == 0 else self._pipe[0]
+        return self._pipe[0]
 
 
 class F18Mul(_PipelinedTwin):
