@@ -93,3 +93,30 @@ def test_manifest_listing_a_missing_file(capsys, tmp_path):
 def test_bad_device_is_refused_before_synthesis(capsys):
     rc, out, err = _run(capsys, FIX / "good", "--device", "xc2s15-pq208-5", "--no-lint")
     assert rc == 2 and "not offered in pq208" in err
+
+
+@pytest.mark.synth
+@needs_tools
+def test_fast_abc_keeps_the_hand_counts(capsys):
+    rc, out, err = _run(capsys, FIX / "good", "--device", "xc2s30-pq208-5", "--json", "--abc", "fast", "--no-lint")
+    assert rc == 0, err
+    rep = json.loads(out)
+    assert (rep["ffs"], rep["brams"]) == (19, 1)
+    assert 18 <= rep["luts"] < 400
+    assert "abc -fast" in rep["flow"]
+
+
+def test_pmux_case_blocks_get_a_default():
+    from flann.synth import complete_pmux_cases
+
+    ghdl_style = (
+        "  always @*\n"
+        "    case (sel)\n"
+        "      2'b10: n1_o <= a;\n"
+        "      2'b01: n1_o <= b;\n"
+        "    endcase\n"
+    )
+    text, n = complete_pmux_cases(ghdl_style)
+    assert n == 1
+    assert "      default: n1_o <= 'bx;\n    endcase" in text
+    assert complete_pmux_cases(text)[0] == text  # idempotent

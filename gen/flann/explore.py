@@ -307,10 +307,10 @@ def _width_options(model_path, preset: str, base: dict) -> dict:
     raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
 
 
-def _measure(row: Row, design_dir: Path, device: str, work: Path | None) -> None:
+def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: str) -> None:
     from .synth import synthesize
 
-    rep = synthesize(design_dir, device, work=work)
+    rep = synthesize(design_dir, device, work=work, abc=abc)
     d = rep.to_dict()
     row.luts, row.ffs, row.brams = d["luts"], d["ffs"], d["brams"]
     row.fits, row.smallest_device = d["fits"], d["smallest_device"]
@@ -319,7 +319,7 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None) -> None
 
 
 def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles=("lut", "shiftadd"),
-            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True) -> list[Row]:
+            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast") -> list[Row]:
     """Generate, synthesise and score each candidate; the seed architecture last."""
     import warnings as _w
 
@@ -353,7 +353,7 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                 row.output_lsb_mm = spec.output_lsb_mm
                 ddir = Path(tmp) / f"d{k}"
                 hdlgen.write(spec, ddir)
-                _measure(row, ddir, device, None)
+                _measure(row, ddir, device, None, abc)
             except FlannError as exc:
                 row.note = (row.note + "; " if row.note else "") + str(exc)
         if seed:
@@ -369,7 +369,7 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                 row.max_err_lsb, row.max_err_mm, row.output_lsb_mm = err["max_err_lsb"], err["max_err_mm"], s.output_lsb_mm
                 ddir = Path(tmp) / "seed"
                 s.write(ddir)
-                _measure(row, ddir, device, None)
+                _measure(row, ddir, device, None, abc)
             except FlannError as exc:
                 row.note = (row.note + "; " if row.note else "") + str(exc)
     return rows

@@ -159,6 +159,7 @@ class SynthReport:
     resources: Resources
     warnings: tuple[str, ...]
     manifest: dict
+    abc: str = "full"
 
     @property
     def fits(self) -> bool:
@@ -197,7 +198,8 @@ class SynthReport:
             "latency_cycles": self.manifest.get("latency_cycles"),
             "cells": r.cells,
             "warnings": list(self.warnings),
-            "flow": f"ghdl --synth --std=93c --out=verilog | yosys synth_xilinx -family {FAMILY}",
+            "flow": f"ghdl --synth --std=93c --out=verilog | yosys synth_xilinx -family {FAMILY}"
+                    + (" (abc -fast)" if self.abc == "fast" else ""),
         }
 
     def table(self) -> str:
@@ -208,7 +210,8 @@ class SynthReport:
             ("block RAM (4 Kbit)", r.brams, d.brams),
             ("user I/O", r.io, self.part.user_io),
         ]
-        lines = [f"{self.top} on {self.part.name} (yosys synth_xilinx -family {FAMILY})"]
+        how = " with abc -fast" if self.abc == "fast" else ""
+        lines = [f"{self.top} on {self.part.name} (yosys synth_xilinx -family {FAMILY}{how})"]
         for name, used, avail in rows:
             lines.append(f"  {name:<20} {used:>6} / {avail:<6} {_pct(used, avail):5.1f} %")
         lines.append(f"  {'carry (MUXCY/XORCY)':<20} {r.carry:>6} / {r.xorcy}")
@@ -300,17 +303,42 @@ def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
     return out
 
 
-def yosys_cells(verilog: Path, top: str, work: Path) -> tuple[dict[str, int], list[str]]:
+ABC_MODES = ("full", "fast")
+
+
+def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.json") -> str:
+    """The Yosys script.  ``abc="full"`` is plain ``synth_xilinx -family xcv``.
+
+    ``abc="fast"`` runs the same synth_xilinx steps but replaces its LUT-mapping ABC
+    script (fraig, scorr, dch, mfs2: minutes to hours on wide multipliers) by ``abc -fast``;
+    the map_luts commands are those synth_xilinx runs for a LUT4 family (Yosys 0.23
+    synth_xilinx.cc; xilinx_srl is skipped for xcv).  Counts come out a little higher.
+    """
+    if abc not in ABC_MODES:
+        raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
+    head = [f"read_verilog {verilog}"]
+    tail = ["check", f"tee -q -o {stat} stat -json"]
+    if abc == "full":
+        return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top}"] + tail)
+    return "; ".join(head + [
+        f"synth_xilinx -family {FAMILY} -top {top} -run begin:map_luts",
+        "opt_expr -mux_undef -noclkinv",
+        "abc -fast -lut 4:6",  # LUT4 plus MUXF5/MUXF6 wide functions, as synth_xilinx maps xcv
+        "clean",
+        "techmap -map +/xilinx/ff_map.v",
+        "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=4",
+        "xilinx_dffopt -lut4",
+        "opt_lut_ins -tech xilinx",
+        f"synth_xilinx -family {FAMILY} -top {top} -run map_cells:",
+    ] + tail)
+
+
+def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
     """Run Yosys synth_xilinx -family xcv; return (cells by type, warnings that matter)."""
     yosys = _need_tool("yosys")
     stat = work / "stat.json"
     log = work / "yosys.log"
-    script = (
-        f"read_verilog {verilog.name}; "
-        f"synth_xilinx -family {FAMILY} -top {top}; "
-        "check; "
-        f"tee -q -o {stat.name} stat -json"
-    )
+    script = yosys_script(verilog.name, top, abc, stat.name)
     r = subprocess.run([yosys, "-q", "-l", log.name, "-p", script], capture_output=True, text=True, cwd=work)
     text = log.read_text() if log.exists() else r.stderr
     if r.returncode != 0:
@@ -332,11 +360,23 @@ def yosys_cells(verilog: Path, top: str, work: Path) -> tuple[dict[str, int], li
     return {str(k): int(v) for k, v in cells.items()}, warnings
 
 
-def synthesize(directory: str | Path, device: str = DEFAULT_DEVICE, work: str | Path | None = None,
-               progress: bool = False) -> SynthReport:
-    """Full flow for one generated design directory.  ``work`` keeps the intermediate files."""
-    part = parse_part(device)
+def manifest_device(man: Manifest) -> str:
+    """The part the design was generated for (manifest spec.device), else DEFAULT_DEVICE."""
+    spec = man.data.get("spec")
+    dev = spec.get("device") if isinstance(spec, dict) else None
+    return dev if isinstance(dev, str) and dev else DEFAULT_DEVICE
+
+
+def synthesize(directory: str | Path, device: str | None = None, work: str | Path | None = None,
+               progress: bool = False, abc: str = "full") -> SynthReport:
+    """Full flow for one generated design directory.  ``work`` keeps the intermediate files.
+
+    ``device`` defaults to the part recorded in the manifest (``flann gen --device``).
+    """
     man = read_manifest(directory)
+    part = parse_part(device if device is not None else manifest_device(man))
+    if abc not in ABC_MODES:
+        raise FlannError(f"--abc {abc!r}: allowed {', '.join(ABC_MODES)}")
     _need_tool("ghdl")
     _need_tool("yosys")
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
@@ -346,9 +386,10 @@ def synthesize(directory: str | Path, device: str = DEFAULT_DEVICE, work: str | 
             print(f"synth: ghdl --synth --std=93c {man.top} ({len(man.files)} files)", file=sys.stderr)
         verilog = ghdl_to_verilog(man, wdir)
         if progress:
-            print(f"synth: yosys synth_xilinx -family {FAMILY} (can take a minute)", file=sys.stderr)
-        cells, warnings = yosys_cells(verilog, man.top, wdir)
-    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data)
+            print(f"synth: yosys synth_xilinx -family {FAMILY}, abc {abc} (minutes for wide multipliers)",
+                  file=sys.stderr)
+        cells, warnings = yosys_cells(verilog, man.top, wdir, abc)
+    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc)
 
 
 def not_fit_message(report: SynthReport) -> str:

@@ -6,7 +6,7 @@ import json
 import sys
 
 from .. import synth
-from ..devices import DEVICES
+from ..devices import DEVICES, parse_part
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
@@ -14,21 +14,25 @@ HELP = "resource estimate via GHDL synthesis and Yosys"
 def add_arguments(p):
     p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
     p.add_argument(
-        "--device", default=synth.DEFAULT_DEVICE, metavar="PART",
-        help=f"target part DEVICE-PACKAGE-SPEED (default {synth.DEFAULT_DEVICE}; devices "
-        + ", ".join(d.name for d in DEVICES) + ")",
+        "--device", default=None, metavar="PART",
+        help="target part DEVICE-PACKAGE-SPEED, e.g. xc2s30-pq208-5 (default: the part in DIR/manifest.json, "
+        f"else {synth.DEFAULT_DEVICE}; devices " + ", ".join(d.name for d in DEVICES) + ")",
     )
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
+    p.add_argument("--abc", choices=synth.ABC_MODES, default="full",
+                   help="LUT mapping: full = synth_xilinx as is (default); fast = abc -fast (large designs)")
     p.add_argument("--work", metavar="DIR", help="keep GHDL/Yosys intermediate files (netlist, yosys.log) here")
 
 
 def run(args) -> int:
+    if args.device is not None:
+        parse_part(args.device)  # refuse a bad part before any slow step
     if not args.no_lint:
         man = synth.read_manifest(args.directory)
         synth.check_lint(man.files, args.vsg_config, start=args.directory)
-    report = synth.synthesize(args.directory, args.device, work=args.work, progress=not args.json)
+    report = synth.synthesize(args.directory, args.device, work=args.work, progress=not args.json, abc=args.abc)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:

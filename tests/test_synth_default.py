@@ -1,0 +1,52 @@
+"""CI guard: the default 51-term design still fits the device it is documented for.
+
+The design is the checked-in hdl/ when present, else it is generated from
+data/default_model.json exactly as `make gen` does.  The documented device is the one
+the design was generated for (manifest spec.device) and docs/synthesis.md names it.
+"""
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from flann.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _default_design(tmp_path) -> Path:
+    hdl = ROOT / "hdl"
+    if (hdl / "manifest.json").is_file():
+        return hdl
+    from flann import hdlgen
+
+    hdlgen.generate(ROOT / "data" / "default_model.json", tmp_path / "hdl")
+    return tmp_path / "hdl"
+
+
+def test_docs_name_the_generated_device(tmp_path):
+    d = _default_design(tmp_path)
+    device = json.loads((d / "manifest.json").read_text())["spec"]["device"]
+    assert f"`{device}`" in (ROOT / "docs" / "synthesis.md").read_text()
+
+
+def test_default_design_passes_vsg(tmp_path):
+    from flann.synth import lint_vhdl, read_manifest
+
+    man = read_manifest(_default_design(tmp_path))
+    assert lint_vhdl(man.files, ROOT / "vsg.yaml") == []
+
+
+@pytest.mark.synth
+@pytest.mark.skipif(not (shutil.which("ghdl") and shutil.which("yosys")), reason="ghdl and yosys are required")
+def test_default_design_fits_its_documented_device(tmp_path, capsys):
+    d = _default_design(tmp_path)
+    device = json.loads((d / "manifest.json").read_text())["spec"]["device"]
+    rc = main(["synth", str(d), "--device", device, "--json", "--no-lint"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    rep = json.loads(out)
+    assert rep["device"] == device and rep["fits"] is True
+    assert rep["cycles_per_sample"] == json.loads((d / "manifest.json").read_text())["cycles_per_sample"]
