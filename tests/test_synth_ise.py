@@ -76,3 +76,16 @@ def test_non_pq208_and_small_device(tmp_path):
 def test_missing_manifest(tmp_path, capsys):
     assert main(["ise", str(tmp_path), "-o", str(tmp_path / "o")]) == 2
     assert "manifest.json not found" in capsys.readouterr().err
+
+
+def test_ports_must_match_the_vhdl(tmp_path):
+    import json
+    import shutil
+
+    d = tmp_path / "d"
+    shutil.copytree(FIX, d)
+    man = json.loads((d / "manifest.json").read_text())
+    man["output_bits"] = 16  # the VHDL says 18
+    (d / "manifest.json").write_text(json.dumps(man))
+    with pytest.raises(FlannError, match="declares ports"):
+        write_ise(d, "xc2s200-pq208-5", tmp_path / "o")

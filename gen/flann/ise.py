@@ -23,6 +23,7 @@ PQ208 have 140 user I/O; the XC2S30 has 132, so some of these pins may be unbond
 
 from __future__ import annotations
 
+import re
 import shutil
 import warnings
 from dataclasses import dataclass
@@ -75,6 +76,33 @@ def top_ports(manifest: dict) -> list[Port]:
     ]
 
 
+_PORT_RE = re.compile(
+    r"^\s*(\w+)\s*:\s*(in|out)\s+std_logic(?:_vector\s*\(\s*(\d+)\s+downto\s+0\s*\))?\s*;?\s*$",
+    re.I | re.M,
+)
+
+
+def vhdl_ports(text: str, entity: str) -> list[Port]:
+    """Ports of ``entity`` as declared in VHDL text (flat std_logic / std_logic_vector ports)."""
+    m = re.search(rf"\bentity\s+{entity}\s+is(.*?)\bend\s+entity", text, re.I | re.S)
+    if not m:
+        return []
+    return [Port(n.lower(), d.lower(), int(hi) + 1 if hi else 0) for n, d, hi in _PORT_RE.findall(m.group(1))]
+
+
+def check_ports(ports: list[Port], man) -> None:
+    """The UCF must pin the entity's real ports: compare with the top file's declaration."""
+    for f in man.files:
+        declared = vhdl_ports(f.read_text(errors="replace"), man.top)
+        if declared:
+            if sorted(declared, key=lambda p: p.name) != sorted(ports, key=lambda p: p.name):
+                want = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in ports)
+                got = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in declared)
+                raise FlannError(f"{f.name}: entity {man.top} declares ports ({got}), the manifest implies ({want})")
+            return
+    raise FlannError(f"entity {man.top} not found in the manifest's files")
+
+
 def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
     """(net, LOC, note) for every bit of every port."""
     if part.package != "pq208":
@@ -113,6 +141,7 @@ def write_ise(directory, device: str = "xc2s200-pq208-5", out_dir="ise", clock_m
             "XC2S200 boards (140): check every LOC against DS001 module 4 before building"
         )
     ports = top_ports(man.data)
+    check_ports(ports, man)
     pins = pin_map(ports, part)
     sources = [f"src/{f.name}" for f in man.files]
     period_ns = 1000.0 / clock_mhz
