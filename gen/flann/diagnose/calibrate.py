@@ -86,6 +86,14 @@ def initial_origin(x: np.ndarray, y: np.ndarray, v_tip: float | None) -> float:
         k = cross[np.argmin(np.abs(cross - xs.size / 2))]
         x0, x1, y0, y1 = xs[k], xs[k + 1], ys[k], ys[k + 1]
         return float(x0 - y0 * (x1 - x0) / (y1 - y0))
+    # one side of the null only: extrapolate a line through the quarter nearest zero
+    k = np.argsort(np.abs(ys))[:max(3, ys.size // 4)]
+    if np.ptp(xs[k]) > 0:
+        slope, icpt = np.polyfit(xs[k], ys[k], 1)
+        if slope != 0:
+            guess = -icpt / slope
+            span = float(np.ptp(xs))
+            return float(np.clip(guess, xs[0] - span, xs[-1] + span))
     return float(np.median(xs))
 
 

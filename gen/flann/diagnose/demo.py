@@ -281,8 +281,9 @@ def detection_limit(case: Case, scales=(0.25, 0.5, 1.0, 2.0), reps: int = 20,
         if rate >= 0.95 and limit is None:
             limit = size
     e, p = case.main
+    n_points = len(simulate_case(case, points=points))
     return {"case": case.name, "effect": e, "parameter": p, "noise_v": case.noise_v,
-            "points": points, "reps": reps, "rates": rows, "limit": limit}
+            "points": n_points, "reps": reps, "rates": rows, "limit": limit}
 
 
 def _fmt_val(v: float | None, se: float | None = None) -> str:
