@@ -83,3 +83,27 @@ def test_bench_detects_a_wrong_design(tmp_path_factory):
     r = _run(d, "top", {"product_frac_bits": 4}, testcase="top_every_code", extra={"codes": 30})
     assert r.tests == 1 and r.failures == 1
     assert r.records["top_every_code"]["mismatches"] > 0
+
+
+def test_flann_sim_cli_json_and_plot(tmp_path, capsys):
+    """`flann sim --json` on a small design (11 terms, 8-bit input: every code is 256 samples)."""
+    import json
+
+    from flann.cli import main
+
+    from test_hw_spec import table1_model
+
+    model = tmp_path / "m11.json"
+    table1_model(11).save(model)
+    png = tmp_path / "fig" / "sim.png"
+    code = main(["sim", str(model), "--json", "--plot", str(png), "--input-bits", "8",
+                 "--build", str(tmp_path / "build")])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0, out
+    for k in ("codes_tested", "mismatches", "max_err_lsb", "max_err_mm", "cycles_per_sample",
+              "samples_per_s_at_50mhz"):
+        assert k in out, k
+    assert out["codes_tested"] == 256 and out["mismatches"] == 0
+    assert 0 <= out["max_err_lsb"] <= 1.0
+    assert out["samples_per_s_at_50mhz"] == pytest.approx(50e6 / out["cycles_per_sample"], rel=1e-6)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -66,24 +66,27 @@ class BenchResult:
     seconds: float
     records: dict = field(default_factory=dict)
     failed_tests: list = field(default_factory=list)
+    test_seconds: dict = field(default_factory=dict)  # cocotb's wall time per test (results.xml)
 
     @property
     def ok(self) -> bool:
         return self.failures == 0 and self.tests > 0
 
 
-def _parse_results(path: Path) -> tuple[int, int, list]:
+def _parse_results(path: Path) -> tuple[int, int, list, dict]:
     if not path.is_file():
-        return 0, 1, ["(simulation ended without a results file)"]
+        return 0, 1, ["(simulation ended without a results file)"], {}
     tree = ET.parse(path)
     tests = failures = 0
     failed = []
+    times = {}
     for tc in tree.iter("testcase"):
         tests += 1
+        times[tc.get("name")] = float(tc.get("time", "nan"))
         if tc.find("failure") is not None or tc.find("error") is not None:
             failures += 1
             failed.append(tc.get("name"))
-    return tests, failures, failed
+    return tests, failures, failed, times
 
 
 def run_bench(hdl_dir, bench: str, *, model, options: dict, build_dir, seed: int = 1,
@@ -153,12 +156,12 @@ def run_bench(hdl_dir, bench: str, *, model, options: dict, build_dir, seed: int
         else:
             os.environ["COCOTB_RESULTS_FILE"] = saved
     seconds = time.monotonic() - t0
-    tests, failures, failed = _parse_results(results)
+    tests, failures, failed, times = _parse_results(results)
     recs = {}
     if records.is_dir():
         for p in sorted(records.glob("*.json")):
             recs[p.stem] = json.loads(p.read_text())
-    return BenchResult(bench, tests, failures, seconds, recs, failed)
+    return BenchResult(bench, tests, failures, seconds, recs, failed, times)
 
 
 def simulate(model_path, build_dir, *, options: dict | None = None, seed: int = 1,
