@@ -250,8 +250,19 @@ def _ghdl_errors(stderr: str, top: str) -> FlannError:
             f"{top}: multiple drivers for {', '.join(multi)}: drive each signal from exactly one "
             "process or concurrent assignment"
         )
-    first = next((ln for ln in stderr.splitlines() if ln.strip()), "no message")
-    return FlannError(f"ghdl --synth of {top} failed: {first}")
+    return FlannError(f"ghdl --synth of {top} failed: {_first_problem(stderr)}")
+
+
+def _first_problem(stderr: str) -> str:
+    """The line that says what went wrong (GHDL prints notes about ROMs first)."""
+    lines = [ln.strip() for ln in stderr.splitlines() if ln.strip()]
+    if any("GHDL Bug occurred" in ln for ln in lines):
+        where = next((ln for ln in lines if ln.startswith("raised ")), "")
+        return f"GHDL crashed (internal error{': ' + where[7:] if where else ''}); the VHDL needs a workaround"
+    for ln in lines:
+        if "error" in ln.lower() and "note:" not in ln:
+            return ln
+    return next((ln for ln in lines if "note:" not in ln), lines[0] if lines else "no message")
 
 
 _PMUX_RE = re.compile(
@@ -289,8 +300,7 @@ def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
         [ghdl, "-a", "--std=93c", f"--workdir={lib}", *files], capture_output=True, text=True, cwd=work
     )
     if a.returncode != 0:
-        first = next((ln for ln in a.stderr.splitlines() if ln.strip()), "no message")
-        raise FlannError(f"ghdl -a --std=93c failed: {first}")
+        raise FlannError(f"ghdl -a --std=93c failed: {_first_problem(a.stderr)}")
     s = subprocess.run(
         [ghdl, "--synth", "--std=93c", f"--workdir={lib}", "--out=verilog", man.top],
         capture_output=True, text=True, cwd=work,
