@@ -120,3 +120,16 @@ def test_pmux_case_blocks_get_a_default():
     assert n == 1
     assert "      default: n1_o <= 'bx;\n    endcase" in text
     assert complete_pmux_cases(text)[0] == text  # idempotent
+
+
+def test_ghdl_crash_is_reported_as_such():
+    from flann.synth import _ghdl_errors
+
+    stderr = (
+        'x.vhd:10:5:note: found ROM "n1", width: 19 bits, depth: 512\n'
+        "******************** GHDL Bug occurred ***************************\n"
+        "Exception TYPES.INTERNAL_ERROR raised\n"
+        "raised TYPES.INTERNAL_ERROR : netlists-memories.adb:334\n"
+    )
+    msg = str(_ghdl_errors(stderr, "flann_top"))
+    assert "GHDL crashed" in msg and "netlists-memories.adb:334" in msg and "found ROM" not in msg
