@@ -88,9 +88,11 @@ class F18Spec:
         return self.base.float_reference(codes)
 
     def to_dict(self) -> dict:
-        d = self.base.to_dict()
-        for k in ("weight", "product", "linear", "acc", "output", "output_lsb_mm"):
-            d.pop(k, None)
+        # the shared front end's fields only (the fixed datapath's are not in this design)
+        shared = ("device", "terms", "input_bits", "input_lsb_v", "clamp_codes", "phase_bits",
+                  "table_addr_bits", "interp", "dq_bits", "slope_guard", "norm_guard", "value", "slope",
+                  "term", "steps")
+        d = {k: v for k, v in self.base.to_dict().items() if k in shared}
         d.update(number_format="float18", float=self.fmt.to_dict(), adv_period=self.adv_period,
                  sum_order="start, code term, trig terms in model order (sequential)")
         return d
