@@ -2,10 +2,11 @@
 
     .venv/bin/python bench/bench_float18.py [MODEL] [--device PART]
 
-Generates both designs for MODEL (default data/default_model.json), measures each with the
-`flann synth` flow (GHDL synthesis + Yosys synth_xilinx -family xcv), also each float18
-block alone, and takes the accuracy from `flann trace` over every input code.  Prints a
-table; takes ~3 min on 2 busy cores.
+Generates both designs for MODEL (default data/default_model.json) with the generators'
+default options, measures each with the `flann synth` flow (GHDL synthesis + Yosys
+synth_xilinx -family xcv), also each float18 block alone, and takes the accuracy from
+`flann trace` over every input code (the float18 row is `flann.float18_explore.measure`).
+Prints a table; takes ~3 min on 2 busy cores.
 """
 
 from __future__ import annotations
