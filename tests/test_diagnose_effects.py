@@ -114,3 +114,19 @@ def test_rectified_output_recognised():
         dg = diagnose(rec)
     assert any("rectified" in n for n in dg.notes)
     assert np.all(rec.voltage_v > -0.03)  # the simulated output really is unsigned
+
+
+def test_units_inches_and_millivolts_claim_nothing():
+    # the paper LVDT recorded in inches and millivolts, falling, null at 1 inch: a control
+    case = _case("control: paper")
+    rec = simulate_case(case, seed=707, points=POINTS)
+    from flann.recordings import Recordings
+    rec = Recordings(rec.displacement_mm / 25.4 + 1.0, -1000 * rec.voltage_v, rec.direction,
+                     rec.time_s, rec.temperature_c)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        dg = diagnose(rec)
+    assert dg.named == [] and dg.regions == []
+    assert abs(dg.baseline_params["displacement_scale"]["value"] - 25.4) < 0.5
+    assert abs(dg.baseline_params["origin_mm"]["value"] - 1.0) < 0.01
+    assert 3.5 < dg.noise_v < 6.5  # the simulated 5 mV, recorded as 5 units of mV

@@ -152,7 +152,11 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     fit_idx = np.flatnonzero(~out_mask)
     data = Data(x=x, y=y, direction=direction, temperature_c=temp, time_s=time)
     family = PhysicsFamily(cal.sensor, data, origin_known=known, shape=cal.shape,
-                           gain0=cal.gain, origin0=cal.origin_mm)
+                           gain0=cal.gain, origin0=cal.origin_mm, scale=cal.scale)
+    if cal.scale != 1.0:
+        notes.append(f"the recorded displacement is scaled by {cal.scale:.4g} to match the "
+                     "simulated sensor (recorded in other units than mm, or a sensor of "
+                     "another size); effect parameters in mm are in the sensor's scale")
 
     # -- name the missing physics --------------------------------------------------------
     sel = forward_select(family, family.candidates, fit_idx, progress=progress)
@@ -206,6 +210,9 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
                                           _se(final, "baseline.origin_mm"), "mm")
         for f, v in cal.geometry.items():
             base_params[f] = _param(v, cal.geometry_stderr.get(f, math.nan), "mm")
+        if cal.scale != 1.0:
+            base_params["displacement_scale"] = _param(cal.scale, math.nan,
+                                                       "sensor mm per recorded unit")
     n_dir = "" if direction is None else (
         "directions " + "/".join(sorted({"+" if v > 0 else "-" for v in np.unique(direction)}))
         + (" (inferred from the order)" if passes.inferred else ""))

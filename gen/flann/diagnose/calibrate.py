@@ -44,6 +44,7 @@ class Calibration:
     shape: ShapeModes | None
     resid: np.ndarray            # y - ideal (every point)
     tables: int                  # magnetics tables built (cost)
+    scale: float = 1.0           # sensor mm per recorded displacement unit
 
 
 def _huber_weights(r: np.ndarray, c: float = 2.5) -> np.ndarray:
@@ -116,26 +117,36 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
         gain, origin, cost = _solve_gain_origin(s, x, y, w, gain, origin, origin_free,
                                                 origin_range)
     tables = 1
+    scale = 1.0
     geometry: dict[str, float] = {}
     geo_err: dict[str, float] = {}
     shape = None
     if not geometry_known:
         fields = GEOMETRY_FIELDS
         best = None
-        for g_start in _grid_starts(s, x, y, origin, fields):
+        best_k = 1.0
+        # Each start is (k, geometry): k = sensor mm per recorded unit (1 for mm; the grid
+        # also tries the scales that map the recorded span onto the rated stroke, which
+        # covers recordings in inches or other units).  Everything below works in the
+        # scaled coordinate x * k; the origin is converted back at the end.
+        for k, g_start in _grid_starts(s, x, y, origin, fields):
             trial = _with_geometry(s, fields, g_start)
             if trial is None:
                 continue
-            gn, on, _ = _solve_gain_origin(trial, x, y, np.ones_like(y), gain, origin,
-                                           origin_free, origin_range)
-            out = _gauss_newton(trial, fields, x, y, gn, on, origin_free, origin_range, progress)
+            xk = x * k
+            rng_k = (origin_range[0] * k, origin_range[1] * k)
+            gn, on, _ = _solve_gain_origin(trial, xk, y, np.ones_like(y), gain, origin * k,
+                                           origin_free, rng_k)
+            out = _gauss_newton(trial, fields, xk, y, gn, on, origin_free, rng_k, progress)
             if best is None or out[-1] < best[-1]:
-                best = out
-        s, g, gain, origin, tables_gn, _cost = best
+                best, best_k = out, k
+        s, g, gain, origin_k, tables_gn, _cost = best
+        scale = best_k
+        origin = origin_k / scale
         tables += tables_gn
         # derivatives at the solution -> shape modes and geometry uncertainty
         base = s.replace(demodulator_gain_ratio=gain)
-        u = x - origin
+        u = (x - origin) * scale
         r = y - ideal_output_v(base, u)
         w = _huber_weights(r)
         lo_core, hi_core = float(np.min(u)) - 0.1 * span - 2, float(np.max(u)) + 0.1 * span + 2
@@ -153,44 +164,50 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
         shape, J_geo = _modes(grid, f_grid, dfdx, D, u, origin_free, fields)
         geometry = {f: float(v) for f, v in zip(fields, g)}
         geo_err = _geometry_stderr(J_geo, gain, f_grid, dfdx, grid, u, r, w, origin_free, fields)
-    resid = y - ideal_output_v(s.replace(demodulator_gain_ratio=gain), x - origin)
+    resid = y - ideal_output_v(s.replace(demodulator_gain_ratio=gain), (x - origin) * scale)
     return Calibration(sensor=s.replace(demodulator_gain_ratio=gain), gain=gain,
                        origin_mm=origin, geometry=geometry, geometry_stderr=geo_err,
-                       shape=shape, resid=resid, tables=tables)
+                       shape=shape, resid=resid, tables=tables, scale=scale)
 
 
 def _grid_starts(s, x, y, origin, fields, keep: int = 2):
-    """Coarse grid over the geometry (all lengths scaled to the recorded span, then each
-    varied), gain solved in closed form on <= 200 points; the ``keep`` best start the
-    Gauss-Newton refinement, together with the sensor's own geometry."""
+    """Coarse grid over the geometry (each length varied around the sensor's, all of them
+    or the displacement scaled when the recorded span is far from the rated stroke), gain
+    solved in closed form on <= 200 points; the ``keep`` best (k, geometry) start the
+    Gauss-Newton refinement, together with the sensor's own geometry at k = 1."""
     order = np.argsort(x, kind="stable")
     sub = order[np.unique(np.linspace(0, x.size - 1, min(x.size, 200)).astype(int))]
     xs, ys = x[sub] - origin, y[sub]
     g0 = np.array([getattr(s, f) for f in fields], dtype=float)
-    half = max(float(np.max(np.abs(xs))), 1e-3)
-    k0 = half / max(s.stroke_mm, 1e-3)
+    half = max(float(np.max(np.abs(xs))), 1e-12)
+    k_span = max(s.stroke_mm, 1e-3) / half     # maps the recorded half-span onto the stroke
     factors = {"primary_length_mm": (0.5, 1.0, 3.0, 8.0), "secondary_length_mm": (0.6, 1.0, 1.6),
                "secondary_gap_mm": (0.3, 1.0, 2.5), "core_length_mm": (0.8, 1.0, 1.25)}
     scored = []
     s1 = s.replace(demodulator_gain_ratio=1.0)
-    for k in (0.7 * k0, k0, 1.5 * k0):
+    # (k, length factor): the recorded span is either a sensor of another size in mm
+    # (lengths scaled) or the paper-sized sensor recorded in other units (x scaled)
+    options = [(1.0, f / k_span) for f in (0.7, 1.0, 1.5)]
+    if not 0.5 < k_span < 2.0:
+        options += [(k_span * f, 1.0) for f in (0.7, 1.0, 1.5)]
+    for k, lf in options:
         for fp in factors["primary_length_mm"]:
             for fs in factors["secondary_length_mm"]:
                 for fg in factors["secondary_gap_mm"]:
                     for fc in factors["core_length_mm"]:
-                        g = g0 * k * np.array([fp, fs, fg, fc])
+                        g = g0 * lf * np.array([fp, fs, fg, fc])
                         trial = _with_geometry(s1, fields, g)
                         if trial is None:
                             continue
-                        f = ideal_output_v(trial, xs)
+                        f = ideal_output_v(trial, xs * k)
                         den = float(f @ f)
                         if den <= 0:
                             continue
                         r = ys - f * float(f @ ys) / den
-                        scored.append((float(r @ r), tuple(g)))
+                        scored.append((float(r @ r), k, tuple(g)))
     scored.sort(key=lambda t: t[0])
-    starts = [np.array(g) for _c, g in scored[:keep]]
-    return [g0] + starts
+    starts = [(k, np.array(g)) for _c, k, g in scored[:keep]]
+    return [(1.0, g0)] + starts
 
 
 def _gauss_newton(s, fields, x, y, gain, origin, origin_free, origin_range, progress):

@@ -80,13 +80,14 @@ class PhysicsFamily:
     """Least-squares fits of the calibrated ideal simulation + any set of catalogue effects."""
 
     def __init__(self, sensor, data: Data, origin_known: bool, shape: ShapeModes | None,
-                 gain0: float, origin0: float):
+                 gain0: float, origin0: float, scale: float = 1.0):
         self.sensor = sensor.replace(effects={})
         self.data = data
         self.origin_known = origin_known
         self.shape = shape
         self.gain0 = float(gain0)
         self.origin0 = float(origin0)
+        self.scale = float(scale)     # sensor mm per recorded displacement unit
         y = data.y
         self.v_range = float(np.ptp(y)) or 1.0
         self.t_ref = (float(np.mean(data.temperature_c))
@@ -115,11 +116,12 @@ class PhysicsFamily:
 
     # -- parameters ------------------------------------------------------------------
     def specs(self, effects) -> list[ParamSpec]:
-        g = abs(self.gain0)
-        span = float(np.ptp(self.data.x))
+        span_x = float(np.ptp(self.data.x))        # recorded units (origin)
+        span = span_x * self.scale                 # sensor mm (position effects)
         out = [ParamSpec("baseline.gain_ratio", *sorted((self.gain0 * 0.2, self.gain0 * 5.0)), "")]
         if not self.origin_known:
-            out.append(ParamSpec("baseline.origin_mm", self.origin0 - span, self.origin0 + span, "mm"))
+            out.append(ParamSpec("baseline.origin_mm", self.origin0 - span_x,
+                                 self.origin0 + span_x, "mm"))
         if self.shape is not None:
             out += [ParamSpec(f"baseline.shape_{k + 1}", -2.0, 2.0, "") for k in range(self.shape.k)]
         ymax = float(np.max(np.abs(self.data.y)))
@@ -149,7 +151,7 @@ class PhysicsFamily:
 
     def _typical_step(self) -> float:
         u = np.unique(self.data.x)
-        return float(np.median(np.diff(u))) if u.size > 1 else 1.0
+        return float(np.median(np.diff(u))) * self.scale if u.size > 1 else 1.0
 
     # -- the model -------------------------------------------------------------------
     def _unpack(self, theta: np.ndarray, names: list[str]):
@@ -210,7 +212,7 @@ class PhysicsFamily:
         d = self.data
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
         s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
-        core = d.x[idx] - self.origin0
+        core = (d.x[idx] - self.origin0) * self.scale
         direction = None if d.direction is None else d.direction[idx]
         temp = None if d.temperature_c is None else d.temperature_c[idx]
         time = None if d.time_s is None else d.time_s[idx]
@@ -221,11 +223,11 @@ class PhysicsFamily:
         if self.shape is not None:
             modes = self._modes_at(idx, core)
             if origin != self.origin0:
-                y = y - gain * (origin - self.origin0) * modes[0]
+                y = y - gain * (origin - self.origin0) * self.scale * modes[0]
             if shape is not None:
                 y = y + gain * (shape @ modes[1:])
         elif origin != self.origin0:
-            y = y - gain * (origin - self.origin0) * self._slope_at(idx, core)
+            y = y - gain * (origin - self.origin0) * self.scale * self._slope_at(idx, core)
         outer = [k for k in EFFECTS if k in eff and EFFECTS[k].stage == "output"]
         if outer:
             ctx = Context(displacement_mm=core,
@@ -299,7 +301,7 @@ class PhysicsFamily:
         d = self.data
         gain = base.get("baseline.gain_ratio", self.gain0)
         origin = base.get("baseline.origin_mm", self.origin0)
-        x = d.x[idx] - origin
+        x = (d.x[idx] - origin) * self.scale
         h = 0.01
         s0 = self.sensor.replace(demodulator_gain_ratio=gain)
         slope = (simulate_output_v(s0, x + h) - simulate_output_v(s0, x - h)) / (2 * h)
