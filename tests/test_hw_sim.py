@@ -59,7 +59,8 @@ def test_default_design_each_block_vs_twin(default_design, block):
 @pytest.mark.parametrize("opts,benches", [
     ({"mult_style": "lut"}, ["top", "multiplier"]),
     ({"lanes": 3}, ["top", "expansion", "multiplier", "adder"]),
-], ids=["lut", "3lanes"])
+    ({"input_bits": 14, "mult_digit_bits": 4}, ["top", "norm"]),
+], ids=["lut", "3lanes", "14bit"])
 def test_other_architectures(tmp_path_factory, opts, benches):
     d = _design(tmp_path_factory, "arch", opts)
     for b in benches:

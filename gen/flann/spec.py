@@ -20,6 +20,7 @@ smallest one whose *worst-case* bound fits its share; ``Spec.analysis`` lists bo
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -290,8 +291,6 @@ def derive_spec(
     else:
         clo, chi = cmin, cmax
     if (vlo < cmin * lsb or vhi > cmax * lsb) and clamp:
-        import warnings
-
         warnings.warn(
             f"{B}-bit codes x {lsb} V cover {cmin * lsb:.4g}..{cmax * lsb:.4g} V, less than the "
             f"trained range {vlo:.4g}..{vhi:.4g} V"
@@ -428,8 +427,6 @@ def derive_spec(
     analysis = error_analysis(spec, Sw=Sw, Swm=Swm, N=N)
     spec = replace(spec, analysis=analysis)
     if not analysis["guaranteed_1lsb"]:
-        import warnings
-
         warnings.warn(
             f"these widths bound |hardware - float model| by {analysis['bound_total_lsb']:.3g} output LSB "
             f"(> 1): see the spec analysis for the dominant source"

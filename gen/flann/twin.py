@@ -121,6 +121,7 @@ class TopTrace:
     expansion: dict
     multiplier: dict
     adder: dict
+    n_trig: int = 0
 
     @property
     def out(self) -> np.ndarray:
@@ -135,8 +136,6 @@ class TopTrace:
         a = getattr(self, stage)[key]
         n = a.shape[0]
         return a.reshape(n, -1)[:, : self.n_trig]
-
-    n_trig: int = 0
 
 
 class FlannTop:
