@@ -42,8 +42,15 @@ def explain(name: str, params: dict, contrib: np.ndarray, x: np.ndarray,
                 "offset).")
     if name == "secondary_imbalance":
         halves = _halves(x, y, contrib, origin)
-        return (f"the residual has the same sign on both halves of the stroke and grows away "
-                f"from the null, so one half reads larger than the other{halves}: the two "
+        near = np.abs(x - origin) <= 0.1 * np.ptp(x)
+        far = np.abs(x - origin) >= 0.4 * np.ptp(x)
+        shape = ""
+        if near.any() and far.any():
+            shape = (f" ({_mv(float(np.mean(contrib[near])))} near the null, "
+                     f"{_mv(float(np.mean(contrib[far])))} towards the ends, following the sum "
+                     "of the secondary voltages)")
+        return (f"the residual has the same sign on both halves of the stroke{shape}, so one "
+                f"half reads larger than the other{halves}: the two "
                 f"secondaries are coupled unequally ({p['imbalance_fraction'] * 100:+.2g} %), "
                 "leaving part of their common-mode voltage in the output.")
     if name == "backlash":
@@ -88,4 +95,5 @@ def _halves(x, y, contrib, origin) -> str:
     # relative change of |output| on each half
     rn = float(np.mean(contrib[neg] * np.sign(y[neg])))
     rp = float(np.mean(contrib[pos] * np.sign(y[pos])))
-    return f" (|output| {_mv(rp)} on the + half, {_mv(rn)} on the - half on average)"
+    return (f" (the magnitude of the output changes by {rp * 1e3:+.2g} mV on the + half and "
+            f"{rn * 1e3:+.2g} mV on the - half on average)")

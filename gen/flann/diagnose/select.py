@@ -75,9 +75,13 @@ class Fit:
 
 
 class Family(Protocol):
+    """What selection needs from a model family (:class:`flann.diagnose.model.PhysicsFamily`)."""
+
     def fit(self, effects: Sequence[str], idx: np.ndarray, start: Fit | None = None) -> Fit: ...
 
     def predict(self, fit: Fit, idx: np.ndarray) -> np.ndarray: ...
+
+    def data_y(self, idx: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass
@@ -129,7 +133,7 @@ def oof_errors(family: Family, effects: Sequence[str], idx: np.ndarray,
     return out
 
 
-def forward_select(family, candidates: Sequence[str], idx: np.ndarray,
+def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                    bic_margin: float = BIC_MARGIN, cv_t: float = CV_T,
                    max_effects: int = 4, progress=None) -> Selection:
     current: list[str] = []
