@@ -43,6 +43,7 @@ def test_good_design_fits_with_hand_counted_registers(capsys, tmp_path):
     assert rep["fits"] is True
     assert rep["smallest_device"] == "xc2s30-pq208-5"  # XC2S15 comes in no PQ208
     assert rep["io"] == 1 + 1 + 12 + 1 + 1 + 18 + 1  # every port but clk
+    assert rep["entities"]["flann_top"] == {"luts": rep["luts"], "ffs": 19, "brams": 1}  # one entity
     assert (tmp_path / "flann_top.v").is_file() and (tmp_path / "yosys.log").is_file()
 
 

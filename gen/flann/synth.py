@@ -160,6 +160,7 @@ class SynthReport:
     warnings: tuple[str, ...]
     manifest: dict
     abc: str = "full"
+    entities: dict = field(default_factory=dict)
 
     @property
     def fits(self) -> bool:
@@ -197,6 +198,7 @@ class SynthReport:
             "cycles_per_sample": self.manifest.get("cycles_per_sample"),
             "latency_cycles": self.manifest.get("latency_cycles"),
             "cells": r.cells,
+            "entities": self.entities,
             "warnings": list(self.warnings),
             "flow": f"ghdl --synth --std=93c --out=verilog | yosys synth_xilinx -family {FAMILY}"
                     + (" (abc -fast)" if self.abc == "fast" else ""),
@@ -216,6 +218,9 @@ class SynthReport:
             lines.append(f"  {name:<20} {used:>6} / {avail:<6} {_pct(used, avail):5.1f} %")
         lines.append(f"  {'carry (MUXCY/XORCY)':<20} {r.carry:>6} / {r.xorcy}")
         lines.append(f"  {'MUXF5 / MUXF6':<20} {r.muxf5:>6} / {r.muxf6}")
+        if len(self.entities) > 1:
+            lines.append("  per entity (LUT4 / FF / BRAM): " + ", ".join(
+                f"{n} {e['luts']}/{e['ffs']}/{e['brams']}" for n, e in self.entities.items()))
         cps = self.manifest.get("cycles_per_sample")
         if cps:
             lines.append(f"  {'cycles per sample':<20} {cps:>6}")
@@ -367,7 +372,24 @@ def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple
                 warnings.append(msg)
     data = json.loads(stat.read_text())
     cells = data["design"]["num_cells_by_type"]
+    (work / "modules.json").write_text(json.dumps({
+        str(name).lstrip("\\"): mod.get("num_cells_by_type", {}) for name, mod in data.get("modules", {}).items()
+    }))
     return {str(k): int(v) for k, v in cells.items()}, warnings
+
+
+def entity_breakdown(modules: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
+    """LUT4 / FF / block RAM per entity (synth_xilinx keeps GHDL's hierarchy; cells of one
+    module only, instances of sub-entities are not counted inside their parent)."""
+    out = {}
+    for name, cells in sorted(modules.items()):
+        cells = {str(k): int(v) for k, v in cells.items() if not str(k).startswith("\\")}
+        out[name] = {
+            "luts": sum(n * _LUT_SITES.get(c, 0) for c, n in cells.items()),
+            "ffs": sum(n for c, n in cells.items() if c.startswith("FD")),
+            "brams": sum(n for c, n in cells.items() if c.startswith("RAMB4")),
+        }
+    return out
 
 
 def manifest_device(man: Manifest) -> str:
@@ -399,7 +421,8 @@ def synthesize(directory: str | Path, device: str | None = None, work: str | Pat
             print(f"synth: yosys synth_xilinx -family {FAMILY}, abc {abc} (minutes for wide multipliers)",
                   file=sys.stderr)
         cells, warnings = yosys_cells(verilog, man.top, wdir, abc)
-    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc)
+        modules = entity_breakdown(json.loads((wdir / "modules.json").read_text()))
+    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc, modules)
 
 
 def not_fit_message(report: SynthReport) -> str:
