@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -13,7 +14,8 @@ from flann.float18 import FLOAT18
 from flann.float18_hdl import BLOCKS, render_blocks
 
 SIM_DIR = Path(__file__).resolve().parent.parent / "sim"
-N_RANDOM = {"mul": 15000, "add": 15000}
+# random vectors per block bench; FLANN_F18_N=200000 for a long run
+N_RANDOM = int(os.environ.get("FLANN_F18_N", "15000"))
 
 
 def _write(tmp_path: Path) -> dict[str, Path]:
@@ -64,7 +66,7 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
     files = _write(tmp_path)
     entity = f"flann_f18_{kind}"
     spec = {"kind": kind, "format": FLOAT18.to_dict(), "seed": 1000 + sorted(BLOCKS).index(kind),
-            "n_random": N_RANDOM[kind]}
+            "n_random": N_RANDOM}
     run(simulator="ghdl", toplevel=entity, toplevel_lang="vhdl", module=f"test_f18_{kind}",
         vhdl_sources=[str(files[f"{entity}.vhd"])], python_search=[str(SIM_DIR)],
         compile_args=["--std=93c"], sim_build=str(tmp_path / "sim_build"),
