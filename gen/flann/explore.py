@@ -442,3 +442,61 @@ def markdown(rows: list[Row], device: str) -> str:
             f"| {_fmt(r.smallest_device)} | {r.note} |"
         )
     return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- float18 rows
+def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | None = None,
+                 progress: bool = True) -> list[Row]:
+    """The paper's 18-bit floating point: the project's serial float18 design, and the
+    seed architecture's arithmetic in float18 (N multipliers + N-1 adders, each block
+    synthesised once with this flow and multiplied by its count; tables not included).
+    """
+    from .float18_explore import measure
+    from .float18_hdl import render_block
+    from .devices import parse_part
+    from .synth import Resources, shortfall, smallest_fit, synthesize
+
+    rows = []
+    if progress:
+        print("explore: float18 design (serial)", file=sys.stderr)
+    r = Row("float18 (serial)", 1, "float18", "float18")
+    try:
+        m = measure(model_path, device)
+        r.luts, r.ffs, r.brams, r.fits = m["luts"], m["ffs"], m["brams"], m["fits"]
+        r.cycles_per_sample, r.samples_per_s = m["cycles_per_sample"], m["samples_per_s_at_50mhz"]
+        r.max_err_mm = m["max_err_mm"]
+        r.note = f"dominant error: {m['dominant_error_stage']}"
+        part = parse_part(device)
+        best = smallest_fit(Resources(m["luts"], m["ffs"], m["brams"], 0, 0, 0, 0, 0, 0), part)
+        r.smallest_device = best.name if best else None
+    except FlannError as exc:
+        r.note = str(exc)
+    rows.append(r)
+
+    n = seed_terms or load_model(model_path).terms
+    per = {}
+    with tempfile.TemporaryDirectory(prefix="flann-f18blk-") as tmp:
+        for kind in ("mul", "add"):
+            if progress:
+                print(f"explore: float18 {kind} block", file=sys.stderr)
+            name, text = render_block(kind)
+            d = Path(tmp) / kind
+            d.mkdir()
+            (d / name).write_text(text)
+            (d / "manifest.json").write_text(json.dumps({"top": name[:-4], "files": [name]}))
+            rep = synthesize(d, device, abc=abc)
+            per[kind] = (rep.resources.luts, rep.resources.ffs, rep.resources.brams)
+    luts = n * per["mul"][0] + (n - 1) * per["add"][0]
+    ffs = n * per["mul"][1] + (n - 1) * per["add"][1]
+    brams = n * per["mul"][2] + (n - 1) * per["add"][2]
+    part = parse_part(device)
+    res = Resources(luts, ffs, brams, 0, 0, 0, 0, 0, 0)
+    best = smallest_fit(res, part)
+    rows.append(Row(
+        f"seed arithmetic in float18, {n} terms", None, "float18", "float18", luts=luts, ffs=ffs, brams=brams,
+        cycles_per_sample=1, samples_per_s=CLOCK_HZ, fits=not shortfall(res, part),
+        smallest_device=best.name if best else None,
+        note=(f"{n} x flann_f18_mul ({per['mul'][0]} LUT4, {per['mul'][1]} FF) + {n - 1} x flann_f18_add "
+              f"({per['add'][0]} LUT4, {per['add'][1]} FF), each synthesised once; expansion tables not counted"),
+    ))
+    return rows

@@ -27,6 +27,8 @@ def add_arguments(p):
                    help="width presets: budget (error budget <= 1 LSB), narrow (4 fraction bits fewer)")
     p.add_argument("--no-seed", action="store_true", help="leave out the seed architecture (its synthesis is slow)")
     p.add_argument("--seed-only", action="store_true", help="only the seed architecture rows")
+    p.add_argument("--float18", action="store_true",
+                   help="add the float18 rows: the serial float18 design and the seed's arithmetic in float18")
     p.add_argument("--abc", choices=("fast", "full"), default="fast",
                    help="yosys LUT mapping (default fast: abc -fast; full = synth_xilinx as is, slow)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
@@ -35,12 +37,16 @@ def add_arguments(p):
 def run(args) -> int:
     if args.seed_only:
         rows = explore.seed_rows(args.model, args.device, abc=args.abc)
+        if args.float18:
+            rows += explore.float18_rows(args.model, args.device, abc=args.abc)
         print(json.dumps([r.to_dict() for r in rows], indent=2) if args.json else explore.markdown(rows, args.device))
         return 0
     rows = explore.explore(
         args.model, args.device, lanes=_ints(args.lanes), styles=tuple(args.mult.split(",")),
         widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=True, abc=args.abc,
     )
+    if args.float18:
+        rows += explore.float18_rows(args.model, args.device, abc=args.abc)
     if args.json:
         print(json.dumps([r.to_dict() for r in rows], indent=2))
     else:
