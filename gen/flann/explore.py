@@ -344,8 +344,10 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                     _w.simplefilter("always")
                     opts = {**base, **_width_options(model_path, preset, base)}
                     spec = hdlgen.load(model_path, check_device=False, device=device, **opts)
-                if caught:
-                    row.note = "error bound > 1 LSB"
+                if not spec.analysis.get("guaranteed_1lsb", True):
+                    row.note = f"worst-case bound {spec.analysis['bound_total_lsb']:.2f} LSB > 1"
+                elif caught:
+                    row.note = "; ".join(str(w.message) for w in caught)
                 err = FlannTop(spec).error_vs_float()
                 row.cycles_per_sample = spec.cycles_per_sample
                 row.samples_per_s = SPEC_CLOCK / spec.cycles_per_sample
