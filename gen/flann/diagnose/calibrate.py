@@ -299,7 +299,11 @@ def _modes(grid, f_grid, dfdx, D, u, origin_free, fields):
     U, sv, Vt = np.linalg.svd(Dd_perp, full_matrices=False)
     if sv.size == 0 or sv[0] <= 0:
         return None, Dd
-    keep = sv > 1e-4 * sv[0] * math.sqrt(1.0)
+    keep = sv > 1e-4 * sv[0]
+    # few points cannot carry many free shapes: at most one mode per 8 points beyond 10
+    keep &= np.arange(sv.size) < max(0, min(sv.size, (u.size - 10) // 8))
+    if not keep.any():
+        return None, Dd
     # modes on the grid: the same combinations of the raw derivatives, orthogonalised
     # against gain/origin with the data-point projection coefficients
     coef_B = np.linalg.lstsq(B, Dd, rcond=None)[0]           # (nb, fields)

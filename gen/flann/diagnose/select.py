@@ -34,6 +34,8 @@ CV_SEED = 20260522
 # ("not worth more than a bare mention"); the simplest (fewest parameters, then catalogue
 # order) is named and the others are reported as indistinguishable alternatives.
 TIE_BIC = 2.0
+# an effect is only tried when the fit keeps at least this many residual degrees of freedom
+MIN_DOF = 5
 
 
 @dataclass
@@ -159,7 +161,8 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
             if progress:
                 progress(f"trying {'+'.join(current + [c])}")
             f = family.fit(current + [c], idx, start=best)
-            fits.append((f.bic - best.bic if f.ok else math.inf, c, f))
+            enough = f.n - f.k >= MIN_DOF and idx.size >= 2 * FOLDS
+            fits.append((f.bic - best.bic if f.ok and enough else math.inf, c, f))
         fits.sort(key=lambda t: t[0])
         if fits and math.isfinite(fits[0][0]):
             top = fits[0][0]
