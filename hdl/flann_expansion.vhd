@@ -1099,6 +1099,8 @@ architecture rtl of flann_expansion is
   type dq_t    is array (0 to 0) of signed(10 downto 0);
   type value_t is array (0 to 0) of unsigned(18 downto 0);
   type slope_t is array (0 to 0) of unsigned(9 downto 0);
+  type hi_t    is array (0 to 0) of signed(11 downto 0);
+  type sh_t    is array (0 to 0) of unsigned(9 downto 0);
   type term_t  is array (0 to 0) of signed(19 downto 0);
 
   signal step_even : unsigned(22 downto 0);
@@ -1114,6 +1116,9 @@ architecture rtl of flann_expansion is
   signal s2_dq     : dq_t;
   signal s2_neg    : std_logic_vector(0 to 0);
   signal s2_valid  : std_logic;
+  signal s2_hi     : hi_t;
+  signal s2_sh     : sh_t;
+  signal icnt      : unsigned(2 downto 0);
   signal s3_term   : term_t;
   signal s3_valid  : std_logic;
 begin
@@ -1175,7 +1180,13 @@ begin
   end process p_addr;
 
   -- ---- stage 2: synchronous table read (block RAM or LUT ROM) ----
+  -- Between two advances the offset x slope product is formed serially from the stage-2
+  -- registers (one cycle to copy, then 2 slope bit(s) per cycle, LSB first, the
+  -- dropped bit shifting into the slope copy): no array multiplier, ready by the next advance.
   p_rom : process (clk)
+    variable a  : signed(12 downto 0);
+    variable hv : signed(11 downto 0);
+    variable sv : unsigned(9 downto 0);
   begin
     if rising_edge(clk) then
       if in_adv = '1' then
@@ -1186,9 +1197,34 @@ begin
         s2_dq    <= s1_dq;
         s2_neg   <= s1_neg;
         s2_valid <= s1_valid;
+        icnt     <= "110";
+      elsif icnt = "110" then
+        -- copy out of the ROM's output register (kept plain so it can be a block RAM)
+        for l in 0 to lanes_c - 1 loop
+          s2_hi(l) <= (others => '0');
+          s2_sh(l) <= resize(s2_slope(l), 10);
+        end loop;
+        icnt <= icnt - 1;
+      elsif icnt /= 0 then
+        for l in 0 to lanes_c - 1 loop
+          hv := s2_hi(l);
+          sv := s2_sh(l);
+          for d in 0 to 1 loop
+            a := resize(hv, 13);
+            if sv(0) = '1' then
+              a := a + s2_dq(l);
+            end if;
+            hv := a(12 downto 1);
+            sv := a(0) & sv(9 downto 1);
+          end loop;
+          s2_hi(l) <= hv;
+          s2_sh(l) <= sv;
+        end loop;
+        icnt <= icnt - 1;
       end if;
       if rst = '1' then
         s2_valid <= '0';
+        icnt     <= (others => '0');
       end if;
     end if;
   end process p_rom;
@@ -1202,7 +1238,7 @@ begin
       if in_adv = '1' then
         for l in 0 to lanes_c - 1 loop
           mag := signed(resize(s2_value(l), 20));
-          prod := s2_dq(l) * signed('0' & s2_slope(l));
+          prod := s2_hi(l) & signed(s2_sh(l));
           prod := shift_right(prod + 1024, 11);
           mag  := mag + resize(prod, 20);
           if s2_neg(l) = '1' then

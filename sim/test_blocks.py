@@ -109,7 +109,8 @@ async def expansion_vs_twin(dut):
         dut.in_theta.value = th
         await FallingEdge(dut.clk)
         dut.in_start.value = 0
-        pat = AdvancePattern(r, 1)
+        # shift-add designs form the slope product between advances: keep their spacing
+        pat = AdvancePattern(r, s.adv_period)
         issued, got = 0, []
         while len(got) < s.steps:
             adv = pat.next()

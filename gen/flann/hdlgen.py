@@ -81,6 +81,12 @@ def contexts(spec: Spec) -> dict[str, dict]:
     de, do = s.delta_steps
     starts = [s.lane_start(l) for l in range(L)]
     slope_bits = s.slope_fmt.width if s.interp else 1
+    # shift-add designs have adv_period - 1 idle cycles per step: form offset x slope serially
+    # (one cycle copies the slope out of the ROM register, the rest iterate)
+    serial_interp = s.interp and s.mult_style == "shiftadd" and s.adv_period >= 3
+    kx = -(-slope_bits // (s.adv_period - 2)) if serial_interp else 1
+    slope_reg = -(-slope_bits // kx) * kx if serial_interp else slope_bits
+    icnt_bits = _ubits(slope_reg // kx + 1)
     expansion = dict(
         common, delta_even=de, delta_odd=do, lanes_odd=(L % 2 == 1),
         mult_bits=_ubits(max([de, do, *starts])),
@@ -89,6 +95,9 @@ def contexts(spec: Spec) -> dict[str, dict]:
         quarter=bits_literal(1 << (P - 2), P, False),
         table_depth=1 << A, addr_bits=A, offset_bits=D, dq_bits=s.dq_bits,
         value_bits=s.value_fmt.width, slope_bits=slope_bits, interp=s.interp,
+        serial_interp=serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
+        interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
+        prod_bits=(s.dq_bits + 1 + slope_reg) if serial_interp else (s.dq_bits + slope_bits + 1),
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
         value_words=[bits_literal(v, s.value_fmt.width, False) for v in s.value_rom],
         slope_words=[bits_literal(v, slope_bits, False) for v in s.slope_rom] if s.interp else [],

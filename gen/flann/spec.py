@@ -468,7 +468,9 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
                           f"each bit less doubles the phase bound ({bounds['phase']:.3g} LSB)",
             "table": f"{1 << A} x ({spec.value_fmt.width}+{spec.slope_fmt.width if spec.interp else 0}) bits "
                      f"= {rom_bits} ROM bits per lane; one address bit less x4 interpolation residual",
-            "interp": f"slope multiplier {Dq}x{spec.slope_fmt.width + 1} per lane"
+            "interp": (f"slope product {Dq}x{spec.slope_fmt.width} per lane, "
+                       + ("serial between advances" if spec.mult_style == "shiftadd" and spec.adv_period >= 3
+                          else "array multiplier"))
                       if spec.interp else "off: table step error dominates",
             "weights": f"{spec.weight_fmt.width}-bit weights, {wrom_bits} ROM bits per lane",
             "multiplier": f"{spec.term_fmt.width}x{spec.weight_fmt.width} {spec.mult_style}, "
@@ -487,12 +489,15 @@ def estimate_resources(spec: Spec) -> dict:
     L = spec.lanes
     T, W = spec.term_fmt.width, spec.weight_fmt.width
     P, A = spec.phase_bits, spec.table_addr_bits
-    mult = 5.1 * T * W if spec.mult_style == "lut" else 6.2 * (T + W) + 3 * T * (spec.mult_digit_bits - 1)
-    interp = 2.5 * spec.dq_bits * (spec.slope_fmt.width + 1) if spec.interp else 0
-    expansion = interp + 14.6 * P
-    norm = 1.5 * (P + spec.norm_guard + spec.lin_width)
+    C, Dq = spec.slope_fmt.width, spec.dq_bits
+    serial = spec.mult_style == "shiftadd" and spec.adv_period >= 3
+    mult = 5.3 * T * W if spec.mult_style == "lut" else 5.5 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1)
+    # slope correction: array multiplier, or serial between advances (shift-add designs)
+    interp = 0 if not spec.interp else (6.3 * (Dq + C) if serial else 4.6 * Dq * (C + 1))
+    expansion = interp + 3.4 * P
+    norm = 2 * (P + spec.norm_guard + spec.lin_width)
     adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
-    luts = L * (mult + expansion) + norm + adder + 60
+    luts = L * (mult + expansion) + norm + adder + 30
     ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
     # a 4-Kbit block is 4096/depth bits wide (at most 16); one dual-ported table serves two lanes
     per_block = min(16, max(1, BRAM_BITS >> A))
