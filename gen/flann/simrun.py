@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from .errors import FlannError
-from .hdlgen import generate, read_manifest
+from .hdlgen import generate, load, read_manifest
 from .spec import CLOCK_HZ
+from .twin import FlannTop
 
 # bench name -> (toplevel entity, cocotb module in sim/)
 BENCHES = {
@@ -171,9 +172,6 @@ def simulate(model_path, build_dir, *, options: dict | None = None, seed: int = 
     build_dir = Path(build_dir)
     hdl = build_dir / "hdl"
     man = generate(model_path, hdl, **options)
-    from .hdlgen import load
-    from .twin import FlannTop
-
     spec = load(model_path, **options)
     results = []
     for b in benches:
@@ -191,12 +189,14 @@ def simulate(model_path, build_dir, *, options: dict | None = None, seed: int = 
     if rec:
         codes = np.array(rec["codes"], dtype=np.int64)
         data = np.array(rec["data"], dtype=np.int64)
-        twin_out, _ = FlannTop(spec).process(codes)
+        sat = np.array(rec["sat"], dtype=bool)
+        twin_out, twin_sat = FlannTop(spec).process(codes)
         ref = spec.float_reference(codes) / spec.output_lsb_mm
         err = np.abs(data - ref)
         summary.update(
             codes_tested=int(codes.size),
-            mismatches=max(int(np.count_nonzero(data != twin_out)), int(rec.get("mismatches", 0))),
+            mismatches=max(int(np.count_nonzero((data != twin_out) | (sat != twin_sat))),
+                           int(rec.get("mismatches", 0))),
             max_err_lsb=round(float(err.max()), 4),
             max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6),
         )
