@@ -110,7 +110,13 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
                         f"{options['lanes']}")
     options.pop("lanes", None)
     options.pop("number_format", None)
-    base = derive_spec(model, **options)
+    # The front end must take an advance every adder latency (3 cycles): derive it as for
+    # the array-multiplier design, whose expansion forms the slope correction in one step
+    # (a shift-add spec forms it serially between its own, slower advances).  The fixed
+    # design's device estimate (multiplier, accumulator) does not apply: `flann synth`
+    # measures the float18 design itself.
+    options.pop("check_device", None)
+    base = derive_spec(model, mult_style="lut", check_device=False, **options)
     fmt = FLOAT18
     Tf = base.term_fmt.frac_bits
     if base.input_bits > fmt.sig_bits:
