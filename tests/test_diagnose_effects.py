@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from flann.diagnose import diagnose
-from flann.diagnose.demo import CASES, case_sensor, simulate_case
+from flann.diagnose.demo import CASES, case_sensor, resolved_effects, simulate_case
 
 POINTS = 600
 
@@ -59,7 +59,7 @@ SIGNATURES = [
 def test_effect_signature_named_and_recovered(prefix, scale, words):
     case = _case(prefix)
     effect, param = case.main
-    true = case.effects[effect][param] * scale
+    true = resolved_effects(case)[effect][param] * scale
     dg = _run(case, scale=scale, seed=202)
     assert dg.named == [effect]
     e = dg.effects[0]
