@@ -128,6 +128,8 @@ architecture rtl of flann_multiplier is
   type hi_t      is array (0 to 0) of signed(20 downto 0);
   type product_t is array (0 to 0) of signed(20 downto 0);
 
+  type rom_out_t is array (0 to 0) of signed(19 downto 0);
+  signal w_rom    : rom_out_t;
   signal step     : unsigned(5 downto 0);
   signal op_term  : term_t;
   signal op_w     : weight_t;
@@ -144,6 +146,14 @@ architecture rtl of flann_multiplier is
   end function round_product;
 begin
 
+  -- one ROM per lane, read at the step counter (a per-lane copy: GHDL synthesis does not
+  -- take the two-dimensional read)
+  g_rom : for l in 0 to 0 generate
+    constant lane_rom_c : weight_rom_t := weight_rom_c(l);
+  begin
+    w_rom(l) <= signed(lane_rom_c(to_integer(step)));
+  end generate g_rom;
+
   p_mult : process (clk)
     variable a  : signed(21 downto 0);
     variable hv : signed(20 downto 0);
@@ -158,7 +168,7 @@ begin
           prod(l)    <= round_product(hi(l) & op_w(l));
           hi(l)      <= (others => '0');
           op_term(l) <= signed(in_terms((l + 1) * 20 - 1 downto l * 20));
-          op_w(l)    <= resize(signed(weight_rom_c(l)(to_integer(step))), 20);
+          op_w(l)    <= resize(w_rom(l), 20);
         end loop;
         p_valid  <= op_valid;
         op_valid <= in_valid;

@@ -80,7 +80,7 @@ def test_templates_only_place_computed_text(model_file):
         assert "{{" not in t and "{%" not in t
 
 
-CONFIGS = [{}, {"mult_style": "lut"}, {"lanes": 2}, {"lanes": 3},
+CONFIGS = [{}, {"mult_style": "lut"}, {"lanes": 2}, {"lanes": 3, "check_device": False},
            {"interp": False, "table_addr_bits": 8}, {"input_bits": 14, "clamp": False}]
 
 

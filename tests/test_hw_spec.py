@@ -147,7 +147,7 @@ def test_expansion_terms_match_numpy_sin_cos(spec):
     assert err <= bound, (err, bound)
 
 
-@pytest.mark.parametrize("opts", [{}, {"lanes": 2}, {"lanes": 3, "mult_style": "shiftadd"},
+@pytest.mark.parametrize("opts", [{}, {"lanes": 2}, {"lanes": 3, "check_device": False},
                                   {"input_bits": 14}, {"clamp": False}])
 def test_twin_within_one_lsb_of_float_model_for_every_code(model, opts):
     spec = derive_spec(model, **opts)
@@ -163,7 +163,8 @@ def test_lanes_do_not_change_the_result(model):
     codes = np.arange(-2048, 2048, 7)
     a = FlannTop(derive_spec(model, lanes=1)).process(codes)[0]
     for lanes in (2, 3, 4):
-        assert np.array_equal(FlannTop(derive_spec(model, lanes=lanes)).process(codes)[0], a)
+        spec = derive_spec(model, lanes=lanes, check_device=False)
+        assert np.array_equal(FlannTop(spec).process(codes)[0], a)
 
 
 def test_shorter_table_without_interpolation_costs_accuracy(model):

@@ -499,10 +499,10 @@ def estimate_resources(spec: Spec) -> dict:
     adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
     luts = L * (mult + expansion) + norm + adder + 30
     ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
-    # a 4-Kbit block is 4096/depth bits wide (at most 16); one dual-ported table serves two lanes
+    # a 4-Kbit block is 4096/depth bits wide (at most 16); each lane reads its own copy
     per_block = min(16, max(1, BRAM_BITS >> A))
     tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp else [])
-    brams = math.ceil(L / 2) * sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in tables)
+    brams = L * sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in tables)
     if spec.steps * W > 2048:  # small weight ROMs go to LUTs
         brams += L * math.ceil(spec.steps * W / BRAM_BITS)
     return {"luts": int(luts), "ffs": int(ffs), "brams": int(brams)}
