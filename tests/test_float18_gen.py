@@ -47,3 +47,18 @@ def test_fixed_only_option_is_an_error_and_writes_nothing(tmp_path):
     with pytest.raises(SpecError, match="lanes"):
         run_gen(_args(DEFAULT, "-o", tmp_path / "x", "--lanes", "2"))
     assert not (tmp_path / "x").exists()
+
+
+def test_flann_gen_format_float18_cli(tmp_path, capsys):
+    from flann.cli import main
+
+    assert main(["gen", str(DEFAULT), "-o", str(tmp_path / "f"), "--format", "float18"]) == 0
+    assert "float18" in capsys.readouterr().out
+    man = json.loads((tmp_path / "f" / "manifest.json").read_text())
+    assert man["top"] == "flann_f18_top"
+    assert main(["gen", str(DEFAULT), "-o", str(tmp_path / "g"), "--format", "float18",
+                 "--weight-frac-bits", "9"]) == 2
+    assert "weight-frac-bits" in capsys.readouterr().err and not (tmp_path / "g").exists()
+    # the fixed default is unchanged
+    assert main(["gen", str(DEFAULT), "-o", str(tmp_path / "x")]) == 0
+    assert json.loads((tmp_path / "x" / "manifest.json").read_text())["top"] == "flann_top"

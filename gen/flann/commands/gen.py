@@ -1,4 +1,4 @@
-"""``flann gen model.json -o DIR``: VHDL-93 for a model plus DIR/manifest.json."""
+"""``flann gen model.json -o DIR [--format fixed|float18]``: VHDL-93 for a model plus DIR/manifest.json."""
 
 from __future__ import annotations
 
@@ -46,10 +46,17 @@ def add_arguments(parser) -> None:
     parser.add_argument("model", help="model.json (flann-model/1)")
     parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
+    parser.add_argument("--format", choices=("fixed", "float18"), default="fixed",
+                        help="number format of the products and the sum: fixed point sized by the error "
+                             "budget (default) or the seed's 18-bit floating point (docs/float18.md)")
     add_spec_arguments(parser)
 
 
 def run(args) -> int:
+    if args.format == "float18":
+        from ._float18 import run_gen
+
+        return run_gen(args)
     man = generate(args.model, args.out, **spec_options(args))
     if args.json:
         print(json.dumps(man, indent=2))
