@@ -10,8 +10,7 @@ import json
 from pathlib import Path
 
 from . import __version__
-from .errors import FlannError, SpecError
-from .fileio import atomic_directory
+from .errors import SpecError
 from .fixedpoint import bits_literal, bits_needed
 from .float18 import FLOAT18, F18Add, F18Mul, FloatFormat
 
@@ -169,16 +168,9 @@ def generate(model_path_or_model, out_dir, **options) -> dict:
 
 
 def write(fspec, out_dir) -> dict:
+    from .hdlgen import write_design   # one writer for every design (atomic, manifest last)
     texts = render_design(fspec)
-    man = manifest(fspec, list(texts))
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir) as tmp:
-        for name, text in texts.items():
-            (tmp / name).write_text(text, newline="")
-        (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
-    return man
+    return write_design(texts, manifest(fspec, list(texts)), out_dir)
 
 
 __all__ = ["BLOCKS", "block_context", "render_block", "render_blocks", "render_design", "generate",

@@ -188,7 +188,11 @@ def generate(model_path_or_model, out_dir, **options) -> dict:
 
 def write(spec: Spec, out_dir) -> dict:
     texts = render(spec)
-    man = manifest(spec, list(texts))
+    return write_design(texts, manifest(spec, list(texts)), out_dir)
+
+
+def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
+    """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise FlannError(f"{out_dir}: exists and is not a directory")
