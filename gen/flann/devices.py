@@ -19,7 +19,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .errors import FlannError
+from .errors import SpecError
 
 SOURCE = (
     'Xilinx DS001 "Spartan-II FPGA Family Data Sheet" v2.8 (2008-06-13), '
@@ -101,7 +101,7 @@ class Part:
 def device(name: str) -> Device:
     d = _BY_NAME.get(name.lower())
     if d is None:
-        raise FlannError(f"unknown Spartan-II device {name!r}; allowed: {', '.join(_BY_NAME)}")
+        raise SpecError(f"unknown Spartan-II device {name!r}; allowed: {', '.join(_BY_NAME)}")
     return d
 
 
@@ -112,7 +112,7 @@ def parse_part(text: str) -> Part:
     """Parse ``xc2s200-pq208-5`` (also ``xc2s200pq208-5``) and check it is orderable."""
     m = _PART_RE.match(text.strip().lower())
     if not m:
-        raise FlannError(
+        raise SpecError(
             f"--device {text!r}: expected DEVICE-PACKAGE-SPEED such as xc2s200-pq208-5 "
             f"(devices {', '.join(_BY_NAME)}; speed grades {', '.join('-' + s for s in SPEED_GRADES)})"
         )
@@ -120,9 +120,9 @@ def parse_part(text: str) -> Part:
     package, speed = m.group(2), m.group(3)
     if dev.user_io(package) is None:
         offered = ", ".join(p for p, _ in dev.packages)
-        raise FlannError(f"--device {text!r}: {dev.name} is not offered in {package}; packages: {offered}")
+        raise SpecError(f"--device {text!r}: {dev.name} is not offered in {package}; packages: {offered}")
     if speed not in SPEED_GRADES:
-        raise FlannError(f"--device {text!r}: speed grade -{speed} does not exist; allowed -5, -6")
+        raise SpecError(f"--device {text!r}: speed grade -{speed} does not exist; allowed -5, -6")
     return Part(dev, package, speed)
 
 

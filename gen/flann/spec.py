@@ -26,24 +26,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import __version__
+from . import devices as spartan2
 from .errors import SpecError
 from .fixedpoint import FixedFormat, bits_needed
 from .model import FlannModel, term_kind
 
 MULT_STYLES = ("lut", "shiftadd")
 
-# Spartan-II family (Xilinx DS001 "Spartan-II FPGA Family Data Sheet", table 1):
-# LUT4 = FF = 4 x CLBs; block RAMs of 4096 bits; PQ208 offered for XC2S30..XC2S200.
-DEVICES: dict[str, dict] = {
-    "xc2s15": {"luts": 384, "ffs": 384, "brams": 4, "packages": ("vq100", "tq144", "cs144")},
-    "xc2s30": {"luts": 864, "ffs": 864, "brams": 6, "packages": ("vq100", "tq144", "cs144", "pq208")},
-    "xc2s50": {"luts": 1536, "ffs": 1536, "brams": 8, "packages": ("tq144", "pq208", "fg256")},
-    "xc2s100": {"luts": 2400, "ffs": 2400, "brams": 10, "packages": ("tq144", "pq208", "fg256", "fg456")},
-    "xc2s150": {"luts": 3456, "ffs": 3456, "brams": 12, "packages": ("pq208", "fg256", "fg456")},
-    "xc2s200": {"luts": 4704, "ffs": 4704, "brams": 14, "packages": ("pq208", "fg256", "fg456")},
-}
-SPEED_GRADES = ("5", "6")
-BRAM_BITS = 4096
+# Device data (luts, brams, packages) come from the one Spartan-II table, flann.devices.
+BRAM_BITS = spartan2.BRAM_BITS
 CLOCK_HZ = 50e6
 
 # Share of the 0.5-LSB pre-rounding budget given to each error source.
@@ -51,19 +42,9 @@ BUDGET = {"phase": 0.15, "table": 0.20, "weights": 0.07, "products": 0.03, "line
 
 
 def parse_device(device: str) -> tuple[str, str, str]:
-    """'xc2s200-pq208-5' -> ('xc2s200', 'pq208', '5'); SpecError if unknown."""
-    parts = str(device).lower().split("-")
-    if len(parts) != 3 or parts[0] not in DEVICES:
-        raise SpecError(
-            f"device {device!r}: expected <part>-<package>-<speed> with part one of "
-            f"{', '.join(DEVICES)} (e.g. xc2s200-pq208-5)"
-        )
-    part, pkg, speed = parts
-    if pkg not in DEVICES[part]["packages"]:
-        raise SpecError(f"device {device!r}: {part} comes in {', '.join(DEVICES[part]['packages'])}, not {pkg}")
-    if speed not in SPEED_GRADES:
-        raise SpecError(f"device {device!r}: speed grade must be one of {', '.join(SPEED_GRADES)}")
-    return part, pkg, speed
+    """'xc2s200-pq208-5' -> ('xc2s200', 'pq208', '5'); SpecError if not an orderable part."""
+    part = spartan2.parse_part(str(device))
+    return part.device.name, part.package, part.speed
 
 
 def nice_125(x: float, up: bool) -> float:
@@ -510,18 +491,18 @@ def estimate_resources(spec: Spec) -> dict:
 
 def check_fits(spec: Spec, part: str) -> None:
     est = spec.analysis.get("estimate") or estimate_resources(spec)
-    dev = DEVICES[part]
-    if est["luts"] <= dev["luts"] and est["brams"] <= dev["brams"]:
+    dev = spartan2.device(part)
+    if est["luts"] <= dev.luts and est["brams"] <= dev.brams:
         return
-    fits = [p for p, d in DEVICES.items() if est["luts"] <= d["luts"] and est["brams"] <= d["brams"]]
+    fits = [d.name for d in spartan2.DEVICES if est["luts"] <= d.luts and est["brams"] <= d.brams]
     hint = f"smallest part that could hold it: {fits[0]}" if fits else \
         "no Spartan-II holds it: fewer terms, fewer lanes or mult_style=shiftadd"
     raise SpecError(
         f"{spec.model.terms} terms x {spec.lanes} lane(s) ({spec.mult_style}) need about "
-        f"{est['luts']} LUT4 and {est['brams']} block RAMs; {part} has {dev['luts']} and {dev['brams']} "
+        f"{est['luts']} LUT4 and {est['brams']} block RAMs; {part} has {dev.luts} and {dev.brams} "
         f"({hint})"
     )
 
 
-__all__ = ["Spec", "derive_spec", "DEVICES", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["Spec", "derive_spec", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ"]
