@@ -8,8 +8,8 @@ import pytest
 from flann.errors import FlannError
 from flann.synth import check_lint, find_vsg_config, lint_vhdl
 
-ROOT = Path(__file__).resolve().parents[1]
-FIX = ROOT / "tests" / "fixtures" / "synth"
+ROOT = Path(__file__).resolve().parents[2]
+FIX = ROOT / "tests" / "implement" / "fixtures" / "synth"
 
 needs_vsg = pytest.mark.skipif(shutil.which("vsg") is None and not (ROOT / ".venv/bin/vsg").exists(),
                                reason="vsg (dev extra) not installed")

@@ -15,7 +15,7 @@ from flann.simrun import run_bench
 
 pytestmark = pytest.mark.sim
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 MODEL = REPO / "data" / "default_model.json"
 DEFAULT = {"device": "xc2s200-pq208-5"}
 

@@ -17,7 +17,7 @@ from flann.trace import attribute, run_trace, stages_fixed, stages_float18
 from flann.train import fit_lstsq
 from flann.twin import FlannTop
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DEFAULT = ROOT / "data" / "default_model.json"
 
 

@@ -12,7 +12,7 @@ from flann.physics.sensor import (
     default_sensor, format_sensor, load_sensor, parse_sensor,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PAPER = ROOT / "data" / "sensors" / "paper_lvdt.toml"
 
 

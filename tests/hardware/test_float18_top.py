@@ -16,7 +16,7 @@ from flann.recordings import read_recordings
 from flann.train import fit_lstsq
 from flann.twin import FlannTop
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

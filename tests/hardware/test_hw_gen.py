@@ -17,7 +17,7 @@ from flann.spec import derive_spec
 
 from test_hw_spec import table1_model
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 DEFAULT_MODEL = REPO / "data" / "default_model.json"
 MAKE_GEN_DEVICE = "xc2s200-pq208-5"  # the Makefile's DEVICE default used by `make gen`
 MANIFEST_KEYS = {"top", "files", "input_bits", "input_lsb_v", "output_bits", "output_lsb_mm",

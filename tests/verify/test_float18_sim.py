@@ -13,7 +13,7 @@ import pytest
 from flann.float18 import FLOAT18
 from flann.float18_hdl import BLOCKS, render_blocks
 
-SIM_DIR = Path(__file__).resolve().parent.parent / "sim"
+SIM_DIR = Path(__file__).resolve().parents[2] / "sim"
 # random vectors per block bench; FLANN_F18_N=200000 for a long run
 N_RANDOM = int(os.environ.get("FLANN_F18_N", "15000"))
 
@@ -40,7 +40,7 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
     from flann.float18_hdl import generate
     from flann.model import load_model
 
-    man = generate(load_model(Path(__file__).resolve().parent.parent / "data" / "default_model.json"),
+    man = generate(load_model(Path(__file__).resolve().parents[2] / "data" / "default_model.json"),
                    tmp_path / "design")
     assert man["top"] == "flann_f18_top" and man["files"][-1] == "flann_f18_top.vhd"
     work = tmp_path / "design_work"
@@ -91,7 +91,7 @@ def test_top_every_input_code_matches_twin(tmp_path):
     """Default model, default 12-bit input: all 4096 codes, 0 mismatches (and the latency)."""
     from flann.model import load_model
 
-    model = load_model(Path(__file__).resolve().parent.parent / "data" / "default_model.json")
+    model = load_model(Path(__file__).resolve().parents[2] / "data" / "default_model.json")
     codes = _run_top(tmp_path, model, step=1, seed=11)
     assert codes.size == 4096
 
@@ -102,6 +102,6 @@ def test_top_other_widths_match_twin(tmp_path):
     from flann.recordings import read_recordings
     from flann.train import fit_lstsq
 
-    rec = read_recordings(Path(__file__).resolve().parent.parent / "data" / "paper_table1.csv")
+    rec = read_recordings(Path(__file__).resolve().parents[2] / "data" / "paper_table1.csv")
     model = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="none")
     _run_top(tmp_path, model, step=8, seed=12, input_bits=10, table_addr_bits=6)
