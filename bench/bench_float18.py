@@ -5,7 +5,7 @@
 Generates both designs for MODEL (default data/default_model.json) with the generators'
 default options, measures each with the `flann synth` flow (GHDL synthesis + Yosys
 synth_xilinx -family xcv), also each float18 block alone, and takes the accuracy from
-`flann trace` over every input code (the float18 row is `flann.float18_explore.measure`).
+`flann trace` over every input code (the float18 row is `flann.implement.explore_float18.measure`).
 Prints a table; takes ~3 min on 2 busy cores.
 """
 
@@ -17,12 +17,12 @@ import sys
 import tempfile
 from pathlib import Path
 
-from flann import synth
-from flann.float18_hdl import generate as generate_f18
-from flann.hdlgen import generate as generate_fixed
-from flann.model import load_model
-from flann.spec import CLOCK_HZ
-from flann.trace import run_trace
+from flann.implement import synth
+from flann.hardware.float18.render import generate as generate_f18
+from flann.hardware.fixed.render import generate as generate_fixed
+from flann.golden.model import load_model
+from flann.hardware.fixed.spec import CLOCK_HZ
+from flann.analysis.trace import run_trace
 
 
 def main() -> int:

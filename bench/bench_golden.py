@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from flann.model import FlannModel, load_model
+from flann.golden.model import FlannModel, load_model
 
 
 def main() -> None:

@@ -15,8 +15,8 @@ import resource
 import tempfile
 from pathlib import Path
 
-from flann.hdlgen import generate
-from flann.simrun import run_bench
+from flann.hardware.fixed.render import generate
+from flann.verify.runner import run_bench
 
 REPO = Path(__file__).resolve().parents[1]
 

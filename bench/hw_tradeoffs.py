@@ -14,9 +14,9 @@ import sys
 import warnings
 from pathlib import Path
 
-from flann.model import load_model
-from flann.spec import derive_spec
-from flann.twin import FlannTop
+from flann.golden.model import load_model
+from flann.hardware.fixed.spec import derive_spec
+from flann.hardware.fixed.twin import FlannTop
 
 REPO = Path(__file__).resolve().parents[1]
 

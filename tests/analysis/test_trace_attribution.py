@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.float18_top import F18Top, derive_f18_spec
-from flann.model import load_model, term_kind
+from flann.hardware.float18.spec import F18Top, derive_f18_spec
+from flann.golden.model import load_model, term_kind
 from flann.recordings import read_recordings
-from flann.spec import derive_spec
-from flann.trace import attribute, run_trace, stages_fixed, stages_float18
-from flann.train import fit_lstsq
-from flann.twin import FlannTop
+from flann.hardware.fixed.spec import derive_spec
+from flann.analysis.trace import attribute, run_trace, stages_fixed, stages_float18
+from flann.golden.train import fit_lstsq
+from flann.hardware.fixed.twin import FlannTop
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT = ROOT / "data" / "default_model.json"

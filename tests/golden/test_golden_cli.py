@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.paper import TABLE1_DISPLACEMENT_MM, TABLE1_VOLTAGE_V, s_curve
+from flann.golden.paper import TABLE1_DISPLACEMENT_MM, TABLE1_VOLTAGE_V, s_curve
 from flann.recordings import read_recordings
 
 TABLE1 = "data/paper_table1.csv"

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from flann.metrics import (error_report, full_scale_mm, linearity_pct, raw_line,
+from flann.golden.metrics import (error_report, full_scale_mm, linearity_pct, raw_line,
                            raw_linearity_pct, stroke_fraction_within, stroke_weights)
 from flann.recordings import read_recordings
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from flann.model import FlannModel, expand, term_kind
+from flann.golden.model import FlannModel, expand, term_kind
 
 
 def test_expansion_at_half_by_hand():

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from flann.errors import FlannError, RecordingsError
-from flann.paper import s_curve
-from flann.train import (design_matrix, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
+from flann.golden.paper import s_curve
+from flann.golden.train import (design_matrix, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
                          lms_epochs, lms_leave_one_out, lms_sequential,
                          normalisation)
 

@@ -11,7 +11,7 @@ import pytest
 from flann.commands import gen
 from flann.commands._float18 import run_gen
 from flann.errors import SpecError
-from flann.model import model_sha256
+from flann.golden.model import model_sha256
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT = ROOT / "data" / "default_model.json"

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from flann.errors import SpecError
-from flann.float18 import FLOAT18 as F
-from flann.float18_top import F18Top, derive_f18_spec
-from flann.model import load_model
+from flann.numeric.float18 import FLOAT18 as F
+from flann.hardware.float18.spec import F18Top, derive_f18_spec
+from flann.golden.model import load_model
 from flann.recordings import read_recordings
-from flann.train import fit_lstsq
-from flann.twin import FlannTop
+from flann.golden.train import fit_lstsq
+from flann.hardware.fixed.twin import FlannTop
 
 ROOT = Path(__file__).resolve().parents[2]
 

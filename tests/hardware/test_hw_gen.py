@@ -11,9 +11,9 @@ import pytest
 
 from flann import __version__
 from flann.cli import main
-from flann.hdlgen import generate, render
-from flann.model import FlannModel, load_model, model_sha256
-from flann.spec import derive_spec
+from flann.hardware.fixed.render import generate, render
+from flann.golden.model import FlannModel, load_model, model_sha256
+from flann.hardware.fixed.spec import derive_spec
 
 from test_hw_spec import table1_model
 

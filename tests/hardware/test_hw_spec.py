@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from flann.errors import SpecError
-from flann.fixedpoint import FixedFormat, bits_literal, bits_needed, round_shift, saturate, wrap
-from flann.model import FlannModel, expand
-from flann.spec import derive_spec, parse_device
-from flann.twin import FlannExpansion, FlannNorm, FlannTop
+from flann.numeric.fixed import FixedFormat, bits_literal, bits_needed, round_shift, saturate, wrap
+from flann.golden.model import FlannModel, expand
+from flann.hardware.fixed.spec import derive_spec, parse_device
+from flann.hardware.fixed.twin import FlannExpansion, FlannNorm, FlannTop
 
 
 def table1_model(terms: int = 51) -> FlannModel:

@@ -20,7 +20,7 @@ def _default_design(tmp_path) -> Path:
     hdl = ROOT / "hdl"
     if (hdl / "manifest.json").is_file():
         return hdl
-    from flann import hdlgen
+    from flann.hardware.fixed import render as hdlgen
 
     hdlgen.generate(ROOT / "data" / "default_model.json", tmp_path / "hdl")
     return tmp_path / "hdl"
@@ -33,7 +33,7 @@ def test_docs_name_the_generated_device(tmp_path):
 
 
 def test_default_design_passes_vsg(tmp_path):
-    from flann.synth import lint_vhdl, read_manifest
+    from flann.implement.synth import lint_vhdl, read_manifest
 
     man = read_manifest(_default_design(tmp_path))
     assert lint_vhdl(man.files, ROOT / "vsg.yaml") == []

@@ -1,4 +1,4 @@
-"""Spartan-II device table (flann.devices) against the data sheet's own arithmetic.
+"""Spartan-II device table (flann.hardware.target) against the data sheet's own arithmetic.
 
 Expected figures are typed in from DS001 here (CLB count x 4 LUT4 / 4 FF per CLB, block
 RAMs, PQ208 user I/O), not read from the code under test.
@@ -6,7 +6,7 @@ RAMs, PQ208 user I/O), not read from the code under test.
 
 import pytest
 
-from flann.devices import DEVICES, parse_part, device
+from flann.hardware.target import DEVICES, parse_part, device
 from flann.errors import FlannError
 
 # DS001 Table 1: CLB array (rows x cols), total CLBs, block RAM bits; user I/O chart for PQ208.

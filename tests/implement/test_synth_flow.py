@@ -108,7 +108,7 @@ def test_fast_abc_keeps_the_hand_counts(capsys):
 
 
 def test_pmux_case_blocks_get_a_default():
-    from flann.synth import complete_pmux_cases
+    from flann.implement.synth import complete_pmux_cases
 
     ghdl_style = (
         "  always @*\n"
@@ -124,7 +124,7 @@ def test_pmux_case_blocks_get_a_default():
 
 
 def test_ghdl_crash_is_reported_as_such():
-    from flann.synth import _ghdl_errors
+    from flann.implement.synth import _ghdl_errors
 
     stderr = (
         'x.vhd:10:5:note: found ROM "n1", width: 19 bits, depth: 512\n'

@@ -9,7 +9,7 @@ import yaml
 
 from flann.cli import main
 from flann.errors import FlannError
-from flann.ise import write_ise
+from flann.implement.ise import write_ise
 
 FIX = Path(__file__).parent / "fixtures" / "synth" / "good"
 # flann_top ports of the fixture, by hand: clk rst in_valid in_ready in_data(12) out_valid out_data(18) out_sat

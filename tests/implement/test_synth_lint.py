@@ -1,4 +1,4 @@
-"""VSG style check with the repository's vsg.yaml (flann.synth.lint_vhdl)."""
+"""VSG style check with the repository's vsg.yaml (flann.implement.synth.lint_vhdl)."""
 
 import shutil
 from pathlib import Path
@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from flann.errors import FlannError
-from flann.synth import check_lint, find_vsg_config, lint_vhdl
+from flann.implement.synth import check_lint, find_vsg_config, lint_vhdl
 
 ROOT = Path(__file__).resolve().parents[2]
 FIX = ROOT / "tests" / "implement" / "fixtures" / "synth"

@@ -8,8 +8,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from flann.explore import SEED_FILE, SeedParallel
-from flann.model import load_model
+from flann.implement.explore import SEED_FILE, SeedParallel
+from flann.golden.model import load_model
 
 MODEL = "data/default_model.json"
 

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from flann.errors import FlannError
-from flann.float18 import FLOAT18, F18Add, F18Mul
+from flann.numeric.float18 import FLOAT18, F18Add, F18Mul
 
 F = FLOAT18
 SEED = 20261122

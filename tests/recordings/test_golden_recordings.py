@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from flann.errors import RecordingsError
-from flann.paper import s_curve
+from flann.golden.paper import s_curve
 from flann.recordings import Recordings, monotonic_span, parse_recordings, prepare_for_fit
 
 

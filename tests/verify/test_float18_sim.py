@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from flann.float18 import FLOAT18
-from flann.float18_hdl import BLOCKS, render_blocks
+from flann.numeric.float18 import FLOAT18
+from flann.hardware.float18.render import BLOCKS, render_blocks
 
-SIM_DIR = Path(__file__).resolve().parents[2] / "sim"
+SIM_DIR = Path(__file__).resolve().parents[2] / "gen" / "flann" / "verify" / "benches"
 # random vectors per block bench; FLANN_F18_N=200000 for a long run
 N_RANDOM = int(os.environ.get("FLANN_F18_N", "15000"))
 
@@ -37,8 +37,8 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
                            capture_output=True, text=True, cwd=tmp_path)
         assert r.returncode == 0, r.stderr
     # the whole float18 design (shared front end, converter, blocks, top) analyses in order
-    from flann.float18_hdl import generate
-    from flann.model import load_model
+    from flann.hardware.float18.render import generate
+    from flann.golden.model import load_model
 
     man = generate(load_model(Path(__file__).resolve().parents[2] / "data" / "default_model.json"),
                    tmp_path / "design")
@@ -50,7 +50,7 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
                        capture_output=True, text=True, cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     # VSG with the repository's configuration: no style violations in the float18 files
-    from flann.synth import lint_vhdl
+    from flann.implement.synth import lint_vhdl
 
     assert lint_vhdl(sorted((tmp_path / "design").glob("flann_f18_*.vhd"))) == []
     text = files["flann_f18_add.vhd"].read_text()
@@ -75,8 +75,8 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
 
 # -- top level: every input code ------------------------------------------------------------
 def _run_top(tmp_path, model, step: int, seed: int, **options):
-    from flann.float18_sim import run_top
-    from flann.float18_top import F18Top, derive_f18_spec
+    from flann.verify.float18 import run_top
+    from flann.hardware.float18.spec import F18Top, derive_f18_spec
 
     codes = F18Top(derive_f18_spec(model, **options)).all_codes()[::step]
     r = run_top(model, tmp_path, codes=codes, seed=seed, **options)
@@ -89,7 +89,7 @@ def _run_top(tmp_path, model, step: int, seed: int, **options):
 @pytest.mark.sim
 def test_top_every_input_code_matches_twin(tmp_path):
     """Default model, default 12-bit input: all 4096 codes, 0 mismatches (and the latency)."""
-    from flann.model import load_model
+    from flann.golden.model import load_model
 
     model = load_model(Path(__file__).resolve().parents[2] / "data" / "default_model.json")
     codes = _run_top(tmp_path, model, step=1, seed=11)
@@ -100,7 +100,7 @@ def test_top_every_input_code_matches_twin(tmp_path):
 def test_top_other_widths_match_twin(tmp_path):
     """The paper's raw-volt model, 10-bit input, coarser table: every 8th code."""
     from flann.recordings import read_recordings
-    from flann.train import fit_lstsq
+    from flann.golden.train import fit_lstsq
 
     rec = read_recordings(Path(__file__).resolve().parents[2] / "data" / "paper_table1.csv")
     model = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="none")

@@ -1,4 +1,4 @@
-"""GHDL + cocotb co-simulation of the generated VHDL (benches in sim/, run via flann.simrun).
+"""GHDL + cocotb co-simulation of the generated VHDL (benches in sim/, run via flann.verify.runner).
 
 Budget: the exhaustive run of the default design dominates (~4.7 M clock cycles, see
 bench/bench_sim.py for the codes/s figure); everything else uses small random + corner sets.
@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from flann.hdlgen import generate
-from flann.simrun import run_bench
+from flann.hardware.fixed.render import generate
+from flann.verify.runner import run_bench
 
 pytestmark = pytest.mark.sim
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from ..float18_top import FRONT_END_OPTIONS
+from ..hardware.float18.spec import FRONT_END_OPTIONS
 from .gen import add_spec_arguments, spec_options
 
 
@@ -31,7 +31,7 @@ def float18_options(args, fixed_too: bool = False) -> dict:
 
 def run_gen(args) -> int:
     """`flann gen MODEL -o DIR --format float18`."""
-    from ..float18_hdl import generate
+    from ..hardware.float18.render import generate
 
     man = generate(args.model, args.out, **float18_options(args))
     if getattr(args, "json", False):

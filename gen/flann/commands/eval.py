@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import json
 
-from ..metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
+from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
 from ..errors import FlannError
-from ..model import load_model
+from ..golden.model import load_model
 from ..recordings import read_recordings
 from .predict import warn_outside_range
 

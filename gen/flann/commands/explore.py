@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from .. import explore
+from ..implement import explore
 from ..errors import FlannError
 
 HELP = "design-space table (lanes x multiplier x widths)"

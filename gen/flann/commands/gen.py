@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 
-from ..hdlgen import generate
-from ..spec import MULT_STYLES
+from ..hardware.fixed.render import generate
+from ..hardware.fixed.spec import MULT_STYLES
 
 HELP = "generate VHDL-93 for a model"
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .. import ise
+from ..implement import ise
 
 HELP = "write an ISE 10.1 project for the generated VHDL"
 

@@ -8,10 +8,10 @@ import numpy as np
 
 from ..errors import FlannError
 from ..fileio import atomic_directory
-from ..metrics import DEFAULT_TOL_PCT_FS
+from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
-from .. import paper
+from ..golden.train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
+from ..golden import paper
 
 HELP = "reproduce the seed paper's tables and figures"
 

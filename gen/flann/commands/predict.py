@@ -7,7 +7,7 @@ import io
 import warnings
 
 from ..fileio import atomic_write_text
-from ..model import load_model
+from ..golden.model import load_model
 from ..recordings import read_recordings
 
 HELP = "apply a model to recordings"

@@ -34,7 +34,7 @@ def _progress(msg: str) -> None:
 
 
 def run(args) -> int:
-    from ..simrun import plot, simulate
+    from ..verify.runner import plot, simulate
 
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")

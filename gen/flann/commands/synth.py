@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 import sys
 
-from .. import synth
-from ..devices import DEVICES, parse_part
+from ..implement import synth
+from ..hardware.target import DEVICES, parse_part
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import json
 
-from ..model import load_model
+from ..golden.model import load_model
 from ..recordings import read_recordings
-from ..trace import plot_compare, plot_trace, run_trace
+from ..analysis.trace import plot_compare, plot_trace, run_trace
 from ._float18 import float18_options
 from .gen import add_spec_arguments, spec_options
 
@@ -50,7 +50,7 @@ def run(args) -> int:
         import sys
         import tempfile
 
-        from ..trace import check_hdl
+        from ..analysis.trace import check_hdl
 
         for f, r in results.items():
             print(f"simulating the {f} design over every input code ...", file=sys.stderr)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
-from ..train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                      fit_lms, fit_lstsq)
 
 HELP = "train a FLANN inverse model on recordings"

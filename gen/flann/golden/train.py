@@ -1,0 +1,344 @@
+"""Training the FLANN inverse model: the paper's LMS, closed-form least squares, and ``auto``.
+
+All three return a :class:`flann.golden.model.FlannModel` whose output is
+``y_mm = bias + sum_i w_i phi_i(v_n)`` with ``v_n = (v - input_offset_v) / input_scale_v``.
+
+* :func:`fit_lms` -- the paper's rule, sample by sample in file order (computed epoch-wise
+  as an affine map, see :func:`lms_epochs`; :func:`lms_sequential` is the literal loop):
+  ``w(k+1) = w(k) + eta * e(k) * s(k)``, ``e(k) = d(k) - y(k)``, every weight (and the bias,
+  whose input is the constant 1, the paper's phi_1 = 1) starting at 1.  The mean of e(k)^2
+  over each epoch (the a-priori errors seen while updating) is recorded as the epoch's MSE.
+* :func:`fit_lstsq` -- minimum-norm least squares (``numpy.linalg.lstsq``), optionally with a
+  ridge penalty: minimise ``mean(e^2) + ridge * |w|^2`` (the bias is not penalised).  With
+  more terms than points the problem is under-determined and the minimum-norm interpolant
+  is returned (the paper fits 51 and 61 terms to 13 points).
+* :func:`fit_auto` -- chooses terms, normalisation and ridge by K-fold cross-validation and
+  reports the held-out error (never the training error).
+
+Normalisation: ``"range"`` maps the data's voltage range to [-1, 1] (offset = midpoint,
+scale = half span); ``"half"`` maps it to [-0.5, 0.5] (scale = span: the trigonometric terms,
+periodic over 2 units of v_n, then need not join the two ends of the curve, which avoids the
+Gibbs-like error near the ends); ``"none"`` uses raw volts (offset 0, scale 1) as the paper.
+Everything here is deterministic: no random numbers, a fixed order of operations.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import FlannError, RecordingsError
+from .model import FlannModel, expand
+
+PAPER_TERMS = (11, 25, 51, 61)
+NORMALISATIONS = ("range", "half", "none")
+MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
+AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
+AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0)
+AUTO_MAX_FOLDS = 10
+
+
+# -- normalisation -----------------------------------------------------------------------
+def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
+    """(input_offset_v, input_scale_v) for ``kind`` ('range', 'half' or 'none')."""
+    v = np.asarray(voltage_v, dtype=float)
+    if kind == "none":
+        return 0.0, 1.0
+    if kind in ("range", "half"):
+        lo, hi = float(v.min()), float(v.max())
+        if not hi > lo:
+            raise RecordingsError(
+                f"voltage_v spans no range (all {lo:g} V): cannot normalise or fit"
+            )
+        return (lo + hi) / 2.0, (hi - lo) / (2.0 if kind == "range" else 1.0)
+    raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)}, got {kind!r}")
+
+
+def design_matrix(v_n: np.ndarray, terms: int) -> np.ndarray:
+    """[1, phi_0 .. phi_{terms-1}]: the bias column first."""
+    return np.hstack([np.ones((v_n.size, 1)), expand(v_n, terms)])
+
+
+def check_fit_input(voltage_v, displacement_mm, terms: int, source: str = "recordings") -> None:
+    """Refuse what cannot be fitted at all; warn (as the paper did it) about terms > points."""
+    n = int(np.asarray(voltage_v).size)
+    if terms < 1:
+        raise FlannError(f"--terms must be >= 1, got {terms}")
+    distinct = np.unique(np.asarray(voltage_v, dtype=float)).size
+    if n < MIN_POINTS or distinct < 2:
+        raise RecordingsError(
+            f"{source}: {n} point(s) with {distinct} distinct voltage(s); need at least "
+            f"{MIN_POINTS} points with 2 distinct voltages to fit a model"
+        )
+    if terms + 1 > n:
+        warnings.warn(
+            f"{source}: {terms} terms + bias from {n} points: under-determined, the fit "
+            "interpolates the points (as in the paper); check between-point behaviour with "
+            "'flann eval' on denser data",
+            stacklevel=2,
+        )
+
+
+def _ranges(voltage_v, displacement_mm):
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    return (float(v.min()), float(v.max())), (float(x.min()), float(x.max()))
+
+
+# -- least squares -----------------------------------------------------------------------
+def solve_lstsq(design: np.ndarray, y: np.ndarray, ridge: float = 0.0,
+                samples: int | None = None) -> np.ndarray:
+    """Coefficients c (bias first) minimising mean((design c - y)^2) + ridge |c[1:]|^2.
+
+    ridge = 0: minimum-norm least squares.  ridge > 0: the augmented system
+    [design; sqrt(n ridge) [0 | I]] c = [y; 0], solved by the same routine.  ``samples``
+    is n when ``design`` is a QR-reduced stand-in for an n-row system (cross-validation).
+    """
+    if ridge < 0 or not math.isfinite(ridge):
+        raise FlannError(f"--ridge must be a finite number >= 0, got {ridge!r}")
+    if ridge > 0:
+        n, p = design.shape
+        n = n if samples is None else samples
+        reg = np.zeros((p - 1, p))
+        reg[:, 1:] = np.sqrt(n * ridge) * np.eye(p - 1)
+        design = np.vstack([design, reg])
+        y = np.concatenate([y, np.zeros(p - 1)])
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    return coef
+
+
+def fit_lstsq(voltage_v, displacement_mm, terms: int, *, norm: str = "range",
+              offset_scale: tuple[float, float] | None = None, ridge: float = 0.0,
+              training: dict | None = None) -> FlannModel:
+    """Closed-form least-squares model (see module docstring)."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
+    coef = solve_lstsq(design_matrix((v - offset) / scale, terms), x, ridge)
+    resid = x - (design_matrix((v - offset) / scale, terms) @ coef)
+    vr, xr = _ranges(v, x)
+    info = {"method": "lstsq", "ridge": float(ridge),
+            "normalisation": norm if offset_scale is None else "explicit",
+            "train_rms_error_mm": float(np.sqrt(np.mean(resid**2))), "points": int(v.size)}
+    info.update(training or {})
+    return FlannModel(weights=tuple(float(c) for c in coef[1:]), bias=float(coef[0]),
+                      input_offset_v=float(offset), input_scale_v=float(scale),
+                      voltage_range_v=vr, displacement_range_mm=xr, training=info)
+
+
+# -- LMS -----------------------------------------------------------------------------------
+def _check_lms(eta: float, epochs: int) -> None:
+    if not (eta > 0 and math.isfinite(eta)):
+        raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
+    if epochs < 1:
+        raise FlannError(f"--epochs must be >= 1, got {epochs}")
+
+
+def _diverged(S: np.ndarray, eta: float, where: str) -> FlannError:
+    bound = 2 / float(np.max(np.sum(S**2, 1)))
+    return FlannError(f"LMS diverged {where} with eta={eta:g}: use a smaller --eta "
+                      f"(stability needs roughly eta < 2/|s|^2 = {bound:.3g})")
+
+
+def lms_sequential(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
+                   w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's LMS written literally, one sample at a time (the reference).
+
+    ``S`` has one row per sample (bias column included); samples are visited in row order
+    every epoch: e = d_k - s_k.w, w += eta e s_k.  Returns (weights, mse_per_epoch) with the
+    epoch's MSE the mean of the a-priori e^2.
+    """
+    _check_lms(eta, epochs)
+    w = np.ones(S.shape[1]) if w0 is None else np.array(w0, dtype=float)
+    mse = np.empty(epochs)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for ep in range(epochs):
+            acc = 0.0
+            for s, dk in zip(S, d):
+                e = dk - float(s @ w)
+                w += eta * e * s
+                acc += e * e
+            mse[ep] = acc / S.shape[0]
+            if not math.isfinite(mse[ep]):
+                raise _diverged(S, eta, f"in epoch {ep + 1}")
+    return w, mse
+
+
+def _epoch_map(S: np.ndarray, d: np.ndarray, eta: float, skip: int | None = None):
+    """One LMS epoch as an affine map: w_after = A w + c; a-priori errors e = f - E w.
+
+    Step k is w <- (I - eta s_k s_k^T) w + eta d_k s_k; composing the steps in row order
+    (``skip`` leaves one row out) gives A, c; E, f give each step's a-priori error.
+    """
+    p = S.shape[1]
+    A, c = np.eye(p), np.zeros(p)
+    E, f = np.zeros_like(S), np.zeros(S.shape[0])
+    for k, (s, dk) in enumerate(zip(S, d)):
+        if k == skip:
+            continue
+        sA = s @ A
+        E[k], f[k] = sA, dk - s @ c
+        A = A - eta * np.outer(s, sA)
+        c = c + (eta * (dk - s @ c)) * s
+    return A, c, E, f
+
+
+def lms_epochs(S: np.ndarray, d: np.ndarray, eta: float, epochs: int,
+               w0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's LMS, same result as :func:`lms_sequential` (to rounding), much faster.
+
+    The sample-by-sample rule is linear in w, so one epoch is an affine map computed once
+    (:func:`_epoch_map`); the epochs then cost one small matrix-vector product each.
+    """
+    _check_lms(eta, epochs)
+    w = np.ones(S.shape[1]) if w0 is None else np.array(w0, dtype=float)
+    mse = np.empty(epochs)
+    with np.errstate(over="ignore", invalid="ignore"):
+        A, c, E, f = _epoch_map(S, d, eta)
+        for ep in range(epochs):
+            e = f - E @ w
+            mse[ep] = float(e @ e) / S.shape[0]
+            if not math.isfinite(mse[ep]):
+                raise _diverged(S, eta, f"in epoch {ep + 1}")
+            w = A @ w + c
+    return w, mse
+
+
+def lms_leave_one_out(S: np.ndarray, d: np.ndarray, eta: float, epochs: int) -> np.ndarray:
+    """Held-out predictions of LMS trained without each row in turn.
+
+    Fold i visits every row except row i, in row order, ``epochs`` times, starting from
+    weights of 1 -- :func:`lms_epochs` on the other rows; returns S[i] @ w_i.
+    """
+    _check_lms(eta, epochs)
+    n, p = S.shape
+    maps = [_epoch_map(S, d, eta, skip=i) for i in range(n)]
+    A = np.stack([m[0] for m in maps])
+    C = np.stack([m[1] for m in maps])
+    W = np.ones((n, p))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(epochs):
+            W = np.einsum("ipq,iq->ip", A, W) + C
+    pred = np.einsum("ij,ij->i", W, S)
+    if not np.all(np.isfinite(pred)):
+        raise _diverged(S, eta, "in leave-one-out")
+    return pred
+
+
+def fit_lms(voltage_v, displacement_mm, terms: int, *, eta: float, epochs: int,
+            norm: str = "range", offset_scale: tuple[float, float] | None = None,
+            training: dict | None = None) -> FlannModel:
+    """The paper's LMS (see module docstring).  MSE per epoch goes to training['mse_per_epoch']."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
+    S = design_matrix((v - offset) / scale, terms)
+    w, mse = lms_epochs(S, x, eta, epochs)
+    resid = x - S @ w
+    vr, xr = _ranges(v, x)
+    info = {"method": "lms", "eta": float(eta), "epochs": int(epochs), "weights_start": 1.0,
+            "normalisation": norm if offset_scale is None else "explicit",
+            "train_rms_error_mm": float(np.sqrt(np.mean(resid**2))), "points": int(v.size),
+            "mse_per_epoch": [float(f"{m:.6g}") for m in mse]}
+    info.update(training or {})
+    return FlannModel(weights=tuple(float(c) for c in w[1:]), bias=float(w[0]),
+                      input_offset_v=float(offset), input_scale_v=float(scale),
+                      voltage_range_v=vr, displacement_range_mm=xr, training=info)
+
+
+# -- auto: cross-validation ---------------------------------------------------------------
+@dataclass(frozen=True)
+class CvResult:
+    terms: int
+    norm: str
+    ridge: float
+    rms_mm: float
+    max_mm: float
+
+
+def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
+    """Interleaved held-out folds over the points sorted by voltage.
+
+    The lowest- and highest-voltage points are never held out: cross-validation measures
+    error *inside* the calibrated voltage range (the model is not used beyond it).
+    """
+    v = np.asarray(voltage_v, dtype=float)
+    order = np.argsort(v, kind="stable")
+    inner = order[1:-1]
+    k = min(AUTO_MAX_FOLDS if k is None else k, inner.size)
+    if k < 2:
+        raise RecordingsError(
+            f"{v.size} points: too few for cross-validation (auto needs at least 4); "
+            "give --terms N explicitly"
+        )
+    return [np.sort(inner[i::k]) for i in range(k)]
+
+
+def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
+                   ridges=AUTO_RIDGES, k: int | None = None) -> list[CvResult]:
+    """Held-out RMS and max error (mm) for every (terms, norm, ridge) candidate.
+
+    Per fold one QR factorisation of the largest design, A = Q R; the first k columns of A
+    are Q R[:, :k], so every smaller candidate is the small problem R[:, :k] c = Q^T y
+    (same minimiser, same minimum-norm solution, ridge included) -- exact, and fast.
+    """
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    folds = cv_folds(v, k)
+    held_all = np.sort(np.concatenate(folds))
+    results = []
+    for norm in norms:
+        offset, scale = normalisation(v, norm)
+        full = design_matrix((v - offset) / scale, max(terms_list))
+        errs = {(t, r): np.full(v.size, np.nan) for t in terms_list for r in ridges}
+        for held in folds:
+            train = np.ones(v.size, bool)
+            train[held] = False
+            Q, R = np.linalg.qr(full[train])
+            z = Q.T @ x[train]
+            n_train = int(train.sum())
+            for t in terms_list:
+                B = full[held, : t + 1]
+                for r in ridges:
+                    coef = solve_lstsq(R[:, : t + 1], z, r, samples=n_train)
+                    errs[(t, r)][held] = B @ coef - x[held]
+        for (t, r), e in errs.items():
+            e = e[held_all]
+            if not np.all(np.isfinite(e)):   # numerically broken candidate: never chosen
+                results.append(CvResult(t, norm, r, math.inf, math.inf))
+                continue
+            results.append(CvResult(t, norm, r, float(np.sqrt(np.mean(e**2))),
+                                    float(np.max(np.abs(e)))))
+    return results
+
+
+def pick(results: list[CvResult]) -> CvResult:
+    """Smallest held-out RMS; within 2 % of it, prefer fewer terms, then larger ridge."""
+    best = min(r.rms_mm for r in results)
+    ok = [r for r in results if r.rms_mm <= best * 1.02 + 1e-12]
+    return min(ok, key=lambda r: (r.terms, -r.ridge, NORMALISATIONS.index(r.norm)))
+
+
+def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
+             ridges=AUTO_RIDGES, training: dict | None = None) -> tuple[FlannModel, CvResult]:
+    """Choose (terms, norm, ridge) by cross-validation, then fit on all points."""
+    v = np.asarray(voltage_v, dtype=float)
+    if v.size < 4:
+        raise RecordingsError(
+            f"{v.size} points: too few for cross-validation (auto needs at least 4); "
+            "give --terms N explicitly"
+        )
+    results = cross_validate(v, displacement_mm, terms_list, norms, ridges)
+    choice = pick(results)
+    info = {"selected_by": "cross-validation",
+            "cv_folds": len(cv_folds(v)),
+            "cv_heldout_rms_error_mm": choice.rms_mm,
+            "cv_heldout_max_error_mm": choice.max_mm,
+            "cv_candidates": len(results)}
+    info.update(training or {})
+    model = fit_lstsq(v, displacement_mm, choice.terms, norm=choice.norm, ridge=choice.ridge,
+                      training=info)
+    return model, choice

@@ -1,0 +1,201 @@
+"""Render the VHDL-93 entities of a :class:`~flann.hardware.fixed.spec.Spec` and write ``manifest.json``.
+
+Layer 3: one context dict per entity, computed here (widths, literals checked to fit,
+names), one template per entity in ``flann/templates``; templates only place text.
+Output is deterministic: no timestamps, a header with generator version, model sha256
+and the spec, so regenerating gives identical bytes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ... import __version__
+from ...errors import FlannError, SpecError
+from ...fileio import atomic_directory
+from ...textgen import template
+from ...numeric.fixed import bits_literal
+from ...golden.model import FlannModel, load_model, model_sha256
+from .spec import Spec, derive_spec
+
+TOP = "flann_top"
+# compile order
+ENTITIES = (
+    ("flann_norm", "input clamp and normalisation (serial code x constant)"),
+    ("flann_expansion", "trigonometric expansion (phase accumulation, quarter-wave table)"),
+    ("flann_multiplier", "terms x trained weights"),
+    ("flann_adder", "accumulation, rounding, saturation"),
+    ("flann_top", "FLANN LVDT compensator, top level"),
+)
+MANIFEST = "manifest.json"
+
+
+
+def _ubits(n: int) -> int:
+    """Width of an unsigned counter holding 0..n."""
+    return max(1, int(n).bit_length())
+
+
+def spec_lines(spec: Spec) -> list[str]:
+    return [f"{k} = {json.dumps(v)}" for k, v in spec.to_dict().items()]
+
+
+def contexts(spec: Spec) -> dict[str, dict]:
+    """Template context of every entity."""
+    s = spec
+    B, P, L = s.input_bits, s.phase_bits, s.lanes
+    A = s.table_addr_bits
+    D = P - 2 - A
+    T, W = s.term_fmt.width, s.weight_fmt.width
+    Wp = s.product_fmt.width
+    lin_bits = s.lin_fmt.width
+    NV = P + s.norm_guard
+
+    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits)
+    norm = dict(
+        code_bits=B, phase_bits=P, lin_bits=lin_bits, acc_v_bits=NV, acc_l_bits=s.lin_width,
+        guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
+        clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
+        ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
+        nk1=bits_literal(-s.k1, s.lin_width),
+        kb=bits_literal((s.kb + (1 << (s.norm_guard - 1))) % (1 << NV), NV, False),
+        k1=bits_literal(s.k1, s.lin_width), k0=bits_literal(s.k0 + (1 << (s.lin_guard - 1)), s.lin_width),
+    )
+    de, do = s.delta_steps
+    starts = [s.lane_start(l) for l in range(L)]
+    slope_bits = s.slope_fmt.width if s.interp else 1
+    # shift-add designs have adv_period - 1 idle cycles per step: form offset x slope serially
+    # (one cycle copies the slope out of the ROM register, the rest iterate)
+    serial_interp = s.interp and s.mult_style == "shiftadd" and s.adv_period >= 3
+    kx = -(-slope_bits // (s.adv_period - 2)) if serial_interp else 1
+    slope_reg = -(-slope_bits // kx) * kx if serial_interp else slope_bits
+    icnt_bits = _ubits(slope_reg // kx + 1)
+    expansion = dict(
+        common, delta_even=de, delta_odd=do, lanes_odd=(L % 2 == 1),
+        mult_bits=_ubits(max([de, do, *starts])),
+        start_mults=", ".join(f"{l} => {x}" for l, x in enumerate(starts)),
+        start_par='"' + "".join(str(l % 2) for l in range(L)) + '"',
+        quarter=bits_literal(1 << (P - 2), P, False),
+        table_depth=1 << A, addr_bits=A, offset_bits=D, dq_bits=s.dq_bits,
+        value_bits=s.value_fmt.width, slope_bits=slope_bits, interp=s.interp,
+        serial_interp=serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
+        interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
+        prod_bits=(s.dq_bits + 1 + slope_reg) if serial_interp else (s.dq_bits + slope_bits + 1),
+        slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
+        value_words=[bits_literal(v, s.value_fmt.width, False) for v in s.value_rom],
+        slope_words=[bits_literal(v, slope_bits, False) for v in s.slope_rom] if s.interp else [],
+    )
+    step_bits = _ubits(max(1, s.steps - 1))
+    depth = 1 << step_bits
+    words = [[bits_literal(w, W) for w in lane] + [bits_literal(0, W)] * (depth - len(lane))
+             for lane in s.weight_rom]
+    K = s.mult_digit_bits if s.mult_style == "shiftadd" else 1
+    WX = -(-W // K) * K  # weight register, sign-extended to whole digits
+    cnt_bits = _ubits(WX // K)
+    multiplier = dict(
+        common, style=s.mult_style, weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
+        rom_depth=depth, step_bits=step_bits, weight_words=words,
+        cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
+        shift_bits=WX if s.mult_style == "shiftadd" else W,
+        style_note=("inferred `*` (LUT array multiplier), one product per lane and cycle"
+                    if s.mult_style == "lut" else
+                    f"serial shift-add, {K} weight bit(s) per cycle ({WX // K} cycles per product)"),
+    )
+    AB = s.acc_fmt.width
+    Pf = s.product_fmt.frac_bits
+    adder = dict(
+        common, acc_bits=AB, out_bits=s.out_fmt.width, acc_frac=Pf,
+        acc_half=(1 << (Pf - 1)) if Pf > 0 else 0, output_lsb_mm=s.output_lsb_mm,
+        out_max=bits_literal(s.out_fmt.max_int, AB + 1), out_min=bits_literal(s.out_fmt.min_int, AB + 1),
+    )
+    if s.out_fmt.width > AB + 1:
+        raise SpecError(f"output_bits = {s.out_fmt.width} exceeds the accumulator's range; use <= {AB + 1}")
+    n_advs = s.pipeline_advs
+    top = dict(
+        common, in_bits=B, out_bits=s.out_fmt.width, input_lsb_v=s.input_lsb_v,
+        output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, steps=s.steps, n_advs=n_advs,
+        adv_period=s.adv_period, timer_bits=_ubits(max(1, s.adv_period - 1)), adv_cnt_bits=_ubits(n_advs),
+    )
+    return {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
+            "flann_adder": adder, "flann_top": top}
+
+
+def render(spec: Spec) -> dict[str, str]:
+    """{file name: VHDL text} in compile order."""
+    ctx = contexts(spec)
+    out = {}
+    for name, title in ENTITIES:
+        header = dict(file=f"{name}.vhd", title=title, version=__version__,
+                      model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
+        out[f"{name}.vhd"] = template(f"hardware/fixed/templates/{name}.vhd.j2").render(h=header, **ctx[name])
+    return out
+
+
+def manifest(spec: Spec, files: list[str]) -> dict:
+    return {
+        "top": TOP,
+        "files": list(files),
+        "input_bits": spec.input_bits,
+        "input_lsb_v": spec.input_lsb_v,
+        "output_bits": spec.out_fmt.width,
+        "output_lsb_mm": spec.output_lsb_mm,
+        "latency_cycles": spec.latency_cycles,
+        "cycles_per_sample": spec.cycles_per_sample,
+        "clamp_codes": [spec.clamp_lo, spec.clamp_hi],
+        "generator_version": spec.generator_version,
+        "spec": spec.to_dict(),
+        "analysis": {k: v for k, v in spec.analysis.items() if k != "cost"},
+        "model_sha256": spec.model_sha256,
+    }
+
+
+def load(model_path_or_model, **options) -> Spec:
+    """Spec from a model file path (sha256 of its bytes is stamped) or a FlannModel."""
+    if isinstance(model_path_or_model, FlannModel):
+        return derive_spec(model_path_or_model, **options)
+    path = Path(model_path_or_model)
+    model = load_model(path)
+    return derive_spec(model, model_sha256=model_sha256(path), **options)
+
+
+def generate(model_path_or_model, out_dir, **options) -> dict:
+    """Derive the spec, render every entity and write them plus manifest.json atomically.
+
+    Returns the manifest dict.  Nothing is written if any step fails.
+    """
+    spec = load(model_path_or_model, **options)
+    return write(spec, out_dir)
+
+
+def write(spec: Spec, out_dir) -> dict:
+    texts = render(spec)
+    return write_design(texts, manifest(spec, list(texts)), out_dir)
+
+
+def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
+    """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise FlannError(f"{out_dir}: exists and is not a directory")
+    with atomic_directory(out_dir) as tmp:
+        for name, text in texts.items():
+            (tmp / name).write_text(text, newline="")
+        (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
+    return man
+
+
+def read_manifest(out_dir) -> dict:
+    path = Path(out_dir) / MANIFEST
+    try:
+        return json.loads(path.read_text())
+    except FileNotFoundError:
+        raise FlannError(f"{path}: no such file (run `flann gen` first)") from None
+    except json.JSONDecodeError as exc:
+        raise FlannError(f"{path}: not valid JSON ({exc.msg})") from None
+
+
+__all__ = ["generate", "write", "render", "contexts", "manifest", "load", "read_manifest", "TOP",
+           "ENTITIES", "MANIFEST"]
+

@@ -1,0 +1,508 @@
+"""Fixed-point hardware spec of a FLANN, derived from a model by an error/range analysis.
+
+Layer 1 of the generator: ``derive_spec(model, **options) -> Spec`` validates the options,
+chooses every width (or checks a width the user forced) and computes every constant the
+hardware holds (normalisation constants, sin/slope table, weight ROMs).  The bit-true twin
+(:mod:`flann.hardware.fixed.twin`) and the templates (:mod:`flann.hardware.fixed.render`) only read a :class:`Spec`.
+
+Datapath (see docs/hardware.md)::
+
+    code --clamp--> c --serial x const--> theta = v_n mod 2 (P bits, units of pi)
+                      \\-serial x const--> lin  = (bias + w0 v_n) / q_y      (adder's start value)
+    theta --phase accumulators (m theta mod 2), quarter-wave table + slope--> terms (sin/cos m pi v_n)
+    terms x weights (ROM) --> products --> accumulate --> round, saturate --> out_data, out_sat
+
+Error budget (pre-rounding, in output LSB; the final rounding adds at most 0.5 LSB so the
+total stays below 1 LSB for every input code): each source gets a share and the width is the
+smallest one whose *worst-case* bound fits its share; ``Spec.analysis`` lists bound and cost.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ... import __version__
+from .. import target as spartan2
+from ...errors import SpecError
+from ...numeric.fixed import FixedFormat, bits_needed
+from ...golden.model import FlannModel, term_kind
+
+MULT_STYLES = ("lut", "shiftadd")
+
+# Device data (luts, brams, packages) come from the one Spartan-II table, flann.hardware.target.
+BRAM_BITS = spartan2.BRAM_BITS
+CLOCK_HZ = 50e6
+
+# Share of the 0.5-LSB pre-rounding budget given to each error source.
+BUDGET = {"phase": 0.15, "table": 0.20, "weights": 0.07, "products": 0.03, "linear": 0.02}
+
+
+def parse_device(device: str) -> tuple[str, str, str]:
+    """'xc2s200-pq208-5' -> ('xc2s200', 'pq208', '5'); SpecError if not an orderable part."""
+    part = spartan2.parse_part(str(device))
+    return part.device.name, part.package, part.speed
+
+
+def nice_125(x: float, up: bool) -> float:
+    """Nearest value of the 1-2-5 series at or above (up) / at or below x."""
+    e = math.floor(math.log10(x))
+    cands = [k * 10.0 ** p for p in (e - 1, e, e + 1) for k in (1, 2, 5)]
+    cands = sorted(float(f"{c:.12g}") for c in cands)
+    return min(c for c in cands if c >= x * (1 - 1e-12)) if up else max(c for c in cands if c <= x * (1 + 1e-12))
+
+
+def _round_sig(x: float, sig: int = 3, up: bool = True) -> float:
+    e = math.floor(math.log10(abs(x))) - sig + 1
+    f = math.ceil if up else math.floor
+    return float(f"{f(x / 10.0 ** e) * 10.0 ** e:.12g}")
+
+
+@dataclass(frozen=True)
+class Spec:
+    """Everything the twin and the templates need; nothing is recomputed downstream."""
+
+    # provenance
+    model: FlannModel = field(repr=False, compare=False)
+    model_sha256: str
+    generator_version: str
+    device: str
+    number_format: str  # "fixed" (room for "float18", issue 7)
+    # architecture
+    lanes: int
+    mult_style: str
+    mult_digit_bits: int  # shift-add: weight bits per cycle
+    interp: bool
+    # input
+    input_bits: int
+    input_lsb_v: float
+    clamp_lo: int
+    clamp_hi: int
+    # normaliser: theta = round((ka*c + kb) / 2^norm_guard) mod 2^phase_bits
+    phase_bits: int  # P: phase of v_n in units of pi, mod 2  (v_n has P-1 fraction bits)
+    norm_guard: int
+    ka: int
+    kb: int
+    # linear term + bias in accumulator units: lin = round((k1*c + k0) / 2^lin_guard)
+    lin_guard: int
+    k1: int
+    k0: int
+    lin_width: int  # serial accumulator width (exact, no wrap)
+    lin_fmt: FixedFormat
+    # sin/cos table (quarter wave, midpoint samples)
+    table_addr_bits: int
+    value_fmt: FixedFormat  # unsigned ROM value, frac bits = term frac bits
+    slope_fmt: FixedFormat  # unsigned ROM slope
+    dq_bits: int  # signed phase offset bits fed to the slope multiplier
+    slope_guard: int
+    term_fmt: FixedFormat
+    # multiplier
+    weight_fmt: FixedFormat
+    product_fmt: FixedFormat
+    product_shift: int
+    # adder
+    acc_fmt: FixedFormat
+    out_fmt: FixedFormat
+    output_lsb_mm: float
+    # schedule
+    steps: int
+    adv_period: int
+    # ROM contents
+    value_rom: tuple = field(repr=False)
+    slope_rom: tuple = field(repr=False)
+    weight_rom: tuple = field(repr=False)  # [lane][step]
+    analysis: dict = field(repr=False, compare=False, default_factory=dict)
+    term_bound: int = 0  # largest |term| the expansion can produce (sizes products and acc)
+
+    # -- derived ------------------------------------------------------------------------
+    @property
+    def n_trig(self) -> int:
+        return self.model.terms - 1
+
+    @property
+    def code_min(self) -> int:
+        return -(1 << (self.input_bits - 1))
+
+    @property
+    def code_max(self) -> int:
+        return (1 << (self.input_bits - 1)) - 1
+
+    @property
+    def output_bits(self) -> int:
+        return self.out_fmt.width
+
+    @property
+    def phase_frac_bits(self) -> int:
+        return self.phase_bits - 1
+
+    @property
+    def delta_steps(self) -> tuple[int, int]:
+        """Harmonic increase of one lane per step when its term index j is (even, odd)."""
+        L = self.lanes
+        return ((L // 2, L // 2) if L % 2 == 0 else ((L - 1) // 2, (L + 1) // 2))
+
+    def lane_start(self, lane: int) -> int:
+        """Harmonic of lane ``lane``'s first term (j = lane)."""
+        return lane // 2 + 1
+
+    @property
+    def pipeline_advs(self) -> int:
+        """Pipeline advances: S issue steps + 3 expansion + 2 multiplier stages (adder adds at the last)."""
+        return self.steps + 5
+
+    @property
+    def latency_cycles(self) -> int:
+        """Clock edges from the edge accepting a sample to the edge raising out_valid."""
+        return self.input_bits + 4 + (self.pipeline_advs - 1) * self.adv_period
+
+    @property
+    def cycles_per_sample(self) -> int:
+        return self.latency_cycles + 1
+
+    @property
+    def samples_per_s_at_50mhz(self) -> float:
+        return CLOCK_HZ / self.cycles_per_sample
+
+    def float_reference(self, codes) -> np.ndarray:
+        """Golden float64 model (mm) at the clamped input codes."""
+        c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
+        return self.model.predict(c * self.input_lsb_v)
+
+    def to_dict(self) -> dict:
+        """The spec as stamped in headers and manifest.json (ROM contents excluded)."""
+        return {
+            "number_format": self.number_format,
+            "device": self.device,
+            "lanes": self.lanes,
+            "mult_style": self.mult_style,
+            "mult_digit_bits": self.mult_digit_bits,
+            "terms": self.model.terms,
+            "input_bits": self.input_bits,
+            "input_lsb_v": self.input_lsb_v,
+            "clamp_codes": [self.clamp_lo, self.clamp_hi],
+            "phase_bits": self.phase_bits,
+            "table_addr_bits": self.table_addr_bits,
+            "interp": self.interp,
+            "dq_bits": self.dq_bits,
+            "slope_guard": self.slope_guard,
+            "norm_guard": self.norm_guard,
+            "lin_guard": self.lin_guard,
+            "value": self.value_fmt.describe(),
+            "slope": self.slope_fmt.describe(),
+            "term": self.term_fmt.describe(),
+            "weight": self.weight_fmt.describe(),
+            "product": self.product_fmt.describe(),
+            "linear": self.lin_fmt.describe(),
+            "acc": self.acc_fmt.describe(),
+            "output": self.out_fmt.describe(),
+            "output_lsb_mm": self.output_lsb_mm,
+            "steps": self.steps,
+            "adv_period": self.adv_period,
+        }
+
+
+# ------------------------------------------------------------------------------------------
+def _check_int(name: str, value, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= int(value) <= hi:
+        raise SpecError(f"{name} = {value!r}: must be an integer in {lo}..{hi}")
+    return int(value)
+
+
+def _table(A: int, Tf: int, Dq: int, Gs: int, interp: bool):
+    k = np.arange(1 << A)
+    mid = (k + 0.5) / (1 << A) * (math.pi / 2)
+    value = np.floor(np.sin(mid) * 2.0 ** Tf + 0.5).astype(np.int64)
+    if interp:
+        slope = np.floor((math.pi / 2) * np.cos(mid) * 2.0 ** (Tf - A - Dq + Gs) + 0.5).astype(np.int64)
+    else:
+        slope = np.zeros_like(value)
+    return value, slope
+
+
+def derive_spec(
+    model: FlannModel,
+    *,
+    model_sha256: str = "",
+    device: str = "xc2s200-pq208-5",
+    input_bits: int = 12,
+    input_lsb_v: float | None = None,
+    clamp: bool = True,
+    output_bits: int | None = None,
+    output_lsb_mm: float | None = None,
+    lanes: int = 1,
+    mult_style: str = "shiftadd",
+    mult_digit_bits: int = 2,
+    interp: bool = True,
+    phase_bits: int | None = None,
+    table_addr_bits: int | None = None,
+    term_frac_bits: int | None = None,
+    weight_frac_bits: int | None = None,
+    product_frac_bits: int | None = None,
+    number_format: str = "fixed",
+    check_device: bool = True,
+) -> Spec:
+    """Validate options, size every signal by the error budget, compute every constant."""
+    if not isinstance(model, FlannModel):
+        raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
+    if number_format != "fixed":
+        raise SpecError(f"number format {number_format!r}: only 'fixed' is generated")
+    part, _pkg, _speed = parse_device(device)
+    B = _check_int("input_bits", input_bits, 4, 16)
+    L = _check_int("lanes", lanes, 1, max(1, model.terms - 1))
+    if mult_style not in MULT_STYLES:
+        raise SpecError(f"mult_style {mult_style!r}: must be one of {', '.join(MULT_STYLES)}")
+    if model.terms < 2:
+        raise SpecError("model has 1 term: at least one sin/cos term is needed (terms >= 2)")
+
+    vlo, vhi = sorted(model.voltage_range_v)
+    cmin, cmax = -(1 << (B - 1)), (1 << (B - 1)) - 1
+    if input_lsb_v is None:
+        # cover the trained range with 10 % margin, 3 significant digits (rounded up)
+        input_lsb_v = _round_sig(max(abs(vlo), abs(vhi), 1e-12) * 1.10 / (1 << (B - 1)))
+    if not (isinstance(input_lsb_v, (int, float)) and math.isfinite(input_lsb_v) and input_lsb_v > 0):
+        raise SpecError(f"input_lsb_v = {input_lsb_v!r}: must be a positive number of volts")
+    lsb = float(input_lsb_v)
+    if clamp:
+        clo, chi = max(cmin, math.ceil(vlo / lsb - 1e-9)), min(cmax, math.floor(vhi / lsb + 1e-9))
+        if clo > chi:
+            raise SpecError(f"input_lsb_v = {lsb} V: the trained range {vlo}..{vhi} V holds no input code")
+    else:
+        clo, chi = cmin, cmax
+    if (vlo < cmin * lsb or vhi > cmax * lsb) and clamp:
+        warnings.warn(
+            f"{B}-bit codes x {lsb} V cover {cmin * lsb:.4g}..{cmax * lsb:.4g} V, less than the "
+            f"trained range {vlo:.4g}..{vhi:.4g} V"
+        )
+    codes = np.arange(clo, chi + 1)
+    y = model.predict(codes * lsb)
+    ymax = float(np.max(np.abs(y)))
+
+    # ---- output format --------------------------------------------------------------
+    if output_lsb_mm is None:
+        if output_bits is None:
+            step = (float(y.max() - y.min()) or 1.0) / max(1, codes.size - 1)
+            output_lsb_mm = nice_125(step / 4, up=False)
+        else:
+            ob = _check_int("output_bits", output_bits, 4, 32)
+            output_lsb_mm = nice_125(ymax * 1.05 / ((1 << (ob - 1)) - 1), up=True)
+    if not (isinstance(output_lsb_mm, (int, float)) and math.isfinite(output_lsb_mm) and output_lsb_mm > 0):
+        raise SpecError(f"output_lsb_mm = {output_lsb_mm!r}: must be a positive number of mm")
+    q = float(output_lsb_mm)
+    need_out = bits_needed(-math.ceil(ymax * 1.05 / q), math.ceil(ymax * 1.05 / q))
+    if output_bits is None:
+        output_bits = need_out
+    Bout = _check_int("output_bits", output_bits, 4, 32)
+    if Bout < bits_needed(-math.ceil(ymax / q + 1), math.ceil(ymax / q + 1)):
+        raise SpecError(
+            f"output_bits = {Bout} at {q} mm/LSB holds +-{((1 << (Bout - 1)) - 1) * q:.4g} mm, but the "
+            f"model reaches {ymax:.4g} mm over the input range: use >= {need_out} bits or a coarser LSB"
+        )
+
+    # ---- error-budget widths -----------------------------------------------------------
+    w = np.asarray(model.weights, dtype=float)
+    wt = w[1:] / q  # trig weights in output LSB
+    m = np.array([term_kind(i)[1] for i in range(1, model.terms)], dtype=float)
+    Sw = float(np.sum(np.abs(wt))) or 1e-9
+    Swm = float(np.sum(np.abs(wt) * m)) or 1e-9
+    N = model.terms - 1
+    a = lsb / model.input_scale_v
+    b = -model.input_offset_v / model.input_scale_v
+
+    # phase: error per lookup <= m*(1/2 + 1/4) LSB_v (rounding of v, of ka) + 1/2 LSB (mid-sample bias)
+    if phase_bits is None:
+        F = math.ceil(math.log2(math.pi * (1.5 * Swm + Sw) / (2 * BUDGET["phase"])))
+        phase_bits = F + 1
+    P = _check_int("phase_bits", phase_bits, 6, 40)
+    F = P - 1
+    e_t = BUDGET["table"] / Sw  # allowed error per term (term units)
+    if term_frac_bits is None:
+        # value and correction rounding: 2 x 2^-(Tf+1) <= e_t / 2
+        term_frac_bits = max(4, math.ceil(-math.log2(e_t / 2)))
+    Tf = _check_int("term_frac_bits", term_frac_bits, 4, 30)
+    if table_addr_bits is None:
+        if interp:  # residual of first-order interpolation (pi/2 2^-(A+1))^2 / 2 <= e_t / 4
+            A = math.ceil(math.log2(math.pi / 2 / math.sqrt(e_t / 2)) - 1)
+        else:  # step error pi/2 2^-(A+1) <= e_t / 2
+            A = math.ceil(math.log2(math.pi / 2 / (e_t / 2)) - 1)
+        table_addr_bits = max(2, min(A, P - 3, 10))  # 10: 1024 words, 5 block RAMs
+    A = _check_int("table_addr_bits", table_addr_bits, 2, 16)
+    if A > P - 3:
+        raise SpecError(f"table_addr_bits = {A}: must be <= phase_bits - 3 = {P - 3}")
+    D = P - 2 - A
+    if interp:
+        # offset truncation (pi/2) 2^-(A+Dq) <= e_t/8 ; slope rounding 2^(Dq-2-Gs-Tf) <= e_t/8
+        Dq = min(D + 1, max(2, math.ceil(math.log2(math.pi / 2 * 8 / e_t)) - A))
+        Gs = max(0, math.ceil(Dq - 2 - Tf - math.log2(e_t / 8)))
+    else:
+        Dq, Gs = D + 1, 0
+    value_rom, slope_rom = _table(A, Tf, Dq, Gs, interp)
+    value_fmt = FixedFormat(Tf + 1, 1, signed=False)
+    slope_fmt = FixedFormat(max(1, bits_needed(0, int(slope_rom.max()), signed=False)), 0, signed=False)
+    corr_max = (int(slope_rom.max()) << (Dq - 1)) >> Gs if interp else 0
+    term_max = int(value_rom.max()) + corr_max + 1
+    term_fmt = FixedFormat(bits_needed(-term_max, term_max), bits_needed(-term_max, term_max) - Tf)
+
+    if weight_frac_bits is None:
+        weight_frac_bits = max(0, math.ceil(math.log2(N * term_max / 2.0 ** Tf / (2 * BUDGET["weights"]))))
+    Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30)
+    w_int = np.floor(wt * 2.0 ** Wf + 0.5).astype(np.int64)
+    wmax = int(np.max(np.abs(w_int))) if w_int.size else 1
+    weight_fmt = FixedFormat(bits_needed(-wmax, wmax), bits_needed(-wmax, wmax) - Wf)
+
+    if product_frac_bits is None:
+        product_frac_bits = max(0, math.ceil(math.log2(N / (2 * BUDGET["products"]))))
+    Pf = _check_int("product_frac_bits", product_frac_bits, 0, 30)
+    shift = Tf + Wf - Pf
+    if shift < 1:
+        raise SpecError(f"product_frac_bits = {Pf}: must be < term_frac_bits + weight_frac_bits = {Tf + Wf}")
+    pmax = (term_max * wmax + (1 << (shift - 1))) >> shift
+    product_fmt = FixedFormat(bits_needed(-pmax, pmax), bits_needed(-pmax, pmax) - Pf)
+
+    # linear term + bias, straight into the accumulator (accumulator units 2^-Pf LSB)
+    Gl = B + 3
+    k1 = int(math.floor(w[0] * a / q * 2.0 ** (Pf + Gl) + 0.5))
+    k0 = int(math.floor((w[0] * b + model.bias) / q * 2.0 ** (Pf + Gl) + 0.5))
+    lin_width = bits_needed(-(abs(k1) << (B - 1)) - abs(k0), (abs(k1) << (B - 1)) + abs(k0)) + 1
+    lin_vals = [(k1 * c + k0 + (1 << (Gl - 1))) >> Gl for c in (clo, chi)]
+    lin_bound = max(abs(v) for v in lin_vals) + 1
+    lin_fmt = FixedFormat(bits_needed(-lin_bound, lin_bound), bits_needed(-lin_bound, lin_bound) - Pf)
+
+    # normaliser: theta = v_n mod 2 with F fraction bits; guard bits make ka's rounding
+    # cost at most 1/4 LSB_v over the code range
+    Gn = B + 1
+    ka = int(math.floor(a * 2.0 ** (F + Gn) + 0.5)) % (1 << (P + Gn))
+    kb = int(math.floor(b * 2.0 ** (F + Gn) + 0.5)) % (1 << (P + Gn))
+
+    S = math.ceil(N / L)
+    rom = np.zeros(S * L, dtype=np.int64)
+    rom[:N] = w_int
+    weight_rom = tuple(tuple(int(x) for x in rom[l::L]) for l in range(L))
+    acc_bound = lin_bound + sum(
+        ((term_max * abs(int(x)) + (1 << (shift - 1))) >> shift) + 1 for x in rom
+    )
+    acc_fmt = FixedFormat(bits_needed(-acc_bound, acc_bound), bits_needed(-acc_bound, acc_bound) - Pf)
+    out_fmt = FixedFormat(Bout, Bout, signed=True)
+    for name, width in (("lin accumulator", lin_width), ("normaliser", P + Gn), ("accumulator", acc_fmt.width),
+                        ("product", term_fmt.width + weight_fmt.width)):
+        if width > 62:
+            raise SpecError(f"{name} would need {width} bits (> 62): reduce the requested widths")
+
+    K = _check_int("mult_digit_bits", mult_digit_bits, 1, weight_fmt.width)
+    # shift-add: ceil(W/K) cycles per product, then the advance that hands it on
+    adv_period = 1 if mult_style == "lut" else -(-weight_fmt.width // K) + 1
+    spec = Spec(
+        model=model, model_sha256=model_sha256, generator_version=__version__, device=device.lower(),
+        number_format=number_format, lanes=L, mult_style=mult_style, mult_digit_bits=K, interp=bool(interp),
+        input_bits=B, input_lsb_v=lsb, clamp_lo=int(clo), clamp_hi=int(chi),
+        phase_bits=P, norm_guard=Gn, ka=ka, kb=kb, lin_guard=Gl, k1=k1, k0=k0,
+        lin_width=lin_width, lin_fmt=lin_fmt, table_addr_bits=A, value_fmt=value_fmt,
+        slope_fmt=slope_fmt, dq_bits=Dq, slope_guard=Gs, term_fmt=term_fmt,
+        weight_fmt=weight_fmt, product_fmt=product_fmt, product_shift=shift, acc_fmt=acc_fmt,
+        out_fmt=out_fmt, output_lsb_mm=q, steps=S, adv_period=adv_period,
+        value_rom=tuple(int(x) for x in value_rom), slope_rom=tuple(int(x) for x in slope_rom),
+        weight_rom=weight_rom, term_bound=int(term_max),
+    )
+    analysis = error_analysis(spec, Sw=Sw, Swm=Swm, N=N)
+    spec = replace(spec, analysis=analysis)
+    if not analysis["guaranteed_1lsb"]:
+        warnings.warn(
+            f"these widths bound |hardware - float model| by {analysis['bound_total_lsb']:.3g} output LSB "
+            f"(> 1): see the spec analysis for the dominant source"
+        )
+    if check_device:
+        check_fits(spec, part)
+    return spec
+
+
+def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
+    """Worst-case bound (output LSB) of each error source, and what each choice costs."""
+    F, Tf, A, Dq, Gs = spec.phase_bits - 1, spec.term_fmt.frac_bits, spec.table_addr_bits, spec.dq_bits, spec.slope_guard
+    Wf, Pf = spec.weight_fmt.frac_bits, spec.product_fmt.frac_bits
+    term_max = spec.term_fmt.max_int / 2.0 ** Tf
+    e_phase = math.pi * (Swm * 1.5 + Sw) * 2.0 ** -(F + 1)
+    if spec.interp:
+        e_tab = 2 * 2.0 ** -(Tf + 1) + (math.pi / 2 * 2.0 ** -(A + 1)) ** 2 / 2 \
+            + math.pi / 2 * 2.0 ** -(A + Dq) + 2.0 ** (Dq - 2 - Gs - Tf)
+    else:
+        e_tab = 2.0 ** -(Tf + 1) + math.pi / 2 * 2.0 ** -(A + 1)
+    bounds = {
+        "phase": e_phase,
+        "table": Sw * e_tab,
+        "weights": N * term_max * 2.0 ** -(Wf + 1),
+        "products": N * 2.0 ** -(Pf + 1),
+        "linear": 2.0 ** -(Pf + 1) + 2.0 ** -(Pf + 4),
+    }
+    bounds["output_rounding"] = 0.5
+    total = sum(bounds.values())
+    rom_bits = (1 << A) * (spec.value_fmt.width + (spec.slope_fmt.width if spec.interp else 0))
+    wrom_bits = spec.steps * spec.weight_fmt.width
+    est = estimate_resources(spec)
+    return {
+        "bound_lsb": {k: round(v, 6) for k, v in bounds.items()},
+        "bound_total_lsb": round(total, 6),
+        "guaranteed_1lsb": total <= 1.0,
+        "cost": {
+            "phase_bits": f"{spec.phase_bits}: phase accumulators {spec.lanes}x{spec.phase_bits} FF + adders; "
+                          f"each bit less doubles the phase bound ({bounds['phase']:.3g} LSB)",
+            "table": f"{1 << A} x ({spec.value_fmt.width}+{spec.slope_fmt.width if spec.interp else 0}) bits "
+                     f"= {rom_bits} ROM bits per lane; one address bit less x4 interpolation residual",
+            "interp": (f"slope product {Dq}x{spec.slope_fmt.width} per lane, "
+                       + ("serial between advances" if spec.mult_style == "shiftadd" and spec.adv_period >= 3
+                          else "array multiplier"))
+                      if spec.interp else "off: table step error dominates",
+            "weights": f"{spec.weight_fmt.width}-bit weights, {wrom_bits} ROM bits per lane",
+            "multiplier": f"{spec.term_fmt.width}x{spec.weight_fmt.width} {spec.mult_style}, "
+                          f"{spec.adv_period} cycle(s) per step",
+        },
+        "estimate": est,
+    }
+
+
+def estimate_resources(spec: Spec) -> dict:
+    """Rough pre-synthesis estimate (LUT4, FF, block RAM) used to reject hopeless requests.
+
+    Coefficients calibrated on `flann synth` (GHDL + yosys synth_xilinx -family xcv) of the
+    51-term default in both multiplier styles; ``flann synth`` gives the measured figures.
+    """
+    L = spec.lanes
+    T, W = spec.term_fmt.width, spec.weight_fmt.width
+    P, A = spec.phase_bits, spec.table_addr_bits
+    C, Dq = spec.slope_fmt.width, spec.dq_bits
+    serial = spec.mult_style == "shiftadd" and spec.adv_period >= 3
+    mult = 5.3 * T * W if spec.mult_style == "lut" else 5.5 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1)
+    # slope correction: array multiplier, or serial between advances (shift-add designs)
+    interp = 0 if not spec.interp else (6.3 * (Dq + C) if serial else 4.6 * Dq * (C + 1))
+    expansion = interp + 3.4 * P
+    norm = 2 * (P + spec.norm_guard + spec.lin_width)
+    adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
+    luts = L * (mult + expansion) + norm + adder + 30
+    ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
+    # a 4-Kbit block is 4096/depth bits wide (at most 16); each lane reads its own copy
+    per_block = min(16, max(1, BRAM_BITS >> A))
+    tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp else [])
+    brams = L * sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in tables)
+    if spec.steps * W > 2048:  # small weight ROMs go to LUTs
+        brams += L * math.ceil(spec.steps * W / BRAM_BITS)
+    return {"luts": int(luts), "ffs": int(ffs), "brams": int(brams)}
+
+
+def check_fits(spec: Spec, part: str) -> None:
+    est = spec.analysis.get("estimate") or estimate_resources(spec)
+    dev = spartan2.device(part)
+    if est["luts"] <= dev.luts and est["brams"] <= dev.brams:
+        return
+    fits = [d.name for d in spartan2.DEVICES if est["luts"] <= d.luts and est["brams"] <= d.brams]
+    hint = f"smallest part that could hold it: {fits[0]}" if fits else \
+        "no Spartan-II holds it: fewer terms, fewer lanes or mult_style=shiftadd"
+    raise SpecError(
+        f"{spec.model.terms} terms x {spec.lanes} lane(s) ({spec.mult_style}) need about "
+        f"{est['luts']} LUT4 and {est['brams']} block RAMs; {part} has {dev.luts} and {dev.brams} "
+        f"({hint})"
+    )
+
+
+__all__ = ["Spec", "derive_spec", "MULT_STYLES", "parse_device", "estimate_resources",
+           "error_analysis", "BUDGET", "CLOCK_HZ"]

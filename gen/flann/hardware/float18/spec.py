@@ -1,0 +1,216 @@
+"""The FLANN datapath in float18 (the seed's number format): spec and bit-true twin.
+
+The float18 design shares the fixed-point design's input stage and expansion block (the
+same :class:`~flann.hardware.fixed.spec.Spec`, the same ``flann_norm`` / ``flann_expansion`` entities and
+twins), and replaces the multiplier and the adder by the seed's 18-bit floating-point
+blocks::
+
+    code --clamp--> c ------------------------------.
+    code --flann_norm--> theta --flann_expansion--> terms (fixed, Tf fraction bits)
+                                                      |
+                    flann_f18_cvt: fixed -> float18 (RNE)   [term 0 is c itself]
+                    flann_f18_mul: x weight (float18 ROM)
+                    flann_f18_add: running sum, one term at a time, in model term order
+                    out_data = float18 code of the displacement in mm
+
+Term 0 (the linear term w0 v_n) enters as the clamped code c read as a term value
+c * 2^-Tf (exact in float18: |c| < 2^12), with weight w0 * (lsb / scale) * 2^Tf; the
+scaling by 2^Tf is exact, so the product is RNE(c * w0 lsb / scale).  The offset part
+w0 * (-offset / scale) and the bias form the running sum's start value.  The sum order
+(start, term 0, term 1, ..., term N-1) is the hardware's and is part of the bit-true
+definition: float addition is not associative.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import SpecError
+from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
+from ...golden.model import FlannModel
+from ..fixed.spec import Spec, derive_spec
+from ..fixed.twin import FlannExpansion, FlannNorm
+
+# options of the fixed-point spec that the float18 datapath shares (input stage, expansion);
+# every other generator option (widths of weights/products/output, multiplier style, ...)
+# belongs to the fixed datapath only
+FRONT_END_OPTIONS = ("device", "input_bits", "input_lsb_v", "clamp", "phase_bits", "table_addr_bits",
+                     "interp", "term_frac_bits", "model_sha256", "check_device", "lanes")
+
+
+@dataclass(frozen=True)
+class F18Spec:
+    """A fixed-point front end (input, expansion) plus the float18 arithmetic constants."""
+
+    base: Spec = field(repr=False)
+    fmt: FloatFormat
+    weight_codes: tuple[int, ...]   # model term order; [0] is the code term's weight
+    start_code: int                 # bias + w0 * (-offset / scale)
+    adv_period: int                 # cycles per term: the adder's latency (result forwarded)
+
+    number_format = "float18"
+
+    @property
+    def model(self) -> FlannModel:
+        return self.base.model
+
+    @property
+    def terms(self) -> int:
+        return self.base.model.terms
+
+    @property
+    def term_frac_bits(self) -> int:
+        return self.base.term_fmt.frac_bits
+
+    @property
+    def code_min(self) -> int:
+        return self.base.code_min
+
+    @property
+    def code_max(self) -> int:
+        return self.base.code_max
+
+    def golden_weights(self) -> np.ndarray:
+        """Exact (float64) constants the float18 ROM approximates, same order and scaling."""
+        m = self.model
+        w = np.asarray(m.weights, dtype=float).copy()
+        w[0] = w[0] * (self.base.input_lsb_v / m.input_scale_v) * 2.0 ** self.term_frac_bits
+        return w
+
+    def golden_start(self) -> float:
+        m = self.model
+        return m.bias + m.weights[0] * (-m.input_offset_v / m.input_scale_v)
+
+    def float_reference(self, codes) -> np.ndarray:
+        return self.base.float_reference(codes)
+
+    def to_dict(self) -> dict:
+        # the shared front end's fields only (the fixed datapath's are not in this design)
+        shared = ("device", "terms", "input_bits", "input_lsb_v", "clamp_codes", "phase_bits",
+                  "table_addr_bits", "interp", "dq_bits", "slope_guard", "norm_guard", "value", "slope",
+                  "term", "steps")
+        d = {k: v for k, v in self.base.to_dict().items() if k in shared}
+        d.update(number_format="float18", float=self.fmt.to_dict(), adv_period=self.adv_period,
+                 sum_order="start, code term, trig terms in model order (sequential)")
+        return d
+
+
+def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
+    """Float18 spec: the fixed spec's input stage and expansion, float18 constants."""
+    options = {k: v for k, v in options.items() if v is not None and k != "number_format"}
+    for k in options:
+        if k not in FRONT_END_OPTIONS:
+            raise SpecError(f"{k.replace('_', '-')}: applies to the fixed format only, not float18 "
+                            "(which has its own multiplier and adder)")
+    if options.get("lanes", 1) != 1:
+        raise SpecError("lanes: the float18 datapath has one lane (sequential float sum), got "
+                        f"{options['lanes']}")
+    options.pop("lanes", None)
+    options.pop("number_format", None)
+    # The front end must take an advance every adder latency (3 cycles): derive it as for
+    # the array-multiplier design, whose expansion forms the slope correction in one step
+    # (a shift-add spec forms it serially between its own, slower advances).  The fixed
+    # design's device estimate (multiplier, accumulator) does not apply: `flann synth`
+    # measures the float18 design itself.
+    options.pop("check_device", None)
+    base = derive_spec(model, mult_style="lut", check_device=False, **options)
+    fmt = FLOAT18
+    Tf = base.term_fmt.frac_bits
+    if base.input_bits > fmt.sig_bits:
+        raise SpecError(f"input_bits = {base.input_bits}: float18 holds input codes exactly only up to "
+                        f"{fmt.sig_bits} bits")
+    if base.term_fmt.width < base.input_bits:
+        raise SpecError(f"term width {base.term_fmt.width} < input_bits {base.input_bits}: the code "
+                        "cannot share the term converter")
+    if Tf > fmt.bias - 1:
+        raise SpecError(f"term_frac_bits = {Tf}: float18 cannot hold 2^-{Tf} (min normal 2^{1 - fmt.bias})")
+    spec = F18Spec(base=base, fmt=fmt, weight_codes=(), start_code=0, adv_period=F18Add.latency)
+    w = spec.golden_weights()
+    for i, x in enumerate(w):
+        if abs(x) > float(fmt.max_value):
+            raise SpecError(f"weight {i} = {x:.4g} exceeds float18's max finite {float(fmt.max_value):.4g}")
+    start = spec.golden_start()
+    if not math.isfinite(start) or abs(start) > float(fmt.max_value):
+        raise SpecError(f"bias {start:.4g} exceeds float18's range")
+    return F18Spec(base=base, fmt=fmt, weight_codes=tuple(int(c) for c in fmt.encode_array(w)),
+                   start_code=int(fmt.encode_array([start])[0]), adv_period=F18Add.latency)
+
+
+# -- twins ---------------------------------------------------------------------------------
+class F18Cvt:
+    """Twin of ``flann_f18_cvt``: signed fixed (``frac_bits`` fraction bits) -> float18, RNE."""
+
+    latency = 1
+
+    def __init__(self, frac_bits: int, fmt: FloatFormat = FLOAT18):
+        self.frac_bits = frac_bits
+        self.fmt = fmt
+
+    def compute_array(self, ints) -> np.ndarray:
+        a = np.asarray(ints, dtype=np.int64)
+        if a.size and np.abs(a).max() >= 2 ** 53:
+            raise ValueError("fixed value too wide for the float64 path")
+        return self.fmt.encode_array(np.ldexp(a.astype(float), -self.frac_bits))
+
+
+@dataclass
+class F18Trace:
+    """Every stage of the float18 twin (codes are float18 codes, int64)."""
+
+    codes: np.ndarray          # input codes as given
+    code: np.ndarray           # clamped
+    sat_in: np.ndarray
+    fixed_terms: np.ndarray    # (n, N): [c, trig terms...] as Tf-fraction integers
+    terms: np.ndarray          # (n, N) float18 codes after conversion
+    products: np.ndarray       # (n, N) float18 codes
+    running: np.ndarray        # (n, N) float18 codes after each add
+    out: np.ndarray            # (n,) float18 code
+    sat: np.ndarray            # (n,) input clamped or output at +-max finite
+
+
+class F18Top:
+    """Twin of ``flann_f18_top``: out_data (float18 code) and out_sat for each input code."""
+
+    def __init__(self, spec: F18Spec):
+        self.spec = spec
+        self.norm = FlannNorm(spec.base)
+        self.expansion = FlannExpansion(spec.base)
+        self.cvt = F18Cvt(spec.term_frac_bits, spec.fmt)
+        self.fmt = spec.fmt
+
+    def trace(self, codes) -> F18Trace:
+        s = self.spec
+        fmt = self.fmt
+        codes = np.asarray(codes, dtype=np.int64)
+        n = self.norm.process(codes)
+        e = self.expansion.process(n["theta"])
+        trig = e["terms"].reshape(codes.size, -1)[:, : s.terms - 1]
+        fixed = np.concatenate([n["code"][:, None], trig], axis=1)
+        terms = self.cvt.compute_array(fixed)
+        w = np.asarray(s.weight_codes, dtype=np.int64)[None, :]
+        products = fmt.mul_array(terms, np.broadcast_to(w, terms.shape))
+        running = np.empty_like(products)
+        acc = np.full(codes.size, s.start_code, dtype=np.int64)
+        for i in range(s.terms):
+            acc = fmt.add_array(acc, products[:, i])
+            running[:, i] = acc
+        out = running[:, -1]
+        sat = n["sat"] | ((out & fmt.max_code) == fmt.max_code)
+        return F18Trace(codes=codes, code=n["code"], sat_in=n["sat"], fixed_terms=fixed, terms=terms,
+                        products=products, running=running, out=out, sat=sat)
+
+    def process(self, codes) -> tuple[np.ndarray, np.ndarray]:
+        t = self.trace(codes)
+        return t.out, t.sat
+
+    def out_mm(self, codes) -> np.ndarray:
+        return self.fmt.decode_array(self.process(codes)[0])
+
+    def all_codes(self) -> np.ndarray:
+        return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
+
+
+__all__ = ["F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]

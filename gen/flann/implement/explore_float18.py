@@ -1,0 +1,37 @@
+"""The float18 design as a row of the design-space table (issue 7, item 4).
+
+``measure(model_path, device)`` generates the float18 design, measures it with the same
+flow as ``flann synth`` (GHDL synthesis + Yosys ``synth_xilinx -family xcv``) and takes
+the accuracy from the bit-true twin over every input code (``flann trace``), so a
+design-space table can list it beside the fixed-point candidates.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from ..hardware.float18.render import generate
+from ..golden.model import load_model
+from ..hardware.fixed.spec import CLOCK_HZ
+from ..analysis.trace import run_trace
+
+
+def measure(model_path, device: str = "xc2s200-pq208-5", **options) -> dict:
+    from . import synth
+
+    with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:
+        man = generate(model_path, Path(tmp) / "float18", **options)
+        rep = synth.synthesize(Path(tmp) / "float18", device, progress=False).to_dict()
+    tr = run_trace(load_model(model_path), "float18", **options)
+    return {
+        "format": "float18", "top": man["top"], "device": device,
+        "luts": rep["luts"], "ffs": rep["ffs"], "brams": rep["brams"], "fits": rep["fits"],
+        "cycles_per_sample": man["cycles_per_sample"],
+        "samples_per_s_at_50mhz": round(CLOCK_HZ / man["cycles_per_sample"], 1),
+        "max_err_mm": tr.total["max_mm"], "rms_err_mm": tr.total["rms_mm"],
+        "dominant_error_stage": tr.dominant["stage"],
+    }
+
+
+__all__ = ["measure"]

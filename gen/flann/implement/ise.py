@@ -1,0 +1,180 @@
+"""ISE 10.1 handoff: an xtclsh project script, a UCF and a FuseSoC core for a generated design.
+
+ISE 10.1 is the last ISE release that supports Spartan-II.  ``write_ise`` copies the
+design's VHDL (compile order from ``manifest.json``) into ``OUT/src`` so the directory can
+be carried to the machine that runs ISE, and renders from ``templates/ise_*.j2``:
+
+* ``flann_top.tcl``: ``xtclsh flann_top.tcl`` creates ``flann_top.ise`` (family Spartan2,
+  device/package/speed of the part), adds sources and UCF, sets the XST options and runs
+  the flow up to "Generate Programming File";
+* ``flann_top.ucf``: clock PERIOD constraint and a LOC for every bit of every top-level
+  port.  The pin map is an *example assignment* to edit for the real board;
+* ``flann_top.core``: FuseSoC CAPI2 description (GHDL simulation target; its ISE target
+  is for ISE 11+ because Edalize writes .xise projects);
+* ``README.txt``: the steps.
+
+Pin map source.  Global clock input GCK1 is P77 on Spartan-II PQ208 (DS001 module 4; the
+public BurchED B3 XC2S200-PQ208 board files use P77 for the system clock and P185 as a
+global clock input).  The user I/O pins below are the ones those board files use as plain
+I/O on the same PQ208 footprint (B3 connectors, B5 slots): P57 for reset; inputs on the
+left side (P3..P49), outputs on the right (P55..P68, P161..P194).  XC2S50..XC2S200 in
+PQ208 have 140 user I/O; the XC2S30 has 132, so some of these pins may be unbonded there.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+from .. import __version__
+from ..hardware.target import Part, parse_part
+from ..errors import FlannError
+from ..fileio import atomic_directory
+from ..textgen import template
+from .synth import read_manifest
+
+CLOCK_PIN = "P77"  # GCK1
+RESET_PIN = "P57"
+INPUT_PINS = (
+    "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11", "P15", "P16", "P17", "P18",
+    "P20", "P21", "P22", "P23", "P24", "P27", "P29", "P30", "P31", "P33", "P34", "P35",
+    "P36", "P40", "P41", "P42", "P43", "P44", "P45", "P46", "P47", "P48", "P49",
+)
+OUTPUT_PINS = (
+    "P161", "P162", "P163", "P164", "P165", "P166", "P167", "P168", "P169", "P173",
+    "P174", "P175", "P176", "P178", "P179", "P180", "P181", "P187", "P188", "P189",
+    "P191", "P192", "P193", "P194", "P55", "P56", "P58", "P59", "P60", "P61", "P62",
+    "P63", "P64", "P68",
+)
+PIN_MAP_DEVICES = ("xc2s50", "xc2s100", "xc2s150", "xc2s200")  # 140 user I/O in PQ208
+
+
+@dataclass(frozen=True)
+class Port:
+    name: str
+    direction: str  # "in" | "out"
+    width: int  # 0 for a scalar std_logic
+
+    def bits(self) -> list[str]:
+        if self.width == 0:
+            return [self.name]
+        return [f"{self.name}<{i}>" for i in range(self.width)]
+
+
+def top_ports(manifest: dict) -> list[Port]:
+    """flann_top's ports (fixed interface; widths from the manifest)."""
+    try:
+        ib, ob = int(manifest["input_bits"]), int(manifest["output_bits"])
+    except (KeyError, TypeError, ValueError):
+        raise FlannError("manifest.json: fields 'input_bits' and 'output_bits' (integers) are needed for the pin map") from None
+    return [
+        Port("clk", "in", 0), Port("rst", "in", 0),
+        Port("in_valid", "in", 0), Port("in_ready", "out", 0), Port("in_data", "in", ib),
+        Port("out_valid", "out", 0), Port("out_data", "out", ob), Port("out_sat", "out", 0),
+    ]
+
+
+_PORT_RE = re.compile(
+    r"^\s*(\w+)\s*:\s*(in|out)\s+std_logic(?:_vector\s*\(\s*(\d+)\s+downto\s+0\s*\))?\s*;?\s*$",
+    re.I | re.M,
+)
+
+
+def vhdl_ports(text: str, entity: str) -> list[Port]:
+    """Ports of ``entity`` as declared in VHDL text (flat std_logic / std_logic_vector ports)."""
+    m = re.search(rf"\bentity\s+{entity}\s+is(.*?)\bend\s+entity", text, re.I | re.S)
+    if not m:
+        return []
+    return [Port(n.lower(), d.lower(), int(hi) + 1 if hi else 0) for n, d, hi in _PORT_RE.findall(m.group(1))]
+
+
+def check_ports(ports: list[Port], man) -> None:
+    """The UCF must pin the entity's real ports: compare with the top file's declaration."""
+    for f in man.files:
+        declared = vhdl_ports(f.read_text(errors="replace"), man.top)
+        if declared:
+            if sorted(declared, key=lambda p: p.name) != sorted(ports, key=lambda p: p.name):
+                want = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in ports)
+                got = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in declared)
+                raise FlannError(f"{f.name}: entity {man.top} declares ports ({got}), the manifest implies ({want})")
+            return
+    raise FlannError(f"entity {man.top} not found in the manifest's files")
+
+
+def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
+    """(net, LOC, note) for every bit of every port."""
+    if part.package != "pq208":
+        raise FlannError(f"--device {part.name}: the example pin map is for the PQ208 package only")
+    ins, outs = iter(INPUT_PINS), iter(OUTPUT_PINS)
+    rows = []
+    for p in ports:
+        for net in p.bits():
+            if p.name == "clk":
+                rows.append((net, CLOCK_PIN, "GCK1 global clock input"))
+            elif p.name == "rst":
+                rows.append((net, RESET_PIN, "synchronous reset, active high"))
+            else:
+                pool = ins if p.direction == "in" else outs
+                try:
+                    rows.append((net, next(pool), p.direction))
+                except StopIteration:
+                    raise FlannError(
+                        f"the example pin map has {len(INPUT_PINS)} input and {len(OUTPUT_PINS)} output "
+                        f"pins; port {p.name} needs more: assign the rest in the UCF by hand"
+                    ) from None
+    return rows
+
+
+def write_ise(directory, device: str = "xc2s200-pq208-5", out_dir="ise", clock_mhz: float = 50.0) -> list[str]:
+    """Write the ISE 10.1 handoff for a generated design; returns the files written."""
+    part = parse_part(device)
+    man = read_manifest(directory)
+    if not (0 < clock_mhz <= 200):
+        raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
+    if part.device.name not in PIN_MAP_DEVICES:
+        warnings.warn(
+            f"{part.device.name} in PQ208 has {part.user_io} user I/O, the pin map was taken from "
+            "XC2S200 boards (140): check every LOC against DS001 module 4 before building"
+        )
+    ports = top_ports(man.data)
+    check_ports(ports, man)
+    pins = pin_map(ports, part)
+    sources = [f"src/{f.name}" for f in man.files]
+    period_ns = 1000.0 / clock_mhz
+    ctx = dict(
+        version=__version__, part=part, top=man.top, sources=sources, ucf=f"{man.top}.ucf",
+        period_ns=f"{period_ns:.3f}".rstrip("0").rstrip("."), clock_mhz=f"{clock_mhz:g}",
+        pins=pins, ports=ports, model_sha256=man.data.get("model_sha256") or "(not recorded)",
+        cycles_per_sample=man.data.get("cycles_per_sample"), latency=man.data.get("latency_cycles"),
+        core_name=f"flann:lvdt:{man.top}:{__version__}", input_bits=man.data["input_bits"],
+        output_bits=man.data["output_bits"],
+    )
+    texts = {
+        f"{man.top}.tcl": template("implement/templates/ise_project.tcl.j2").render(**ctx),
+        f"{man.top}.ucf": template("implement/templates/ise_pins.ucf.j2").render(**ctx),
+        f"{man.top}.core": template("implement/templates/ise_fusesoc.core.j2").render(**ctx),
+        "README.txt": template("implement/templates/ise_readme.txt.j2").render(**ctx),
+    }
+    out = Path(out_dir)
+    with atomic_directory(out) as tmp:
+        tmp = Path(tmp)
+        (tmp / "src").mkdir()
+        for f in man.files:
+            shutil.copyfile(f, tmp / "src" / f.name)
+        shutil.copyfile(man.directory / "manifest.json", tmp / "src" / "manifest.json")
+        for name, text in texts.items():
+            (tmp / name).write_text(text, newline="")
+    return [*texts, *sources, "src/manifest.json"]
+
+
+def summary(files: list[str], out_dir, part: Part | str) -> str:
+    p = part if isinstance(part, Part) else parse_part(part)
+    return (f"wrote {len(files)} files to {out_dir} for {p.name}: run `xtclsh {files[0]}` there "
+            f"with ISE 10.1 (see README.txt)")
+
+
+__all__ = ["write_ise", "pin_map", "top_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
+           "INPUT_PINS", "OUTPUT_PINS"]

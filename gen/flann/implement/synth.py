@@ -1,0 +1,491 @@
+"""Resource estimate of generated VHDL for a Spartan-II.
+
+Flow: ``DIR/manifest.json`` (top entity, files in compile order) → ``ghdl -a --std=93c``
+→ ``ghdl --synth --std=93c --out=verilog`` (fails on inferred latches and multiple
+assignments) → Yosys ``synth_xilinx -family xcv`` (Yosys's Virtex / Spartan-II target) →
+cell counts → utilisation of the target part (:mod:`flann.hardware.target`).
+
+The numbers are a synthesis estimate, not a place-and-route result: ISE's XST maps
+differently and the packer may not pair every LUT with a flip-flop.  The check is
+"fits before place and route"; the ISE handoff (:mod:`flann.implement.ise`) gives the final word.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..hardware.target import DEVICES, Part, parse_part
+from ..errors import FlannError
+
+DEFAULT_DEVICE = "xc2s30-pq208-5"
+FAMILY = "xcv"
+
+# Yosys warnings that say nothing about the design (feature gaps of the xcv target).
+BENIGN_YOSYS_WARNINGS = (
+    "Shift register inference not yet supported for family xcv",
+)
+
+# LUT4 sites used per cell (Virtex/Spartan-II library): INV is a LUT1, distributed RAM
+# and SRL16 live in LUTs.
+_LUT_SITES = {
+    "LUT1": 1, "LUT2": 1, "LUT3": 1, "LUT4": 1, "INV": 1,
+    "SRL16": 1, "SRL16E": 1, "SRL16_1": 1, "SRL16E_1": 1,
+    "RAM16X1S": 1, "RAM16X1S_1": 1, "RAM16X1D": 2, "RAM16X1D_1": 2,
+    "RAM32X1S": 2, "RAM32X1S_1": 2,
+}
+_IO_CELLS = ("IBUF", "IBUFG", "OBUF", "OBUFT", "IOBUF")
+
+
+class SynthCheckError(FlannError):
+    """The design synthesises to something that must not reach hardware (latch, multiple drivers)."""
+
+
+@dataclass(frozen=True)
+class Manifest:
+    directory: Path
+    top: str
+    files: tuple[Path, ...]
+    data: dict
+
+
+def read_manifest(directory: str | Path) -> Manifest:
+    directory = Path(directory)
+    path = directory / "manifest.json"
+    if not path.is_file():
+        raise FlannError(f"{path} not found: generate the design first (flann gen MODEL -o {directory})")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise FlannError(f"{path}: not valid JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise FlannError(f"{path}: expected a JSON object with 'top' and 'files'")
+    top = data.get("top")
+    files = data.get("files")
+    if not isinstance(top, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", top):
+        raise FlannError(f"{path}: field 'top' must name the top entity (a VHDL identifier), got {top!r}")
+    if not isinstance(files, list) or not files or not all(isinstance(f, str) for f in files):
+        raise FlannError(f"{path}: field 'files' must be a non-empty list of VHDL files in compile order")
+    paths = []
+    for f in files:
+        p = directory / f
+        if not p.is_file():
+            raise FlannError(f"{path}: listed file {f!r} does not exist in {directory}")
+        paths.append(p)
+    return Manifest(directory, top, tuple(paths), data)
+
+
+@dataclass(frozen=True)
+class Resources:
+    luts: int
+    ffs: int
+    brams: int
+    carry: int  # MUXCY: one per carry-chain bit
+    xorcy: int
+    mult_and: int
+    muxf5: int
+    muxf6: int
+    io: int  # user I/O pins (clock input on a global clock pin not counted)
+    cells: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_cells(cls, cells: dict[str, int]) -> "Resources":
+        unknown_latches = sorted(c for c in cells if c.startswith("LD") or c.startswith("$_DLATCH"))
+        if unknown_latches:
+            raise SynthCheckError(f"synthesis produced latches ({', '.join(unknown_latches)}): every storage element must be a clocked flip-flop")
+        luts = sum(n * _LUT_SITES.get(c, 0) for c, n in cells.items())
+        ffs = sum(n for c, n in cells.items() if c.startswith("FD"))
+        brams = sum(n for c, n in cells.items() if c.startswith("RAMB4"))
+        io = sum(n for c, n in cells.items() if c in _IO_CELLS)
+        gclk = min(cells.get("BUFG", 0), 4)  # clocks enter on dedicated GCK pins, not user I/O
+        return cls(
+            luts=luts,
+            ffs=ffs,
+            brams=brams,
+            carry=cells.get("MUXCY", 0),
+            xorcy=cells.get("XORCY", 0),
+            mult_and=cells.get("MULT_AND", 0),
+            muxf5=cells.get("MUXF5", 0),
+            muxf6=cells.get("MUXF6", 0),
+            io=max(io - gclk, 0),
+            cells=dict(sorted(cells.items())),
+        )
+
+
+def shortfall(res: Resources, part: Part) -> list[str]:
+    """What does not fit on ``part`` (empty when it fits)."""
+    d = part.device
+    out = []
+    if res.luts > d.luts:
+        out.append(f"{res.luts} LUT4 > {d.luts}")
+    if res.ffs > d.ffs:
+        out.append(f"{res.ffs} flip-flops > {d.ffs}")
+    if res.brams > d.brams:
+        out.append(f"{res.brams} block RAMs > {d.brams}")
+    if res.io > part.user_io:
+        out.append(f"{res.io} user I/O > {part.user_io} on {part.package}")
+    return out
+
+
+def smallest_fit(res: Resources, part: Part) -> Part | None:
+    """Smallest Spartan-II that fits, preferring the target's package and speed grade."""
+    for d in DEVICES:
+        if d.user_io(part.package) is not None:
+            cand = Part(d, part.package, part.speed)
+            if not shortfall(res, cand):
+                return cand
+    for d in DEVICES:  # any package, fewest pins that suffice
+        for pkg, _io in sorted(d.packages, key=lambda p: p[1]):
+            cand = Part(d, pkg, part.speed)
+            if not shortfall(res, cand):
+                return cand
+    return None
+
+
+def _pct(used: int, avail: int) -> float:
+    return round(100.0 * used / avail, 1) if avail else 0.0
+
+
+@dataclass(frozen=True)
+class SynthReport:
+    part: Part
+    top: str
+    resources: Resources
+    warnings: tuple[str, ...]
+    manifest: dict
+    abc: str = "full"
+    entities: dict = field(default_factory=dict)
+
+    @property
+    def fits(self) -> bool:
+        return not shortfall(self.resources, self.part)
+
+    @property
+    def smallest(self) -> Part | None:
+        return smallest_fit(self.resources, self.part)
+
+    def to_dict(self) -> dict:
+        r, d = self.resources, self.part.device
+        smallest = self.smallest
+        return {
+            "device": self.part.name,
+            "luts": r.luts,
+            "ffs": r.ffs,
+            "brams": r.brams,
+            "lut_pct": _pct(r.luts, d.luts),
+            "ff_pct": _pct(r.ffs, d.ffs),
+            "bram_pct": _pct(r.brams, d.brams),
+            "fits": self.fits,
+            "smallest_device": smallest.name if smallest else None,
+            # details beyond the issue's keys
+            "carry": r.carry,
+            "xorcy": r.xorcy,
+            "mult_and": r.mult_and,
+            "muxf5": r.muxf5,
+            "muxf6": r.muxf6,
+            "io": r.io,
+            "io_available": self.part.user_io,
+            "device_luts": d.luts,
+            "device_ffs": d.ffs,
+            "device_brams": d.brams,
+            "top": self.top,
+            "cycles_per_sample": self.manifest.get("cycles_per_sample"),
+            "latency_cycles": self.manifest.get("latency_cycles"),
+            "cells": r.cells,
+            "entities": self.entities,
+            "warnings": list(self.warnings),
+            "flow": f"ghdl --synth --std=93c --out=verilog | yosys synth_xilinx -family {FAMILY}"
+                    + (" (abc -fast)" if self.abc == "fast" else ""),
+        }
+
+    def table(self) -> str:
+        r, d = self.resources, self.part.device
+        rows = [
+            ("LUT4", r.luts, d.luts),
+            ("flip-flops", r.ffs, d.ffs),
+            ("block RAM (4 Kbit)", r.brams, d.brams),
+            ("user I/O", r.io, self.part.user_io),
+        ]
+        how = " with abc -fast" if self.abc == "fast" else ""
+        lines = [f"{self.top} on {self.part.name} (yosys synth_xilinx -family {FAMILY}{how})"]
+        for name, used, avail in rows:
+            lines.append(f"  {name:<20} {used:>6} / {avail:<6} {_pct(used, avail):5.1f} %")
+        lines.append(f"  {'carry (MUXCY/XORCY)':<20} {r.carry:>6} / {r.xorcy}")
+        lines.append(f"  {'MUXF5 / MUXF6':<20} {r.muxf5:>6} / {r.muxf6}")
+        if len(self.entities) > 1:
+            lines.append("  per entity (LUT4 / FF / BRAM): " + ", ".join(
+                f"{n} {e['luts']}/{e['ffs']}/{e['brams']}" for n, e in self.entities.items()))
+        cps = self.manifest.get("cycles_per_sample")
+        if cps:
+            lines.append(f"  {'cycles per sample':<20} {cps:>6}")
+        if self.fits:
+            lines.append(f"  fits {self.part.name}")
+        else:
+            lines.append(f"  DOES NOT FIT {self.part.name}: {'; '.join(shortfall(r, self.part))}")
+        return "\n".join(lines)
+
+
+def _need_tool(name: str) -> str:
+    path = shutil.which(name)
+    if path is None:
+        raise FlannError(f"{name} not found on PATH: run scripts/ensure_tools.sh (Debian packages ghdl, yosys)")
+    return path
+
+
+_LATCH_RE = re.compile(r'^(?P<loc>[^\s:]+:\d+:\d+):.*latch infered for net "(?P<net>[^"]+)"', re.M)
+_MULTI_RE = re.compile(r'^(?P<loc>[^\s:]+:\d+:\d+):.*multiple assignments for "(?P<net>[^"]+)"', re.M)
+
+
+def _ghdl_errors(stderr: str, top: str) -> FlannError:
+    latches = [f'"{m["net"]}" ({Path(m["loc"]).name})' for m in _LATCH_RE.finditer(stderr)]
+    multi = [f'"{m["net"]}" ({Path(m["loc"]).name})' for m in _MULTI_RE.finditer(stderr)]
+    if latches:
+        return SynthCheckError(
+            f"{top}: latch inferred for {', '.join(latches)}: assign the signal on every path "
+            "of the combinational process, or register it in a clocked process"
+        )
+    if multi:
+        return SynthCheckError(
+            f"{top}: multiple drivers for {', '.join(multi)}: drive each signal from exactly one "
+            "process or concurrent assignment"
+        )
+    return FlannError(f"ghdl --synth of {top} failed: {_first_problem(stderr)}")
+
+
+def _first_problem(stderr: str) -> str:
+    """The line that says what went wrong (GHDL prints notes about ROMs first)."""
+    lines = [ln.strip() for ln in stderr.splitlines() if ln.strip()]
+    if any("GHDL Bug occurred" in ln for ln in lines):
+        where = next((ln for ln in lines if ln.startswith("raised ")), "")
+        return f"GHDL crashed (internal error{': ' + where[7:] if where else ''}); the VHDL needs a workaround"
+    for ln in lines:
+        if "error" in ln.lower() and "note:" not in ln:
+            return ln
+    return next((ln for ln in lines if "note:" not in ln), lines[0] if lines else "no message")
+
+
+_PMUX_RE = re.compile(
+    r"(always @\*\n\s*case \([^\n]*\)\n)((?:[ \t]+[^\n]*:\s*(\S+)\s*<=[^\n]*\n)+)([ \t]*)endcase"
+)
+
+
+def complete_pmux_cases(verilog: str) -> tuple[str, int]:
+    """Give GHDL's one-hot ``always @* case`` blocks a ``default: x <= 'bx``.
+
+    GHDL writes the parallel mux of a VHDL ``case`` (all choices covered, one-hot select)
+    as a combinational Verilog ``case`` without ``default``; Yosys cannot prove the select
+    one-hot and infers a latch for the impossible remaining values.  GHDL has already
+    checked the VHDL for real latches (it refuses them), so the missing selections are
+    don't-cares.  Returns (text, number of such case blocks).
+    """
+
+    def fix(m: re.Match) -> str:
+        body = m.group(2)
+        if re.search(r"^\s*default\s*:", body, re.M):
+            return m.group(0)
+        indent = re.match(r"[ \t]*", body).group(0)
+        return f"{m.group(1)}{body}{indent}default: {m.group(3)} <= 'bx;\n{m.group(4)}endcase"
+
+    return _PMUX_RE.subn(fix, verilog)
+
+
+def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
+    """Analyse and synthesise the manifest's files with GHDL; return the Verilog netlist."""
+    ghdl = _need_tool("ghdl")
+    lib = work / "ghdl"
+    lib.mkdir(parents=True, exist_ok=True)
+    files = [str(f.resolve()) for f in man.files]
+    a = subprocess.run(
+        [ghdl, "-a", "--std=93c", f"--workdir={lib}", *files], capture_output=True, text=True, cwd=work
+    )
+    if a.returncode != 0:
+        raise FlannError(f"ghdl -a --std=93c failed: {_first_problem(a.stderr)}")
+    s = subprocess.run(
+        [ghdl, "--synth", "--std=93c", f"--workdir={lib}", "--out=verilog", man.top],
+        capture_output=True, text=True, cwd=work,
+    )
+    if s.returncode != 0:
+        raise _ghdl_errors(s.stderr, man.top)
+    out = work / f"{man.top}.v"
+    text, _ = complete_pmux_cases(s.stdout)
+    out.write_text(text)
+    return out
+
+
+ABC_MODES = ("full", "fast")
+
+
+def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.json") -> str:
+    """The Yosys script.  ``abc="full"`` is plain ``synth_xilinx -family xcv``.
+
+    ``abc="fast"`` runs the same synth_xilinx steps but replaces its LUT-mapping ABC
+    script (fraig, scorr, dch, mfs2: minutes to hours on wide multipliers) by ``abc -fast``;
+    the map_luts commands are those synth_xilinx runs for a LUT4 family (Yosys 0.23
+    synth_xilinx.cc; xilinx_srl is skipped for xcv).  Counts come out a little higher.
+    """
+    if abc not in ABC_MODES:
+        raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
+    head = [f"read_verilog {verilog}"]
+    tail = ["check", f"tee -q -o {stat} stat -json"]
+    if abc == "full":
+        return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top}"] + tail)
+    return "; ".join(head + [
+        f"synth_xilinx -family {FAMILY} -top {top} -run begin:map_luts",
+        "opt_expr -mux_undef -noclkinv",
+        "abc -fast -lut 4:6",  # LUT4 plus MUXF5/MUXF6 wide functions, as synth_xilinx maps xcv
+        "clean",
+        "techmap -map +/xilinx/ff_map.v",
+        "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=4",
+        "xilinx_dffopt -lut4",
+        "opt_lut_ins -tech xilinx",
+        f"synth_xilinx -family {FAMILY} -top {top} -run map_cells:",
+    ] + tail)
+
+
+def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
+    """Run Yosys synth_xilinx -family xcv; return (cells by type, warnings that matter)."""
+    yosys = _need_tool("yosys")
+    stat = work / "stat.json"
+    log = work / "yosys.log"
+    script = yosys_script(verilog.name, top, abc, stat.name)
+    r = subprocess.run([yosys, "-q", "-l", log.name, "-p", script], capture_output=True, text=True, cwd=work)
+    text = log.read_text() if log.exists() else r.stderr
+    if r.returncode != 0:
+        err = next((ln for ln in (r.stderr + text).splitlines() if "ERROR" in ln), "see yosys log")
+        raise FlannError(f"yosys synth_xilinx -family {FAMILY} failed: {err.strip()}")
+    problems = re.findall(r"Found and reported (\d+) problems", text)
+    if problems and int(problems[-1]) > 0:
+        driver_lines = [ln.strip() for ln in text.splitlines() if "conflicting driver" in ln or "multiple" in ln.lower()]
+        detail = driver_lines[0] if driver_lines else f"{problems[-1]} problems reported by yosys check"
+        raise SynthCheckError(f"{top}: yosys check failed: {detail}")
+    warnings = []
+    for ln in text.splitlines():
+        if ln.startswith("Warning:"):
+            msg = ln[len("Warning:"):].strip()
+            if not any(b in msg for b in BENIGN_YOSYS_WARNINGS) and msg not in warnings:
+                warnings.append(msg)
+    data = json.loads(stat.read_text())
+    cells = data["design"]["num_cells_by_type"]
+    (work / "modules.json").write_text(json.dumps({
+        str(name).lstrip("\\"): mod.get("num_cells_by_type", {}) for name, mod in data.get("modules", {}).items()
+    }))
+    return {str(k): int(v) for k, v in cells.items()}, warnings
+
+
+def entity_breakdown(modules: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
+    """LUT4 / FF / block RAM per entity (synth_xilinx keeps GHDL's hierarchy; cells of one
+    module only, instances of sub-entities are not counted inside their parent)."""
+    out = {}
+    for name, cells in sorted(modules.items()):
+        cells = {str(k): int(v) for k, v in cells.items() if not str(k).startswith("\\")}
+        out[name] = {
+            "luts": sum(n * _LUT_SITES.get(c, 0) for c, n in cells.items()),
+            "ffs": sum(n for c, n in cells.items() if c.startswith("FD")),
+            "brams": sum(n for c, n in cells.items() if c.startswith("RAMB4")),
+        }
+    return out
+
+
+def manifest_device(man: Manifest) -> str:
+    """The part the design was generated for (manifest spec.device), else DEFAULT_DEVICE."""
+    spec = man.data.get("spec")
+    dev = spec.get("device") if isinstance(spec, dict) else None
+    return dev if isinstance(dev, str) and dev else DEFAULT_DEVICE
+
+
+def synthesize(directory: str | Path, device: str | None = None, work: str | Path | None = None,
+               progress: bool = False, abc: str = "full") -> SynthReport:
+    """Full flow for one generated design directory.  ``work`` keeps the intermediate files.
+
+    ``device`` defaults to the part recorded in the manifest (``flann gen --device``).
+    """
+    man = read_manifest(directory)
+    part = parse_part(device if device is not None else manifest_device(man))
+    if abc not in ABC_MODES:
+        raise FlannError(f"--abc {abc!r}: allowed {', '.join(ABC_MODES)}")
+    _need_tool("ghdl")
+    _need_tool("yosys")
+    with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
+        wdir = Path(work) if work is not None else Path(tmp)
+        wdir.mkdir(parents=True, exist_ok=True)
+        if progress:
+            print(f"synth: ghdl --synth --std=93c {man.top} ({len(man.files)} files)", file=sys.stderr)
+        verilog = ghdl_to_verilog(man, wdir)
+        if progress:
+            print(f"synth: yosys synth_xilinx -family {FAMILY}, abc {abc} (minutes for wide multipliers)",
+                  file=sys.stderr)
+        cells, warnings = yosys_cells(verilog, man.top, wdir, abc)
+        modules = entity_breakdown(json.loads((wdir / "modules.json").read_text()))
+    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc, modules)
+
+
+def not_fit_message(report: SynthReport) -> str:
+    short = "; ".join(shortfall(report.resources, report.part))
+    best = report.smallest
+    if best is not None:
+        return f"{report.top} does not fit {report.part.name} ({short}); smallest Spartan-II that fits: {best.name}"
+    biggest = DEVICES[-1]
+    return (
+        f"{report.top} does not fit {report.part.name} ({short}) nor any Spartan-II "
+        f"(largest: {biggest.name}, {biggest.luts} LUT4, {biggest.brams} block RAMs): "
+        "generate a smaller datapath (fewer lanes, a serial multiplier or narrower words)"
+    )
+
+
+
+# --------------------------------------------------------------------------- VSG lint
+def find_vsg_config(start: str | Path | None = None) -> Path | None:
+    """The repository's vsg.yaml: searched upwards from ``start``, the cwd and the package."""
+    roots = [Path(start).resolve()] if start is not None else []
+    roots += [Path.cwd(), Path(__file__).resolve().parent]
+    for root in roots:
+        for d in (root, *root.parents):
+            cand = d / "vsg.yaml"
+            if cand.is_file():
+                return cand
+    return None
+
+
+def lint_vhdl(files, config: str | Path | None = None, start: str | Path | None = None) -> list[str]:
+    """Run VSG (all phases) on ``files``; return violations as 'file(line) rule -- message'.
+
+    Raises FlannError when vsg or the configuration is missing: a lint that silently does
+    nothing would read as a pass.
+    """
+    sibling = Path(sys.executable).with_name("vsg")  # the venv's vsg when the venv is not activated
+    vsg = shutil.which("vsg") or (str(sibling) if sibling.exists() else None)
+    if vsg is None:
+        raise FlannError("vsg not found: install the dev extras (pip install -e '.[dev]') or pass --no-lint")
+    cfg = Path(config) if config is not None else find_vsg_config(start)
+    if cfg is None or not cfg.is_file():
+        raise FlannError(f"VSG configuration {cfg or 'vsg.yaml'} not found: pass --vsg-config or --no-lint")
+    with tempfile.TemporaryDirectory(prefix="flann-vsg-") as tmp:
+        out = Path(tmp) / "vsg.json"
+        r = subprocess.run(
+            [vsg, "-c", str(cfg), "-ap", "-p", "1", "-js", str(out), "-of", "syntastic",
+             "-f", *[str(f) for f in files]],
+            capture_output=True, text=True,
+        )
+        if not out.exists():
+            first = next((ln for ln in (r.stdout + r.stderr).splitlines() if ln.strip()), "no output")
+            raise FlannError(f"vsg failed: {first}")
+        data = json.loads(out.read_text())
+    violations = []
+    for f in data.get("files", []):
+        for v in f.get("violations", []):
+            if str(v.get("severity", "Error")).lower() == "error":
+                violations.append(f"{Path(f['file_path']).name}({v.get('linenumber')}) {v['rule']} -- {v.get('solution', '')}")
+    return violations
+
+
+def check_lint(files, config: str | Path | None = None, start: str | Path | None = None) -> None:
+    violations = lint_vhdl(files, config, start)
+    if violations:
+        more = f" (+{len(violations) - 3} more)" if len(violations) > 3 else ""
+        raise FlannError(f"VSG style check failed, {len(violations)} violations: " + "; ".join(violations[:3]) + more)

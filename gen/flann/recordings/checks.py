@@ -1,0 +1,184 @@
+"""Checks before fitting an inverse model: the monotonic span, repeated displacements, noise."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import RecordingsError
+from .csvio import Recordings
+
+MIN_FIT_POINTS = 3
+
+
+@dataclass(frozen=True)
+class MonotonicSpan:
+    """Result of :func:`monotonic_span`.
+
+    ``mask`` selects (in file order) the rows of the monotonic span; it is all True when
+    the voltage never folds back beyond the noise.  ``foldback`` tells whether it did,
+    ``trimmable`` whether dropping rows at the ends removes it, ``message`` says where
+    (empty when monotonic).  ``noise_v`` and ``threshold_v`` are the noise estimate and the
+    fold-back threshold used.
+    """
+
+    mask: np.ndarray
+    foldback: bool
+    trimmable: bool
+    message: str
+    noise_v: float
+    threshold_v: float
+
+
+def estimate_noise_v(voltage_sorted: np.ndarray) -> float:
+    """Point-to-point noise (V, 1 sigma) of a curve sampled in displacement order.
+
+    Robust: median absolute second difference / (0.6745 * sqrt(6)); for white noise of
+    standard deviation s the second difference has standard deviation s * sqrt(6).  A
+    smooth curve sampled densely adds little; on coarse data (e.g. 13 points) the curvature
+    inflates the estimate, which only makes the fold-back test more tolerant.
+    """
+    v = np.asarray(voltage_sorted, dtype=float)
+    if v.size < 3:
+        return 0.0
+    d2 = v[:-2] - 2.0 * v[1:-1] + v[2:]
+    return float(np.median(np.abs(d2)) / (0.6745 * np.sqrt(6.0)))
+
+
+def _span_one(x: np.ndarray, v: np.ndarray, noise_v: float | None, k_sigma: float,
+              floor_frac: float):
+    """Fold-back test on one sweep sorted by displacement. Returns (keep, kind, text, n, thr)."""
+    n = v.size
+    slope = np.polyfit(x, v, 1)[0] if n >= 2 and np.ptp(x) > 0 else 1.0
+    sign = 1.0 if slope >= 0 else -1.0
+    u = sign * v
+    noise = estimate_noise_v(v) if noise_v is None else float(noise_v)
+    thr = max(k_sigma * noise, floor_frac * float(np.ptp(v)))
+    keep = np.ones(n, bool)
+    if n < 3 or thr <= 0:
+        return keep, None, "", noise, thr
+    i_lo, i_hi = int(np.argmin(u)), int(np.argmax(u))
+    if i_lo > i_hi:
+        return keep, "interior", (f"voltage falls from {v[i_lo]:.6g} V at {x[i_lo]:g} mm back to "
+                                  f"{v[i_hi]:.6g} V at {x[i_hi]:g} mm"), noise, thr
+    inner = u[i_lo:i_hi + 1]
+    drop = np.maximum.accumulate(inner) - inner
+    if drop.max() > thr:
+        j = int(np.argmax(drop)) + i_lo
+        peak = int(np.argmax(u[i_lo:j + 1])) + i_lo
+        return keep, "interior", (f"voltage turns back between {x[peak]:g} mm "
+                                  f"({v[peak]:.6g} V) and {x[j]:g} mm ({v[j]:.6g} V)"), noise, thr
+    parts = []
+    if i_hi < n - 1 and (u[i_hi] - u[i_hi + 1:].min()) > thr:
+        j = int(np.argmin(u[i_hi + 1:])) + i_hi + 1
+        parts.append(f"beyond {x[i_hi]:g} mm (turning point {v[i_hi]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
+        keep[i_hi + 1:] = False
+    if i_lo > 0 and (u[:i_lo].max() - u[i_lo]) > thr:
+        j = int(np.argmax(u[:i_lo]))
+        parts.append(f"below {x[i_lo]:g} mm (turning point {v[i_lo]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
+        keep[:i_lo] = False
+    if not parts:
+        return np.ones(n, bool), None, "", noise, thr
+    return keep, "ends", "voltage folds back " + " and ".join(parts), noise, thr
+
+
+def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float = 8.0,
+                   floor_frac: float = 0.01) -> MonotonicSpan:
+    """Where the voltage folds back beyond the noise (no inverse exists), per direction.
+
+    Within each direction (all rows when there is no ``direction`` column) the rows are
+    ordered by displacement and the voltage is oriented to rise.  A fold-back is a fall of
+    more than ``threshold = max(k_sigma * noise, floor_frac * voltage span)`` below an
+    earlier value; point-to-point wiggles smaller than that (noise on the flat ends) are
+    not fold-backs.  A fold-back beyond the voltage extremes (the core leaving the coils)
+    is *trimmable*: the span from the voltage minimum to its maximum is kept.  A fold-back
+    inside that span is not.
+    """
+    groups = ([np.flatnonzero(rec.direction == d) for d in (1.0, -1.0)]
+              if rec.direction is not None else [np.arange(len(rec))])
+    mask = np.ones(len(rec), bool)
+    messages, trimmable, noises, thrs = [], True, [], []
+    for idx in groups:
+        if idx.size == 0:
+            continue
+        order = idx[np.argsort(rec.displacement_mm[idx], kind="stable")]
+        keep, kind, text, noise, thr = _span_one(rec.displacement_mm[order], rec.voltage_v[order],
+                                                 noise_v, k_sigma, floor_frac)
+        noises.append(noise)
+        thrs.append(thr)
+        if kind is None:
+            continue
+        where = "" if rec.direction is None else \
+            f" (direction {int(rec.direction[idx[0]]):+d})"
+        messages.append(f"{text}{where}")
+        mask[order[~keep]] = False
+        trimmable &= kind == "ends"
+    noise = max(noises) if noises else 0.0
+    thr = max(thrs) if thrs else 0.0
+    msg = ""
+    if messages:
+        msg = (f"{rec.source}: {'; '.join(messages)}: no inverse exists there "
+               f"(fold-back threshold {thr:.3g} V, noise estimate {noise:.3g} V)")
+    if not trimmable:
+        mask = np.ones(len(rec), bool)
+    return MonotonicSpan(mask=mask, foldback=bool(messages), trimmable=bool(messages) and trimmable,
+                         message=msg, noise_v=noise, threshold_v=thr)
+
+
+def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01) -> None:
+    """One voltage per displacement per direction: a repeat with another voltage is refused.
+
+    Recordings with a ``time_s`` column may hold repeated sweeps: there a repeat is refused
+    only when it differs by more than the noise allows, ``max(k_sigma * noise, floor_frac *
+    voltage span)`` with the noise estimated on the first pass; without ``time_s`` any
+    differing repeat is refused.
+    """
+    direction = rec.direction if rec.direction is not None else np.zeros(len(rec))
+    tol = 0.0
+    if rec.time_s is not None:
+        keys = np.stack([direction, rec.displacement_mm], axis=1)
+        first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
+        sub = rec.subset(first)
+        order = np.lexsort((sub.displacement_mm, direction[first]))
+        tol = max(k_sigma * estimate_noise_v(sub.voltage_v[order]),
+                  floor_frac * float(np.ptp(rec.voltage_v)))
+    seen: dict[tuple[float, float], int] = {}
+    for i, (d, x, v) in enumerate(zip(direction, rec.displacement_mm, rec.voltage_v)):
+        key = (float(d), float(x))
+        j = seen.setdefault(key, i)
+        if j != i and abs(rec.voltage_v[j] - v) > tol:
+            where = "" if rec.direction is None else f" in direction {int(d):+d}"
+            raise RecordingsError(
+                f"{rec.source}: rows {j + 1} and {i + 1}: displacement {x:g} mm appears twice"
+                f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
+                "average repeats or give each sweep its direction (+1/-1)"
+                + (f" (repeats may differ by {tol:.3g} V)" if tol else "")
+            )
+
+
+def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None) -> Recordings:
+    """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span."""
+    if len(rec) < MIN_FIT_POINTS:
+        raise RecordingsError(
+            f"{rec.source}: {len(rec)} point(s); need at least {MIN_FIT_POINTS} to fit a model"
+        )
+    check_duplicates(rec)
+    span = monotonic_span(rec, noise_v=noise_v)
+    if span.foldback:
+        if not span.trimmable:
+            raise RecordingsError(span.message + "; the fold-back is inside the span, "
+                                  "--trim cannot remove it")
+        if not trim:
+            raise RecordingsError(span.message + "; use --trim to keep the monotonic span")
+        kept = rec.subset(span.mask)
+        lo, hi = kept.displacement_mm.min(), kept.displacement_mm.max()
+        warnings.warn(f"{rec.source}: --trim kept {len(kept)} of {len(rec)} rows, "
+                      f"the monotonic span {lo:g} .. {hi:g} mm", stacklevel=2)
+        if len(kept) < MIN_FIT_POINTS:
+            raise RecordingsError(
+                f"{rec.source}: only {len(kept)} point(s) left after --trim; need at least "
+                f"{MIN_FIT_POINTS}")
+        return kept
+    return rec

@@ -1,0 +1,96 @@
+"""Run the float18 top-level cocotb bench (``sim/test_f18_top.py``) under GHDL.
+
+``run_top(model, build_dir, codes=None, **options)`` generates the float18 design,
+computes the twin's outputs, simulates the given input codes (default: every code) and
+returns what the HDL produced with the comparison; pass/fail comes from cocotb's results
+file, the outputs from the bench's records.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FlannError
+from .benches import BENCH_DIR
+from ..hardware.float18.render import generate
+from ..hardware.float18.spec import F18Top, derive_f18_spec
+from ..golden.model import FlannModel, load_model, model_sha256
+
+
+def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **options) -> dict:
+    """Simulate flann_f18_top; returns codes, HDL out/sat, twin out/sat, mismatches, latency,
+    and for ``stage_codes`` the internal stages captured by cocotb compared with the twin's."""
+    import shutil
+
+    if shutil.which("ghdl") is None:
+        raise FlannError("ghdl not found on PATH (install GHDL 2.x, mcode backend: `make tools`)")
+    from cocotb_test.simulator import run as cocotb_run
+
+    build_dir = Path(build_dir)
+    if isinstance(model, FlannModel):
+        fmodel, sha = model, ""
+    else:
+        fmodel, sha = load_model(model), model_sha256(model)
+    fspec = derive_f18_spec(fmodel, model_sha256=sha, **options)
+    man = generate(model, build_dir / "hdl", **options)
+    top = F18Top(fspec)
+    codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
+    out, sat = top.process(codes)
+    exp = build_dir / "expected.json"
+    rec = build_dir / "hdl_outputs.json"
+    if rec.exists():
+        rec.unlink()
+    exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
+                               "latency": man["latency_cycles"], "in_bits": man["input_bits"],
+                               "seed": seed, "records": str(rec.resolve()),
+                               "stage_codes": [int(c) for c in stage_codes]}))
+    logger = logging.getLogger("cocotb")
+    saved = logger.handlers[:], logger.propagate
+    handler = logging.FileHandler(build_dir / "sim.log")
+    logger.handlers, logger.propagate = [handler], False
+    failed = False
+    try:
+        cocotb_run(simulator="ghdl", toplevel=man["top"], toplevel_lang="vhdl", module="test_f18_top",
+                   vhdl_sources=[str(build_dir / "hdl" / f) for f in man["files"]],
+                   python_search=[str(BENCH_DIR)], compile_args=["--std=93c"],
+                   sim_build=str(build_dir / "sim_build"),
+                   extra_env={"FLANN_F18_TOP": str(exp.resolve())})
+    except SystemExit:
+        failed = True                      # mismatches are counted from the records below
+    finally:
+        logger.handlers, logger.propagate = saved
+        handler.close()
+    if not rec.is_file():
+        raise FlannError(f"float18 simulation produced no outputs (see {build_dir / 'sim.log'})")
+    got = json.loads(rec.read_text())
+    hcodes = np.asarray(got["codes"], dtype=np.int64)
+    order = np.argsort(hcodes)
+    hcodes = hcodes[order]
+    hout = np.asarray(got["out"], dtype=np.int64)[order]
+    hsat = np.asarray(got["sat"], dtype=bool)[order]
+    k = np.argsort(codes)
+    mism = int(np.count_nonzero((hout != out[k]) | (hsat != sat[k]))) if hcodes.size == codes.size else None
+    stages = None
+    if len(stage_codes):
+        sc = np.asarray(list(stage_codes), dtype=np.int64)
+        tw = top.trace(sc)
+        stages = {"codes": int(sc.size), "terms": 0, "products": 0, "sums": 0, "missing": 0}
+        for n, c in enumerate(sc):
+            h = got["stages"].get(str(int(c)))
+            if h is None:
+                stages["missing"] += 1
+                continue
+            for key, arr in (("terms", tw.terms), ("products", tw.products), ("sums", tw.running)):
+                want = [int(x) for x in arr[n]]
+                stages[key] += int(sum(a != b for a, b in zip(h[key], want)) + abs(len(h[key]) - len(want)))
+        stages["all_equal"] = stages["missing"] == 0 and not any(stages[k] for k in ("terms", "products", "sums"))
+    return {"codes": hcodes, "out": hout, "sat": hsat, "twin_out": out[k], "twin_sat": sat[k],
+            "mismatches": mism, "latency": got["latency"], "bench_failed": failed,
+            "manifest": man, "spec": fspec, "stages": stages}
+
+
+__all__ = ["run_top"]
