@@ -127,6 +127,12 @@ def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float
                          message=msg, noise_v=noise, threshold_v=thr)
 
 
+def _pair(rec: Recordings, j: int, i: int) -> str:
+    """'lines 3 and 4' (file lines) or 'rows 2 and 3' for recordings not read from a file."""
+    a, b = rec.line_of(j), rec.line_of(i)
+    return f"{a.split()[0]}s {a.split()[1]} and {b.split()[1]}"
+
+
 def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01) -> None:
     """One voltage per displacement per direction: a repeat with another voltage is refused.
 
@@ -151,7 +157,7 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
         if j != i and abs(rec.voltage_v[j] - v) > tol:
             where = "" if rec.direction is None else f" in direction {int(d):+d}"
             raise RecordingsError(
-                f"{rec.source}: rows {j + 1} and {i + 1}: displacement {x:g} mm appears twice"
+                f"{rec.source}: {_pair(rec, j, i)}: displacement {x:g} mm appears twice"
                 f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
                 "average repeats or give each sweep its direction (+1/-1)"
                 + (f" (repeats may differ by {tol:.3g} V)" if tol else "")
