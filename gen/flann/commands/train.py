@@ -9,7 +9,8 @@ from pathlib import Path
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
-                     fit_lms, fit_lstsq)
+                            fit_lms, fit_lstsq)
+from ..hardware.accuracy import fixed_point_cost
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -80,10 +81,16 @@ def run(args) -> int:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
         check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
-        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance)
+        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
+                                 cost=fixed_point_cost)
+        t = model.training
         print(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-              f"held-out error (cross-validation, {model.training['cv_folds']} folds): "
+              f"held-out error (cross-validation, {t['cv_folds']} folds): "
               f"RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+        if "traded" in t:
+            print(f"auto: {t['selected_by']}: {t['traded']}", file=sys.stderr)
+        elif "hardware_why" in t:
+            print(f"auto: no candidate builds in fixed point ({t['hardware_why']})", file=sys.stderr)
     else:
         norm = args.normalise or "range"
         check_fit_input(rec.voltage_v, rec.displacement_mm, args.terms, rec.source)

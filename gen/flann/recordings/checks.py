@@ -11,6 +11,9 @@ from ..errors import RecordingsError
 from .csvio import Recordings
 
 MIN_FIT_POINTS = 3
+# An LVDT conditioner's output (and any ADC input) is at most a few tens of volts: a larger
+# number under a volts header is almost surely millivolts.
+MAX_PLAUSIBLE_V = 60.0
 
 
 @dataclass(frozen=True)
@@ -164,12 +167,23 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
             )
 
 
+def check_units(rec: Recordings) -> None:
+    """Voltages no sensor conditioner gives are refused: millivolts under a volts header."""
+    vmax = float(np.max(np.abs(rec.voltage_v)))
+    if vmax > MAX_PLAUSIBLE_V:
+        raise RecordingsError(
+            f"{rec.source}: voltage_v reaches {vmax:.6g} V, more than any LVDT conditioner or ADC "
+            f"gives (> {MAX_PLAUSIBLE_V:g} V): if these are millivolts, name the column voltage_mv "
+            "or 'Voltage (mV)'")
+
+
 def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None) -> Recordings:
     """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span."""
     if len(rec) < MIN_FIT_POINTS:
         raise RecordingsError(
             f"{rec.source}: {len(rec)} point(s); need at least {MIN_FIT_POINTS} to fit a model"
         )
+    check_units(rec)
     check_duplicates(rec)
     span = monotonic_span(rec, noise_v=noise_v)
     if span.foldback:
