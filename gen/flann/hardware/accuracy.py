@@ -147,6 +147,8 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm) -> dict:
         "output_lsb_mm": spec.output_lsb_mm,
         "points_clamped": int(np.count_nonzero(sat)),
         "max_abs_hardware_minus_float_mm": float(np.max(np.abs(hw_mm - fl_mm))),
+        # the datapath's own error: the float model at the same (clamped) ADC codes
+        "max_abs_hardware_minus_float_at_codes_mm": float(np.max(np.abs(hw_mm - spec.float_reference(codes)))),
         "physical_limit_mm": {"max": lim_max, "median": float(np.median(limit)),
                               "min": float(limit.min())},
         "ratio_to_limit": float(np.max(np.abs(e_hw)) / lim_max),
