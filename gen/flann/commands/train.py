@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from ..errors import FlannError
@@ -107,5 +108,10 @@ def run(args) -> int:
             print(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
                   f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
                   + _heldout_text(rec, args.terms, norm, args.ridge, explicit), file=sys.stderr)
+    if args.terms != "auto":
+        hw = fixed_point_cost(model)
+        if not hw["buildable"]:
+            warnings.warn(f"this model cannot be built in fixed point ({hw['why']}); "
+                          "--terms auto selects a buildable one")
     model.save(args.output)
     return 0

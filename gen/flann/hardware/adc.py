@@ -86,6 +86,7 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             f"input_lsb_v = {lsb:g} V (--input-lsb-v) gives the trained range {vlo:.6g}..{vhi:.6g} V only "
             f"{codes:.3g} ADC codes (need >= {MIN_TRAINED_CODES}): the input LSB is too coarse "
             "for this sensor (volts per code, not the full scale?)")
+    check_output_range(model)
     used = (vhi - vlo) / (hi_v - lo_v)
     if used < SMALL_FRACTION:
         notes.append(
@@ -102,6 +103,20 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             f"{eff_lsb:.4g} V, adding up to {0.5 * eff_lsb * slope:.3g} mm of quantisation error "
             f"at the steepest point (was {0.5 * lsb * slope:.3g} mm)")
     return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
+
+
+def check_output_range(model: FlannModel, points: int = 2001) -> None:
+    """A model whose output over its own voltage range is far outside its displacement range
+    is not a compensator (a file edited by hand, or weights that do not cancel as they should)."""
+    vlo, vhi = sorted(model.voltage_range_v)
+    y = model.predict(np.linspace(vlo, vhi, points))
+    xlo, xhi = sorted(model.displacement_range_mm)
+    reach = max(abs(xlo), abs(xhi), xhi - xlo)
+    if not np.all(np.isfinite(y)) or float(np.max(np.abs(y))) > 10 * reach:
+        raise SpecError(
+            f"the model's output reaches {float(np.max(np.abs(y))):.3g} mm over its trained voltage range "
+            f"{vlo:.6g}..{vhi:.6g} V, but it was trained on {xlo:.6g}..{xhi:.6g} mm: not a usable model "
+            "(edited by hand?); retrain it with `flann train`")
 
 
 def max_mm_per_v(model: FlannModel, points: int = 2001) -> float:
