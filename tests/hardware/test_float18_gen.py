@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from flann.commands import gen
-from flann.commands._float18 import run_gen
 from flann.errors import SpecError
 from flann.golden.model import model_sha256
 
@@ -21,6 +20,11 @@ def _args(*argv):
     p = argparse.ArgumentParser()
     gen.add_arguments(p)
     return p.parse_args([str(a) for a in argv])
+
+
+def run_gen(args):
+    args.format = "float18"
+    return gen.run(args)
 
 
 def test_writes_design_and_manifest_deterministically(tmp_path, capsys):

@@ -25,8 +25,8 @@ from ..fileio import atomic_directory
 from ..textgen import template
 from ..numeric.fixed import bits_literal
 from ..golden.model import FlannModel, load_model, model_sha256, term_kind
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 
-CLOCK_HZ = 50e6
 SEED_FILE = "flann_seed_parallel.vhd"
 
 
@@ -317,14 +317,13 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
         row.note = (row.note + "; " if row.note else "") + f"{len(d['warnings'])} yosys warning(s)"
 
 
-def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles=("lut", "shiftadd"),
+def explore(model_path, device: str = DEFAULT_PART, lanes=(1, 2, 4), styles=("lut", "shiftadd"),
             widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast") -> list[Row]:
     """Generate, synthesise and score each candidate; the seed architecture last."""
     import warnings as _w
 
     from ..hardware.fixed import render as hdlgen
     from ..hardware.target import parse_part
-    from ..hardware.fixed.spec import CLOCK_HZ as SPEC_CLOCK
     from ..hardware.fixed.twin import FlannTop
 
     parse_part(device)
@@ -349,7 +348,7 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                     row.note = "; ".join(str(w.message) for w in caught)
                 err = FlannTop(spec).error_vs_float()
                 row.cycles_per_sample = spec.cycles_per_sample
-                row.samples_per_s = SPEC_CLOCK / spec.cycles_per_sample
+                row.samples_per_s = CLOCK_HZ / spec.cycles_per_sample
                 row.max_err_lsb, row.max_err_mm = err["max_err_lsb"], err["max_err_mm"]
                 row.output_lsb_mm = spec.output_lsb_mm
                 ddir = Path(tmp) / f"d{k}"

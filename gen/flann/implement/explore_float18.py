@@ -13,11 +13,11 @@ from pathlib import Path
 
 from ..hardware.float18.render import generate
 from ..golden.model import load_model
-from ..hardware.fixed.spec import CLOCK_HZ
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 from ..analysis.trace import run_trace
 
 
-def measure(model_path, device: str = "xc2s200-pq208-5", **options) -> dict:
+def measure(model_path, device: str = DEFAULT_PART, **options) -> dict:
     from . import synth
 
     with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:

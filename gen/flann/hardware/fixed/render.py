@@ -17,6 +17,7 @@ from ...fileio import atomic_directory
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..options import GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
@@ -151,21 +152,21 @@ def manifest(spec: Spec, files: list[str]) -> dict:
     }
 
 
-def load(model_path_or_model, **options) -> Spec:
+def load(model_path_or_model, options: GenOptions | None = None, **overrides) -> Spec:
     """Spec from a model file path (sha256 of its bytes is stamped) or a FlannModel."""
     if isinstance(model_path_or_model, FlannModel):
-        return derive_spec(model_path_or_model, **options)
+        return derive_spec(model_path_or_model, options, **overrides)
     path = Path(model_path_or_model)
     model = load_model(path)
-    return derive_spec(model, model_sha256=model_sha256(path), **options)
+    return derive_spec(model, options, model_sha256=model_sha256(path), **overrides)
 
 
-def generate(model_path_or_model, out_dir, **options) -> dict:
+def generate(model_path_or_model, out_dir, options: GenOptions | None = None, **overrides) -> dict:
     """Derive the spec, render every entity and write them plus manifest.json atomically.
 
     Returns the manifest dict.  Nothing is written if any step fails.
     """
-    spec = load(model_path_or_model, **options)
+    spec = load(model_path_or_model, options, **overrides)
     return write(spec, out_dir)
 
 

@@ -30,12 +30,11 @@ from .. import target as spartan2
 from ...errors import SpecError
 from ...numeric.fixed import FixedFormat, bits_needed
 from ...golden.model import FlannModel, term_kind
+from ..options import MULT_STYLES, GenOptions
 
-MULT_STYLES = ("lut", "shiftadd")
-
-# Device data (luts, brams, packages) come from the one Spartan-II table, flann.hardware.target.
+# Device data (luts, brams, packages) and the clock come from flann.hardware.target.
 BRAM_BITS = spartan2.BRAM_BITS
-CLOCK_HZ = 50e6
+CLOCK_HZ = spartan2.CLOCK_HZ
 
 # Share of the 0.5-LSB pre-rounding budget given to each error source.
 BUDGET = {"phase": 0.15, "table": 0.20, "weights": 0.07, "products": 0.03, "linear": 0.02}
@@ -224,27 +223,23 @@ def _table(A: int, Tf: int, Dq: int, Gs: int, interp: bool):
 
 def derive_spec(
     model: FlannModel,
+    options: GenOptions | None = None,
     *,
     model_sha256: str = "",
-    device: str = "xc2s200-pq208-5",
-    input_bits: int = 12,
-    input_lsb_v: float | None = None,
-    clamp: bool = True,
-    output_bits: int | None = None,
-    output_lsb_mm: float | None = None,
-    lanes: int = 1,
-    mult_style: str = "shiftadd",
-    mult_digit_bits: int = 2,
-    interp: bool = True,
-    phase_bits: int | None = None,
-    table_addr_bits: int | None = None,
-    term_frac_bits: int | None = None,
-    weight_frac_bits: int | None = None,
-    product_frac_bits: int | None = None,
     number_format: str = "fixed",
     check_device: bool = True,
+    **overrides,
 ) -> Spec:
-    """Validate options, size every signal by the error budget, compute every constant."""
+    """Validate options, size every signal by the error budget, compute every constant.
+
+    ``options`` (default: :class:`GenOptions`'s defaults) with ``overrides`` by keyword.
+    """
+    o = GenOptions.of(options, **overrides)
+    device, input_bits, input_lsb_v, clamp = o.device, o.input_bits, o.input_lsb_v, o.clamp
+    output_bits, output_lsb_mm, lanes = o.output_bits, o.output_lsb_mm, o.lanes
+    mult_style, mult_digit_bits, interp = o.mult_style, o.mult_digit_bits, o.interp
+    phase_bits, table_addr_bits, term_frac_bits = o.phase_bits, o.table_addr_bits, o.term_frac_bits
+    weight_frac_bits, product_frac_bits = o.weight_frac_bits, o.product_frac_bits
     if not isinstance(model, FlannModel):
         raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
     if number_format != "fixed":

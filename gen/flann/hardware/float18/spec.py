@@ -32,6 +32,7 @@ from ...errors import SpecError
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
 from ...golden.model import FlannModel
 from ..fixed.spec import Spec, derive_spec
+from ..options import GenOptions
 from ..fixed.twin import FlannExpansion, FlannNorm
 
 # options of the fixed-point spec that the float18 datapath shares (input stage, expansion);
@@ -39,6 +40,15 @@ from ..fixed.twin import FlannExpansion, FlannNorm
 # belongs to the fixed datapath only
 FRONT_END_OPTIONS = ("device", "input_bits", "input_lsb_v", "clamp", "phase_bits", "table_addr_bits",
                      "interp", "term_frac_bits", "model_sha256", "check_device", "lanes")
+
+
+def float18_options(options: GenOptions, fixed_too: bool = False) -> dict:
+    """Generator options for the float18 design.  Fixed-only options left at their defaults
+    are dropped; given explicitly they are kept, so that the spec rejects them with a clear
+    message, unless ``fixed_too`` (a comparison where they are meant for the fixed design)."""
+    changed = options.changed()
+    return {k: v for k, v in options.to_kwargs().items()
+            if k in FRONT_END_OPTIONS or (k in changed and not fixed_too)}
 
 
 @dataclass(frozen=True)
@@ -213,4 +223,4 @@ class F18Top:
         return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
 
 
-__all__ = ["F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]
+__all__ = ["float18_options", "FRONT_END_OPTIONS", "F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]
