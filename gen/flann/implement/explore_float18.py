@@ -15,11 +15,10 @@ from ..hardware.float18.render import generate
 from ..golden.model import load_model
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 from ..analysis.trace import run_trace
+from . import synth
 
 
 def measure(model_path, device: str = DEFAULT_PART, **options) -> dict:
-    from . import synth
-
     with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:
         man = generate(model_path, Path(tmp) / "float18", **options)
         rep = synth.synthesize(Path(tmp) / "float18", device, progress=False).to_dict()

@@ -34,7 +34,7 @@ from ..hardware.target import CLOCK_HZ, DEFAULT_PART, Part, parse_part
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
-from .synth import read_manifest
+from ..hardware.manifest import read_manifest
 
 CLOCK_PIN = "P77"  # GCK1
 RESET_PIN = "P57"

@@ -12,11 +12,11 @@ import json
 from pathlib import Path
 
 from ... import __version__
-from ...errors import FlannError, SpecError
-from ...fileio import atomic_directory
+from ...errors import SpecError
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..manifest import MANIFEST, read_manifest, write_design
 from ..options import GenOptions
 from .spec import Spec, derive_spec
 
@@ -29,7 +29,6 @@ ENTITIES = (
     ("flann_adder", "accumulation, rounding, saturation"),
     ("flann_top", "FLANN LVDT compensator, top level"),
 )
-MANIFEST = "manifest.json"
 
 
 
@@ -128,7 +127,7 @@ def render(spec: Spec) -> dict[str, str]:
     ctx = contexts(spec)
     out = {}
     for name, title in ENTITIES:
-        header = dict(file=f"{name}.vhd", title=title, version=__version__,
+        header = dict(file=f"{name}.vhd", title=title, command="flann gen", version=__version__,
                       model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
         out[f"{name}.vhd"] = template(f"hardware/fixed/templates/{name}.vhd.j2").render(h=header, **ctx[name])
     return out
@@ -175,28 +174,6 @@ def write(spec: Spec, out_dir) -> dict:
     return write_design(texts, manifest(spec, list(texts)), out_dir)
 
 
-def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
-    """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir) as tmp:
-        for name, text in texts.items():
-            (tmp / name).write_text(text, newline="")
-        (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
-    return man
-
-
-def read_manifest(out_dir) -> dict:
-    path = Path(out_dir) / MANIFEST
-    try:
-        return json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FlannError(f"{path}: no such file (run `flann gen` first)") from None
-    except json.JSONDecodeError as exc:
-        raise FlannError(f"{path}: not valid JSON ({exc.msg})") from None
-
-
 __all__ = ["generate", "write", "render", "contexts", "manifest", "load", "read_manifest", "TOP",
-           "ENTITIES", "MANIFEST"]
+           "ENTITIES", "MANIFEST", "write_design"]
 

@@ -14,11 +14,11 @@ from ...errors import SpecError
 from ...numeric.fixed import bits_literal, bits_needed
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
 from ...textgen import template
+from ..manifest import write_design
 
 BLOCKS = {"mul": F18Mul, "add": F18Add}
 TOP = "flann_f18_top"
 CVT = "flann_f18_cvt"
-MANIFEST = "manifest.json"
 
 
 
@@ -165,7 +165,6 @@ def generate(model_path_or_model, out_dir, **options) -> dict:
 
 
 def write(fspec, out_dir) -> dict:
-    from ..fixed.render import write_design   # one writer for every design (atomic, manifest last)
     texts = render_design(fspec)
     return write_design(texts, manifest(fspec, list(texts)), out_dir)
 
