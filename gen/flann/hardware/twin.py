@@ -26,7 +26,7 @@ class Record:
 
 @dataclass(frozen=True)
 class TopOut(Record):
-    """Output ports of a top-level entity; unpacks as ``out_data, out_sat``."""
+    """Output ports of a top-level entity; unpacks (and indexes) as ``out_data, out_sat``."""
 
     out_data: np.ndarray
     out_sat: np.ndarray
@@ -35,6 +35,9 @@ class TopOut(Record):
 
     def __iter__(self):
         return iter((self.out_data, self.out_sat))
+
+    def __getitem__(self, key):
+        return (self.out_data, self.out_sat)[key] if isinstance(key, int) else super().__getitem__(key)
 
 
 __all__ = ["Record", "TopOut"]
