@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import FlannError
@@ -19,18 +18,17 @@ from ..fileio import atomic_directory
 MANIFEST = "manifest.json"
 
 
-@dataclass(frozen=True)
-class Manifest:
-    directory: Path
-    top: str
-    files: tuple[Path, ...]  # in compile order
-    data: dict               # the whole manifest.json
+class Manifest(dict):
+    """manifest.json as a dict, plus where it was read: ``directory``, ``top`` and ``files``
+    (paths of the VHDL files in compile order)."""
 
-    def __getitem__(self, key: str):
-        return self.data[key]
+    def __init__(self, directory: Path, top: str, files: tuple[Path, ...], data: dict):
+        super().__init__(data)
+        self.directory, self.top, self.files = directory, top, files
 
-    def get(self, key: str, default=None):
-        return self.data.get(key, default)
+    @property
+    def data(self) -> dict:
+        return dict(self)
 
 
 def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:

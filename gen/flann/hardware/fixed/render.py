@@ -87,7 +87,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, style=s.mult_style, weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, style=s.mult_style, fragments=f"hardware/fixed/templates/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
