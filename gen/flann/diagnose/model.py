@@ -115,7 +115,8 @@ class PhysicsFamily:
                  gain0: float, origin0: float, scale: float = 1.0,
                  disc: OddBasis | None = None, origin_from_travel: bool = False):
         self.sensor = sensor.replace(effects={})
-        self.disc = disc if disc is not None and disc.k > 0 else None
+        self._disc_ref = None
+        self.disc = disc
         self.origin_from_travel = origin_from_travel
         self.data = data
         self.origin_known = origin_known
@@ -300,7 +301,7 @@ class PhysicsFamily:
         return (y, coef) if want_coef else y
 
     def _disc_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
-        key = ("disc", idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        key = ("disc", self.disc.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         hit = self._shape_cache.get(key)
         if hit is None:
             if len(self._shape_cache) > 400:
@@ -422,20 +423,65 @@ class PhysicsFamily:
     def fit(self, effects, idx: np.ndarray, start: Fit | None = None) -> Fit:
         """Levenberg-Marquardt (MINPACK: no threaded BLAS, fast on a busy machine); bounds
         are enforced by :meth:`_physical` (|.| for one-sided, clipping for two-sided).
-        Clipping is tried with the upper rail, the lower rail and both, unless ``start``
-        already says which."""
+
+        Clipping is tried with the upper rail, the lower rail and both, each with the shape
+        term as chosen and with fewer terms (a rail and a smooth shape both flatten the
+        ends: BIC decides which needs fewer parameters), unless ``start`` already says."""
         effects = tuple(effects)
+        k0 = self.disc.k if self.disc is not None else 0
+        if start is not None and "k_shape" in start.extra:
+            k0 = start.extra["k_shape"]
         if "adc_clipping" not in effects:
-            return self._fit(effects, idx, start, "both")
+            return self._fit(effects, idx, start, "both", k0)
         if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
             sides = {"adc_clipping.rail_high_v": "high", "adc_clipping.rail_low_v": "low"}
             have = [sides[n] for n in start.names if n in sides]
-            return self._fit(effects, idx, start, have[0] if len(have) == 1 else "both")
-        fits = [self._fit(effects, idx, start, side) for side in ("high", "low", "both")]
+            return self._fit(effects, idx, start, have[0] if len(have) == 1 else "both", k0)
+        ks = [k0] + [k for k in self.fewer_terms if k < k0]
+        fits = [self._fit(effects, idx, start, side, k)
+                for side in ("high", "low", "both") for k in ks]
         ok = [f for f in fits if f.ok] or fits
         return min(ok, key=lambda f: f.bic)
 
-    def _fit(self, effects, idx, start, clip_sides) -> Fit:
+    fewer_terms = (0, 2)
+
+    def _basis(self, k: int):
+        if self.disc is None and k == 0:
+            return None
+        ref = self._disc_ref
+        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified)
+
+    @property
+    def disc(self):
+        return self._disc
+
+    @disc.setter
+    def disc(self, value):
+        self._disc = value if value is not None and value.k > 0 else None
+        if self._disc is not None:
+            self._disc_ref = self._disc
+
+    def _with_k(self, k: int):
+        """Context: the shape term with ``k`` terms while a fit or prediction runs."""
+        family = self
+
+        class _Swap:
+            def __enter__(self):
+                self.old = family._disc
+                family._disc = family._basis(k)
+
+            def __exit__(self, *exc):
+                family._disc = self.old
+
+        return _Swap()
+
+    def _fit(self, effects, idx, start, clip_sides, k_shape) -> Fit:
+        with self._with_k(k_shape):
+            f = self._fit_now(effects, idx, start, clip_sides)
+        f.extra["k_shape"] = k_shape
+        return f
+
+    def _fit_now(self, effects, idx, start, clip_sides) -> Fit:
         specs = self.specs(effects, clip_sides)
         names = [p.name for p in specs]
         lo = np.array([p.lower for p in specs])
@@ -461,14 +507,24 @@ class PhysicsFamily:
                    ok=bool(np.all(np.isfinite(resid))), extra={"coef": coef}, k_extra=k_extra)
 
     def predict(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
-        return self.evaluate(fit.theta, fit.names, idx, coef=fit.extra.get("coef"))
+        with self._with_k(self._k_of(fit)):
+            return self.evaluate(fit.theta, fit.names, idx, coef=fit.extra.get("coef"))
+
+    def _k_of(self, fit: Fit) -> int:
+        return fit.extra.get("k_shape", self.disc.k if self.disc is not None else 0)
+
+    def evaluate_like(self, fit: Fit, theta: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """``theta`` in ``fit``'s parameterisation, with its shape term."""
+        with self._with_k(self._k_of(fit)):
+            return self.evaluate(theta, fit.names, idx, coef=fit.extra.get("coef"))
 
     def shape_term(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
         """The smooth shape term's contribution (V) at ``idx`` (zeros without one)."""
-        if self.disc is None or fit.extra.get("coef") is None:
+        basis = self._basis(self._k_of(fit))
+        if basis is None or fit.extra.get("coef") is None:
             return np.zeros(idx.size)
         core = (self.data.x[idx] - self.origin0) * self.scale
-        return self.disc.evaluate(core) @ fit.extra["coef"]
+        return basis.evaluate(core) @ fit.extra["coef"]
 
     def specs_by_name(self, effects) -> dict[str, ParamSpec]:
         return {p.name: p for p in self.specs(effects)}

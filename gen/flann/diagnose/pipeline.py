@@ -346,7 +346,7 @@ def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
     for i, n in enumerate(fit.names):
         if n.startswith(effect + "."):
             theta[i] = neutral[n.split(".", 1)[1]]
-    return family.evaluate(theta, fit.names, idx, coef=fit.extra.get("coef"))
+    return family.evaluate_like(fit, theta, idx)
 
 
 def _slope(family: PhysicsFamily, fit: Fit, idx) -> np.ndarray:
