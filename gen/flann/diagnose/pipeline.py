@@ -149,8 +149,12 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     # -- calibrate the ideal simulation (off the rails) ----------------------------------
     if progress:
         progress("calibrating the ideal simulation")
+    # A travel centred on 0 mm says where the null should be: a null elsewhere is a
+    # zero_shift.  A travel starting at 0 (or anywhere else) leaves the null to calibration.
+    lo_x, hi_x = float(np.min(x)), float(np.max(x))
+    centred = (not known) and abs(lo_x + hi_x) <= CENTRED * (hi_x - lo_x)
     origin0 = initial_origin(x[off], y[off], tip)
-    cal = calibrate(sensor, x[off], y[off], origin_known=known, geometry_known=known,
+    cal = calibrate(sensor, x[off], y[off], origin_known=known or centred, geometry_known=known,
                     origin0=origin0, progress=progress)
     gsj = D.estimate_noise(x[off], cal.resid, passes_off)
     out_off = D.find_outliers(x[off], cal.resid, passes_off, gsj)
@@ -162,10 +166,6 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     skip = out_mask | on_rail
     fit_idx = np.flatnonzero(~skip)
 
-    # A travel centred on 0 mm says where the null should be: a null elsewhere is a
-    # zero_shift.  A travel starting at 0 (or anywhere else) leaves the null to calibration.
-    lo_x, hi_x = float(np.min(x)), float(np.max(x))
-    centred = (not known) and abs(lo_x + hi_x) <= CENTRED * (hi_x - lo_x)
     data = Data(x=x, y=y, direction=direction, temperature_c=temp, time_s=time)
     family = PhysicsFamily(cal.sensor, data, origin_known=known or centred, shape=cal.shape,
                            gain0=cal.gain, origin0=0.0 if centred else cal.origin_mm,
@@ -173,7 +173,7 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     if cal.scale != 1.0:
         notes.append(f"the recorded displacement is scaled by {cal.scale:.4g} to match the "
                      "simulated sensor (recorded in other units than mm, or a sensor of "
-                     "another size); effect parameters in mm are in the sensor's scale")
+                     "another size); effect parameters in mm are given in recorded units")
     if centred:
         notes.append(f"the travel ({lo_x:g}..{hi_x:g} mm) is centred on 0 mm, so the null is "
                      "expected at 0 mm: a null elsewhere is tested as zero_shift")
@@ -228,7 +228,9 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
         params = {}
         for n, v, se in zip(final.names, final.theta, final.stderr):
             if n.startswith(name + "."):
-                params[n.split(".", 1)[1]] = _param(v, se, units.get(n, ""))
+                # position effects act in the simulated sensor's mm: back to recorded units
+                k_unit = 1.0 / family.scale if units.get(n) == "mm" else 1.0
+                params[n.split(".", 1)[1]] = _param(v * k_unit, se * k_unit, units.get(n, ""))
         if name == "thermal_drift":
             params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
         contrib = family.predict(final, all_idx) - _without(family, final, name, all_idx)
