@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from ..hardware.fixed.render import generate
+from ..hardware.family.command import add_family_arguments, run_family
 from ..hardware.fixed.spec import MULT_STYLES
 
 HELP = "generate VHDL-93 for a model"
@@ -43,16 +44,19 @@ def spec_options(args) -> dict:
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", help="model.json (flann-model/1)")
+    parser.add_argument("model", nargs="?", help="model.json (flann-model/1); not with --family")
     parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
     parser.add_argument("--format", choices=("fixed", "float18"), default="fixed",
                         help="number format of the products and the sum: fixed point sized by the error "
                              "budget (default) or the seed's 18-bit floating point (docs/float18.md)")
     add_spec_arguments(parser)
+    add_family_arguments(parser)
 
 
 def run(args) -> int:
+    if args.family is not None or args.model is None:
+        return run_family(args, spec_options(args))
     if args.format == "float18":
         from ._float18 import run_gen
 
