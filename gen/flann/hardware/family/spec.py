@@ -330,8 +330,12 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
         if need > have:
             raise FitError(f"{what} reach {need}, the design holds {have}: outside the family "
                            f"(margin {fam.margin:g}); regenerate the design with this sensor in --family")
+    # clamp to the codes the recorded range rounds to (the ADC rounds too): the end points of
+    # a calibration sweep are then measured, not clamped
+    clo = max(f.code_min, math.floor(lo / f.input_lsb_v + 0.5))
+    chi = min(f.code_max, math.floor(hi / f.input_lsb_v + 0.5))
     return replace(f, model=model, model_sha256=model_sha256, ka=s.ka, kb=s.kb, k1=s.k1, k0=s.k0,
-                   clamp_lo=s.clamp_lo, clamp_hi=s.clamp_hi, weight_rom=s.weight_rom,
+                   clamp_lo=clo, clamp_hi=chi, weight_rom=s.weight_rom,
                    analysis={**s.analysis, "estimate": f.analysis.get("estimate")})
 
 
