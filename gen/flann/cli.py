@@ -30,6 +30,7 @@ COMMANDS: dict[str, str] = {
     "trace": "stage-by-stage error of hardware against the golden model",
     "simulate": "LVDT physics simulator: write recordings from a sensor file",
     "diagnose": "locate and name the physics missing between simulation and recordings",
+    "calibrate": "calibrate sensors for a family design: weight images and certificates",
 }
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from ..hardware import options as gen_options
+from ..hardware.family.command import add_family_arguments, run_family
 from ..hardware.fixed.render import generate as generate_fixed
 from ..hardware.float18.render import generate as generate_float18
 from ..hardware.float18.spec import float18_options
@@ -13,17 +14,20 @@ HELP = "generate VHDL-93 for a model"
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", help="model.json (flann-model/1)")
+    parser.add_argument("model", nargs="?", help="model.json (flann-model/1); not with --family")
     parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
     parser.add_argument("--format", choices=("fixed", "float18"), default="fixed",
                         help="number format of the products and the sum: fixed point sized by the error "
                              "budget (default) or the seed's 18-bit floating point (docs/float18.md)")
     gen_options.add_arguments(parser)
+    add_family_arguments(parser)
 
 
 def run(args) -> int:
     opts = gen_options.from_args(args)
+    if args.family is not None or args.model is None:
+        return run_family(args, opts.to_kwargs())
     if args.format == "float18":
         man = generate_float18(args.model, args.out, **float18_options(opts))
     else:
