@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 import warnings
 
@@ -29,6 +30,7 @@ COMMANDS: dict[str, str] = {
     "trace": "stage-by-stage error of hardware against the golden model",
     "simulate": "LVDT physics simulator: write recordings from a sensor file",
     "diagnose": "locate and name the physics missing between simulation and recordings",
+    "calibrate": "calibrate sensors for a family design: weight images and certificates",
 }
 
 
@@ -66,7 +68,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     _one_line_warnings()
     try:
-        return int(_load(args.command).run(args) or 0)
+        code = int(_load(args.command).run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
+        return code
+    except BrokenPipeError:
+        # the reader (e.g. `| head`) stopped reading: exit quietly, as a tool killed by
+        # SIGPIPE would (128 + 13); stdout goes to devnull so the final flush cannot fail
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except FlannError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -1,6 +1,7 @@
 """`flann diagnose` command: JSON schema, bad input (one line, exit 2), fold-back, Table 1."""
 
 import json
+import os
 import warnings
 
 import numpy as np
@@ -34,7 +35,10 @@ def test_table1_json_plot(tmp_path, capsys):
     d = json.loads(out.read_text())
     assert list(d) == ["baseline", "noise_v", "regions", "outliers", "effects", "final",
                        "improvement"]
-    assert set(d["baseline"]) == {"rms_v", "params"}
+    assert {"rms_v", "params", "shape_term"} <= set(d["baseline"])
+    assert "odd" in d["baseline"]["shape_term"]["description"] or \
+        d["baseline"]["shape_term"]["terms"] == 0
+    assert "local quadratic" in d["baseline"]["noise_method"]
     assert set(d["final"]) == {"rms_v"}
     # the +10 mm / 1.810 V reading: row 8 (0-based), about 1 V below the curve
     assert [o["row"] for o in d["outliers"]] == [8]
@@ -49,6 +53,9 @@ def test_table1_json_plot(tmp_path, capsys):
     assert d["improvement"] == pytest.approx(d["baseline"]["rms_v"] / d["final"]["rms_v"])
     assert "row 8 at 10 mm" in text
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    mask = os.umask(0)
+    os.umask(mask)
+    assert png.stat().st_mode & 0o777 == 0o666 & ~mask
 
 
 def test_json_to_stdout(capsys):

@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from flann.commands import gen
-from flann.commands._float18 import run_gen
 from flann.errors import SpecError
 from flann.golden.model import model_sha256
 
@@ -21,6 +20,15 @@ def _args(*argv):
     p = argparse.ArgumentParser()
     gen.add_arguments(p)
     return p.parse_args([str(a) for a in argv])
+
+
+def _f18(args):
+    args.format = "float18"
+    return args
+
+
+def run_gen(args):
+    return gen.run(_f18(args))
 
 
 def test_writes_design_and_manifest_deterministically(tmp_path, capsys):
@@ -62,3 +70,48 @@ def test_flann_gen_format_float18_cli(tmp_path, capsys):
     # the fixed default is unchanged
     assert main(["gen", str(DEFAULT), "-o", str(tmp_path / "x")]) == 0
     assert json.loads((tmp_path / "x" / "manifest.json").read_text())["top"] == "flann_top"
+
+
+def _f18_encode(x: float) -> int:
+    """Independent float18 encoder (1 sign, 6 exponent bits, bias 31, 11 fraction bits, RNE),
+    written from the seed's format description, not from flann.numeric.float18."""
+    from fractions import Fraction
+
+    if x == 0:
+        return 0
+    sign = 1 if x < 0 else 0
+    a = Fraction(abs(x))
+    e = a.numerator.bit_length() - a.denominator.bit_length()
+    if Fraction(2) ** e > a:
+        e -= 1
+    sig = a / Fraction(2) ** e * 2 ** 11  # in [2^11, 2^12)
+    q, r = divmod(sig, 1)
+    if r > Fraction(1, 2) or (r == Fraction(1, 2) and q % 2 == 1):
+        q += 1
+    if q == 2 ** 12:
+        q, e = 2 ** 11, e + 1
+    return (sign << 17) | ((e + 31) << 11) | (int(q) - 2 ** 11)
+
+
+def test_weight_rom_holds_every_weight_word_by_word(tmp_path):
+    import re
+
+    from flann.golden.model import load_model
+
+    assert gen.run(_f18(_args(DEFAULT, "-o", tmp_path / "d"))) == 0
+    man = json.loads((tmp_path / "d" / "manifest.json").read_text())
+    text = (tmp_path / "d" / "flann_f18_top.vhd").read_text()
+    rom = text[text.index("constant weight_rom_c"):]
+    rom = rom[:rom.index(");")]
+    words = [int(w, 2) for w in re.findall(r'"([01]{18})"', rom)]
+    m = load_model(DEFAULT)
+    # term 0 enters as the code read with the term format's fraction bits: its weight carries
+    # lsb / scale * 2^Tf (docs/float18.md); the others are the model's weights as they are
+    width, int_bits = (int(x) for x in re.match(r"sfix<(\d+),(\d+)", man["spec"]["term"]).groups())
+    tf = width - int_bits
+    want = [m.weights[0] * man["input_lsb_v"] / m.input_scale_v * 2.0 ** tf, *m.weights[1:]]
+    assert len(words) == m.terms == 51
+    for i, (got, w) in enumerate(zip(words, want)):
+        assert got == _f18_encode(w), f"ROM word {i}: {got:018b} != float18({w})"
+    start = re.search(r'constant start_c\s*:.*:= "([01]{18})"', text).group(1)
+    assert int(start, 2) == _f18_encode(m.bias + m.weights[0] * (-m.input_offset_v / m.input_scale_v))

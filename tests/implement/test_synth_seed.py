@@ -1,4 +1,4 @@
-"""The seed paper's fully parallel architecture (templates/seed_parallel.vhd.j2, SeedParallel)."""
+"""The seed paper's fully parallel architecture (hardware/seed: SeedSpec, SeedTop, flann_seed_top)."""
 
 import dataclasses
 import math
@@ -8,7 +8,10 @@ import subprocess
 import numpy as np
 import pytest
 
-from flann.implement.explore import SEED_FILE, SeedParallel
+from flann.hardware.seed import render
+from flann.hardware.seed.render import SEED_FILE
+from flann.hardware.seed.spec import SeedSpec
+from flann.hardware.seed.twin import SeedTop
 from flann.golden.model import load_model
 
 MODEL = "data/default_model.json"
@@ -19,7 +22,7 @@ def _seed(terms=None, **kw):
     if terms is not None:
         m = dataclasses.replace(m, weights=m.weights[:terms])
     lsb = 0.00284
-    return SeedParallel(model=m, input_bits=12, input_lsb_v=lsb,
+    return SeedSpec(model=m, input_bits=12, input_lsb_v=lsb,
                         clamp_lo=math.ceil(m.voltage_range_v[0] / lsb), clamp_hi=math.floor(m.voltage_range_v[1] / lsb), **kw)
 
 
@@ -29,15 +32,17 @@ def test_seed_structure_is_the_papers():
     # a binary tree of two-input adders over 51 leaves has 51 - 1 internal nodes
     assert s.n_adders == 50
     assert len(s.levels) == math.ceil(math.log2(51)) == 6
-    text = s.render()
+    text = render.render(s)[SEED_FILE]
     assert text.count("g_lvl") == 2 * 6  # generate label + its end label per level
     assert "constant terms_c    : natural := 51;" in text
-    assert s.manifest()["cycles_per_sample"] == 1
+    assert "entity flann_seed_top is" in text and "flann_top" not in text.replace("flann_seed_top", "")
+    assert render.manifest(s)["cycles_per_sample"] == 1 and render.manifest(s)["top"] == "flann_seed_top"
+    assert SeedTop(s).entity == "flann_seed_top" and SeedTop(s).latency == s.latency_cycles
 
 
 def test_seed_error_within_the_table_step_bound():
     s = _seed()
-    err = s.error_vs_float()
+    err = SeedTop(s).error_vs_float()
     m = s.model
     # full-wave table with 2^A midpoint samples: |sin error| <= pi / 2^A per trig term,
     # plus half an LSB per rounding (v, terms, weights, products) -- a loose independent bound
@@ -63,7 +68,7 @@ architecture sim of tb is
   signal out_data : std_logic_vector(17 downto 0);
   signal done     : boolean := false;
 begin
-  dut : entity work.flann_top
+  dut : entity work.flann_seed_top
     port map (clk => clk, rst => rst, in_valid => in_valid, in_ready => in_ready, in_data => in_data,
               out_valid => out_valid, out_data => out_data, out_sat => out_sat);
   clk <= not clk after 5 ns when not done;
@@ -104,7 +109,7 @@ end architecture sim;
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl is required")
 def test_seed_vhdl_equals_its_twin(tmp_path):
     s = _seed(terms=5)
-    s.write(tmp_path)
+    render.write(s, tmp_path)
     lo, hi = s.clamp_lo - 3, s.clamp_lo + 60  # includes clamped codes below the range
     (tmp_path / "tb.vhd").write_text(TB.replace("{lo}", str(lo)).replace("{hi}", str(hi)))
     for cmd in (["ghdl", "-a", "--std=93c", SEED_FILE, "tb.vhd"], ["ghdl", "-e", "--std=93c", "tb"]):
@@ -115,7 +120,7 @@ def test_seed_vhdl_equals_its_twin(tmp_path):
     vals = np.array([int(g[0]) for g in got])
     sats = np.array([g[1] == "'1'" for g in got])
     codes = np.arange(lo, hi + 1)
-    out, sat = s.process(codes)
+    out, sat = SeedTop(s).process(codes)
     assert vals.size == codes.size
     np.testing.assert_array_equal(vals, out)
     np.testing.assert_array_equal(sats, sat)

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FlannError
+from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
@@ -391,30 +392,6 @@ def _ulp(x: float, sig_bits: int) -> float:
 
 
 # -- plot ---------------------------------------------------------------------------------
-def _save_fig(fig, path) -> None:
-    import io
-    import os
-    import tempfile
-    from pathlib import Path
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(buf.getvalue())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)      # mkstemp's 0600 is not meant for a figure
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def plot_trace(result: TraceResult, path, title: str = "") -> None:
     """Error per stage vs input voltage (PNG)."""
     import matplotlib
@@ -443,7 +420,7 @@ def plot_trace(result: TraceResult, path, title: str = "") -> None:
     ax1.legend(loc="upper left", fontsize=7, ncol=2)
     ax1.grid(alpha=0.3)
     fig.tight_layout()
-    _save_fig(fig, path)
+    atomic_save_figure(fig, path)
     plt.close(fig)
 
 
@@ -470,7 +447,7 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
     fig.tight_layout()
-    _save_fig(fig, path)
+    atomic_save_figure(fig, path)
     plt.close(fig)
 
 

@@ -47,10 +47,12 @@ def run(args) -> int:
 
         results = run_demo(progress=_progress(args.quiet), limits=args.limits)
         if args.json:
-            obj = [r.to_json() for r in results.cases]
-            if results.limits or results.alarms:
+            obj = [r.to_json() for r in results.cases] + [r.to_json() for r in results.independent]
+            if results.limits or results.alarms or results.independent_alarms:
                 obj = {"cases": obj, "false_alarms": results.alarms,
-                       "detection_limits": results.limits}
+                       "detection_limits": results.limits,
+                       "independent_false_alarms": results.independent_alarms,
+                       "independent_detection_limits": results.independent_limits}
             if args.json == "-":
                 print(json.dumps(obj, indent=2))
             else:

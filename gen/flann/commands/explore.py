@@ -6,6 +6,7 @@ import json
 
 from ..implement import explore
 from ..errors import FlannError
+from ..hardware.target import DEFAULT_PART
 
 HELP = "design-space table (lanes x multiplier x widths)"
 
@@ -20,7 +21,7 @@ def _ints(text: str) -> tuple[int, ...]:
 
 def add_arguments(p):
     p.add_argument("model", help="model.json")
-    p.add_argument("--device", default="xc2s200-pq208-5", metavar="PART", help="target part (default xc2s200-pq208-5)")
+    p.add_argument("--device", default=DEFAULT_PART, metavar="PART", help="target part (default %(default)s)")
     p.add_argument("--lanes", default="1,2,4", help="lane counts to try (default 1,2,4)")
     p.add_argument("--mult", default="lut,shiftadd", help="multiplier styles (default lut,shiftadd)")
     p.add_argument("--widths", default=",".join(explore.WIDTH_PRESETS),

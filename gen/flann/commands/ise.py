@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 from ..implement import ise
 
 HELP = "write an ISE 10.1 project for the generated VHDL"
@@ -9,10 +10,11 @@ HELP = "write an ISE 10.1 project for the generated VHDL"
 
 def add_arguments(p):
     p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
-    p.add_argument("--device", default="xc2s200-pq208-5", metavar="PART",
-                   help="Spartan-II part DEVICE-PQ208-SPEED (default xc2s200-pq208-5)")
+    p.add_argument("--device", default=DEFAULT_PART, metavar="PART",
+                   help="Spartan-II part DEVICE-PQ208-SPEED (default %(default)s)")
     p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
-    p.add_argument("--clock-mhz", type=float, default=50.0, help="clock frequency for the PERIOD constraint (default 50)")
+    p.add_argument("--clock-mhz", type=float, default=CLOCK_HZ / 1e6,
+                   help="clock frequency for the PERIOD constraint (default %(default)g)")
 
 
 def run(args) -> int:

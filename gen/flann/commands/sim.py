@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..fileio import atomic_write_json
-from .gen import add_spec_arguments, spec_options
+from ..hardware import options as gen_options
 
 HELP = "co-simulate the generated VHDL under GHDL/cocotb"
 
@@ -26,7 +26,7 @@ def add_arguments(parser) -> None:
                         help="keep generated HDL, logs and results here (default: a temporary directory)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the random stimuli (default %(default)s)")
     parser.add_argument("--summary-json", metavar="FILE", default=None, help="also write the summary here")
-    add_spec_arguments(parser)
+    gen_options.add_arguments(parser)
 
 
 def _progress(msg: str) -> None:
@@ -38,7 +38,7 @@ def run(args) -> int:
 
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
-    opts = spec_options(args)
+    opts = gen_options.from_args(args).to_kwargs()
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build) if args.build else Path(tmp)
         res = simulate(args.model, build, options=opts, seed=args.seed, progress=_progress)

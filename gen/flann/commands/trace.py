@@ -14,8 +14,8 @@ import json
 from ..golden.model import load_model
 from ..recordings import read_recordings
 from ..analysis.trace import plot_compare, plot_trace, run_trace
-from ._float18 import float18_options
-from .gen import add_spec_arguments, spec_options
+from ..hardware import options as gen_options
+from ..hardware.float18.spec import float18_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
 FORMATS = ("fixed", "float18")
@@ -33,13 +33,14 @@ def add_arguments(parser) -> None:
                              "about a minute) and compare its outputs with the twin and the golden model")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--plot", metavar="OUT.png", help="plot error per stage vs input voltage")
-    add_spec_arguments(parser)
+    gen_options.add_arguments(parser)
 
 
 def _options(args, fmt: str) -> dict:
+    opts = gen_options.from_args(args)
     if fmt == "float18":
-        return float18_options(args, fixed_too=args.compare)
-    return spec_options(args)
+        return float18_options(opts, fixed_too=args.compare)
+    return opts.to_kwargs()
 
 
 def run(args) -> int:

@@ -362,3 +362,124 @@ def detect_v_shape(x: np.ndarray, y: np.ndarray, sigma_raw: float) -> float | No
                     and np.mean(sgn * y >= -tol) > 0.97):
                 return float(xs[k])
     return None
+
+
+# --------------------------------------------------------------------------- local noise
+
+NOISE_METHOD = ("robust (MAD) scale of leave-one-out residuals from a local quadratic through "
+                "the 6 nearest points of the same pass, on the residual of the baseline "
+                "(calibrated simulation + smooth shape term); points on a rail excluded")
+
+
+def local_fit_residuals(x: np.ndarray, r: np.ndarray, order: np.ndarray,
+                        h: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """Standardised leave-one-out residuals of a local quadratic along ``order``.
+
+    For each point, a quadratic through its 2h nearest neighbours in the sorted group
+    (the point itself left out) predicts it; the difference divided by
+    sqrt(1 + leverage) has the per-point noise variance.  Curvature of the curve does not
+    enter (the quadratic takes it) and neither does a plateau (it is fitted exactly).
+    """
+    m = order.size
+    w = 2 * h
+    if m < w + 1:
+        return np.empty(0, dtype=int), np.empty(0)
+    xs, rs = x[order], r[order]
+    i = np.arange(m)
+    start = np.clip(i - h, 0, m - w - 1)
+    win = start[:, None] + np.arange(w + 1)[None, :]           # includes the point itself
+    nb = win[win != i[:, None]].reshape(m, w)
+    dx = xs[nb] - xs[:, None]
+    scale = np.maximum(np.max(np.abs(dx), axis=1, keepdims=True), 1e-300)
+    t = dx / scale
+    X = np.stack([np.ones_like(t), t, t * t], axis=2)           # (m, w, 3)
+    A = np.einsum("mwi,mwj->mij", X, X) + 1e-12 * np.eye(3)
+    try:
+        Ainv = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        return np.empty(0, dtype=int), np.empty(0)
+    coef = np.einsum("mij,mwj,mw->mi", Ainv, X, rs[nb])
+    lev = Ainv[:, 0, 0]
+    e = (rs - coef[:, 0]) / np.sqrt(1.0 + np.clip(lev, 0, None))
+    ok = np.isfinite(e)
+    return order[ok], e[ok]
+
+
+def estimate_noise_local(x: np.ndarray, r: np.ndarray, passes: Passes,
+                         exclude: np.ndarray | None = None,
+                         n_regions: int = 3) -> tuple[float, list[dict]]:
+    """Per-point noise (V) of residuals ``r`` and its value per region of the stroke.
+
+    Pooled MAD scale of :func:`local_fit_residuals` in every pass; per region (equal
+    thirds of the recorded displacement) the same scale of that region's points.
+    Falls back to the pseudo-residual estimate on passes too short for a local fit.
+    """
+    keep = np.ones(x.size, bool) if exclude is None else ~exclude
+    idx_all, val_all = [], []
+    for g in _sorted_groups(x, passes):
+        g = g[keep[g]]
+        i, v = local_fit_residuals(x, r, g)
+        idx_all.append(i)
+        val_all.append(v)
+    idx = np.concatenate(idx_all) if idx_all else np.empty(0, int)
+    val = np.concatenate(val_all) if val_all else np.empty(0)
+    if val.size < 5:
+        return estimate_noise(x, r, passes, exclude=exclude), []
+    sigma = float(1.4826 * np.median(np.abs(val)))
+    lo, hi = float(np.min(x[keep])), float(np.max(x[keep]))
+    edges = np.linspace(lo, hi, n_regions + 1)
+    regions = []
+    for k in range(n_regions):
+        sel = (x[idx] >= edges[k]) & (x[idx] <= edges[k + 1])
+        if sel.sum() >= 5:
+            regions.append({"from_mm": float(edges[k]), "to_mm": float(edges[k + 1]),
+                            "noise_v": float(1.4826 * np.median(np.abs(val[sel]))),
+                            "points": int(sel.sum())})
+    return sigma, regions
+
+
+# --------------------------------------------------------------------------- rails
+
+MIN_RAIL_POINTS = 4
+
+
+def find_rails(x: np.ndarray, y: np.ndarray, passes: Passes) -> list[dict]:
+    """Flat rails read off the data: runs of equal or nearly equal readings at an extreme.
+
+    A rail is at least ``MIN_RAIL_POINTS`` readings (at >= 3 distinct displacements)
+    within a tolerance of the highest (or lowest) reading, holding every reading beyond
+    them towards that end of the travel, whose tolerance is 5 % of the noise of the
+    other points.  A smooth peak with noise never gives that: its top readings scatter
+    by the noise and lie among lower ones.  Returns dicts (side, level_v, stderr_v, n, mask).
+    """
+    rails = []
+    rng = float(np.ptp(y))
+    if rng <= 0:
+        return rails
+    sigma, _ = estimate_noise_local(x, y, passes)
+    tol = max(0.05 * sigma, 1e-9 * rng)
+    for side, sgn in (("high", 1.0), ("low", -1.0)):
+        v = sgn * y
+        top = float(np.max(v))
+        on = v >= top - tol
+        if on.sum() < MIN_RAIL_POINTS or np.unique(x[on]).size < 3:
+            continue
+        # the plateau must hold the end of the travel it sits at
+        xr = x[on]
+        if np.median(xr) >= np.median(x):
+            beyond = x >= np.min(xr)
+        else:
+            beyond = x <= np.max(xr)
+        if np.any(beyond & ~on):
+            continue
+        others = ~on
+        if others.sum() >= 8:
+            sig_o, _ = estimate_noise_local(x, y, passes, exclude=on)
+            spread = float(np.std(y[on]))
+            if spread > 0.2 * sig_o and sig_o > 0:
+                continue
+        level = float(np.mean(y[on]))
+        se = float(np.std(y[on], ddof=1) / math.sqrt(on.sum()))
+        rails.append({"side": side, "level_v": level, "stderr_v": se, "n": int(on.sum()),
+                      "mask": on})
+    return rails

@@ -75,10 +75,16 @@ def explain(name: str, params: dict, contrib: np.ndarray, x: np.ndarray,
                 f"{p['coefficient_per_c'] * 100:+.3g} %/degC (primary copper resistance, core "
                 "permeability).")
     if name == "adc_clipping":
+        rails = " and ".join(f"{p[k]:+.4g} V" for k in ("rail_high_v", "rail_low_v") if k in p)
+        if "readings_on_rail" in p:
+            n_on = int(p["readings_on_rail"])
+            return (f"{n_on} readings at the end(s) of the stroke sit on a flat level "
+                    f"({rails}) whose scatter is far below the noise elsewhere: the "
+                    "converter or amplifier saturates at its rail(s).")
         n_clip = int(np.sum(np.abs(contrib) > 1e-9))
-        return (f"beyond the natural roll-off the recordings stop at a flat "
-                f"+-{p['rail_v']:.4g} V while the simulated S-curve keeps rising ({n_clip} "
-                f"points, up to {_mv(big)}): the converter or amplifier saturates at its rail.")
+        return (f"beyond the natural roll-off the recordings stop at a flat {rails} while "
+                f"the smooth curve keeps going ({n_clip} points, up to {_mv(big)}): the "
+                "converter or amplifier saturates at its rail(s).")
     if name == "leadscrew_periodic":
         return (f"the residual oscillates with a period of {p['period_mm']:.4g} mm of "
                 f"displacement, its amplitude following the slope (up to {_mv(big)}): a "

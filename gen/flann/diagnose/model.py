@@ -76,12 +76,48 @@ class ShapeModes:
         return np.stack([np.interp(core_mm, self.grid_mm, m) for m in self.modes])
 
 
+class OddBasis:
+    """Smooth odd functions of the core position: the shape of this sensor that the
+    physics model's geometry cannot take (model-form error).
+
+    ``k`` differences of Gaussians ``g(u - c_j) - g(u + c_j)``, centres ``c_j = j U / k``
+    over the recorded half-range ``U``, width ``U / k``: odd about the null, the same in
+    both directions of travel and at every time, and too broad to draw a short period, a
+    flat rail or the rounded tip of a V.  Their coefficients are linear and solved in
+    closed form inside every fit (variable projection), so they cost no iterations.
+    """
+
+    def __init__(self, half_range_mm: float, k: int, rectified: bool = False):
+        self.half = max(float(half_range_mm), 1e-9)
+        self.k = int(k)
+        self.rectified = rectified
+        self.centres = self.half * np.arange(1, self.k + 1) / max(self.k, 1)
+        self.width = self.half / max(self.k, 1)
+
+    def evaluate(self, core_mm: np.ndarray) -> np.ndarray:
+        """(n, k) basis matrix at the core positions."""
+        u = np.asarray(core_mm, float)[:, None]
+        c = self.centres[None, :]
+        b = np.exp(-((u - c) / self.width) ** 2) - np.exp(-((u + c) / self.width) ** 2)
+        if self.rectified:   # an amplitude detector folds the odd shape into an even one
+            b = b * np.where(u >= 0, 1.0, -1.0)
+        return b
+
+    def describe(self) -> str:
+        return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm), "
+                "complexity chosen by 5-fold cross-validation")
+
+
 class PhysicsFamily:
     """Least-squares fits of the calibrated ideal simulation + any set of catalogue effects."""
 
     def __init__(self, sensor, data: Data, origin_known: bool, shape: ShapeModes | None,
-                 gain0: float, origin0: float, scale: float = 1.0):
+                 gain0: float, origin0: float, scale: float = 1.0,
+                 disc: OddBasis | None = None, origin_from_travel: bool = False):
         self.sensor = sensor.replace(effects={})
+        self._disc_ref = None
+        self.disc = disc
+        self.origin_from_travel = origin_from_travel
         self.data = data
         self.origin_known = origin_known
         self.shape = shape
@@ -104,8 +140,8 @@ class PhysicsFamily:
         if self.sensor.demodulator_kind == "phase_sensitive":
             out["quadrature_null"] = "a phase-sensitive detector rejects quadrature"
         if not self.origin_known:
-            out["zero_shift"] = ("the origin is calibrated (no sensor file), so a shifted null "
-                                 "is the fitted origin_mm")
+            out["zero_shift"] = ("the travel is not centred on 0 mm and there is no sensor file: "
+                                 "the null position is calibration (origin_mm)")
         if d.direction is None or np.unique(d.direction).size < 2:
             out["backlash"] = "needs travel in both directions"
         if d.temperature_c is None or np.ptp(d.temperature_c) == 0:
@@ -115,7 +151,7 @@ class PhysicsFamily:
         return out
 
     # -- parameters ------------------------------------------------------------------
-    def specs(self, effects) -> list[ParamSpec]:
+    def specs(self, effects, clip_sides: str = "both") -> list[ParamSpec]:
         span_x = float(np.ptp(self.data.x))        # recorded units (origin)
         span = span_x * self.scale                 # sensor mm (position effects)
         out = [ParamSpec("baseline.gain_ratio", *sorted((self.gain0 * 0.2, self.gain0 * 5.0)), "")]
@@ -139,15 +175,25 @@ class PhysicsFamily:
             elif e == "thermal_drift":
                 out.append(ParamSpec("thermal_drift.coefficient_per_c", -0.05, 0.05, "1/degC"))
             elif e == "adc_clipping":
-                out.append(ParamSpec("adc_clipping.rail_v", 0.3 * ymax, 3.0 * ymax, "V"))
+                # each rail on its own (amplifier rails are rarely symmetric)
+                if clip_sides in ("high", "both"):
+                    out.append(ParamSpec("adc_clipping.rail_high_v", -3 * ymax, 3 * ymax, "V"))
+                if clip_sides in ("low", "both"):
+                    out.append(ParamSpec("adc_clipping.rail_low_v", -3 * ymax, 3 * ymax, "V"))
             elif e == "leadscrew_periodic":
                 step = self._typical_step()
                 out += [ParamSpec("leadscrew_periodic.amplitude_mm", -span / 20, span / 20, "mm"),
-                        ParamSpec("leadscrew_periodic.period_mm", 2.05 * step, span / 3, "mm"),
+                        ParamSpec("leadscrew_periodic.period_mm", 2.05 * step,
+                                  max(self.max_period(), 2.1 * step), "mm"),
                         ParamSpec("leadscrew_periodic.phase_rad", -4 * math.pi, 4 * math.pi, "rad")]
             else:
                 raise ValueError(f"unknown candidate {e}")
         return out
+
+    def max_period(self) -> float:
+        """A lead-screw period must be short against the stroke: the smooth shape term
+        draws anything slower."""
+        return float(np.ptp(self.data.x)) * self.scale / 8
 
     def _typical_step(self) -> float:
         u = np.unique(self.data.x)
@@ -177,7 +223,7 @@ class PhysicsFamily:
             eff[e] = full
         return float(gain), float(origin), shape, eff
 
-    _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm", "adc_clipping.rail_v",
+    _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
     _CLIPPED = {"secondary_imbalance.imbalance_fraction": 0.9,
                 "thermal_drift.coefficient_per_c": 0.2}
@@ -206,7 +252,12 @@ class PhysicsFamily:
             th[ip] = math.pi - (math.pi - th[ip]) % (2 * math.pi)
         return th
 
-    def evaluate(self, theta: np.ndarray, names: list[str], idx: np.ndarray) -> np.ndarray:
+    def evaluate(self, theta: np.ndarray, names: list[str], idx: np.ndarray,
+                 coef: np.ndarray | None = None, target: np.ndarray | None = None,
+                 want_coef: bool = False):
+        """Model output at the points ``idx``.  With a shape term, its coefficients are
+        ``coef`` or, given ``target``, solved by least squares against it (on the points
+        the rails leave free); ``want_coef`` returns (output, coef)."""
         self.nfev += 1
         gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
         d = self.data
@@ -228,18 +279,36 @@ class PhysicsFamily:
                 y = y + gain * (shape @ modes[1:])
         elif origin != self.origin0:
             y = y - gain * (origin - self.origin0) * self.scale * self._slope_at(idx, core)
-        outer = [k for k in EFFECTS if k in eff and EFFECTS[k].stage == "output"]
-        if outer:
-            ctx = Context(displacement_mm=core,
-                          direction=np.zeros_like(core) if direction is None else direction,
-                          temperature_c=temp, time_s=np.zeros_like(core) if time is None else time,
-                          sensor=s)
-            sig = Signal(core_mm=core, output_v=y)
-            # catalogue order keeps clipping last, as the simulator does
-            for k in outer:
-                sig = EFFECTS[k].apply(eff[k], ctx, sig)
-            y = sig.output_v
-        return y
+        if "null_offset" in eff:
+            y = y + eff["null_offset"]["offset_v"]
+        hi = eff.get("adc_clipping", {}).get("rail_high_v", math.inf)
+        lo = eff.get("adc_clipping", {}).get("rail_low_v", -math.inf)
+        if self.disc is not None:
+            shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
+            B = self._disc_at(idx, core - shift - (origin - self.origin0) * self.scale)
+            if coef is None:
+                if target is None:
+                    coef = np.zeros(self.disc.k)
+                else:
+                    free = (y < hi) & (y > lo)
+                    if free.sum() > self.disc.k:
+                        coef = np.linalg.lstsq(B[free], (target - y)[free], rcond=1e-10)[0]
+                    else:
+                        coef = np.zeros(self.disc.k)
+            y = y + B @ coef
+        if "adc_clipping" in eff:
+            y = np.clip(y, lo, hi)
+        return (y, coef) if want_coef else y
+
+    def _disc_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+        key = ("disc", self.disc.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        hit = self._shape_cache.get(key)
+        if hit is None:
+            if len(self._shape_cache) > 400:
+                self._shape_cache.clear()
+            hit = self.disc.evaluate(core)
+            self._shape_cache[key] = hit
+        return hit
 
     def _modes_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
         """[slope, shape_1..K] at the points idx (per unit gain), cached per index set."""
@@ -283,12 +352,14 @@ class PhysicsFamily:
         missing = [i for i in range(len(names)) if np.isnan(theta[i])]
         if missing:
             if start is not None:
-                resid = self.data_y(idx) - self.evaluate(start.theta, start.names, idx)
+                resid = self.data_y(idx) - self.evaluate(start.theta, start.names, idx,
+                                                          target=self.data_y(idx))
                 base_theta, base_names = start.theta, start.names
             else:
                 base_names = [n for n in names if n.startswith("baseline.")]
                 base_theta = theta[:len(base_names)]
-                resid = self.data_y(idx) - self.evaluate(base_theta, base_names, idx)
+                resid = self.data_y(idx) - self.evaluate(base_theta, base_names, idx,
+                                                          target=self.data_y(idx))
             want = {names[i].split(".", 1)[0] for i in missing}
             guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)), want)
             for i in missing:
@@ -313,8 +384,8 @@ class PhysicsFamily:
         if d.direction is not None:
             dd = d.direction[idx]
             g["backlash.deadband_mm"] = max(float(-2 * np.dot(resid * dd, slope) / denom), 1e-4)
-        ymax = float(np.max(np.abs(d.y[idx])))
-        g["adc_clipping.rail_v"] = ymax
+        g["adc_clipping.rail_high_v"] = float(np.max(d.y[idx]))
+        g["adc_clipping.rail_low_v"] = float(np.min(d.y[idx]))
         g["secondary_imbalance.imbalance_fraction"] = 0.0
         g["thermal_drift.coefficient_per_c"] = 0.0
         if "leadscrew_periodic" in want:
@@ -351,34 +422,115 @@ class PhysicsFamily:
     # -- fitting -----------------------------------------------------------------------
     def fit(self, effects, idx: np.ndarray, start: Fit | None = None) -> Fit:
         """Levenberg-Marquardt (MINPACK: no threaded BLAS, fast on a busy machine); bounds
-        are enforced by :meth:`_physical` (|.| for one-sided, clipping for two-sided)."""
+        are enforced by :meth:`_physical` (|.| for one-sided, clipping for two-sided).
+
+        Clipping is tried with the upper rail, the lower rail and both, each with the shape
+        term as chosen and with fewer terms (a rail and a smooth shape both flatten the
+        ends: BIC decides which needs fewer parameters), unless ``start`` already says."""
         effects = tuple(effects)
-        specs = self.specs(effects)
+        k0 = self.disc.k if self.disc is not None else 0
+        if start is not None and "k_shape" in start.extra:
+            k0 = start.extra["k_shape"]
+        if "adc_clipping" not in effects:
+            return self._fit(effects, idx, start, "both", k0)
+        if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
+            sides = {"adc_clipping.rail_high_v": "high", "adc_clipping.rail_low_v": "low"}
+            have = [sides[n] for n in start.names if n in sides]
+            return self._fit(effects, idx, start, have[0] if len(have) == 1 else "both", k0)
+        ks = [k0] + [k for k in self.fewer_terms if k < k0]
+        fits = [self._fit(effects, idx, start, side, k)
+                for side in ("high", "low", "both") for k in ks]
+        ok = [f for f in fits if f.ok] or fits
+        return min(ok, key=lambda f: f.bic)
+
+    fewer_terms = (0, 2)
+
+    def _basis(self, k: int):
+        if self.disc is None and k == 0:
+            return None
+        ref = self._disc_ref
+        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified)
+
+    @property
+    def disc(self):
+        return self._disc
+
+    @disc.setter
+    def disc(self, value):
+        self._disc = value if value is not None and value.k > 0 else None
+        if self._disc is not None:
+            self._disc_ref = self._disc
+
+    def _with_k(self, k: int):
+        """Context: the shape term with ``k`` terms while a fit or prediction runs."""
+        family = self
+
+        class _Swap:
+            def __enter__(self):
+                self.old = family._disc
+                family._disc = family._basis(k)
+
+            def __exit__(self, *exc):
+                family._disc = self.old
+
+        return _Swap()
+
+    def _fit(self, effects, idx, start, clip_sides, k_shape) -> Fit:
+        with self._with_k(k_shape):
+            f = self._fit_now(effects, idx, start, clip_sides)
+        f.extra["k_shape"] = k_shape
+        return f
+
+    def _fit_now(self, effects, idx, start, clip_sides) -> Fit:
+        specs = self.specs(effects, clip_sides)
         names = [p.name for p in specs]
         lo = np.array([p.lower for p in specs])
         hi = np.array([p.upper for p in specs])
         theta0 = np.clip(self._start(effects, names, idx, start), lo, hi)
         y = self.data_y(idx)
+        k_extra = self.disc.k if self.disc is not None else 0
 
         def fun(th):
-            return self.evaluate(th, names, idx) - y
+            return self.evaluate(th, names, idx, target=y) - y
 
         try:
             res = least_squares(fun, theta0, method="lm", x_scale="jac",
                                 max_nfev=40 * (len(names) + 1), xtol=1e-9, ftol=1e-9)
-        except (ValueError, FloatingPointError):
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError):
             return Fit(effects, names, theta0, np.full(len(names), np.nan), -fun(theta0), idx,
-                       ok=False)
+                       ok=False, k_extra=k_extra)
         theta = self._canonical(self._physical(res.x, names), names)
-        resid = -res.fun
-        stderr = _stderr(res.jac, resid, len(names))
-        return Fit(effects, names, theta, stderr, resid, idx, ok=bool(np.all(np.isfinite(resid))))
+        pred, coef = self.evaluate(theta, names, idx, target=y, want_coef=True)
+        resid = y - pred
+        stderr = _stderr(res.jac, resid, len(names) + k_extra)[:len(names)]
+        return Fit(effects, names, theta, stderr, resid, idx,
+                   ok=bool(np.all(np.isfinite(resid))), extra={"coef": coef}, k_extra=k_extra)
 
     def predict(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
-        return self.evaluate(fit.theta, fit.names, idx)
+        with self._with_k(self._k_of(fit)):
+            return self.evaluate(fit.theta, fit.names, idx, coef=fit.extra.get("coef"))
+
+    def _k_of(self, fit: Fit) -> int:
+        return fit.extra.get("k_shape", self.disc.k if self.disc is not None else 0)
+
+    def evaluate_like(self, fit: Fit, theta: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """``theta`` in ``fit``'s parameterisation, with its shape term."""
+        with self._with_k(self._k_of(fit)):
+            return self.evaluate(theta, fit.names, idx, coef=fit.extra.get("coef"))
+
+    def shape_term(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
+        """The smooth shape term's contribution (V) at ``idx`` (zeros without one)."""
+        basis = self._basis(self._k_of(fit))
+        if basis is None or fit.extra.get("coef") is None:
+            return np.zeros(idx.size)
+        core = (self.data.x[idx] - self.origin0) * self.scale
+        return basis.evaluate(core) @ fit.extra["coef"]
 
     def specs_by_name(self, effects) -> dict[str, ParamSpec]:
         return {p.name: p for p in self.specs(effects)}
+
+    def units(self) -> dict[str, str]:
+        return {p.name: p.unit for p in self.specs(CANDIDATES)}
 
 
 def _stderr(jac, resid: np.ndarray, k: int) -> np.ndarray:

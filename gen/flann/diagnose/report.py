@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
+import os
+import tempfile
+from pathlib import Path
 
 import numpy as np
+
+from .data import running_mean, window_size
 
 
 def _num(v: float) -> float:
@@ -15,7 +22,11 @@ def _num(v: float) -> float:
 def to_json(dg) -> dict:
     """The issue's JSON, keys exactly as specified (params as {"value", "stderr", "unit"})."""
     return {
-        "baseline": {"rms_v": _num(dg.baseline_rms), "params": dg.baseline_params},
+        "baseline": {"rms_v": _num(dg.baseline_rms), "params": dg.baseline_params,
+                     "ideal_rms_v": _num(dg.ideal_rms),
+                     "shape_term": _clean(dg.shape_description),
+                     "noise_method": dg.noise_method,
+                     "noise_by_region": _clean(dg.noise_regions)},
         "noise_v": _num(dg.noise_v),
         "regions": [{"from_mm": _num(r["from_mm"]), "to_mm": _num(r["to_mm"]),
                      "direction": r["direction"], "peak_residual_v": _num(r["peak_residual_v"])}
@@ -28,6 +39,17 @@ def to_json(dg) -> dict:
         "final": {"rms_v": _num(dg.final_rms)},
         "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
     }
+
+
+def _clean(obj):
+    """JSON-safe copy (no inf/nan)."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, float):
+        return _num(obj)
+    return obj
 
 
 def _fmt_param(name: str, p: dict) -> str:
@@ -51,7 +73,15 @@ def format_text(dg) -> str:
     lines.append(f"calibrated ideal simulation ({dg.calibration_text}): RMS residual "
                  f"{_mv(dg.baseline_rms)}")
     lines.append("  " + "; ".join(_fmt_param(k, v) for k, v in dg.baseline_params.items()))
-    lines.append(f"noise estimated from point-to-point scatter: {_mv(dg.noise_v)} (1 sigma)")
+    sd = dg.shape_description
+    if sd:
+        lines.append(f"shape of this sensor (smooth, odd term; not an effect): {sd['description']}; "
+                     f"{_mv(sd['rms_v'])} RMS, up to {_mv(sd['peak_v'])}; ideal simulation alone "
+                     f"leaves {_mv(dg.ideal_rms)}")
+    lines.append(f"noise: {_mv(dg.noise_v)} (1 sigma), {dg.noise_method}")
+    if dg.noise_regions:
+        lines.append("  by region: " + "; ".join(
+            f"{r['from_mm']:.3g}..{r['to_mm']:.3g} mm {_mv(r['noise_v'])}" for r in dg.noise_regions))
     if dg.outliers:
         lines.append(f"isolated outliers ({len(dg.outliers)}, measurement glitches, left out of "
                      "the fits):")
@@ -103,8 +133,7 @@ def format_text(dg) -> str:
 
 def plot(dg, path) -> None:
     """Residuals against displacement before and after the added effects, spans shaded."""
-    import io
-
+    # lazy: matplotlib is only loaded when a plot is asked for
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -128,7 +157,6 @@ def plot(dg, path) -> None:
         else:
             ax.plot(x[keep], r[keep] * 1e3, ".", ms=ms, color="k", label="points")
         # running means make a pattern below the per-point noise visible
-        from .data import running_mean, window_size
         groups = ([(d == sign) & keep for sign in (1, -1)] if d is not None else [keep])
         for m, color in zip(groups, ("darkred", "navy") if d is not None else ("k",)):
             if m.sum() >= 5:
@@ -163,18 +191,22 @@ def plot(dg, path) -> None:
     _atomic_write_bytes(path, buf.getvalue())
 
 
-def _atomic_write_bytes(path, data: bytes) -> None:
-    import contextlib
-    import os
-    import tempfile
-    from pathlib import Path
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
+
+def _atomic_write_bytes(path, data: bytes) -> None:
+    """Write via a temporary file and rename (never a half-written PNG), with the mode an
+    ordinary open() would give (mkstemp creates 0600)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):

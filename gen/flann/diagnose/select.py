@@ -50,6 +50,7 @@ class Fit:
     idx: np.ndarray
     ok: bool = True
     extra: dict = field(default_factory=dict)
+    k_extra: int = 0             # parameters solved in closed form (not in theta)
 
     @property
     def n(self) -> int:
@@ -57,7 +58,7 @@ class Fit:
 
     @property
     def k(self) -> int:
-        return int(self.theta.size)
+        return int(self.theta.size) + int(self.k_extra)
 
     @property
     def rss(self) -> float:

@@ -3,266 +3,33 @@
 ``explore(model_path)`` generates each candidate with :mod:`flann.hardware.fixed.render`, measures it with
 the same flow as ``flann synth`` (GHDL synthesis + Yosys ``synth_xilinx -family xcv``) and
 takes the accuracy from the bit-true twin over every input code.  The seed architecture
-(51 expansion outputs, 51 multipliers, 50 two-input adders, all in parallel) is rendered
-from ``templates/seed_parallel.vhd.j2`` in 18-bit fixed point and measured the same way;
-its accuracy comes from :class:`SeedParallel`, the template's bit-true twin.
+(51 expansion outputs, 51 multipliers, 50 two-input adders, all in parallel;
+:mod:`flann.hardware.seed`) is measured the same way; its accuracy comes from its twin.
 """
 
 from __future__ import annotations
 
-import json
-import math
+import dataclasses
 import sys
 import tempfile
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..errors import FlannError, SpecError
-from ..fileio import atomic_directory
-from ..textgen import template
-from ..numeric.fixed import bits_literal
-from ..golden.model import FlannModel, load_model, model_sha256, term_kind
-
-CLOCK_HZ = 50e6
-SEED_FILE = "flann_seed_parallel.vhd"
-
-
-# ----------------------------------------------------------------------------- seed twin
-@dataclass(frozen=True)
-class SeedParallel:
-    """The seed architecture in ``word``-bit fixed point: constants and bit-true arithmetic.
-
-    Formats (all ``word`` = 18 bits, signed): v in Q1.17 (saturated), terms with 16 fraction
-    bits, weights with ``weight_frac`` fraction bits, products rounded to the accumulator
-    format with ``acc_frac`` fraction bits, chosen so that bias + sum |w_i| fits: the adder
-    tree cannot overflow.  Phase of harmonic m: (m v) mod 2 on ``word`` bits.
-    """
-
-    model: FlannModel = field(repr=False)
-    input_bits: int
-    input_lsb_v: float
-    clamp_lo: int
-    clamp_hi: int
-    word: int = 18
-    addr_bits: int = 10
-    norm_guard: int = 16
-    model_sha256: str = ""
-
-    # ---- derived constants ----------------------------------------------------------------
-    @property
-    def terms(self) -> int:
-        return self.model.terms
-
-    @property
-    def frac_v(self) -> int:
-        return self.word - 1
-
-    @property
-    def frac_t(self) -> int:
-        return self.word - 2
-
-    @property
-    def ka(self) -> int:
-        return round(self.input_lsb_v / self.model.input_scale_v * 2.0 ** (self.frac_v + self.norm_guard))
-
-    @property
-    def kb(self) -> int:
-        off = -self.model.input_offset_v / self.model.input_scale_v
-        return round(off * 2.0 ** (self.frac_v + self.norm_guard)) + (1 << (self.norm_guard - 1))
-
-    @property
-    def weight_frac(self) -> int:
-        wmax = max(abs(w) for w in self.model.weights)
-        return math.floor(math.log2(((1 << (self.word - 1)) - 1) / wmax))
-
-    @property
-    def weights_q(self) -> list[int]:
-        return [round(w * 2.0 ** self.weight_frac) for w in self.model.weights]
-
-    @property
-    def acc_frac(self) -> int:
-        bound = abs(self.model.bias) + sum(abs(w) for w in self.model.weights)
-        room = (1 << (self.word - 1)) - 1 - self.terms  # one rounding LSB per product
-        return math.floor(math.log2(room / bound))
-
-    @property
-    def shift(self) -> int:
-        s = self.frac_t + self.weight_frac - self.acc_frac
-        if s < 1:
-            raise SpecError(f"seed architecture: product shift {s} < 1 (weights too small for {self.word} bits)")
-        return s
-
-    @property
-    def bias_q(self) -> int:
-        return round(self.model.bias * 2.0 ** (self.frac_t + self.weight_frac))
-
-    @property
-    def rounds(self) -> list[int]:
-        half = 1 << (self.shift - 1)
-        return [half + self.bias_q] + [half] * (self.terms - 1)
-
-    @property
-    def table(self) -> list[int]:
-        n = 1 << self.addr_bits
-        k = np.arange(n)
-        vals = np.round(np.sin(2 * np.pi * (k + 0.5) / n) * 2.0 ** self.frac_t).astype(np.int64)
-        return [int(v) for v in np.clip(vals, -(1 << (self.word - 1)), (1 << (self.word - 1)) - 1)]
-
-    @property
-    def harmonics(self) -> list[int]:
-        return [term_kind(i)[1] for i in range(1, self.terms)]
-
-    @property
-    def phase_offsets(self) -> list[int]:
-        quarter = 1 << (self.word - 2)  # pi/2 in units of pi with word-1 fraction bits
-        return [quarter if term_kind(i)[0] == "cos" else 0 for i in range(1, self.terms)]
-
-    @property
-    def levels(self) -> list[dict]:
-        """Adder tree levels: input offset, output offset, pairs, odd pass-through."""
-        out, inp, n, nxt = [], 0, self.terms, self.terms
-        while n > 1:
-            pairs, odd = n // 2, n % 2
-            out.append({"inp": inp, "out": nxt, "pairs": pairs, "odd": bool(odd)})
-            inp, n = nxt, pairs + odd
-            nxt = inp + n
-        return out
-
-    @property
-    def n_adders(self) -> int:
-        return sum(lv["pairs"] for lv in self.levels)
-
-    @property
-    def nodes(self) -> int:
-        lv = self.levels
-        return (lv[-1]["out"] + 1) if lv else self.terms
-
-    @property
-    def latency_cycles(self) -> int:
-        return 5 + len(self.levels)
-
-    @property
-    def output_lsb_mm(self) -> float:
-        return 2.0 ** -self.acc_frac
-
-    def _widths(self) -> dict:
-        ka_bits = max(2, int(self.ka).bit_length() + 1)
-        norm_bits = max(self.input_bits + ka_bits, int(abs(self.kb)).bit_length() + 1) + 1
-        harm_bits = max(self.harmonics, default=1).bit_length() + 1
-        pmax = (1 << (self.word - 1)) ** 2 + max(abs(r) for r in self.rounds)
-        prod_bits = max(2 * self.word, pmax.bit_length() + 1)
-        return dict(ka_bits=ka_bits, norm_bits=norm_bits, harm_bits=harm_bits, prod_bits=prod_bits)
-
-    # ---- bit-true twin ----------------------------------------------------------------------
-    def process(self, codes) -> tuple[np.ndarray, np.ndarray]:
-        """(out_data, out_sat) for ADC codes, exactly as the template computes them."""
-        c_in = np.asarray(codes, dtype=np.int64)
-        c = np.clip(c_in, self.clamp_lo, self.clamp_hi)
-        W = self.word
-        full = (c * self.ka + self.kb) >> self.norm_guard
-        v = np.clip(full, -(1 << (W - 1)), (1 << (W - 1)) - 1)
-        table = np.asarray(self.table, dtype=np.int64)
-        terms = [v >> 1]
-        for m, off in zip(self.harmonics, self.phase_offsets):
-            theta = ((v * m) + off) & ((1 << W) - 1)
-            terms.append(table[theta >> (W - self.addr_bits)])
-        acc = np.zeros_like(v)
-        lim = 1 << (W - 1)
-        for t, w, r in zip(terms, self.weights_q, self.rounds):
-            p = (t * w + r) >> self.shift
-            if np.any((p < -lim) | (p >= lim)):
-                raise SpecError("seed architecture: a product overflows the accumulator format")
-            acc = acc + p
-        if np.any((acc < -lim) | (acc >= lim)):
-            raise SpecError("seed architecture: the adder tree overflows")
-        return acc, c != c_in
-
-    def error_vs_float(self) -> dict:
-        codes = np.arange(self.clamp_lo, self.clamp_hi + 1, dtype=np.int64)
-        out, _ = self.process(codes)
-        ref = self.model.predict(codes * self.input_lsb_v)
-        e = float(np.max(np.abs(out * self.output_lsb_mm - ref)))
-        return {"max_err_lsb": e / self.output_lsb_mm, "max_err_mm": e, "codes": int(codes.size)}
-
-    # ---- rendering ----------------------------------------------------------------------------
-    def spec_dict(self) -> dict:
-        return {
-            "architecture": "seed_parallel",
-            "number_format": f"fixed{self.word}",
-            "terms": self.terms,
-            "multipliers": self.terms,
-            "adders": self.n_adders,
-            "input_bits": self.input_bits,
-            "input_lsb_v": self.input_lsb_v,
-            "clamp_codes": [self.clamp_lo, self.clamp_hi],
-            "table_addr_bits": self.addr_bits,
-            "weight_frac_bits": self.weight_frac,
-            "acc_frac_bits": self.acc_frac,
-            "output_lsb_mm": self.output_lsb_mm,
-        }
-
-    def render(self) -> str:
-        W = self.word
-        wd = self._widths()
-        lim = (1 << (W - 1)) - 1
-        ctx = dict(
-            terms=self.terms, n_adders=self.n_adders, word=W, latency=self.latency_cycles,
-            in_bits=self.input_bits, shift=self.shift, norm_guard=self.norm_guard,
-            clamp_lo=bits_literal(self.clamp_lo, self.input_bits),
-            clamp_hi=bits_literal(self.clamp_hi, self.input_bits),
-            ka=bits_literal(self.ka, wd["ka_bits"]), kb=bits_literal(self.kb, wd["norm_bits"]),
-            v_max=bits_literal(lim, wd["norm_bits"]), v_min=bits_literal(-lim - 1, wd["norm_bits"]),
-            depth=1 << self.addr_bits, addr_bits=self.addr_bits,
-            table=[bits_literal(t, W) for t in self.table],
-            harmonics=self.harmonics,
-            phase_offsets=[bits_literal(p, W, False) for p in self.phase_offsets],
-            weights=[bits_literal(w, W) for w in self.weights_q],
-            rounds=[bits_literal(r, wd["prod_bits"]) for r in self.rounds],
-            levels=self.levels, nodes=self.nodes, **wd,
-        )
-        header = dict(
-            file=SEED_FILE, version=__version__, model_sha256=self.model_sha256 or "(not from a file)",
-            spec_lines=[f"{k} = {json.dumps(v)}" for k, v in self.spec_dict().items()],
-        )
-        return template("hardware/seed/templates/seed_parallel.vhd.j2").render(h=header, **ctx)
-
-    def manifest(self) -> dict:
-        return {
-            "top": "flann_top",
-            "files": [SEED_FILE],
-            "input_bits": self.input_bits,
-            "input_lsb_v": self.input_lsb_v,
-            "output_bits": self.word,
-            "output_lsb_mm": self.output_lsb_mm,
-            "latency_cycles": self.latency_cycles,
-            "cycles_per_sample": 1,
-            "generator_version": __version__,
-            "spec": self.spec_dict(),
-            "model_sha256": self.model_sha256,
-        }
-
-    def write(self, out_dir) -> dict:
-        man = self.manifest()
-        text = self.render()
-        with atomic_directory(out_dir) as tmp:
-            (Path(tmp) / SEED_FILE).write_text(text, newline="")
-            (Path(tmp) / "manifest.json").write_text(json.dumps(man, indent=2) + "\n", newline="")
-        return man
-
-
-def seed_for(model_path, **spec_options) -> SeedParallel:
-    """The seed architecture with the same ADC scaling and clamp as our design for this model."""
-    from ..hardware.fixed import render as hdlgen
-
-    spec = hdlgen.load(model_path, check_device=False, **spec_options)
-    path = Path(model_path)
-    return SeedParallel(
-        model=load_model(path), input_bits=spec.input_bits, input_lsb_v=spec.input_lsb_v,
-        clamp_lo=spec.clamp_lo, clamp_hi=spec.clamp_hi, model_sha256=model_sha256(path),
-    )
+from ..errors import FlannError
+from ..golden.model import load_model
+from ..hardware.fixed import render as hdlgen
+from ..hardware.fixed.twin import FlannTop
+from ..hardware.float18.render import render_block
+from ..hardware.manifest import write_design
+from ..hardware.seed import render as seed_render
+from ..hardware.seed.spec import derive_seed_spec
+from ..hardware.seed.twin import SeedTop
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
+from .explore_float18 import measure
+from .synth import Resources, shortfall, smallest_fit, synthesize
 
 
 # ----------------------------------------------------------------------------- design space
@@ -296,8 +63,6 @@ def _width_options(model_path, preset: str, base: dict) -> dict:
     if preset == "budget":
         return {}
     if preset == "narrow":
-        from ..hardware.fixed import render as hdlgen
-
         ref = hdlgen.load(model_path, check_device=False, **base)
         return {
             "term_frac_bits": max(4, ref.term_fmt.frac_bits - NARROW_BITS),
@@ -307,8 +72,6 @@ def _width_options(model_path, preset: str, base: dict) -> dict:
 
 
 def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: str) -> None:
-    from .synth import synthesize
-
     rep = synthesize(design_dir, device, work=work, abc=abc)
     d = rep.to_dict()
     row.luts, row.ffs, row.brams = d["luts"], d["ffs"], d["brams"]
@@ -317,16 +80,9 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
         row.note = (row.note + "; " if row.note else "") + f"{len(d['warnings'])} yosys warning(s)"
 
 
-def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles=("lut", "shiftadd"),
+def explore(model_path, device: str = DEFAULT_PART, lanes=(1, 2, 4), styles=("lut", "shiftadd"),
             widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast") -> list[Row]:
     """Generate, synthesise and score each candidate; the seed architecture last."""
-    import warnings as _w
-
-    from ..hardware.fixed import render as hdlgen
-    from ..hardware.target import parse_part
-    from ..hardware.fixed.spec import CLOCK_HZ as SPEC_CLOCK
-    from ..hardware.fixed.twin import FlannTop
-
     parse_part(device)
     rows: list[Row] = []
     combos = [(l, s, w) for w in widths for s in styles for l in lanes]
@@ -339,8 +95,8 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                       file=sys.stderr)
             try:
                 base = dict(lanes=lane, mult_style=style)
-                with _w.catch_warnings(record=True) as caught:
-                    _w.simplefilter("always")
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always")
                     opts = {**base, **_width_options(model_path, preset, base)}
                     spec = hdlgen.load(model_path, check_device=False, device=device, **opts)
                 if not spec.analysis.get("guaranteed_1lsb", True):
@@ -349,7 +105,7 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                     row.note = "; ".join(str(w.message) for w in caught)
                 err = FlannTop(spec).error_vs_float()
                 row.cycles_per_sample = spec.cycles_per_sample
-                row.samples_per_s = SPEC_CLOCK / spec.cycles_per_sample
+                row.samples_per_s = CLOCK_HZ / spec.cycles_per_sample
                 row.max_err_lsb, row.max_err_mm = err["max_err_lsb"], err["max_err_mm"]
                 row.output_lsb_mm = spec.output_lsb_mm
                 ddir = Path(tmp) / f"d{k}"
@@ -374,9 +130,7 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
     measured with the first 5, 9 and 17 terms of the model and a least-squares line per
     resource gives the figure at the full term count (stated in the row's note).
     """
-    import dataclasses
-
-    full = seed_for(model_path)
+    full = derive_seed_spec(model_path)
     rows, pts = [], []
     with tempfile.TemporaryDirectory(prefix="flann-seed-") as tmp:
         for k, n in enumerate(terms, 1):
@@ -386,14 +140,14 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
             row = Row(f"seed, first {n} terms", None, "constant", f"fixed{s.word}", cycles_per_sample=1,
                       samples_per_s=CLOCK_HZ)
             ddir = Path(tmp) / f"seed{n}"
-            s.write(ddir)
+            seed_render.write(s, ddir)
             try:
                 _measure(row, ddir, device, None, abc)
                 pts.append((n, row.luts, row.ffs, row.brams))
             except FlannError as exc:
                 row.note = str(exc)
             rows.append(row)
-    err = full.error_vs_float()
+    err = SeedTop(full).error_vs_float()
     row = Row(f"seed (paper), {full.terms} terms", None, "constant", f"fixed{full.word}", cycles_per_sample=1,
               samples_per_s=CLOCK_HZ, max_err_lsb=err["max_err_lsb"], max_err_mm=err["max_err_mm"],
               output_lsb_mm=full.output_lsb_mm)
@@ -405,9 +159,6 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
             b, a = np.polyfit(n, y, 1)
             est.append(int(round(a + b * full.terms)))
         row.luts, row.ffs, row.brams = est
-        from ..hardware.target import parse_part
-        from .synth import Resources, smallest_fit, shortfall
-
         part = parse_part(device)
         res = Resources(luts=est[0], ffs=est[1], brams=est[2], carry=0, xorcy=0, mult_and=0, muxf5=0, muxf6=0,
                         io=0)
@@ -452,11 +203,6 @@ def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | N
     seed architecture's arithmetic in float18 (N multipliers + N-1 adders, each block
     synthesised once with this flow and multiplied by its count; tables not included).
     """
-    from .explore_float18 import measure
-    from ..hardware.float18.render import render_block
-    from ..hardware.target import parse_part
-    from .synth import Resources, shortfall, smallest_fit, synthesize
-
     rows = []
     if progress:
         print("explore: float18 design (serial)", file=sys.stderr)
@@ -482,9 +228,7 @@ def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | N
                 print(f"explore: float18 {kind} block", file=sys.stderr)
             name, text = render_block(kind)
             d = Path(tmp) / kind
-            d.mkdir()
-            (d / name).write_text(text)
-            (d / "manifest.json").write_text(json.dumps({"top": name[:-4], "files": [name]}))
+            write_design({name: text}, {"top": name[:-4], "files": [name]}, d)
             rep = synthesize(d, device, abc=abc)
             per[kind] = (rep.resources.luts, rep.resources.ffs, rep.resources.brams)
     luts = n * per["mul"][0] + (n - 1) * per["add"][0]

@@ -13,13 +13,12 @@ from pathlib import Path
 
 from ..hardware.float18.render import generate
 from ..golden.model import load_model
-from ..hardware.fixed.spec import CLOCK_HZ
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 from ..analysis.trace import run_trace
+from . import synth
 
 
-def measure(model_path, device: str = "xc2s200-pq208-5", **options) -> dict:
-    from . import synth
-
+def measure(model_path, device: str = DEFAULT_PART, **options) -> dict:
     with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:
         man = generate(model_path, Path(tmp) / "float18", **options)
         rep = synth.synthesize(Path(tmp) / "float18", device, progress=False).to_dict()

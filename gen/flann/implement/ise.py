@@ -30,11 +30,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from ..hardware.target import Part, parse_part
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART, Part, parse_part
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
-from .synth import read_manifest
+from ..hardware.manifest import read_manifest
 
 CLOCK_PIN = "P77"  # GCK1
 RESET_PIN = "P57"
@@ -128,7 +128,7 @@ def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
     return rows
 
 
-def write_ise(directory, device: str = "xc2s200-pq208-5", out_dir="ise", clock_mhz: float = 50.0) -> list[str]:
+def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6) -> list[str]:
     """Write the ISE 10.1 handoff for a generated design; returns the files written."""
     part = parse_part(device)
     man = read_manifest(directory)

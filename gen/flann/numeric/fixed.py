@@ -14,7 +14,6 @@ the bit-true twin and the benches, so all three do the same integer arithmetic.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -58,14 +57,6 @@ class FixedFormat:
     def max_int(self) -> int:
         return (1 << (self.width - 1)) - 1 if self.signed else (1 << self.width) - 1
 
-    @property
-    def min_value(self) -> float:
-        return self.min_int * self.lsb
-
-    @property
-    def max_value(self) -> float:
-        return self.max_int * self.lsb
-
     def fits(self, ints) -> bool:
         a = np.asarray(ints)
         return bool(a.size == 0 or (a.min() >= self.min_int and a.max() <= self.max_int))
@@ -83,14 +74,19 @@ class FixedFormat:
             return np.clip(a, self.min_int, self.max_int)
         return wrap(a, self.width, self.signed)
 
+    def round_from(self, ints, frac_bits: int) -> np.ndarray:
+        """Integers with ``frac_bits`` fraction bits -> this format's fraction bits, by its
+        rounding (as the VHDL does: add half an LSB, shift); range is not touched."""
+        return round_shift(ints, frac_bits - self.frac_bits, self.rounding)
+
+    def saturate(self, ints) -> tuple[np.ndarray, np.ndarray]:
+        """Clip to this format's range; returns (clipped, saturated flag)."""
+        return saturate(ints, self.width, self.signed)
+
     def to_float(self, ints) -> np.ndarray:
         return np.asarray(ints, dtype=float) * self.lsb
 
     # -- text ---------------------------------------------------------------------------
-    def vhdl_type(self) -> str:
-        kind = "signed" if self.signed else "unsigned"
-        return f"{kind}({self.width - 1} downto 0)"
-
     def literal(self, value: int) -> str:
         """VHDL bit-string literal of ``value`` (checked to fit)."""
         return bits_literal(value, self.width, self.signed)
@@ -155,9 +151,5 @@ def bits_literal(value: int, width: int, signed: bool = True) -> str:
     return '"' + format(value & ((1 << width) - 1), f"0{width}b") + '"'
 
 
-def ceil_log2(x: float) -> int:
-    return int(math.ceil(math.log2(x))) if x > 0 else 0
-
-
 __all__ = ["FixedFormat", "bits_needed", "wrap", "round_shift", "saturate", "bits_literal",
-           "ceil_log2", "ROUNDING", "OVERFLOW"]
+           "ROUNDING", "OVERFLOW"]

@@ -50,20 +50,10 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..errors import SensorError
+from .effect_params import SPECS, Param, validate_effects  # noqa: F401 (re-exported)
+from .lvdt import inductances_h
 
 STAGES = ("position", "transformer", "output")
-
-
-@dataclass(frozen=True)
-class Param:
-    name: str          # key in the sensor file, ends with its unit
-    unit: str
-    default: float     # a typical size (used by with_effect and examples)
-    neutral: float     # value at which the effect does nothing
-    lower: float
-    upper: float
-    description: str
 
 
 @dataclass(frozen=True)
@@ -162,69 +152,14 @@ def _clipping(p, ctx, sig):
     return _rep(sig, output_v=np.clip(sig.output_v, -p["rail_v"], p["rail_v"]))
 
 
-_I = math.inf
+_APPLY = {"null_offset": _null_offset, "quadrature_null": _quadrature, "zero_shift": _zero_shift,
+          "secondary_imbalance": _imbalance, "backlash": _backlash, "thermal_drift": _thermal,
+          "adc_clipping": _clipping, "leadscrew_periodic": _leadscrew,
+          "secondary_loading": _loading}
 EFFECTS: dict[str, Effect] = {
-    e.name: e for e in (
-        Effect("null_offset", "output",
-               "electrical offset at null: in-phase residual or amplifier/demodulator DC offset",
-               "y += offset_v",
-               (Param("offset_v", "V", 0.01, 0.0, -1e3, 1e3, "output offset"),),
-               _null_offset),
-        Effect("quadrature_null", "transformer",
-               "quadrature/harmonic null residual (capacitive coupling, phase mismatch) that an "
-               "amplitude detector adds in quadrature; a phase-sensitive detector rejects it",
-               "amplitude detector: y = sqrt(y0^2 + quadrature_v^2); phase-sensitive: y = y0",
-               (Param("quadrature_v", "V", 0.02, 0.0, 0.0, 1e3,
-                      "output-referred quadrature residual at null"),),
-               _quadrature),
-        Effect("zero_shift", "position",
-               "mechanical null not at zero displacement (core or actuator origin offset)",
-               "core = x - shift_mm",
-               (Param("shift_mm", "mm", 0.5, 0.0, -1e3, 1e3, "displacement at which the core is centred"),),
-               _zero_shift),
-        Effect("secondary_imbalance", "transformer",
-               "unequal secondary coupling (turns or position mismatch) leaves part of the "
-               "common-mode secondary voltage in the output",
-               "v1 *= 1 + e/2, v2 *= 1 - e/2",
-               (Param("imbalance_fraction", "1", 0.01, 0.0, -0.99, 0.99,
-                      "relative coupling mismatch e of secondary 1 over secondary 2"),),
-               _imbalance),
-        Effect("backlash", "position",
-               "lost motion of the actuator: the core lags behind the commanded position "
-               "against the direction of travel",
-               "core = x - direction * deadband_mm / 2",
-               (Param("deadband_mm", "mm", 0.2, 0.0, 0.0, 1e3, "full dead band"),),
-               _backlash),
-        Effect("thermal_drift", "transformer",
-               "sensitivity changes with temperature, e.g. the primary's copper resistance "
-               "(+0.39 %/degC) lowering the excitation current",
-               "primary current *= 1 + coefficient_per_c * (T - reference_temperature_c)",
-               (Param("coefficient_per_c", "1/degC", -0.001, 0.0, -0.5, 0.5,
-                      "relative sensitivity change per degC"),
-                Param("reference_temperature_c", "degC", 20.0, 20.0, -273.15, 1e3,
-                      "temperature at which the sensitivity is nominal")),
-               _thermal),
-        Effect("adc_clipping", "output",
-               "converter or amplifier rails: the output saturates at +-rail_v",
-               "y = clip(y, -rail_v, rail_v)",
-               (Param("rail_v", "V", 5.0, _I, 1e-9, _I, "rail (saturation) voltage"),),
-               _clipping),
-        Effect("leadscrew_periodic", "position",
-               "periodic position error of the actuator's lead screw (thread pitch, "
-               "eccentricity): the core is displaced sinusoidally in the commanded position",
-               "core = x + amplitude_mm * sin(2 pi x / period_mm + phase_rad)",
-               (Param("amplitude_mm", "mm", 0.05, 0.0, -1e3, 1e3, "position error amplitude"),
-                Param("period_mm", "mm", 2.54, 2.54, 1e-6, 1e6,
-                      "period (lead of the screw; 2.54 mm = 10 threads per inch)"),
-                Param("phase_rad", "rad", 0.0, 0.0, -1e3, 1e3, "phase at x = 0")),
-               _leadscrew),
-        Effect("secondary_loading", "transformer",
-               "finite load resistance on the series-opposed secondaries: their "
-               "position-dependent inductance and resistance divide the e.m.f. (gain and phase)",
-               "v_d *= R_L / (R_L + 2 R_s + j w L_loop(core))",
-               (Param("load_ohm", "ohm", 100e3, _I, 1e-3, _I, "load resistance"),),
-               _loading),
-    )
+    spec.name: Effect(spec.name, spec.stage, spec.description, spec.formula, spec.params,
+                      _APPLY[spec.name])
+    for spec in SPECS.values()
 }
 
 
@@ -236,8 +171,6 @@ def thermal_coefficient_from_copper(sensor, alpha_per_c: float = COPPER_TEMPCO_P
     with ``Ip = V / Z``, ``Z = R_p + j w Lp`` and ``R_p(T) = R_p (1 + alpha dT)``,
     ``d ln|Ip| / dT = -alpha R_p Re(Z) / |Z|^2`` (= ``-alpha R_p^2 / |Z|^2`` for a lossless core).  A physical starting value for
     ``thermal_drift.coefficient_per_c`` (core permeability and secondary loading add more)."""
-    from .lvdt import inductances_h
-
     lp = complex(inductances_h(sensor, [0.0])[2][0])   # complex with core eddy losses
     r = sensor.primary_resistance_ohm
     z = r + 1j * sensor.omega_rad_s * lp
@@ -245,23 +178,3 @@ def thermal_coefficient_from_copper(sensor, alpha_per_c: float = COPPER_TEMPCO_P
     return float(-alpha_per_c * r * z.real / abs(z) ** 2)
 
 
-def validate_effects(effects: Mapping[str, Mapping[str, float]], source: str = "<memory>") -> None:
-    """Raise SensorError for an unknown effect, a missing/unknown parameter or a value
-    outside the parameter's physical range."""
-    for name, params in effects.items():
-        if name not in EFFECTS:
-            raise SensorError(f"{source}: unknown effect '{name}' (known: {', '.join(EFFECTS)})")
-        eff = EFFECTS[name]
-        for key in params:
-            if key not in eff.param_names:
-                raise SensorError(f"{source}: effects.{name}.{key}: unknown parameter "
-                                  f"(allowed: {', '.join(eff.param_names)})")
-        for p in eff.params:
-            if p.name not in params:
-                raise SensorError(f"{source}: effects.{name}.{p.name} missing")
-            v = params[p.name]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v):
-                raise SensorError(f"{source}: effects.{name}.{p.name} must be a number, got {v!r}")
-            if not p.lower <= v <= p.upper:
-                raise SensorError(f"{source}: effects.{name}.{p.name} = {v:g} out of range "
-                                  f"[{p.lower:g}, {p.upper:g}] {p.unit}")

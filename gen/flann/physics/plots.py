@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 
 from ..recordings import Recordings  # noqa: E402
 from .fit import FitResult  # noqa: E402
-from .lvdt import ideal_output_v  # noqa: E402
+from .lvdt import coupling_table, flux_profile, ideal_output_v  # noqa: E402
 from .sensor import Sensor  # noqa: E402
 from .simulate import contributions_v  # noqa: E402
 
@@ -104,7 +104,6 @@ def plot_fit(rec: Recordings, fit: FitResult, path: str | Path) -> None:
 def plot_anatomy(s: Sensor, path: str | Path) -> None:
     """Top: axial flux along the bore for a few core positions, windings shaded.
     Bottom: mutual inductances and the ideal output versus core position."""
-    from .lvdt import coupling_table, flux_profile
 
     a1 = s.primary_length_mm / 2
     a2 = a1 + s.secondary_gap_mm

@@ -75,6 +75,7 @@ from types import MappingProxyType
 from typing import Any, Mapping
 
 from ..errors import SensorError
+from .effect_params import SPECS, validate_effects
 
 FORMAT = "flann-sensor/1"
 DEMODULATORS = ("phase_sensitive", "amplitude")
@@ -186,11 +187,9 @@ class Sensor:
 
     def with_effect(self, name: str, **params: float) -> "Sensor":
         """Copy with effect ``name`` enabled (defaults for parameters not given)."""
-        from .effects import EFFECTS  # local: effects imports this module
-
-        if name not in EFFECTS:
-            raise SensorError(f"unknown effect '{name}' (known: {', '.join(EFFECTS)})")
-        merged = {**EFFECTS[name].defaults(), **params}
+        if name not in SPECS:
+            raise SensorError(f"unknown effect '{name}' (known: {', '.join(SPECS)})")
+        merged = {**SPECS[name].defaults(), **params}
         return self.replace(effects={**self.effects, name: merged})
 
     @property
@@ -264,8 +263,6 @@ def _validate(s: Sensor) -> None:
     if not s.coil_outer_diameter_mm < s.housing_inner_diameter_mm:
         raise _bad(src, f"coil.outer_diameter_mm = {s.coil_outer_diameter_mm:g} must be < "
                         f"coil.housing_inner_diameter_mm = {s.housing_inner_diameter_mm:g}")
-    from .effects import validate_effects  # local: effects imports this module
-
     validate_effects(s.effects, src)
 
 
@@ -329,12 +326,10 @@ def sensor_from_dict(doc: Mapping[str, Any], source: str = "<memory>") -> Sensor
             if not _has_unit(pkey):
                 raise _bad(source, f"effects.{name}.{pkey}: key has no unit suffix "
                                    f"(one of {', '.join(UNIT_SUFFIXES)})")
-    from .effects import EFFECTS
-
     filled = {}
     for name, params in effects.items():
-        if name in EFFECTS:
-            filled[name] = {**EFFECTS[name].defaults(), **params}
+        if name in SPECS:
+            filled[name] = {**SPECS[name].defaults(), **params}
         else:
             filled[name] = dict(params)  # validate_effects names the unknown effect
     values["effects"] = filled

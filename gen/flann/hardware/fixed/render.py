@@ -12,11 +12,12 @@ import json
 from pathlib import Path
 
 from ... import __version__
-from ...errors import FlannError, SpecError
-from ...fileio import atomic_directory
+from ...errors import SpecError
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..manifest import MANIFEST, read_manifest, write_design
+from ..options import GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
@@ -28,7 +29,6 @@ ENTITIES = (
     ("flann_adder", "accumulation, rounding, saturation"),
     ("flann_top", "FLANN LVDT compensator, top level"),
 )
-MANIFEST = "manifest.json"
 
 
 
@@ -46,7 +46,6 @@ def contexts(spec: Spec) -> dict[str, dict]:
     s = spec
     B, P, L = s.input_bits, s.phase_bits, s.lanes
     A = s.table_addr_bits
-    D = P - 2 - A
     T, W = s.term_fmt.width, s.weight_fmt.width
     Wp = s.product_fmt.width
     lin_bits = s.lin_fmt.width
@@ -59,42 +58,36 @@ def contexts(spec: Spec) -> dict[str, dict]:
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
         ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
         nk1=bits_literal(-s.k1, s.lin_width),
-        kb=bits_literal((s.kb + (1 << (s.norm_guard - 1))) % (1 << NV), NV, False),
-        k1=bits_literal(s.k1, s.lin_width), k0=bits_literal(s.k0 + (1 << (s.lin_guard - 1)), s.lin_width),
+        kb=bits_literal(s.kb_rounded, NV, False),
+        k1=bits_literal(s.k1, s.lin_width), k0=bits_literal(s.k0_rounded, s.lin_width),
     )
     de, do = s.delta_steps
     starts = [s.lane_start(l) for l in range(L)]
-    slope_bits = s.slope_fmt.width if s.interp else 1
-    # shift-add designs have adv_period - 1 idle cycles per step: form offset x slope serially
-    # (one cycle copies the slope out of the ROM register, the rest iterate)
-    serial_interp = s.interp and s.mult_style == "shiftadd" and s.adv_period >= 3
-    kx = -(-slope_bits // (s.adv_period - 2)) if serial_interp else 1
-    slope_reg = -(-slope_bits // kx) * kx if serial_interp else slope_bits
+    slope_bits, kx, slope_reg = s.slope_rom_bits, s.interp_digit, s.slope_reg_bits
     icnt_bits = _ubits(slope_reg // kx + 1)
     expansion = dict(
         common, delta_even=de, delta_odd=do, lanes_odd=(L % 2 == 1),
         mult_bits=_ubits(max([de, do, *starts])),
         start_mults=", ".join(f"{l} => {x}" for l, x in enumerate(starts)),
-        start_par='"' + "".join(str(l % 2) for l in range(L)) + '"',
+        start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
         quarter=bits_literal(1 << (P - 2), P, False),
-        table_depth=1 << A, addr_bits=A, offset_bits=D, dq_bits=s.dq_bits,
+        table_depth=1 << A, addr_bits=A, offset_bits=s.offset_bits, dq_bits=s.dq_bits,
         value_bits=s.value_fmt.width, slope_bits=slope_bits, interp=s.interp,
-        serial_interp=serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
+        serial_interp=s.serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
         interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
-        prod_bits=(s.dq_bits + 1 + slope_reg) if serial_interp else (s.dq_bits + slope_bits + 1),
+        prod_bits=s.interp_prod_bits,
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
-        value_words=[bits_literal(v, s.value_fmt.width, False) for v in s.value_rom],
-        slope_words=[bits_literal(v, slope_bits, False) for v in s.slope_rom] if s.interp else [],
+        value_words=[s.value_fmt.literal(v) for v in s.value_rom],
+        slope_words=[s.slope_fmt.literal(v) for v in s.slope_rom] if s.interp else [],
     )
     step_bits = _ubits(max(1, s.steps - 1))
     depth = 1 << step_bits
-    words = [[bits_literal(w, W) for w in lane] + [bits_literal(0, W)] * (depth - len(lane))
+    words = [[s.weight_fmt.literal(w) for w in lane] + [s.weight_fmt.literal(0)] * (depth - len(lane))
              for lane in s.weight_rom]
-    K = s.mult_digit_bits if s.mult_style == "shiftadd" else 1
-    WX = -(-W // K) * K  # weight register, sign-extended to whole digits
+    K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, style=s.mult_style, weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, style=s.mult_style, fragments=f"hardware/fixed/templates/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
@@ -127,7 +120,7 @@ def render(spec: Spec) -> dict[str, str]:
     ctx = contexts(spec)
     out = {}
     for name, title in ENTITIES:
-        header = dict(file=f"{name}.vhd", title=title, version=__version__,
+        header = dict(file=f"{name}.vhd", title=title, command="flann gen", version=__version__,
                       model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
         out[f"{name}.vhd"] = template(f"hardware/fixed/templates/{name}.vhd.j2").render(h=header, **ctx[name])
     return out
@@ -151,21 +144,21 @@ def manifest(spec: Spec, files: list[str]) -> dict:
     }
 
 
-def load(model_path_or_model, **options) -> Spec:
+def load(model_path_or_model, options: GenOptions | None = None, **overrides) -> Spec:
     """Spec from a model file path (sha256 of its bytes is stamped) or a FlannModel."""
     if isinstance(model_path_or_model, FlannModel):
-        return derive_spec(model_path_or_model, **options)
+        return derive_spec(model_path_or_model, options, **overrides)
     path = Path(model_path_or_model)
     model = load_model(path)
-    return derive_spec(model, model_sha256=model_sha256(path), **options)
+    return derive_spec(model, options, model_sha256=model_sha256(path), **overrides)
 
 
-def generate(model_path_or_model, out_dir, **options) -> dict:
+def generate(model_path_or_model, out_dir, options: GenOptions | None = None, **overrides) -> dict:
     """Derive the spec, render every entity and write them plus manifest.json atomically.
 
     Returns the manifest dict.  Nothing is written if any step fails.
     """
-    spec = load(model_path_or_model, **options)
+    spec = load(model_path_or_model, options, **overrides)
     return write(spec, out_dir)
 
 
@@ -174,28 +167,6 @@ def write(spec: Spec, out_dir) -> dict:
     return write_design(texts, manifest(spec, list(texts)), out_dir)
 
 
-def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
-    """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir) as tmp:
-        for name, text in texts.items():
-            (tmp / name).write_text(text, newline="")
-        (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
-    return man
-
-
-def read_manifest(out_dir) -> dict:
-    path = Path(out_dir) / MANIFEST
-    try:
-        return json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FlannError(f"{path}: no such file (run `flann gen` first)") from None
-    except json.JSONDecodeError as exc:
-        raise FlannError(f"{path}: not valid JSON ({exc.msg})") from None
-
-
 __all__ = ["generate", "write", "render", "contexts", "manifest", "load", "read_manifest", "TOP",
-           "ENTITIES", "MANIFEST"]
+           "ENTITIES", "MANIFEST", "write_design"]
 

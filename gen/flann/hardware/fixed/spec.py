@@ -31,12 +31,11 @@ from .. import target as spartan2
 from ...errors import SpecError
 from ...numeric.fixed import FixedFormat, bits_needed
 from ...golden.model import FlannModel, term_kind
+from ..options import MULT_STYLES, GenOptions
 
-MULT_STYLES = ("lut", "shiftadd")
-
-# Device data (luts, brams, packages) come from the one Spartan-II table, flann.hardware.target.
+# Device data (luts, brams, packages) and the clock come from flann.hardware.target.
 BRAM_BITS = spartan2.BRAM_BITS
-CLOCK_HZ = 50e6
+CLOCK_HZ = spartan2.CLOCK_HZ
 
 # Share of the 0.5-LSB pre-rounding budget given to each error source.
 BUDGET = {"phase": 0.15, "table": 0.20, "weights": 0.07, "products": 0.03, "linear": 0.02}
@@ -46,6 +45,11 @@ def parse_device(device: str) -> tuple[str, str, str]:
     """'xc2s200-pq208-5' -> ('xc2s200', 'pq208', '5'); SpecError if not an orderable part."""
     part = spartan2.parse_part(str(device))
     return part.device.name, part.package, part.speed
+
+
+def _offset_bits(phase_bits: int, table_addr_bits: int) -> int:
+    # phase = 2 quadrant bits, table address, offset inside the bin
+    return phase_bits - 2 - table_addr_bits
 
 
 def nice_125(x: float, up: bool) -> float:
@@ -139,15 +143,73 @@ class Spec:
     def phase_frac_bits(self) -> int:
         return self.phase_bits - 1
 
+    # -- term order: hardware trig term j is model term j + 1 (golden.model.term_kind) ---
+    @staticmethod
+    def trig_term(j: int) -> tuple[str, int]:
+        """('sin'|'cos', harmonic m) of hardware trig term j (lane j % lanes, step j // lanes)."""
+        return term_kind(j + 1)
+
     @property
     def delta_steps(self) -> tuple[int, int]:
         """Harmonic increase of one lane per step when its term index j is (even, odd)."""
         L = self.lanes
-        return ((L // 2, L // 2) if L % 2 == 0 else ((L - 1) // 2, (L + 1) // 2))
+        return tuple(self.trig_term(j + L)[1] - self.trig_term(j)[1] for j in (0, 1))
 
     def lane_start(self, lane: int) -> int:
         """Harmonic of lane ``lane``'s first term (j = lane)."""
-        return lane // 2 + 1
+        return self.trig_term(lane)[1]
+
+    # -- expansion architecture ---------------------------------------------------------
+    @property
+    def offset_bits(self) -> int:
+        """D: phase bits below the table address (offset inside a table bin)."""
+        return _offset_bits(self.phase_bits, self.table_addr_bits)
+
+    @property
+    def slope_rom_bits(self) -> int:
+        return self.slope_fmt.width if self.interp else 1
+
+    @property
+    def serial_interp(self) -> bool:
+        """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope
+        product is formed serially then (one cycle copies the slope, the rest iterate)."""
+        return self.interp and self.mult_style == "shiftadd" and self.adv_period >= 3
+
+    @property
+    def interp_digit(self) -> int:
+        """Slope bits per cycle of the serial offset x slope product."""
+        return -(-self.slope_rom_bits // (self.adv_period - 2)) if self.serial_interp else 1
+
+    @property
+    def slope_reg_bits(self) -> int:
+        """Slope register, padded to whole digits of the serial product."""
+        kx = self.interp_digit
+        return -(-self.slope_rom_bits // kx) * kx if self.serial_interp else self.slope_rom_bits
+
+    @property
+    def interp_prod_bits(self) -> int:
+        return self.dq_bits + 1 + self.slope_reg_bits if self.serial_interp else self.dq_bits + self.slope_rom_bits + 1
+
+    # -- constants with the rounding half-LSB folded in (the VHDL adds them, then shifts) --
+    @property
+    def kb_rounded(self) -> int:
+        return (self.kb + (1 << (self.norm_guard - 1))) % (1 << (self.phase_bits + self.norm_guard))
+
+    @property
+    def k0_rounded(self) -> int:
+        return self.k0 + (1 << (self.lin_guard - 1))
+
+    # -- multiplier architecture ----------------------------------------------------------
+    @property
+    def mult_digits(self) -> int:
+        """Weight bits per cycle: shift-add's digit, 1 for the inferred multiplier."""
+        return self.mult_digit_bits if self.mult_style == "shiftadd" else 1
+
+    @property
+    def weight_reg_bits(self) -> int:
+        """Weight register, sign-extended to whole digits (shift-add)."""
+        W, K = self.weight_fmt.width, self.mult_digits
+        return -(-W // K) * K
 
     @property
     def pipeline_advs(self) -> int:
@@ -215,10 +277,11 @@ def _check_int(name: str, value, lo: int, hi: int, derived: str = "") -> int:
     return int(value)
 
 
-def _table(A: int, Tf: int, Dq: int, Gs: int, interp: bool):
+def _table(A: int, value_fmt: FixedFormat, Dq: int, Gs: int, interp: bool):
+    Tf = value_fmt.frac_bits
     k = np.arange(1 << A)
     mid = (k + 0.5) / (1 << A) * (math.pi / 2)
-    value = np.floor(np.sin(mid) * 2.0 ** Tf + 0.5).astype(np.int64)
+    value = value_fmt.quantize(np.sin(mid))
     if interp:
         slope = np.floor((math.pi / 2) * np.cos(mid) * 2.0 ** (Tf - A - Dq + Gs) + 0.5).astype(np.int64)
     else:
@@ -228,27 +291,23 @@ def _table(A: int, Tf: int, Dq: int, Gs: int, interp: bool):
 
 def derive_spec(
     model: FlannModel,
+    options: GenOptions | None = None,
     *,
     model_sha256: str = "",
-    device: str = "xc2s200-pq208-5",
-    input_bits: int = 12,
-    input_lsb_v: float | None = None,
-    clamp: bool = True,
-    output_bits: int | None = None,
-    output_lsb_mm: float | None = None,
-    lanes: int = 1,
-    mult_style: str = "shiftadd",
-    mult_digit_bits: int = 2,
-    interp: bool = True,
-    phase_bits: int | None = None,
-    table_addr_bits: int | None = None,
-    term_frac_bits: int | None = None,
-    weight_frac_bits: int | None = None,
-    product_frac_bits: int | None = None,
     number_format: str = "fixed",
     check_device: bool = True,
+    **overrides,
 ) -> Spec:
-    """Validate options, size every signal by the error budget, compute every constant."""
+    """Validate options, size every signal by the error budget, compute every constant.
+
+    ``options`` (default: :class:`GenOptions`'s defaults) with ``overrides`` by keyword.
+    """
+    o = GenOptions.of(options, **overrides)
+    device, input_bits, input_lsb_v, clamp = o.device, o.input_bits, o.input_lsb_v, o.clamp
+    output_bits, output_lsb_mm, lanes = o.output_bits, o.output_lsb_mm, o.lanes
+    mult_style, mult_digit_bits, interp = o.mult_style, o.mult_digit_bits, o.interp
+    phase_bits, table_addr_bits, term_frac_bits = o.phase_bits, o.table_addr_bits, o.term_frac_bits
+    weight_frac_bits, product_frac_bits = o.weight_frac_bits, o.product_frac_bits
     if not isinstance(model, FlannModel):
         raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
     if number_format != "fixed":
@@ -342,15 +401,15 @@ def derive_spec(
     A = _check_int("table_addr_bits", table_addr_bits, 2, 16)
     if A > P - 3:
         raise SpecError(f"table_addr_bits = {A}: must be <= phase_bits - 3 = {P - 3}")
-    D = P - 2 - A
+    D = _offset_bits(P, A)
     if interp:
         # offset truncation (pi/2) 2^-(A+Dq) <= e_t/8 ; slope rounding 2^(Dq-2-Gs-Tf) <= e_t/8
         Dq = min(D + 1, max(2, math.ceil(math.log2(math.pi / 2 * 8 / e_t)) - A))
         Gs = max(0, math.ceil(Dq - 2 - Tf - math.log2(e_t / 8)))
     else:
         Dq, Gs = D + 1, 0
-    value_rom, slope_rom = _table(A, Tf, Dq, Gs, interp)
     value_fmt = FixedFormat(Tf + 1, 1, signed=False)
+    value_rom, slope_rom = _table(A, value_fmt, Dq, Gs, interp)
     slope_fmt = FixedFormat(max(1, bits_needed(0, int(slope_rom.max()), signed=False)), 0, signed=False)
     corr_max = (int(slope_rom.max()) << (Dq - 1)) >> Gs if interp else 0
     term_max = int(value_rom.max()) + corr_max + 1
@@ -462,8 +521,7 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
             "table": f"{1 << A} x ({spec.value_fmt.width}+{spec.slope_fmt.width if spec.interp else 0}) bits "
                      f"= {rom_bits} ROM bits per lane; one address bit less x4 interpolation residual",
             "interp": (f"slope product {Dq}x{spec.slope_fmt.width} per lane, "
-                       + ("serial between advances" if spec.mult_style == "shiftadd" and spec.adv_period >= 3
-                          else "array multiplier"))
+                       + ("serial between advances" if spec.serial_interp else "array multiplier"))
                       if spec.interp else "off: table step error dominates",
             "weights": f"{spec.weight_fmt.width}-bit weights, {wrom_bits} ROM bits per lane",
             "multiplier": f"{spec.term_fmt.width}x{spec.weight_fmt.width} {spec.mult_style}, "
@@ -483,7 +541,7 @@ def estimate_resources(spec: Spec) -> dict:
     T, W = spec.term_fmt.width, spec.weight_fmt.width
     P, A = spec.phase_bits, spec.table_addr_bits
     C, Dq = spec.slope_fmt.width, spec.dq_bits
-    serial = spec.mult_style == "shiftadd" and spec.adv_period >= 3
+    serial = spec.serial_interp
     mult = 5.3 * T * W if spec.mult_style == "lut" else 5.5 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1)
     # slope correction: array multiplier, or serial between advances (shift-add designs)
     interp = 0 if not spec.interp else (6.3 * (Dq + C) if serial else 4.6 * Dq * (C + 1))

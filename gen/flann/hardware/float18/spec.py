@@ -32,6 +32,11 @@ from ...errors import SpecError
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
 from ...golden.model import FlannModel
 from ..fixed.spec import Spec, derive_spec
+from ..options import GenOptions
+from ..twin import TopOut
+
+TOP = "flann_f18_top"
+CVT = "flann_f18_cvt"
 from ..fixed.twin import FlannExpansion, FlannNorm
 
 # options of the fixed-point spec that the float18 datapath shares (input stage, expansion);
@@ -39,6 +44,15 @@ from ..fixed.twin import FlannExpansion, FlannNorm
 # belongs to the fixed datapath only
 FRONT_END_OPTIONS = ("device", "input_bits", "input_lsb_v", "clamp", "phase_bits", "table_addr_bits",
                      "interp", "term_frac_bits", "model_sha256", "check_device", "lanes")
+
+
+def float18_options(options: GenOptions, fixed_too: bool = False) -> dict:
+    """Generator options for the float18 design.  Fixed-only options left at their defaults
+    are dropped; given explicitly they are kept, so that the spec rejects them with a clear
+    message, unless ``fixed_too`` (a comparison where they are meant for the fixed design)."""
+    changed = options.changed()
+    return {k: v for k, v in options.to_kwargs().items()
+            if k in FRONT_END_OPTIONS or (k in changed and not fixed_too)}
 
 
 @dataclass(frozen=True)
@@ -72,6 +86,25 @@ class F18Spec:
     @property
     def code_max(self) -> int:
         return self.base.code_max
+
+    @property
+    def n_advs(self) -> int:
+        """Expansion advances: one per trig term, plus 3 to bring the first term out."""
+        return self.base.steps + 3
+
+    @property
+    def latency_cycles(self) -> int:
+        """Accepting edge to the edge that raises out_valid (checked by the top-level bench)."""
+        norm = self.base.input_bits + 2   # flann_norm: accept -> out_valid, serial over the code bits
+        # advance k is 1 + k * period edges after norm_valid; the last term is captured at
+        # advance n_advs - 1, then converter (1) + multiplier + adder; then the sum register
+        # and count (1), st_drain -> st_fin (1), the output register (1)
+        last_capture = 1 + (self.n_advs - 1) * self.adv_period
+        return norm + last_capture + 1 + F18Mul.latency + F18Add.latency + 3
+
+    @property
+    def cycles_per_sample(self) -> int:
+        return self.latency_cycles + 1
 
     def golden_weights(self) -> np.ndarray:
         """Exact (float64) constants the float18 ROM approximates, same order and scaling."""
@@ -143,6 +176,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
 class F18Cvt:
     """Twin of ``flann_f18_cvt``: signed fixed (``frac_bits`` fraction bits) -> float18, RNE."""
 
+    entity = CVT
     latency = 1
 
     def __init__(self, frac_bits: int, fmt: FloatFormat = FLOAT18):
@@ -174,8 +208,11 @@ class F18Trace:
 class F18Top:
     """Twin of ``flann_f18_top``: out_data (float18 code) and out_sat for each input code."""
 
+    entity = TOP
+
     def __init__(self, spec: F18Spec):
         self.spec = spec
+        self.latency = spec.latency_cycles
         self.norm = FlannNorm(spec.base)
         self.expansion = FlannExpansion(spec.base)
         self.cvt = F18Cvt(spec.term_frac_bits, spec.fmt)
@@ -186,9 +223,9 @@ class F18Top:
         fmt = self.fmt
         codes = np.asarray(codes, dtype=np.int64)
         n = self.norm.process(codes)
-        e = self.expansion.process(n["theta"])
-        trig = e["terms"].reshape(codes.size, -1)[:, : s.terms - 1]
-        fixed = np.concatenate([n["code"][:, None], trig], axis=1)
+        e = self.expansion.process(n.out_theta)
+        trig = e.out_terms.reshape(codes.size, -1)[:, : s.terms - 1]
+        fixed = np.concatenate([n.code[:, None], trig], axis=1)
         terms = self.cvt.compute_array(fixed)
         w = np.asarray(s.weight_codes, dtype=np.int64)[None, :]
         products = fmt.mul_array(terms, np.broadcast_to(w, terms.shape))
@@ -198,19 +235,19 @@ class F18Top:
             acc = fmt.add_array(acc, products[:, i])
             running[:, i] = acc
         out = running[:, -1]
-        sat = n["sat"] | ((out & fmt.max_code) == fmt.max_code)
-        return F18Trace(codes=codes, code=n["code"], sat_in=n["sat"], fixed_terms=fixed, terms=terms,
+        sat = n.out_sat | ((out & fmt.max_code) == fmt.max_code)
+        return F18Trace(codes=codes, code=n.code, sat_in=n.out_sat, fixed_terms=fixed, terms=terms,
                         products=products, running=running, out=out, sat=sat)
 
-    def process(self, codes) -> tuple[np.ndarray, np.ndarray]:
+    def process(self, codes) -> TopOut:
         t = self.trace(codes)
-        return t.out, t.sat
+        return TopOut(out_data=t.out, out_sat=t.sat)
 
     def out_mm(self, codes) -> np.ndarray:
-        return self.fmt.decode_array(self.process(codes)[0])
+        return self.fmt.decode_array(self.process(codes).out_data)
 
     def all_codes(self) -> np.ndarray:
         return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
 
 
-__all__ = ["F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]
+__all__ = ["float18_options", "FRONT_END_OPTIONS", "F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]

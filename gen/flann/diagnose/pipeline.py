@@ -1,0 +1,365 @@
+"""The diagnosis, step by step: shape checks, rails, calibration, shape term, noise,
+outliers, effect selection, located mismatch (see docs/diagnose.md)."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RecordingsError
+from ..physics.effects import EFFECTS
+from ..physics.sensor import default_sensor
+from ..recordings import Recordings, monotonic_span
+from . import data as D
+from .calibrate import calibrate, initial_origin
+from .explain import explain
+from .model import Data, OddBasis, PhysicsFamily
+from .select import Fit, forward_select, make_folds
+
+# candidate numbers of smooth shape terms (chosen by cross-validation)
+SHAPE_TERMS = (0, 2, 3, 4, 6)
+# the travel is "centred on 0 mm" when |min + max| <= this fraction of the span
+CENTRED = 0.1
+
+
+@dataclass
+class EffectReport:
+    name: str
+    explanation: str
+    params: dict
+    rms_v_after: float
+    delta_bic: float
+    cv_t: float
+    alternatives: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Diagnosis:
+    source: str
+    n: int
+    n_used: int
+    passes_text: str
+    calibration_text: str
+    notes: list[str]
+    baseline_rms: float
+    baseline_params: dict
+    noise_v: float
+    regions: list[dict]
+    time_spans: list[tuple[float, float, float]]
+    time_unit: str
+    outliers: list[dict]
+    effects: list[EffectReport]
+    final_rms: float
+    untestable: dict[str, str]
+    shape_description: dict = field(default_factory=dict)
+    noise_method: str = ""
+    noise_regions: list = field(default_factory=list)
+    ideal_rms: float = math.nan
+    # for the plot (kept points only)
+    x: np.ndarray = field(repr=False, default=None)
+    direction: np.ndarray | None = field(repr=False, default=None)
+    resid_before: np.ndarray = field(repr=False, default=None)
+    resid_after: np.ndarray = field(repr=False, default=None)
+    outlier_mask: np.ndarray = field(repr=False, default=None)
+    trials: list = field(repr=False, default_factory=list)
+    final_fit: Fit | None = field(repr=False, default=None)
+    family: PhysicsFamily | None = field(repr=False, default=None)
+    fit_idx: np.ndarray | None = field(repr=False, default=None)
+
+    @property
+    def named(self) -> list[str]:
+        return [e.name for e in self.effects]
+
+    @property
+    def improvement(self) -> float:
+        return self.baseline_rms / self.final_rms if self.final_rms > 0 else math.inf
+
+
+def _param(value, stderr, unit) -> dict:
+    se = float(stderr)
+    return {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
+
+
+def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
+    """Calibrate the ideal simulation to ``rec``, locate the mismatch, name missing physics.
+
+    ``sensor`` (a :class:`flann.physics.sensor.Sensor`) makes geometry and origin known;
+    without it the paper's LVDT is the starting point and geometry, gain and origin are
+    calibrated.
+    """
+    x_all = np.asarray(rec.displacement_mm, dtype=float)
+    y_all = np.asarray(rec.voltage_v, dtype=float)
+    d_given = None if rec.direction is None else np.asarray(rec.direction, dtype=float)
+    D.check_inputs(x_all, y_all, d_given, rec.source)
+    notes: list[str] = []
+    known = sensor is not None
+    sensor = (sensor or default_sensor()).replace(effects={})
+
+    # -- shape: rectified output, fold-back beyond the stroke ---------------------------
+    passes_all = D.find_passes(x_all, d_given)
+    raw_noise = D.estimate_noise(x_all, y_all, passes_all)
+    tip = D.detect_v_shape(x_all, y_all, raw_noise)
+    keep = np.ones(x_all.size, bool)
+    if tip is not None:
+        msg = (f"the output is rectified (unsigned, V-shaped through the null at about "
+               f"{tip:.3g} mm): an amplitude demodulator without phase sensitivity; "
+               "diagnosing against an amplitude-demodulated simulation")
+        notes.append(msg)
+        if sensor.demodulator_kind != "amplitude":
+            warnings.warn(f"{rec.source}: {msg}", stacklevel=2)
+            sensor = sensor.replace(demodulator_kind="amplitude")
+    elif sensor.demodulator_kind == "amplitude":
+        notes.append("the sensor file says amplitude demodulator but the output changes sign; "
+                     "diagnosing it as phase-sensitive")
+        sensor = sensor.replace(demodulator_kind="phase_sensitive")
+    if tip is None:
+        span = monotonic_span(rec)
+        if span.foldback:
+            if not span.trimmable:
+                raise RecordingsError(f"{span.message}; diagnose cannot judge a curve that "
+                                      "turns back inside its stroke")
+            keep = span.mask.copy()
+            if keep.sum() < D.MIN_POINTS or np.unique(x_all[keep]).size < 4:
+                raise RecordingsError(f"{span.message}; the monotonic span leaves only "
+                                      f"{int(keep.sum())} points, too few to diagnose")
+            msg = (f"{span.message}; trimmed to the monotonic span "
+                   f"{x_all[keep].min():g}..{x_all[keep].max():g} mm "
+                   f"({int((~keep).sum())} points dropped)")
+            warnings.warn(msg, stacklevel=2)
+            notes.append(msg.split(": ", 1)[-1])
+    rows = np.flatnonzero(keep)
+    x = x_all[keep]
+    y = y_all[keep]
+    passes = D.find_passes(x, None if d_given is None else d_given[keep])
+    direction = passes.direction
+    temp = None if rec.temperature_c is None else np.asarray(rec.temperature_c, float)[keep]
+    time = None if rec.time_s is None else np.asarray(rec.time_s, float)[keep]
+
+    # -- rails read off the data: flat runs at the extremes --------------------------------
+    rails = D.find_rails(x, y, passes) if tip is None else []
+    on_rail = np.zeros(x.size, bool)
+    for r in rails:
+        on_rail |= r["mask"]
+    off = np.flatnonzero(~on_rail)
+    passes_off = D.find_passes(x[off], None if direction is None else direction[off])
+
+    # -- calibrate the ideal simulation (off the rails) ----------------------------------
+    if progress:
+        progress("calibrating the ideal simulation")
+    # A travel centred on 0 mm says where the null should be: a null elsewhere is a
+    # zero_shift.  A travel starting at 0 (or anywhere else) leaves the null to calibration.
+    lo_x, hi_x = float(np.min(x)), float(np.max(x))
+    centred = (not known) and abs(lo_x + hi_x) <= CENTRED * (hi_x - lo_x)
+    origin0 = initial_origin(x[off], y[off], tip)
+    cal = calibrate(sensor, x[off], y[off], origin_known=known or centred, geometry_known=known,
+                    origin0=origin0, progress=progress)
+    gsj = D.estimate_noise(x[off], cal.resid, passes_off)
+    out_off = D.find_outliers(x[off], cal.resid, passes_off, gsj)
+    if out_off.sum() > max(1, 0.02 * off.size):
+        # many "glitches" are not glitches: keep them (they are structure or noise)
+        out_off[:] = False
+    out_mask = np.zeros(x.size, bool)
+    out_mask[off[out_off]] = True
+    skip = out_mask | on_rail
+    fit_idx = np.flatnonzero(~skip)
+
+    data = Data(x=x, y=y, direction=direction, temperature_c=temp, time_s=time)
+    family = PhysicsFamily(cal.sensor, data, origin_known=known or centred, shape=cal.shape,
+                           gain0=cal.gain, origin0=0.0 if centred else cal.origin_mm,
+                           scale=cal.scale, origin_from_travel=centred)
+    if cal.scale != 1.0:
+        notes.append(f"the recorded displacement is scaled by {cal.scale:.4g} to match the "
+                     "simulated sensor (recorded in other units than mm, or a sensor of "
+                     "another size); effect parameters in mm are given in recorded units")
+    if centred:
+        notes.append(f"the travel ({lo_x:g}..{hi_x:g} mm) is centred on 0 mm, so the null is "
+                     "expected at 0 mm: a null elsewhere is tested as zero_shift")
+
+    # -- the smooth shape term: model-form error of the physics model ----------------------
+    if progress:
+        progress("choosing the smooth shape term")
+    core_half = float(np.max(np.abs((x[fit_idx] - family.origin0) * family.scale)))
+    k_shape, cv_table = choose_shape_terms(family, fit_idx, core_half,
+                                           rectified=sensor.demodulator_kind == "amplitude")
+    if k_shape:
+        family.disc = OddBasis(core_half, k_shape, rectified=sensor.demodulator_kind == "amplitude")
+
+    # -- name the missing physics --------------------------------------------------------
+    candidates = tuple(c for c in family.candidates if not (rails and c == "adc_clipping"))
+    sel = forward_select(family, candidates, fit_idx, progress=progress)
+    all_idx = np.arange(x.size)
+    before = y - family.predict(sel.baseline, all_idx)
+    after = y - family.predict(sel.final, all_idx)
+    shape_v = family.shape_term(sel.baseline, all_idx)
+
+    order = [s.name for s in sel.steps]
+    cumulative: list[Fit] = [s.fit for s in sel.steps]
+    deltas = [s.delta_bic for s in sel.steps]
+    cvts = [s.cv_t for s in sel.steps]
+    alts = {s.name: s.alternatives for s in sel.steps}
+    if sel.dropped:  # recompute the cumulative chain in the surviving order
+        cumulative, deltas = [], []
+        prev = sel.baseline
+        for k in range(len(order)):
+            f = family.fit(order[:k + 1], fit_idx, start=prev)
+            cumulative.append(f)
+            deltas.append(f.bic - prev.bic)
+            prev = f
+        cumulative[-1] = sel.final
+    final = sel.final
+    effects = []
+    slope = _slope(family, final, all_idx)
+    units = family.units()
+    null_at = final.value("baseline.origin_mm") if not family.origin_known else 0.0
+    if rails:
+        params = {}
+        for r in rails:
+            params[f"rail_{r['side']}_v"] = _param(r["level_v"], r["stderr_v"], "V")
+        params["readings_on_rail"] = _param(sum(r["n"] for r in rails), math.nan, "")
+        contrib = np.zeros(x.size)
+        effects.append(EffectReport("adc_clipping",
+                                    explain("adc_clipping", params, contrib, x, direction,
+                                            temp, y, slope, null_at),
+                                    params, final.rms, math.nan, math.nan))
+    for k, name in enumerate(order):
+        params = {}
+        for n, v, se in zip(final.names, final.theta, final.stderr):
+            if n.startswith(name + "."):
+                # position effects act in the simulated sensor's mm: back to recorded units
+                k_unit = 1.0 / family.scale if units.get(n) == "mm" else 1.0
+                params[n.split(".", 1)[1]] = _param(v * k_unit, se * k_unit, units.get(n, ""))
+        if name == "thermal_drift":
+            params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
+        contrib = family.predict(final, all_idx) - _without(family, final, name, all_idx)
+        sentence = explain(name, params, contrib, x, direction, temp, y, slope, null_at)
+        effects.append(EffectReport(name, sentence, params, cumulative[k].rms, deltas[k],
+                                    cvts[k] if k < len(cvts) else math.nan,
+                                    alternatives=alts.get(name, [])))
+
+    # -- noise and located mismatch (residual of the baseline: simulation + shape) --------
+    noise, noise_regions = D.estimate_noise_local(x, before, passes, exclude=skip)
+    regions = D.locate_regions(x, before, passes, noise, exclude=skip)
+    t_axis, t_unit = (time, "s") if time is not None else (rows.astype(float), "rows")
+    time_spans = D.locate_time_spans(t_axis, before, noise, exclude=skip) if regions else []
+    outliers = [{"row": int(rows[i]), "displacement_mm": float(x[i]),
+                 "residual_v": float(after[i])} for i in np.flatnonzero(out_mask)]
+
+    base = sel.baseline
+    base_params = {"gain_ratio": _param(base.value("baseline.gain_ratio"),
+                                        _se(base, "baseline.gain_ratio"), "")}
+    if not family.origin_known:
+        base_params["origin_mm"] = _param(base.value("baseline.origin_mm"),
+                                          _se(base, "baseline.origin_mm"), "mm")
+    elif centred:
+        base_params["origin_mm"] = _param(0.0, math.nan, "mm")
+    if not known:
+        for f, v in cal.geometry.items():
+            base_params[f] = _param(v, cal.geometry_stderr.get(f, math.nan), "mm")
+        if cal.scale != 1.0:
+            base_params["displacement_scale"] = _param(cal.scale, math.nan,
+                                                       "sensor mm per recorded unit")
+    shape_rms = float(np.sqrt(np.mean(shape_v[fit_idx] ** 2)))
+    shape_desc = {
+        "terms": int(k_shape),
+        "description": (family.disc.describe() if family.disc is not None else
+                        "none: cross-validation prefers the calibrated simulation alone"),
+        "rms_v": shape_rms,
+        "peak_v": float(np.max(np.abs(shape_v[fit_idx]))) if fit_idx.size else 0.0,
+        "cv_rms_v_by_terms": {str(k): v for k, v in cv_table.items()},
+        "meaning": ("a smooth, odd, direction- and time-independent difference between this "
+                    "sensor's curve and the simulated one: the shape of this sensor, not an "
+                    "effect"),
+    }
+    n_dir = "" if direction is None else (
+        "directions " + "/".join(sorted({"+" if v > 0 else "-" for v in np.unique(direction)}))
+        + (" (inferred from the order)" if passes.inferred else ""))
+    passes_text = f"{len(passes.runs)} pass(es)" + (f", {n_dir}" if n_dir else "")
+    cal_text = ("sensor file: geometry and origin known; gain fitted" if known else
+                "paper LVDT as start; geometry, gain and "
+                + ("origin fitted" if not centred else "shape fitted, null expected at 0 mm")) + \
+        f", {sensor.demodulator_kind.replace('_', '-')} detector"
+    untestable = dict(family.untestable)
+    if rails:
+        untestable.pop("adc_clipping", None)
+    return Diagnosis(
+        source=rec.source, n=int(x_all.size), n_used=int(fit_idx.size), passes_text=passes_text,
+        calibration_text=cal_text, notes=notes,
+        baseline_rms=float(np.sqrt(np.mean(before[fit_idx] ** 2))),
+        baseline_params=base_params, noise_v=float(noise), regions=regions,
+        time_spans=time_spans, time_unit=t_unit, outliers=outliers, effects=effects,
+        final_rms=float(np.sqrt(np.mean(after[fit_idx] ** 2))), untestable=untestable,
+        shape_description=shape_desc, noise_method=D.NOISE_METHOD,
+        noise_regions=noise_regions,
+        ideal_rms=float(np.sqrt(np.mean((before + shape_v)[fit_idx] ** 2))),
+        x=x, direction=direction, resid_before=before, resid_after=after,
+        outlier_mask=skip, trials=sel.trials, final_fit=final, family=family,
+        fit_idx=fit_idx)
+
+
+def choose_shape_terms(family: PhysicsFamily, idx: np.ndarray, half_range: float,
+                       rectified: bool) -> tuple[int, dict]:
+    """Number of smooth shape terms by 5-fold cross-validation.
+
+    Linearised about the fitted baseline (gain, origin and geometry modes re-adjust to
+    first order through their Jacobian columns), so each candidate costs one small least
+    squares per fold instead of a nonlinear fit.  The smallest number within 1 % of the
+    best out-of-fold error is taken."""
+    fit0 = family.fit([], idx)
+    r0 = fit0.resid
+    cols = []
+    for j, th in enumerate(fit0.theta):
+        h = 1e-6 * max(abs(th), 1e-3)
+        t1 = fit0.theta.copy()
+        t1[j] += h
+        cols.append((family.evaluate(t1, fit0.names, idx) - (family.data_y(idx) - r0)) / h)
+    J = np.stack(cols, 1)
+    core = (family.data.x[idx] - family.origin0) * family.scale
+    folds = make_folds(np.arange(idx.size))
+    table = {}
+    for k in SHAPE_TERMS:
+        if idx.size - J.shape[1] - k < 10:
+            continue
+        X = J if k == 0 else np.hstack([J, OddBasis(half_range, k, rectified).evaluate(core)])
+        err = 0.0
+        for test in folds:
+            train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
+            c = np.linalg.lstsq(X[train], r0[train], rcond=1e-10)[0]
+            e = r0[test] - X[test] @ c
+            err += float(e @ e)
+        table[k] = math.sqrt(err / idx.size)
+    if not table:
+        return 0, {}
+    best = min(table.values())
+    k = min(k for k, v in table.items() if v <= best * 1.01)
+    return k, table
+
+
+def _se(fit: Fit, name: str) -> float:
+    return float(fit.stderr[fit.names.index(name)])
+
+
+def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
+    """The fitted model's output with ``effect`` switched off (its parameters neutral)."""
+    theta = fit.theta.copy()
+    neutral = {**EFFECTS[effect].neutral(), "rail_high_v": math.inf, "rail_low_v": -math.inf}
+    for i, n in enumerate(fit.names):
+        if n.startswith(effect + "."):
+            theta[i] = neutral[n.split(".", 1)[1]]
+    return family.evaluate_like(fit, theta, idx)
+
+
+def _slope(family: PhysicsFamily, fit: Fit, idx) -> np.ndarray:
+    h = 0.01
+    x = family.data.x
+    orig = family.data
+    try:
+        family.data = Data(x + h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
+        up = family.predict(fit, idx)
+        family.data = Data(x - h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
+        dn = family.predict(fit, idx)
+    finally:
+        family.data = orig
+    return (up - dn) / (2 * h)

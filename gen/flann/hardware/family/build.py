@@ -1,0 +1,53 @@
+"""``flann gen --family REC_OR_MODEL...``: models of the family's sensors -> one design.
+
+A recordings CSV is trained here (:func:`train_model`, the one training call of the family
+flow, also used by ``flann calibrate``); a model.json is used as it is.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...errors import FlannError
+from ...golden.model import FlannModel, load_model
+from ...golden.train import fit_lstsq
+from ...recordings import prepare_for_fit, read_recordings
+from .render import write
+from .spec import DEFAULT_MARGIN, derive_family
+
+DEFAULT_TERMS = 15
+NORMALISATION = "half"  # v_n in [-0.5, 0.5]: the periodic terms need not join the two ends
+RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in accuracy
+
+
+def train_model(rec, terms: int = DEFAULT_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
+    """Least-squares FLANN of ``terms`` terms on validated recordings."""
+    rec = prepare_for_fit(rec)
+    info = {"data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})}
+    return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
+
+
+def load_member(path, terms: int = DEFAULT_TERMS) -> FlannModel:
+    """A model.json as it is, or a recordings CSV trained with ``terms`` terms."""
+    path = Path(path)
+    if path.suffix.lower() == ".json":
+        return load_model(path)
+    if path.suffix.lower() == ".csv":
+        return train_model(read_recordings(path), terms)
+    raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
+
+
+def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
+                    **options) -> dict:
+    """Size one design for every source and write it (nothing written if any step fails)."""
+    if not sources:
+        raise FlannError("--family needs at least one recordings CSV or model.json")
+    if not 2 <= int(terms) <= 200:
+        raise FlannError(f"--terms {terms}: must be 2..200")
+    models = [load_member(p, terms) for p in sources]
+    names = [Path(p).stem for p in sources]
+    fam = derive_family(models, names=names, margin=margin, **options)
+    return write(fam, out_dir, fam.spec.model, init_name=names[0])
+
+
+__all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "NORMALISATION"]

@@ -1,0 +1,153 @@
+"""Render the family design (``flann gen --family``) and read it back.
+
+The expansion and the adder are the fixed datapath's entities, rendered from its templates
+with its contexts; the weight memory, the normaliser with fetched constants, the multiplier
+reading the memory and the top level are this folder's templates.  The design directory
+holds the VHDL, ``manifest.json`` (with the memory map and number formats under ``family``)
+and ``init_model.json`` (the sensor the memory is initialised from, so the design can be
+rebuilt from the directory alone).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+from ... import __version__
+from ...errors import FlannError
+from ...fileio import atomic_directory
+from ...golden.model import FlannModel, load_model
+from ...numeric.fixed import bits_literal
+from ...textgen import template
+from ..fixed import render as fixed
+from .spec import DATA_BITS, FamilySpec, family_from_dict
+from .twin import FlannFamilyMem
+
+TOP = "flann_family_top"
+INIT_MODEL = "init_model.json"
+# compile order: (entity, title, template path)
+ENTITIES = (
+    ("flann_family_mem", "weight memory (per-sensor values, cfg write port)", "hardware/family/templates"),
+    ("flann_family_norm", "input clamp and normalisation, constants fetched from the memory",
+     "hardware/family/templates"),
+    ("flann_expansion", "trigonometric expansion (phase accumulation, quarter-wave table)",
+     "hardware/fixed/templates"),
+    ("flann_family_multiplier", "terms x weights read from the memory", "hardware/family/templates"),
+    ("flann_adder", "accumulation, rounding, saturation", "hardware/fixed/templates"),
+    ("flann_family_top", "FLANN LVDT compensator for a sensor family, top level", "hardware/family/templates"),
+)
+
+
+def _slices(fam: FamilySpec) -> dict:
+    """hi/lo bit of every normaliser field inside the fetched words (lowest address lowest)."""
+    out = {}
+    for f in fam.fields[1:]:
+        lo = (f.addr - fam.param_base) * DATA_BITS
+        out[f"{f.name}_lo"], out[f"{f.name}_hi"] = lo, lo + f.bits - 1
+    return out
+
+
+def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
+    s = fam.spec
+    base = fixed.contexts(s)
+    words = FlannFamilyMem.encode(fam, s)
+    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits, init_name=init_name,
+               words=[bits_literal(w, DATA_BITS, False) for w in words])
+    n = base["flann_norm"]
+    norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
+                acc_v_bits=n["acc_v_bits"], acc_l_bits=n["acc_l_bits"], guard_v=n["guard_v"],
+                guard_l=n["guard_l"], cnt_bits=n["cnt_bits"], cnt_init=n["cnt_init"], data_bits=DATA_BITS,
+                prm_bits=fam.param_words * DATA_BITS, **_slices(fam))
+    mu = base["flann_multiplier"]
+    step_bits = mu["step_bits"]
+    if step_bits > fam.addr_bits:
+        raise FlannError(f"internal: step counter ({step_bits} bits) wider than the memory address")
+    mult = dict(term_bits=mu["term_bits"], product_bits=mu["product_bits"], weight_bits=mu["weight_bits"],
+                weight_frac=mu["weight_frac"], full_bits=mu["full_bits"], shift=mu["shift"], half=mu["half"],
+                step_bits=step_bits, cnt_bits=mu["cnt_bits"], cnt_init=mu["cnt_init"],
+                cnt_init_n=int(mu["cnt_init"].strip('"'), 2), digit_bits=mu["digit_bits"],
+                shift_bits=mu["shift_bits"], data_bits=DATA_BITS)
+    t = base["flann_top"]
+    top = dict(t, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
+               param_words=fam.param_words, param_base=fam.param_base, step_bits=step_bits,
+               fcnt_bits=max(1, fam.param_words.bit_length()))
+    return {"flann_family_mem": mem, "flann_family_norm": norm, "flann_expansion": base["flann_expansion"],
+            "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_family_top": top}
+
+
+def spec_lines(fam: FamilySpec) -> list[str]:
+    d = fam.to_dict()
+    lines = fixed.spec_lines(fam.spec)
+    lines.append(f"family = {json.dumps({k: d[k] for k in ('margin', 'members', 'terms', 'widths')})}")
+    return lines
+
+
+def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
+    ctx = contexts(fam, init_name or "(first member)")
+    out = {}
+    for name, title, folder in ENTITIES:
+        header = dict(file=f"{name}.vhd", title=title, command="flann gen --family", version=__version__,
+                      model_sha256=fam.spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(fam))
+        out[f"{name}.vhd"] = template(f"{folder}/{name}.vhd.j2").render(h=header, **ctx[name])
+    return out
+
+
+def manifest(fam: FamilySpec, files: list[str]) -> dict:
+    s = fam.spec
+    man = fixed.manifest(s, files)
+    man.update(top=TOP, latency_cycles=fam.latency_cycles, cycles_per_sample=fam.cycles_per_sample,
+               family=fam.to_dict(), init_model=INIT_MODEL)
+    man["cfg_port"] = {
+        "ports": {"cfg_we": "in std_logic", "cfg_addr": f"in std_logic_vector({fam.addr_bits - 1} downto 0)",
+                  "cfg_data": f"in std_logic_vector({DATA_BITS - 1} downto 0)"},
+        "timing": "cfg_data is written at cfg_addr on every rising clk edge with cfg_we = 1 (one word per "
+                  "cycle, back to back allowed)",
+        "in_flight": "a write cancels the sample in flight (no out_valid for it); in_ready is 0 while "
+                     "cfg_we = 1; the next accepted sample uses the memory as written",
+        "reset": "rst clears the sequencer and valid flags, not the memory",
+    }
+    return man
+
+
+def design_hash(out_dir) -> str:
+    """sha256 over the design's VHDL files (compile order), the hash a certificate names."""
+    out_dir = Path(out_dir)
+    man = read_manifest(out_dir)
+    h = hashlib.sha256()
+    for name in man["files"]:
+        h.update(name.encode() + b"\0" + (out_dir / name).read_bytes())
+    return h.hexdigest()
+
+
+def write(fam: FamilySpec, out_dir, init_model: FlannModel, init_name: str = "") -> dict:
+    texts = render(fam, init_name)
+    man = manifest(fam, list(texts))
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise FlannError(f"{out_dir}: exists and is not a directory")
+    with atomic_directory(out_dir) as tmp:
+        for name, text in texts.items():
+            (tmp / name).write_text(text, newline="")
+        (tmp / fixed.MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
+        (tmp / INIT_MODEL).write_text(init_model.to_json(), newline="")
+    return man
+
+
+def read_manifest(out_dir) -> dict:
+    man = fixed.read_manifest(out_dir)
+    if "family" not in man:
+        raise FlannError(f"{Path(out_dir) / fixed.MANIFEST}: not a family design (generate it with "
+                         "`flann gen --family`)")
+    return man
+
+
+def load_design(out_dir) -> FamilySpec:
+    """The FamilySpec of a design directory written by :func:`write`."""
+    out_dir = Path(out_dir)
+    man = read_manifest(out_dir)
+    return family_from_dict(man["family"], load_model(out_dir / man.get("init_model", INIT_MODEL)))
+
+
+__all__ = ["render", "manifest", "write", "load_design", "read_manifest", "design_hash", "contexts",
+           "TOP", "ENTITIES", "INIT_MODEL"]

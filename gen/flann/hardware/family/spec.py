@@ -1,0 +1,343 @@
+"""One design for a family of sensors: common number formats, per-sensor values in a memory.
+
+Layer 1 of the family datapath.  The arithmetic is the fixed datapath's
+(:mod:`flann.hardware.fixed.spec`): the same normaliser, sin/cos table, shift-add multiplier
+and adder.  What differs between sensors -- the trig weights, bias and linear weight (k1, k0),
+input offset and scale (ka, kb), clamp range -- is no longer a constant but a word of the
+weight memory, so one bitstream serves every sensor of the family.
+
+Sizing (``derive_family``):
+
+* the input code LSB covers every member's voltage range plus ``margin``; the output LSB is
+  the finest a member needs, its width holds every member's output range plus ``margin``;
+* fraction bits (phase, table, terms, weights, products) are those the error budget of the
+  fixed datapath gives a member whose weights are ``(1 + margin)`` times larger than any
+  member's, so a sensor like them still meets the 1-LSB bound;
+* integer widths (weights, linear constants, products, accumulator) hold ``(1 + margin)``
+  times the family's largest value.
+
+``member_spec`` derives one sensor's values under these formats (a fixed :class:`Spec`
+with the family's widths and the sensor's constants) and says why a sensor does not fit.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ...errors import SpecError
+from ...golden.model import FlannModel
+from ...numeric.fixed import FixedFormat, bits_needed
+from ..fixed.spec import Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
+
+DATA_BITS = 32  # two RAMB4_S16 side by side (Spartan-II block RAM: 256 x 16 each)
+MEM_DEPTH_MAX = 256
+DEFAULT_MARGIN = 0.5
+# the forced generator options every member is derived with (stored in the manifest)
+FORCED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "phase_bits", "table_addr_bits",
+          "term_frac_bits", "weight_frac_bits", "product_frac_bits", "interp", "mult_style",
+          "mult_digit_bits", "device")
+
+
+class FitError(SpecError):
+    """A sensor whose values do not fit the family design's formats."""
+
+
+def _words(bits: int) -> int:
+    return -(-int(bits) // DATA_BITS)
+
+
+@dataclass(frozen=True)
+class Field:
+    """One per-sensor value in the weight memory: ``words`` words from ``addr``, LSW first."""
+
+    name: str
+    addr: int
+    words: int
+    bits: int
+    signed: bool
+    meaning: str
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "addr": self.addr, "words": self.words, "bits": self.bits,
+                "format": f"{'s' if self.signed else 'u'}int<{self.bits}>", "meaning": self.meaning}
+
+
+@dataclass(frozen=True)
+class FamilySpec:
+    """The family design: the envelope :class:`Spec` (family widths, initial sensor's values)."""
+
+    spec: Spec
+    margin: float
+    options: dict = field(compare=False)  # FORCED options, as every member is derived
+    members: tuple = ()  # names the design was sized from
+
+    # -- shape ----------------------------------------------------------------------------
+    @property
+    def terms(self) -> int:
+        return self.spec.model.terms
+
+    @property
+    def norm_bits(self) -> int:
+        return self.spec.phase_bits + self.spec.norm_guard
+
+    @property
+    def fields(self) -> tuple[Field, ...]:
+        """The memory map: weights first (one word each, hardware term order), then the normaliser."""
+        s = self.spec
+        B, NV, LW = s.input_bits, self.norm_bits, s.lin_width
+        out = [Field("weights", 0, s.steps, s.weight_fmt.width, True,
+                     f"trig weight j = 0..{s.steps - 1} (model term j + 1), output LSB x 2^{s.weight_fmt.frac_bits}")]
+        addr = s.steps
+        for name, bits, signed, meaning in (
+            ("clamp_lo", B, True, "lowest input code used (lower codes clamp, out_sat)"),
+            ("clamp_hi", B, True, "highest input code used"),
+            ("ka", NV, False, f"phase per input code: (lsb / input_scale) x 2^{s.phase_bits - 1 + s.norm_guard}, mod 2^{NV}"),
+            ("kb", NV, False, f"phase offset -input_offset/input_scale x 2^{s.phase_bits - 1 + s.norm_guard} "
+                              f"+ 2^{s.norm_guard - 1} (rounding), mod 2^{NV}"),
+            ("k1", LW, True, f"linear weight per code w0 lsb/(scale q) x 2^{s.product_fmt.frac_bits + s.lin_guard}"),
+            ("k0", LW, True, f"bias + w0 b in accumulator units x 2^{s.lin_guard} + 2^{s.lin_guard - 1} (rounding)"),
+        ):
+            out.append(Field(name, addr, _words(bits), bits, signed, meaning))
+            addr += _words(bits)
+        return tuple(out)
+
+    @property
+    def param_base(self) -> int:
+        return self.spec.steps
+
+    @property
+    def param_words(self) -> int:
+        return sum(f.words for f in self.fields[1:])
+
+    @property
+    def used_words(self) -> int:
+        return self.param_base + self.param_words
+
+    @property
+    def addr_bits(self) -> int:
+        return max(1, (self.used_words - 1).bit_length())
+
+    @property
+    def mem_depth(self) -> int:
+        return 1 << self.addr_bits
+
+    @property
+    def latency_cycles(self) -> int:
+        """The fixed datapath's latency plus the parameter fetch (one word per cycle) and hand-over."""
+        return self.spec.latency_cycles + self.param_words + 2
+
+    @property
+    def cycles_per_sample(self) -> int:
+        return self.latency_cycles + 1
+
+    def to_dict(self) -> dict:
+        s = self.spec
+        return {
+            "margin": self.margin,
+            "members": list(self.members),
+            "options": dict(self.options),
+            "terms": self.terms,
+            "widths": {"weight_bits": s.weight_fmt.width, "lin_width": s.lin_width, "lin_bits": s.lin_fmt.width,
+                       "product_bits": s.product_fmt.width, "acc_bits": s.acc_fmt.width,
+                       "term_bound": s.term_bound},
+            "memory": {"data_bits": DATA_BITS, "addr_bits": self.addr_bits, "depth": self.mem_depth,
+                       "used_words": self.used_words, "word_order": "least significant word first",
+                       "fields": [f.to_dict() for f in self.fields]},
+            "formats": {"input_code": f"sint<{s.input_bits}> x {s.input_lsb_v} V",
+                        "output_code": f"sint<{s.out_fmt.width}> x {s.output_lsb_mm} mm",
+                        "weight": s.weight_fmt.describe(), "term": s.term_fmt.describe(),
+                        "product": s.product_fmt.describe(), "linear": s.lin_fmt.describe(),
+                        "acc": s.acc_fmt.describe()},
+        }
+
+
+# ------------------------------------------------------------------------------------------
+def _check_margin(margin) -> float:
+    if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not 0 <= margin <= 10:
+        raise SpecError(f"margin = {margin!r}: must be a number in 0..10 (0.5 = 50 % headroom)")
+    return float(margin)
+
+
+def _quiet(fn, *args, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fn(*args, **kw)
+
+
+def _padded(model: FlannModel, terms: int) -> FlannModel:
+    """The same function with ``terms`` terms (zero weights appended)."""
+    if model.terms > terms:
+        raise FitError(f"model has {model.terms} terms, the design {terms}")
+    return replace(model, weights=tuple(model.weights) + (0.0,) * (terms - model.terms))
+
+
+def _scaled(model: FlannModel, k: float) -> FlannModel:
+    return replace(model, weights=tuple(w * k for w in model.weights))
+
+
+def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT_MARGIN,
+                  input_bits: int = 12, input_lsb_v: float | None = None, output_bits: int | None = None,
+                  output_lsb_mm: float | None = None, device: str = "xc2s200-pq208-5",
+                  mult_style: str = "shiftadd", mult_digit_bits: int = 2, interp: bool = True,
+                  phase_bits: int | None = None, table_addr_bits: int | None = None,
+                  term_frac_bits: int | None = None, weight_frac_bits: int | None = None,
+                  product_frac_bits: int | None = None, lanes: int = 1, clamp: bool = True,
+                  check_device: bool = True) -> FamilySpec:
+    """Size one design for ``models`` (see the module docstring); the first model initialises the memory."""
+    if not models:
+        raise SpecError("a family needs at least one sensor")
+    mu = _check_margin(margin)
+    if lanes != 1:
+        raise SpecError(f"lanes = {lanes}: the family design reads one weight per step from its memory (lanes = 1)")
+    if mult_style != "shiftadd":
+        raise SpecError(f"mult_style {mult_style!r}: the family design needs 'shiftadd' (the weight memory "
+                        "is a block RAM with a registered read)")
+    if not clamp:
+        raise SpecError("the family design always clamps (the clamp range is a per-sensor value)")
+    N = max(m.terms for m in models)
+    models = [_padded(m, N) for m in models]
+    # common input code: every member's voltage range + margin
+    vmax = max(max(abs(v) for v in m.voltage_range_v) for m in models)
+    if input_lsb_v is None:
+        input_lsb_v = _round_sig(max(vmax, 1e-12) * (1 + mu) / (1 << (input_bits - 1)))
+    # common output code: the finest LSB a member needs, range of all + margin
+    ys = []
+    for m in models:
+        lo, hi = sorted(m.voltage_range_v)
+        ys.append(m.predict(np.linspace(lo, hi, 257)))
+    ymax = max(float(np.max(np.abs(y))) for y in ys)
+    if output_lsb_mm is None:
+        steps = [(float(np.ptp(y)) or 1.0) / max(1, (max(m.voltage_range_v) - min(m.voltage_range_v)) / input_lsb_v)
+                 for y, m in zip(ys, models)]
+        output_lsb_mm = nice_125(min(steps) / 4, up=False)
+    if output_bits is None:
+        r = math.ceil(ymax * (1 + mu) / output_lsb_mm)
+        output_bits = bits_needed(-r, r)
+    common = dict(input_bits=input_bits, input_lsb_v=input_lsb_v, output_lsb_mm=output_lsb_mm,
+                  device=device, mult_style=mult_style, mult_digit_bits=mult_digit_bits, interp=interp,
+                  check_device=False)
+    # fraction bits: the budget of a member with (1 + margin) x larger weights
+    forced = dict(phase_bits=phase_bits, table_addr_bits=table_addr_bits, term_frac_bits=term_frac_bits,
+                  weight_frac_bits=weight_frac_bits, product_frac_bits=product_frac_bits)
+    if any(v is None for v in forced.values()):
+        big = [_quiet(derive_spec, _scaled(m, 1 + mu), **common) for m in models]
+        picks = dict(phase_bits=max(s.phase_bits for s in big),
+                     table_addr_bits=max(s.table_addr_bits for s in big),
+                     term_frac_bits=max(s.term_fmt.frac_bits for s in big),
+                     weight_frac_bits=max(s.weight_fmt.frac_bits for s in big),
+                     product_frac_bits=max(s.product_fmt.frac_bits for s in big))
+        forced = {k: (picks[k] if v is None else v) for k, v in forced.items()}
+    options = {**{k: v for k, v in common.items() if k != "check_device"}, **forced, "output_bits": output_bits}
+    specs = [derive_spec(m, **options, check_device=False) for m in models]
+
+    def grow(n: int) -> int:  # (1 + margin) x the family's largest magnitude
+        return int(math.ceil(n * (1 + mu)))
+
+    s0 = specs[0]
+    wmax = grow(max(max(abs(w) for lane in s.weight_rom for w in lane) for s in specs))
+    W = bits_needed(-wmax, wmax)
+    weight_fmt = FixedFormat(W, W - s0.weight_fmt.frac_bits)
+    shift = s0.product_shift
+    pmax = (s0.term_bound * wmax + (1 << (shift - 1))) >> shift
+    product_fmt = FixedFormat(bits_needed(-pmax, pmax), bits_needed(-pmax, pmax) - s0.product_fmt.frac_bits)
+    kmax = grow(max(max(abs(s.k1), abs(s.k0) + (1 << (s.lin_guard - 1))) for s in specs))
+    B = input_bits
+    lin_width = bits_needed(-(kmax << (B - 1)) - kmax, (kmax << (B - 1)) + kmax) + 1
+    lin_bound = grow(max(s.lin_fmt.max_int for s in specs))
+    Pf = s0.product_fmt.frac_bits
+    lin_fmt = FixedFormat(bits_needed(-lin_bound, lin_bound), bits_needed(-lin_bound, lin_bound) - Pf)
+    acc_bound = lin_bound + s0.steps * (pmax + 1)
+    acc_fmt = FixedFormat(bits_needed(-acc_bound, acc_bound), bits_needed(-acc_bound, acc_bound) - Pf)
+    fam = FamilySpec(spec=_envelope(s0, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt),
+                     margin=mu, options=options, members=tuple(names))
+    _check_memory(fam)
+    for s in specs:  # every member fits by construction; keep the check honest
+        member_spec(fam, s.model)
+    if check_device:
+        check_fits(fam.spec, fam.spec.device.split("-")[0])
+    return fam
+
+
+def _envelope(s: Spec, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt) -> Spec:
+    fam = replace(s, weight_fmt=weight_fmt, product_fmt=product_fmt, lin_width=lin_width, lin_fmt=lin_fmt,
+                  acc_fmt=acc_fmt)
+    K = fam.mult_digit_bits
+    if K > weight_fmt.width:
+        raise SpecError(f"mult_digit_bits = {K}: must be <= the weight width {weight_fmt.width}")
+    adv = -(-weight_fmt.width // K) + 1
+    fam = replace(fam, adv_period=adv)
+    analysis = dict(s.analysis)
+    analysis["estimate"] = estimate_resources(fam)
+    return replace(fam, analysis=analysis)
+
+
+def _check_memory(fam: FamilySpec) -> None:
+    s = fam.spec
+    if s.weight_fmt.width > DATA_BITS:
+        raise SpecError(f"weights need {s.weight_fmt.width} bits, the memory word has {DATA_BITS}: "
+                        "use fewer --weight-frac-bits or a smaller margin")
+    if fam.used_words > MEM_DEPTH_MAX:
+        raise SpecError(f"{fam.used_words} memory words needed, two RAMB4_S16 hold {MEM_DEPTH_MAX}: fewer terms")
+
+
+def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
+    """Rebuild the FamilySpec of a manifest's ``family`` entry (and the initial model)."""
+    try:
+        options = dict(d["options"])
+        w = d["widths"]
+        margin = float(d["margin"])
+        terms = int(d["terms"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SpecError(f"manifest 'family' entry is incomplete ({exc})") from None
+    s = _quiet(derive_spec, _padded(init_model, terms), **options, check_device=False)
+    Pf, Wf = s.product_fmt.frac_bits, s.weight_fmt.frac_bits
+    spec = _envelope(s, FixedFormat(w["weight_bits"], w["weight_bits"] - Wf),
+                     FixedFormat(w["product_bits"], w["product_bits"] - Pf), int(w["lin_width"]),
+                     FixedFormat(w["lin_bits"], w["lin_bits"] - Pf), FixedFormat(w["acc_bits"], w["acc_bits"] - Pf))
+    fam = FamilySpec(spec=spec, margin=margin, options=options, members=tuple(d.get("members", ())))
+    _check_memory(fam)
+    return fam
+
+
+def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> Spec:
+    """One sensor's values under the family formats; FitError names what does not fit."""
+    f = fam.spec
+    if not isinstance(model, FlannModel):
+        raise SpecError("model must be a FlannModel")
+    model = _padded(model, fam.terms)
+    lo, hi = sorted(model.voltage_range_v)
+    if lo < f.code_min * f.input_lsb_v or hi > f.code_max * f.input_lsb_v:
+        raise FitError(f"voltage range {lo:.4g}..{hi:.4g} V exceeds the design's input "
+                       f"{f.code_min * f.input_lsb_v:.4g}..{f.code_max * f.input_lsb_v:.4g} V")
+    try:
+        s = _quiet(derive_spec, model, **fam.options, model_sha256=model_sha256, check_device=False)
+    except SpecError as exc:
+        raise FitError(str(exc)) from None
+    words = [w for lane in s.weight_rom for w in lane]
+    checks = (
+        ("weights", max(abs(w) for w in words), f.weight_fmt.max_int),
+        ("linear constants", max(abs(s.k1), abs(s.k0) + (1 << (s.lin_guard - 1))) * ((1 << (f.input_bits - 1)) + 1),
+         (1 << (f.lin_width - 2)) - 1),
+        ("linear part", s.lin_fmt.max_int, f.lin_fmt.max_int),
+        ("products", s.product_fmt.max_int, f.product_fmt.max_int),
+        ("accumulator", s.acc_fmt.max_int, f.acc_fmt.max_int),
+    )
+    for what, need, have in checks:
+        if need > have:
+            raise FitError(f"{what} reach {need}, the design holds {have}: outside the family "
+                           f"(margin {fam.margin:g}); regenerate the design with this sensor in --family")
+    # clamp to the codes the recorded range rounds to (the ADC rounds too): the end points of
+    # a calibration sweep are then measured, not clamped
+    clo = max(f.code_min, math.floor(lo / f.input_lsb_v + 0.5))
+    chi = min(f.code_max, math.floor(hi / f.input_lsb_v + 0.5))
+    return replace(f, model=model, model_sha256=model_sha256, ka=s.ka, kb=s.kb, k1=s.k1, k0=s.k0,
+                   clamp_lo=clo, clamp_hi=chi, weight_rom=s.weight_rom,
+                   analysis={**s.analysis, "estimate": f.analysis.get("estimate")})
+
+
+__all__ = ["FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
+           "DATA_BITS", "DEFAULT_MARGIN", "FORCED"]

@@ -1,0 +1,71 @@
+"""The design manifest: ``manifest.json`` beside the generated VHDL, written and read here only.
+
+Every datapath writes its files and its manifest through :func:`write_design` (atomically,
+so a failed generation leaves nothing); every consumer (simulation, synthesis, ISE export)
+reads it through :func:`read_manifest`, which checks the two fields all of them rely on:
+``top`` (the top entity) and ``files`` (VHDL files in compile order, present in the directory).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+from ..errors import FlannError
+from ..fileio import atomic_directory
+
+MANIFEST = "manifest.json"
+
+
+class Manifest(dict):
+    """manifest.json as a dict, plus where it was read: ``directory``, ``top`` and ``files``
+    (paths of the VHDL files in compile order)."""
+
+    def __init__(self, directory: Path, top: str, files: tuple[Path, ...], data: dict):
+        super().__init__(data)
+        self.directory, self.top, self.files = directory, top, files
+
+    @property
+    def data(self) -> dict:
+        return dict(self)
+
+
+def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
+    """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise FlannError(f"{out_dir}: exists and is not a directory")
+    with atomic_directory(out_dir) as tmp:
+        for name, text in texts.items():
+            (tmp / name).write_text(text, newline="")
+        (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
+    return man
+
+
+def read_manifest(directory) -> Manifest:
+    directory = Path(directory)
+    path = directory / MANIFEST
+    if not path.is_file():
+        raise FlannError(f"{path} not found: generate the design first (flann gen MODEL -o {directory})")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise FlannError(f"{path}: not valid JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise FlannError(f"{path}: expected a JSON object with 'top' and 'files'")
+    top, files = data.get("top"), data.get("files")
+    if not isinstance(top, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", top):
+        raise FlannError(f"{path}: field 'top' must name the top entity (a VHDL identifier), got {top!r}")
+    if not isinstance(files, list) or not files or not all(isinstance(f, str) for f in files):
+        raise FlannError(f"{path}: field 'files' must be a non-empty list of VHDL files in compile order")
+    paths = []
+    for f in files:
+        p = directory / f
+        if not p.is_file():
+            raise FlannError(f"{path}: listed file {f!r} does not exist in {directory}")
+        paths.append(p)
+    return Manifest(directory, top, tuple(paths), data)
+
+
+__all__ = ["MANIFEST", "Manifest", "read_manifest", "write_design"]

@@ -1,0 +1,262 @@
+"""``flann calibrate``: one family design, many sensors -- train, quantise, check, certify.
+
+Per recording (:func:`calibrate_one`, no HDL simulation: the design was verified once and
+the bit-true twin of the family design stands for it):
+
+1. read the recordings, train a FLANN with the design's terms (:func:`train_for_design`:
+   the family's training call, with more ridge until the weights fit the design's formats);
+2. quantise into the design's memory words and check with the design's twin over every
+   input code: |twin - float model| against the error bound of the formats;
+3. hardware error on the recording (the twin at the recording's input codes) against the
+   physical limit: half an input LSB divided by the local slope dv/dx, worst over the stroke;
+4. run the diagnosis (:func:`flann.diagnose.diagnose`) for warnings;
+5. write ``OUTDIR/<sensor>/``: model.json, weights.hex, weights.mem, weights.bmm and
+   certificate.html, all or nothing.
+
+:func:`calibrate_batch` runs recordings over a process pool; a bad recording becomes a
+``failed`` row with its reason and the batch goes on; ``summary.csv`` is written last.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import math
+import os
+import sys
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..errors import FlannError
+from ..fileio import atomic_directory, atomic_write_text
+from ..golden.metrics import raw_output_mm
+from ..hardware.family.build import train_model
+from ..hardware.family.render import design_hash, load_design
+from ..hardware.family.spec import FamilySpec, FitError, member_spec
+from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
+from ..recordings import read_recordings
+from . import images
+from .certificate import render_certificate
+
+RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the design
+SUMMARY = "summary.csv"
+SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit", "limit_mm",
+                  "raw_max_error_mm", "twin_vs_float_lsb", "recording")
+
+
+@dataclass
+class Result:
+    sensor: str
+    recording: str
+    status: str = "failed"
+    reason: str = ""
+    max_error_mm: float | None = None
+    limit_mm: float | None = None
+    ratio_to_limit: float | None = None
+    raw_max_error_mm: float | None = None
+    twin_vs_float_lsb: float | None = None
+    warnings: list = field(default_factory=list)
+
+    def row(self) -> dict:
+        def f(x, nd=6):
+            return "" if x is None else f"{x:.{nd}g}"
+        return {"sensor": self.sensor, "status": self.status, "reason": self.reason,
+                "max_error_mm": f(self.max_error_mm), "ratio_to_limit": f(self.ratio_to_limit, 4),
+                "limit_mm": f(self.limit_mm), "raw_max_error_mm": f(self.raw_max_error_mm),
+                "twin_vs_float_lsb": f(self.twin_vs_float_lsb, 4), "recording": self.recording}
+
+
+def train_for_design(rec, fam: FamilySpec):
+    """(model, member spec): the least ridge whose weights fit the design's formats."""
+    last = None
+    for ridge in RIDGES:
+        model = train_model(rec, fam.terms, ridge)
+        try:
+            return model, member_spec(fam, model, hashlib.sha256(model.to_json().encode()).hexdigest())
+        except FitError as exc:
+            last = exc
+    raise last
+
+
+def physical_limit_mm(model, voltage_v, lsb_v: float) -> np.ndarray:
+    """Half an input LSB divided by the local slope dv/dx (from the model's dx/dv), per point."""
+    v = np.asarray(voltage_v, dtype=float)
+    dxdv = (model.predict(v + lsb_v / 2) - model.predict(v - lsb_v / 2)) / lsb_v
+    return 0.5 * lsb_v * np.abs(dxdv)
+
+
+def check_sensor(rec, fam: FamilySpec) -> dict:
+    """Train, quantise and check one sensor's recordings against the family design's twin."""
+    model, spec = train_for_design(rec, fam)
+    words = FlannFamilyMem.encode(fam, spec)
+    twin = FlannFamilyTop(fam, words)
+    s = fam.spec
+    codes = twin.all_codes()
+    out, sat = twin.process(codes)
+    q, lsb = s.output_lsb_mm, s.input_lsb_v
+    inside = (codes >= spec.clamp_lo) & (codes <= spec.clamp_hi)
+    ref = model.predict(codes * lsb) / q
+    twin_err = float(np.max(np.abs(out - ref)[inside]))
+    bound = float(spec.analysis["bound_total_lsb"])
+    # the recording through the hardware: ADC code of each voltage, the twin's output
+    v, x = rec.voltage_v, rec.displacement_mm
+    rc = np.clip(np.floor(v / lsb + 0.5).astype(np.int64), s.code_min, s.code_max)
+    hw_mm = out[rc - s.code_min] * q
+    err = hw_mm - x
+    raw_err = raw_output_mm(v, x) - x
+    limit = physical_limit_mm(model, v, lsb)
+    return {"model": model, "spec": spec, "words": words, "codes": codes, "out": out, "sat": sat,
+            "twin_err_lsb": twin_err, "bound_lsb": bound, "hw_err_mm": err, "raw_err_mm": raw_err,
+            "limit_mm": limit, "rec": rec}
+
+
+def _diagnosis(rec, sensor) -> list[str]:
+    """The diagnosis' findings as sentences (warnings for the certificate, never a failure)."""
+    from ..diagnose import diagnose  # heavy (scipy): only when calibrating
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            dg = diagnose(rec, sensor=sensor)
+        except FlannError as exc:
+            return [f"diagnosis not possible: {exc}"]
+    found = [f"{e.name}: {e.explanation}" for e in dg.effects]
+    found += list(dg.notes)
+    if dg.outliers:
+        found.append(f"{len(dg.outliers)} outlier point(s)")
+    found += [f"warning: {w.message}" for w in caught]
+    return found
+
+
+def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
+                  max_error_mm: float | None = None) -> Result:
+    """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row."""
+    path = Path(path)
+    res = Result(sensor=path.stem, recording=str(path))
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rec = read_recordings(path)
+            chk = check_sensor(rec, fam)
+        res.warnings += [str(w.message) for w in caught]
+        res.twin_vs_float_lsb = chk["twin_err_lsb"]
+        res.max_error_mm = float(np.max(np.abs(chk["hw_err_mm"])))
+        res.raw_max_error_mm = float(np.max(np.abs(chk["raw_err_mm"])))
+        res.limit_mm = float(np.max(chk["limit_mm"]))
+        res.ratio_to_limit = res.max_error_mm / res.limit_mm if res.limit_mm > 0 else math.inf
+        if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
+            raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
+                             f"the bound {chk['bound_lsb']:.3g} LSB")
+        if max_error_mm is not None and res.max_error_mm > max_error_mm:
+            raise FlannError(f"hardware max error {res.max_error_mm:.4g} mm > --max-error-mm {max_error_mm:g}")
+        sensor = None
+        if sensor_toml is not None:
+            from ..physics.sensor import load_sensor  # only with --sensor
+
+            sensor = load_sensor(sensor_toml)
+        findings = _diagnosis(rec, sensor)
+        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings)
+        res.status, res.reason = "ok", ""
+    except FlannError as exc:
+        res.status, res.reason = "failed", str(exc)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
+        res.status, res.reason = "failed", f"{exc.__class__.__name__}: {exc}"
+    return res
+
+
+def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings) -> None:
+    model, words = chk["model"], chk["words"]
+    model_json = model.to_json()
+    mhash = hashlib.sha256(model_json.encode()).hexdigest()
+    head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
+            f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
+    html = render_certificate(res, chk, fam, dhash, mhash, findings)
+    with atomic_directory(dest) as tmp:
+        (tmp / "model.json").write_text(model_json, newline="")
+        (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
+        (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
+        (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")
+        (tmp / "certificate.html").write_text(html, newline="")
+
+
+# ------------------------------------------------------------------------------------------
+def _progress(done: int, total: int, failed: int, t0: float) -> None:
+    width = 30
+    k = int(width * done / max(1, total))
+    rate = done / max(1e-9, time.monotonic() - t0) * 60
+    sys.stderr.write(f"\r[{'#' * k}{'.' * (width - k)}] {done}/{total} sensors, {failed} failed, "
+                     f"{rate:.0f}/min")
+    sys.stderr.flush()
+
+
+def _worker_init() -> None:
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
+def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
+                    max_error_mm: float | None = None, progress: bool | None = None) -> list[Result]:
+    """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording."""
+    fam = load_design(design_dir)
+    dhash = design_hash(design_dir)
+    out_dir = Path(out_dir)
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise FlannError("no recordings given")
+    if jobs is not None and jobs < 1:
+        raise FlannError(f"-j {jobs}: must be >= 1")
+    jobs = jobs or os.cpu_count() or 1
+    if progress is None:
+        progress = sys.stderr.isatty()
+    results: dict[int, Result] = {}
+    seen: dict[str, int] = {}
+    todo = []
+    for i, p in enumerate(paths):
+        if p.stem in seen:  # two files would write the same folder
+            results[i] = Result(sensor=p.stem, recording=str(p),
+                                reason=f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
+        else:
+            seen[p.stem] = i
+            todo.append(i)
+    t0 = time.monotonic()
+    failed = sum(1 for r in results.values() if r.status != "ok")
+    args = (out_dir, fam, dhash, sensor_toml, max_error_mm)
+    if jobs == 1 or len(todo) == 1:
+        for i in todo:
+            results[i] = calibrate_one(paths[i], *args)
+            failed += results[i].status != "ok"
+            if progress:
+                _progress(len(results), len(paths), failed, t0)
+    else:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), initializer=_worker_init) as pool:
+            futs = {pool.submit(calibrate_one, paths[i], *args): i for i in todo}
+            for fut in as_completed(futs):
+                i = futs[fut]
+                results[i] = fut.result()
+                failed += results[i].status != "ok"
+                if progress:
+                    _progress(len(results), len(paths), failed, t0)
+    if progress:
+        sys.stderr.write("\n")
+    ordered = [results[i] for i in range(len(paths))]
+    write_summary(out_dir / SUMMARY, ordered)
+    return ordered
+
+
+def write_summary(path, results) -> None:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
+    w.writeheader()
+    for r in results:
+        w.writerow(r.row())
+    atomic_write_text(path, buf.getvalue())
+
+
+__all__ = ["calibrate_batch", "calibrate_one", "check_sensor", "train_for_design", "physical_limit_mm",
+           "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES"]

@@ -1,0 +1,89 @@
+"""flann calibrate on a small simulated batch with bad files (the 200-sensor batch is bench/bench_calibrate.py)."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from flann.cli import main
+from flann.golden.model import load_model
+from flann.hardware.family.render import load_design
+from flann.hardware.family.twin import FlannFamilyTop
+from flann.production.demo import bad_files, write_batch
+from flann.production.images import parse_hex
+from flann.recordings import read_recordings
+
+
+@pytest.fixture(scope="module")
+def batch(tmp_path_factory):
+    d = tmp_path_factory.mktemp("batch")
+    good = write_batch(d / "rec", 3, seed=7, points=600)
+    bad = bad_files(d / "rec")
+    design = d / "design"
+    assert main(["gen", "--family", *map(str, good[:2]), "-o", str(design), "--input-bits", "10"]) == 0
+    out = d / "out"
+    rc = main(["calibrate", *map(str, good + bad), "-o", str(out), "--design", str(design), "-j", "2"])
+    with open(out / "summary.csv", newline="") as fh:
+        rows = {r["sensor"]: r for r in csv.DictReader(fh)}
+    return {"good": good, "bad": bad, "design": design, "out": out, "rc": rc, "rows": rows}
+
+
+def test_batch_reports_bad_rows_and_goes_on(batch):
+    assert batch["rc"] == 2
+    rows = batch["rows"]
+    assert len(rows) == 6
+    for p in batch["bad"]:
+        r = rows[p.stem]
+        assert r["status"] == "failed" and r["reason"], r
+        assert not (batch["out"] / p.stem).exists(), "a failed sensor left files"
+    assert "voltage_v" in rows["bad_no_voltage"]["reason"]
+    assert "exceeds the design's input" in rows["bad_out_of_family"]["reason"]
+    for p in batch["good"]:
+        assert rows[p.stem]["status"] == "ok", rows[p.stem]
+    # nothing half-written: no temporary files or folders anywhere
+    assert not [p for p in batch["out"].rglob(".*")]
+
+
+def test_certificate_is_self_contained(batch):
+    for p in batch["good"]:
+        html = (batch["out"] / p.stem / "certificate.html").read_text()
+        assert "data:image/png;base64," in html
+        assert "<img" in html and 'src="http' not in html and "<script" not in html
+        man_hash = json.loads((batch["out"] / p.stem / "model.json").read_text())  # readable model
+        assert man_hash["terms"] == load_design(batch["design"]).terms
+        assert "physical limit" in html and "design sha256" in html
+
+
+def test_weight_image_reproduces_the_recording(batch):
+    """The hex image, through the design's twin, measures the recording as the summary says,
+    and stays within one output LSB of the float model written beside it."""
+    fam = load_design(batch["design"])
+    s = fam.spec
+    for p in batch["good"]:
+        d = batch["out"] / p.stem
+        words = parse_hex((d / "weights.hex").read_text())
+        assert len(words) == fam.mem_depth
+        twin = FlannFamilyTop(fam, words)
+        rec = read_recordings(p)
+        codes = np.clip(np.floor(rec.voltage_v / s.input_lsb_v + 0.5).astype(int), s.code_min, s.code_max)
+        out, _ = twin.process(codes)
+        model = load_model(d / "model.json")
+        ref = model.predict(codes * s.input_lsb_v)
+        assert np.max(np.abs(out * s.output_lsb_mm - ref)) <= s.output_lsb_mm
+        err = float(np.max(np.abs(out * s.output_lsb_mm - rec.displacement_mm)))
+        assert err == pytest.approx(float(batch["rows"][p.stem]["max_error_mm"]), rel=1e-4)
+        # the .mem file holds the same words
+        mem = (d / "weights.mem").read_text().split("@0000", 1)[1].split()
+        assert [int(w, 16) for w in mem] == words
+
+
+def test_duplicate_names_and_missing_design(batch, tmp_path, capsys):
+    p = batch["good"][0]
+    rc = main(["calibrate", str(p), str(p), "-o", str(tmp_path / "o"), "--design", str(tmp_path / "none")])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "Traceback" not in err
+    assert not (tmp_path / "o").exists()

@@ -1,0 +1,18 @@
+"""A command whose reader has gone (``flann ... | head``) exits quietly, without a traceback."""
+
+import os
+import subprocess
+import sys
+
+
+def test_closed_pipe_exits_quietly(default_model_json, tmp_path):
+    r, w = os.pipe()
+    os.close(r)  # the reader is gone before the first write
+    try:
+        p = subprocess.run([sys.executable, "-m", "flann.cli", "gen", str(default_model_json), "-o",
+                            str(tmp_path / "d"), "--json"], stdout=w, stderr=subprocess.PIPE, text=True,
+                           timeout=120)
+    finally:
+        os.close(w)
+    assert p.returncode == 141
+    assert "Traceback" not in p.stderr and "BrokenPipe" not in p.stderr, p.stderr

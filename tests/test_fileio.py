@@ -1,0 +1,42 @@
+"""The atomic writers leave no temporary file behind and respect the umask (not mkstemp's 0600)."""
+
+import os
+import stat
+
+import pytest
+
+from flann.fileio import atomic_save_figure, atomic_write_json, atomic_write_text
+
+
+@pytest.fixture
+def umask_027():
+    old = os.umask(0o027)
+    yield
+    os.umask(old)
+
+
+def test_files_get_the_umask_permissions(tmp_path, umask_027):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    atomic_write_text(tmp_path / "a.txt", "x\n")
+    atomic_write_json(tmp_path / "b.json", {"a": 1})
+    fig = plt.figure()
+    atomic_save_figure(fig, tmp_path / "c.png")
+    plt.close(fig)
+    for name in ("a.txt", "b.json", "c.png"):
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o640, name
+    assert (tmp_path / "c.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.json", "c.png"]
+
+
+def test_failed_write_leaves_nothing(tmp_path):
+    class Boom:
+        def savefig(self, *a, **k):
+            raise RuntimeError("boom")
+
+    with pytest.raises(RuntimeError):
+        atomic_save_figure(Boom(), tmp_path / "x.png")
+    assert list(tmp_path.iterdir()) == []
