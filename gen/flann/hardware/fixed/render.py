@@ -21,6 +21,8 @@ from ..options import GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
+# the entities' templates; a variant the spec chooses is a fragment in a sub-folder
+TEMPLATES = "hardware/fixed/templates"
 # compile order
 ENTITIES = (
     ("flann_norm", "input clamp and normalisation (serial code x constant)"),
@@ -66,14 +68,17 @@ def contexts(spec: Spec) -> dict[str, dict]:
     slope_bits, kx, slope_reg = s.slope_rom_bits, s.interp_digit, s.slope_reg_bits
     icnt_bits = _ubits(slope_reg // kx + 1)
     expansion = dict(
-        common, delta_even=de, delta_odd=do, lanes_odd=(L % 2 == 1),
+        common, delta_even=de, delta_odd=do,
+        fragments=f"{TEMPLATES}/expansion/interp/{s.interp_style}",
+        parity=f"{TEMPLATES}/expansion/parity/{'alternate' if s.lane_kind_alternates else 'fixed'}.vhd.j2",
+        slope_round=f"{TEMPLATES}/expansion/slope_round/{'half_up' if s.slope_guard > 0 else 'exact'}.vhd.j2",
+        interp_note="; a slope table corrects to first order inside a bin" if s.interp else "",
         mult_bits=_ubits(max([de, do, *starts])),
         start_mults=", ".join(f"{l} => {x}" for l, x in enumerate(starts)),
         start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
         quarter=bits_literal(1 << (P - 2), P, False),
         table_depth=1 << A, addr_bits=A, offset_bits=s.offset_bits, dq_bits=s.dq_bits,
-        value_bits=s.value_fmt.width, slope_bits=slope_bits, interp=s.interp,
-        serial_interp=s.serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
+        value_bits=s.value_fmt.width, slope_bits=slope_bits, interp_digit=kx, slope_reg_bits=slope_reg,
         interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
         prod_bits=s.interp_prod_bits,
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
@@ -87,7 +92,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, style=s.mult_style, fragments=f"hardware/fixed/templates/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
@@ -100,7 +105,8 @@ def contexts(spec: Spec) -> dict[str, dict]:
     Pf = s.product_fmt.frac_bits
     adder = dict(
         common, acc_bits=AB, out_bits=s.out_fmt.width, acc_frac=Pf,
-        acc_half=(1 << (Pf - 1)) if Pf > 0 else 0, output_lsb_mm=s.output_lsb_mm,
+        acc_half=(1 << (Pf - 1)) if Pf > 0 else 0,
+        round=f"{TEMPLATES}/adder/round/{'half_up' if Pf > 0 else 'exact'}.vhd.j2", output_lsb_mm=s.output_lsb_mm,
         out_max=bits_literal(s.out_fmt.max_int, AB + 1), out_min=bits_literal(s.out_fmt.min_int, AB + 1),
     )
     if s.out_fmt.width > AB + 1:
@@ -122,7 +128,7 @@ def render(spec: Spec) -> dict[str, str]:
     for name, title in ENTITIES:
         header = dict(file=f"{name}.vhd", title=title, command="flann gen", version=__version__,
                       model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
-        out[f"{name}.vhd"] = template(f"hardware/fixed/templates/{name}.vhd.j2").render(h=header, **ctx[name])
+        out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=header, **ctx[name])
     return out
 
 
