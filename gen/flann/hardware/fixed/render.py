@@ -1,21 +1,21 @@
 """Render the VHDL-93 entities of a :class:`~flann.hardware.fixed.spec.Spec` and write ``manifest.json``.
 
 Layer 3: one context dict per entity, computed here (widths, literals checked to fit,
-names), one template per entity in ``flann/templates``; templates only place text.
+names), one template per entity in ``hardware/fixed/templates``; templates only place text,
+and an architecture choice the spec makes picks a fragment from a sub-folder there.
 Output is deterministic: no timestamps, a header with generator version, model sha256
 and the spec, so regenerating gives identical bytes.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from ... import __version__
 from ...errors import SpecError
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..header import header
 from ..manifest import MANIFEST, read_manifest, write_design
 from ..options import GenOptions
 from .spec import Spec, derive_spec
@@ -37,10 +37,6 @@ ENTITIES = (
 def _ubits(n: int) -> int:
     """Width of an unsigned counter holding 0..n."""
     return max(1, int(n).bit_length())
-
-
-def spec_lines(spec: Spec) -> list[str]:
-    return [f"{k} = {json.dumps(v)}" for k, v in spec.to_dict().items()]
 
 
 def contexts(spec: Spec) -> dict[str, dict]:
@@ -126,9 +122,8 @@ def render(spec: Spec) -> dict[str, str]:
     ctx = contexts(spec)
     out = {}
     for name, title in ENTITIES:
-        header = dict(file=f"{name}.vhd", title=title, command="flann gen", version=__version__,
-                      model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
-        out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=header, **ctx[name])
+        h = header(f"{name}.vhd", title, "flann gen", spec.to_dict(), spec.model_sha256)
+        out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import json
-
 from ... import __version__
 from ...numeric.fixed import bits_literal
 from ...textgen import template
+from ..header import header
 from ..manifest import write_design
 from .spec import ENTITY, SeedSpec
 
@@ -33,17 +32,12 @@ def context(s: SeedSpec) -> dict:
     )
 
 
-def header(s: SeedSpec) -> dict:
-    return dict(
-        file=SEED_FILE, title="the seed paper's FLANN architecture, fully parallel, for comparison only",
-        command="flann explore", version=__version__, model_sha256=s.model_sha256 or "(not from a file)",
-        spec_lines=[f"{k} = {json.dumps(v)}" for k, v in s.to_dict().items()],
-    )
-
-
 def render(s: SeedSpec) -> dict[str, str]:
     """{file name: VHDL text}."""
-    text = template("hardware/seed/templates/seed_parallel.vhd.j2").render(h=header(s), **context(s))
+    text = template("hardware/seed/templates/seed_parallel.vhd.j2").render(
+        h=header(SEED_FILE, "the seed paper's FLANN architecture, fully parallel, for comparison only",
+                 "flann explore", s.to_dict(), s.model_sha256),
+        **context(s))
     return {SEED_FILE: text}
 
 
