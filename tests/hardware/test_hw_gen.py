@@ -80,6 +80,16 @@ def test_templates_only_place_computed_text(model_file):
         assert "{{" not in t and "{%" not in t
 
 
+@pytest.mark.parametrize("entity,signal,fmt", [
+    ("flann_adder", "acc", "acc_fmt"), ("flann_adder", "data_r", "out_fmt"), ("flann_norm", "lin_r", "lin_fmt"),
+])
+def test_signals_are_declared_in_their_formats_width_and_sign(model_file, entity, signal, fmt):
+    spec = derive_spec(load_model(model_file), lanes=2)
+    decl = re.search(rf"signal {signal}\s+: (signed|unsigned)\((\d+) downto 0\);", render(spec)[f"{entity}.vhd"])
+    f = getattr(spec, fmt)
+    assert decl and int(decl[2]) + 1 == f.width and (decl[1] == "signed") == f.signed
+
+
 FIXED_TEMPLATES = REPO / "gen" / "flann" / "hardware" / "fixed" / "templates"
 
 

@@ -49,9 +49,10 @@ def contexts(spec: Spec) -> dict[str, dict]:
     lin_bits = s.lin_fmt.width
     NV = P + s.norm_guard
 
-    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits)
+    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits,
+                  term_type=s.term_fmt.vhdl_type)
     norm = dict(
-        code_bits=B, phase_bits=P, lin_bits=lin_bits, acc_v_bits=NV, acc_l_bits=s.lin_width,
+        code_bits=B, phase_bits=P, lin_bits=lin_bits, lin_type=s.lin_fmt.vhdl_type, acc_v_bits=NV, acc_l_bits=s.lin_width,
         guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
         ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
@@ -74,7 +75,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
         start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
         quarter=bits_literal(1 << (P - 2), P, False),
         table_depth=1 << A, addr_bits=A, offset_bits=s.offset_bits, dq_bits=s.dq_bits,
-        value_bits=s.value_fmt.width, slope_bits=slope_bits, interp_digit=kx, slope_reg_bits=slope_reg,
+        value_bits=s.value_fmt.width, value_type=s.value_fmt.vhdl_type, slope_bits=slope_bits, interp_digit=kx, slope_reg_bits=slope_reg,
         interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
         prod_bits=s.interp_prod_bits,
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
@@ -89,6 +90,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
         common, style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        weight_type=s.weight_fmt.vhdl_type, product_type=s.product_fmt.vhdl_type,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
@@ -101,6 +103,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     Pf = s.product_fmt.frac_bits
     adder = dict(
         common, acc_bits=AB, out_bits=s.out_fmt.width, acc_frac=Pf,
+        acc_type=s.acc_fmt.vhdl_type, out_type=s.out_fmt.vhdl_type,
         acc_half=(1 << (Pf - 1)) if Pf > 0 else 0,
         round=f"{TEMPLATES}/adder/round/{'half_up' if Pf > 0 else 'exact'}.vhd.j2", output_lsb_mm=s.output_lsb_mm,
         out_max=bits_literal(s.out_fmt.max_int, AB + 1), out_min=bits_literal(s.out_fmt.min_int, AB + 1),

@@ -17,7 +17,8 @@ def context(s: SeedSpec) -> dict:
     wd = s.widths
     wf = s.word_fmt
     return dict(
-        entity=ENTITY, terms=s.terms, n_adders=s.n_adders, word=W, latency=s.latency_cycles,
+        entity=ENTITY, terms=s.terms, n_adders=s.n_adders, word=W, word_type=wf.vhdl_type,
+        latency=s.latency_cycles,
         in_bits=s.input_bits, shift=s.shift, norm_guard=s.norm_guard,
         clamp_lo=bits_literal(s.clamp_lo, s.input_bits), clamp_hi=bits_literal(s.clamp_hi, s.input_bits),
         ka=bits_literal(s.ka, wd["ka_bits"]), kb=bits_literal(s.kb, wd["norm_bits"]),
