@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..fileio import atomic_save_figure
 from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
@@ -209,7 +210,7 @@ def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     for ax in axes.flat:
         ax.grid(True)
     fig.tight_layout()
-    fig.savefig(outdir / "fig5.png", dpi=80)
+    atomic_save_figure(fig, outdir / "fig5.png", dpi=80)
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -220,7 +221,7 @@ def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     ax.legend()
     ax.grid(True)
     fig.tight_layout()
-    fig.savefig(outdir / "between_points_51.png", dpi=80)
+    atomic_save_figure(fig, outdir / "between_points_51.png", dpi=80)
     plt.close(fig)
     return ["fig5.png", "between_points_51.png"]
 

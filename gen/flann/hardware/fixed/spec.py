@@ -159,6 +159,11 @@ class Spec:
         """Harmonic of lane ``lane``'s first term (j = lane)."""
         return self.trig_term(lane)[1]
 
+    @property
+    def lane_kind_alternates(self) -> bool:
+        """Whether a lane's next term is of the other kind (sin <-> cos) than its current one."""
+        return self.trig_term(self.lanes)[0] != self.trig_term(0)[0]
+
     # -- expansion architecture ---------------------------------------------------------
     @property
     def offset_bits(self) -> int:
@@ -174,6 +179,14 @@ class Spec:
         """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope
         product is formed serially then (one cycle copies the slope, the rest iterate)."""
         return self.interp and self.mult_style == "shiftadd" and self.adv_period >= 3
+
+    @property
+    def interp_style(self) -> str:
+        """The expansion's table interpolation: 'plain' (none), 'array' (an offset x slope
+        array multiplier) or 'serial' (the same product formed serially between advances)."""
+        if not self.interp:
+            return "plain"
+        return "serial" if self.serial_interp else "array"
 
     @property
     def interp_digit(self) -> int:
