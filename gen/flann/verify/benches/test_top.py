@@ -6,7 +6,7 @@ import cocotb
 import numpy as np
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
 
-from flann_bench import TopBench, reset, write_record
+from flann.verify.benches.flann_bench import TopBench, reset, write_record
 
 
 def _codes(bench: TopBench) -> list[int]:
