@@ -34,6 +34,8 @@ from ..hardware.fixed.spec import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
 from .benches import BENCH_DIR, CONFIG_ENV
 from .design import Design
+from .netlist import check_netlist
+from .shards import count_lines, cores, merge, read_results, split
 
 # bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
 BENCHES = {
@@ -64,10 +66,6 @@ def ghdl_backend() -> str:
     r = subprocess.run(["ghdl", "--version"], capture_output=True, text=True,
                        env={**os.environ, "GHDL_BACKEND": "llvm"})
     return "llvm" if "llvm" in r.stdout.lower() else "mcode"
-
-
-def cores() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
 
 
 @dataclass
@@ -201,11 +199,6 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
                       parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
 
 
-def _shards(lo: int, hi: int, n: int) -> list[tuple[int, int]]:
-    edges = np.linspace(lo, hi + 1, n + 1).round().astype(int)
-    return [(int(a), int(b) - 1) for a, b in zip(edges[:-1], edges[1:]) if b > a]
-
-
 def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, shards: int | None = None,
           backend: str | None = None, progress=None) -> dict:
     """Every input code (or the range ``codes``) through the VHDL sweep harness, one shard per core.
@@ -224,7 +217,7 @@ def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, sh
     t0 = time.monotonic()
     backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
     t_build = time.monotonic() - t0
-    parts = _shards(lo, hi, shards or min(cores(), max(1, total // 256)))
+    parts = split(lo, hi, shards or min(cores(), max(1, total // 256)))
     shard_cfg = [{"lo": a, "hi": b, "file": str(build_dir / f"sweep_{k}.txt")} for k, (a, b) in enumerate(parts)]
     for k, s in enumerate(shard_cfg):  # one configuration file per shard (the bench's only channel)
         (build_dir / f"bench_config_{k}.json").write_text(
@@ -248,42 +241,12 @@ def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, sh
             t.join(0.5)
             break
         if progress:
-            progress(sum(_count_lines(f) for f in files), total, time.monotonic() - t1)
+            progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
     seconds = time.monotonic() - t1
     bench = _result("sweep", [r for r in results if r is not None], records, time.monotonic() - t0)
-    from .benches.test_sweep import read_sweep  # the bench's own reader (imports cocotb: lazy)
-
-    got = [read_sweep(f) if f.is_file() else read_sweep_empty() for f in files]
-    return {"bench": bench, "codes": np.concatenate([g["codes"] for g in got]),
-            "data": np.concatenate([g["data"] for g in got]), "sat": np.concatenate([g["sat"] for g in got]),
+    got = merge([read_results(f) for f in files])
+    return {"bench": bench, "codes": got["codes"], "data": got["data"], "sat": got["sat"],
             "backend": backend, "shards": len(parts), "seconds": seconds, "build_seconds": t_build}
-
-
-def read_sweep_empty() -> dict:
-    z = np.zeros(0, dtype=np.int64)
-    return {"codes": z, "data": z, "sat": z.astype(bool), "latency": z}
-
-
-def _count_lines(path: Path) -> int:
-    try:
-        with open(path, "rb") as fh:
-            return sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 16), b""))
-    except OSError:
-        return 0
-
-
-def terminal_progress(label: str):
-    """A progress callback for stderr on a terminal (None otherwise)."""
-    if not sys.stderr.isatty():
-        return None
-
-    def show(done: int, total: int, elapsed: float) -> None:
-        rate = done / elapsed if elapsed > 0 else 0.0
-        left = f"{(total - done) / rate:.0f} s left" if rate > 0 else "starting"
-        end = "\n" if done >= total else ""
-        print(f"\r{label}: {done}/{total} codes, {rate:.0f} codes/s, {left}   ", end=end, file=sys.stderr, flush=True)
-
-    return show
 
 
 def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
@@ -323,8 +286,6 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
                                     "seconds": round(r.seconds, 1)} for r in results}
     all_ok = all(r.ok for r in results)
     if netlist:
-        from .netlist import check_netlist
-
         nl = check_netlist(design, build_dir / "netlist", progress=progress("netlist") if progress else None)
         summary["netlist"] = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"],
                               "simulator": nl["simulator"], "seconds": round(nl["seconds"], 1)}
@@ -373,4 +334,4 @@ def plot(curve: dict, spec, path) -> None:
 
 
 __all__ = ["run_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
-           "ghdl_backend", "terminal_progress"]
+           "ghdl_backend"]

@@ -10,14 +10,7 @@ from cocotb.triggers import RisingEdge
 from flann.hardware.fixed.twin import FlannTop
 from flann.verify.benches import config
 from flann.verify.benches.flann_bench import load_spec, write_record
-
-
-def read_sweep(path) -> dict:
-    """The harness's lines "code data sat latency" as arrays."""
-    rows = np.loadtxt(path, dtype=np.int64, ndmin=2)
-    if rows.size == 0:
-        rows = np.zeros((0, 4), dtype=np.int64)
-    return {"codes": rows[:, 0], "data": rows[:, 1], "sat": rows[:, 2].astype(bool), "latency": rows[:, 3]}
+from flann.verify.shards import read_results
 
 
 @cocotb.test()
@@ -27,7 +20,7 @@ async def sweep_vs_twin(dut):
     shard = cfg["shard"]
     await RisingEdge(dut.done)
     spec = load_spec(cfg)
-    got = read_sweep(shard["file"])
+    got = read_results(shard["file"])
     want = np.arange(shard["lo"], shard["hi"] + 1, dtype=np.int64)
     out, sat = FlannTop(spec).process(got["codes"])
     bad = (got["data"] != out) | (got["sat"] != sat)
