@@ -109,8 +109,9 @@ def _runner(backend: str):
 
 
 def build(sources, toplevel: str, build_dir, backend: str | None = None) -> str:
-    """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used."""
-    backend = backend or ghdl_backend()
+    """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used
+    (default mcode: the cocotb benches are short, and mcode compiles in a second)."""
+    backend = backend or "mcode"
     build_dir = Path(build_dir).resolve()
     build_dir.mkdir(parents=True, exist_ok=True)
     args = ["--std=93c"] + (["-O2"] if backend == "llvm" else [])
@@ -201,23 +202,28 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
 
 def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, shards: int | None = None,
           backend: str | None = None, progress=None) -> dict:
-    """Every input code (or the range ``codes``) through the VHDL sweep harness, one shard per core.
+    """Every input code (or the range ``codes`` = (lo, hi), or a list of such ranges, one shard
+    each) through the VHDL sweep harness, one shard per core.
 
     Returns {"bench": BenchResult, "codes", "data", "sat" (arrays in code order), "backend",
     "seconds", "build_seconds"}.  ``progress(done, total, elapsed_s)`` is called about twice a
     second while the shards run.
     """
     man = design.manifest
-    lo, hi = codes if codes is not None else (-(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1)
-    total = hi - lo + 1
+    ranges = list(codes) if isinstance(codes, list) else None  # given ranges, one shard each
+    lo, hi = codes if codes is not None and ranges is None else (-(1 << (man["input_bits"] - 1)),
+                                                                 (1 << (man["input_bits"] - 1)) - 1)
+    total = sum(b - a + 1 for a, b in ranges) if ranges else hi - lo + 1
     build_dir = Path(build_dir).resolve() / "sweep"
     if build_dir.exists():
         shutil.rmtree(build_dir)
     records = build_dir / "records"
     t0 = time.monotonic()
+    # LLVM spends ~10 s more than mcode compiling and runs ~2.6x faster: worth it for long runs only
+    backend = backend or (ghdl_backend() if total * man["cycles_per_sample"] > 2_000_000 else "mcode")
     backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
     t_build = time.monotonic() - t0
-    parts = split(lo, hi, shards or min(cores(), max(1, total // 256)))
+    parts = ranges or split(lo, hi, shards or min(cores(), max(1, total // 256)))
     shard_cfg = [{"lo": a, "hi": b, "file": str(build_dir / f"sweep_{k}.txt")} for k, (a, b) in enumerate(parts)]
     for k, s in enumerate(shard_cfg):  # one configuration file per shard (the bench's only channel)
         (build_dir / f"bench_config_{k}.json").write_text(
