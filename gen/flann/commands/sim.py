@@ -32,6 +32,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--netlist", action="store_true",
                         help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
                              "netlist over every input code (Verilator, Yosys's Xilinx cell models)")
+    parser.add_argument("--engine", choices=("ghdl", "verilator"), default="ghdl",
+                        help="every input code through: ghdl = the VHDL under GHDL (default); verilator = GHDL's "
+                             "synthesised netlist compiled by Verilator (~50x faster), the VHDL on a sample")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     parser.add_argument("--plot", metavar="OUT.png", default=None,
                         help="HDL vs golden model across the input range and their difference (PNG)")
@@ -52,7 +55,8 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, spec_options(args), model=args.design_model)
-        res = simulate(design, build, seed=args.seed, netlist=args.netlist, progress=terminal_progress)
+        res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
+                       progress=terminal_progress)
         s = res["summary"]
         if args.plot and res["curve"] is not None:
             plot(res["curve"], res["spec"], args.plot)
@@ -62,9 +66,12 @@ def run(args) -> int:
         print(json.dumps(s, indent=2))
     else:
         print(f"design                  {s['design']}")
+        sw = s.get("sweep") or {}
+        how = sw.get("backend") or "Verilator on GHDL's synthesised netlist"
         print(f"input codes tested      {s['codes_tested']}"
-              + (f" ({s['sweep']['codes_per_s']} codes/s, {s['sweep']['backend']}, {s['sweep']['shards']} shard(s))"
-                 if s.get("sweep") else ""))
+              + (f" ({sw['codes_per_s']} codes/s, {how}, {sw['shards']} shard(s))" if sw else ""))
+        if sw.get("vhdl_sample"):
+            print(f"  VHDL under GHDL       {sw['vhdl_sample']['codes']} codes (sample)")
         print(f"bit mismatches vs twin  {s['mismatches']}")
         if s["max_err_lsb"] is not None:
             print(f"max |HDL - float model| {s['max_err_lsb']:.4f} LSB = {s['max_err_mm']:.6f} mm "

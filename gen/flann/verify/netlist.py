@@ -57,8 +57,9 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     return work / synth.NETLIST
 
 
-def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int) -> Path:
-    """Verilator model of ``netlist`` with the Xilinx cell models and the sweep driver."""
+def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cells: bool = True) -> Path:
+    """Verilator model of ``netlist`` with the sweep driver (and the Xilinx cell models for a
+    mapped netlist; GHDL's own Verilog has no cells)."""
     exe_tool = shutil.which("verilator")
     if exe_tool is None:
         raise FlannError("verilator not found on PATH (Debian package verilator; `make tools` installs it)")
@@ -66,8 +67,8 @@ def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int) -> 
     if build.exists():
         shutil.rmtree(build)
     build.mkdir(parents=True)
-    cells = yosys_datdir() / "xilinx" / "cells_sim.v"
-    cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), str(cells), str(BENCH_DIR / RAM_MODELS),
+    models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
+    cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *models,
            "--top-module", "flann_top", "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
            "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
            "-CFLAGS", f"-DIN_BITS={in_bits} -DOUT_BITS={out_bits}"]
@@ -133,11 +134,27 @@ def check_netlist(design: Design, build, netlist: Path | None = None, progress=N
     return res
 
 
+def check_rtl_netlist(design: Design, build, progress=None) -> dict:
+    """Every input code through GHDL's own synthesis of the VHDL (``ghdl --synth``, repaired, the
+    text Yosys maps), compiled by Verilator: the fast exhaustive engine (``flann sim --engine
+    verilator``).  Returns the arrays in code order as the VHDL sweep does, plus timings."""
+    build = Path(build).resolve()
+    build.mkdir(parents=True, exist_ok=True)
+    t0 = time.monotonic()
+    man = design.manifest
+    verilog = synth.ghdl_to_verilog(synth.read_manifest(design.directory), build / "ghdl_synth")
+    exe = compile_netlist(verilog, build / "verilator", man["input_bits"], man["output_bits"], cells=False)
+    t_build = time.monotonic() - t0
+    lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1
+    got = run_netlist(exe, lo, hi, build, shards=cores(), progress=progress)
+    return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1)}
+
+
 def check_synthesized(design: Design, netlist: Path) -> dict:
     """``flann synth``'s check of the netlist it just counted (temporary build directory)."""
     with tempfile.TemporaryDirectory(prefix="flann-netlist-") as tmp:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["check_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

@@ -34,7 +34,7 @@ from ..hardware.fixed.spec import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
 from .benches import BENCH_DIR, CONFIG_ENV
 from .design import Design
-from .netlist import check_netlist
+from .netlist import check_netlist, check_rtl_netlist
 from .shards import count_lines, cores, merge, read_results, split
 
 # bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
@@ -200,20 +200,25 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
                       parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
 
 
-def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, shards: int | None = None,
+def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
           backend: str | None = None, progress=None) -> dict:
-    """Every input code (or the range ``codes`` = (lo, hi), or a list of such ranges, one shard
-    each) through the VHDL sweep harness, one shard per core.
+    """Input codes through the VHDL sweep harness, in shards run side by side (one per core).
 
-    Returns {"bench": BenchResult, "codes", "data", "sat" (arrays in code order), "backend",
-    "seconds", "build_seconds"}.  ``progress(done, total, elapsed_s)`` is called about twice a
-    second while the shards run.
+    ``codes``: None = every input code; (lo, hi) = that range; a list or array = those codes
+    (handed to the harness in a file).  Returns {"bench": BenchResult, "codes", "data", "sat",
+    "latency" (arrays in the order simulated), "backend", "shards", "seconds", "build_seconds"}.
+    ``progress(done, total, elapsed_s)`` is called about twice a second while the shards run.
     """
     man = design.manifest
-    ranges = list(codes) if isinstance(codes, list) else None  # given ranges, one shard each
-    lo, hi = codes if codes is not None and ranges is None else (-(1 << (man["input_bits"] - 1)),
-                                                                 (1 << (man["input_bits"] - 1)) - 1)
-    total = sum(b - a + 1 for a, b in ranges) if ranges else hi - lo + 1
+    half = 1 << (man["input_bits"] - 1)
+    listed = codes is not None and not isinstance(codes, tuple)
+    if listed:
+        todo = np.asarray(codes, dtype=np.int64)
+        total = int(todo.size)
+    else:
+        lo, hi = codes if codes is not None else (-half, half - 1)
+        total = hi - lo + 1
+    n_shards = shards or min(cores(), max(1, total // 256))
     build_dir = Path(build_dir).resolve() / "sweep"
     if build_dir.exists():
         shutil.rmtree(build_dir)
@@ -223,21 +228,30 @@ def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, sh
     backend = backend or (ghdl_backend() if total * man["cycles_per_sample"] > 2_000_000 else "mcode")
     backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
     t_build = time.monotonic() - t0
-    parts = ranges or split(lo, hi, shards or min(cores(), max(1, total // 256)))
-    shard_cfg = [{"lo": a, "hi": b, "file": str(build_dir / f"sweep_{k}.txt")} for k, (a, b) in enumerate(parts)]
+    shard_cfg = []
+    if listed:
+        for k, chunk in enumerate(c for c in np.array_split(todo, n_shards) if c.size):
+            cf = build_dir / f"codes_{k}.txt"
+            cf.write_text("".join(f"{int(c)}\n" for c in chunk))
+            shard_cfg.append({"codes": [int(c) for c in chunk], "codes_file": str(cf)})
+    else:
+        shard_cfg = [{"lo": a, "hi": b} for a, b in split(lo, hi, n_shards)]
     for k, s in enumerate(shard_cfg):  # one configuration file per shard (the bench's only channel)
+        s.update(name=f"sweep_{k}", file=str(build_dir / f"sweep_{k}.txt"))
         (build_dir / f"bench_config_{k}.json").write_text(
             json.dumps({**_bench_config(design), "records_dir": str(records), "shard": s}))
-    results: list = [None] * len(parts)
+    results: list = [None] * len(shard_cfg)
 
     def one(k: int) -> None:
         s = shard_cfg[k]
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "code_lo_g": s["lo"],
-                  "code_hi_g": s["hi"], "out_file_g": s["file"]}
+        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"],
+                  "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
+        if "codes_file" in s:
+            params["codes_file_g"] = s["codes_file"]
         results[k] = _test(build_dir, "flann_sweep", "test_sweep", backend, build_dir / f"bench_config_{k}.json",
                            str(k), params, [], None, 1)
 
-    threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(parts))]
+    threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(shard_cfg))]
     t1 = time.monotonic()
     for t in threads:
         t.start()
@@ -251,14 +265,52 @@ def sweep(design: Design, build_dir, *, codes: tuple[int, int] | None = None, sh
     seconds = time.monotonic() - t1
     bench = _result("sweep", [r for r in results if r is not None], records, time.monotonic() - t0)
     got = merge([read_results(f) for f in files])
-    return {"bench": bench, "codes": got["codes"], "data": got["data"], "sat": got["sat"],
-            "backend": backend, "shards": len(parts), "seconds": seconds, "build_seconds": t_build}
+    return {"bench": bench, **got, "backend": backend, "shards": len(shard_cfg), "seconds": seconds,
+            "build_seconds": t_build}
+
+
+ENGINES = ("ghdl", "verilator")
+
+
+def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple[dict, dict]:
+    """Every input code: (the VHDL sweep's result, the outputs of every code with a description).
+
+    engine "ghdl": the VHDL itself under GHDL, every code.  engine "verilator": every code through
+    GHDL's synthesis of the VHDL compiled by Verilator (the netlist Yosys maps), and the VHDL
+    under GHDL on a sample (random windows, the clamp edges, both ends of the range), so the
+    compiled netlist is tied to the VHDL's own simulation on every run.
+    """
+    man = design.manifest
+    if engine == "ghdl":
+        sw = sweep(design, build_dir, progress=progress("sweep") if progress else None)
+        about = {"engine": "ghdl", "backend": f"ghdl-{sw['backend']}", "shards": sw["shards"],
+                 "seconds": round(sw["seconds"], 1), "build_seconds": round(sw["build_seconds"], 1),
+                 "codes_per_s": round(sw["codes"].size / sw["seconds"], 1) if sw["seconds"] else None}
+        return sw, {**{k: sw[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
+    if engine != "verilator":
+        raise FlannError(f"engine {engine!r}: must be one of {', '.join(ENGINES)}")
+    nl = check_rtl_netlist(design, build_dir / "rtl_netlist", progress=progress("sweep") if progress else None)
+    lo, hi = int(nl["codes"].min()), int(nl["codes"].max())
+    rng = np.random.default_rng(int(man["model_sha256"][:8], 16) if man.get("model_sha256") else 1)
+    c_lo, c_hi = man["clamp_codes"]
+    sample = {lo, lo + 1, hi - 1, hi, -1, 0, 1}
+    sample |= {c + d for c in (c_lo, c_hi) for d in range(-3, 4)}
+    sample |= {int(c) for c in rng.integers(lo, hi + 1, 200)}
+    sw = sweep(design, build_dir, codes=sorted(c for c in sample if lo <= c <= hi))
+    about = {"engine": "verilator", "netlist": "ghdl --synth --out=verilog (repaired), Verilator",
+             "shards": nl["shards"], "seconds": round(nl["seconds"], 1), "build_seconds": round(nl["build_seconds"], 1),
+             "codes_per_s": round(nl["codes"].size / nl["seconds"], 1) if nl["seconds"] else None,
+             "vhdl_sample": {"codes": int(sw["codes"].size), "backend": f"ghdl-{sw['backend']}",
+                             "bench_ok": sw["bench"].ok}}
+    return sw, {**{k: nl[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
 
 
 def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
-             progress=None) -> dict:
-    """Verify ``design`` (flann sim): the sweep over every code, the other benches, optionally the
-    post-synthesis netlist; returns {"summary", "curve", "spec"} (summary = `flann sim --json`)."""
+             engine: str = "ghdl", progress=None) -> dict:
+    """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
+    GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches,
+    optionally the post-synthesis netlist; returns {"summary", "curve", "spec"} (summary =
+    `flann sim --json`)."""
     build_dir = Path(build_dir)
     spec, man = design.spec, design.manifest
     results, summary = [], {
@@ -269,21 +321,19 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     curve = None
     for b in benches:
         if b == "sweep":
-            sw = sweep(design, build_dir, progress=progress("sweep") if progress else None)
+            sw, every = _every_code(design, build_dir, engine, progress)
             results.append(sw["bench"])
-            codes, data, sat = sw["codes"], sw["data"], sw["sat"]
+            codes, data, sat = every["codes"], every["data"], every["sat"]
             if codes.size:
                 twin_out, twin_sat = FlannTop(spec).process(codes)
                 ref = spec.float_reference(codes) / spec.output_lsb_mm
                 err = np.abs(data - ref)
-                summary.update(codes_tested=int(codes.size),
-                               mismatches=int(np.count_nonzero((data != twin_out) | (sat != twin_sat))),
+                bad = (data != twin_out) | (sat != twin_sat) | (every["latency"] != man["latency_cycles"])
+                summary.update(codes_tested=int(codes.size), mismatches=int(np.count_nonzero(bad)),
                                max_err_lsb=round(float(err.max()), 4),
                                max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6))
                 curve = {"codes": codes, "hdl": data, "ref": ref}
-            summary["sweep"] = {"backend": f"ghdl-{sw['backend']}", "shards": sw["shards"],
-                                "seconds": round(sw["seconds"], 1),
-                                "codes_per_s": round(codes.size / sw["seconds"], 1) if sw["seconds"] else None}
+            summary["sweep"] = every["about"]
         else:
             if progress:
                 print(f"simulating {b} ...", file=sys.stderr, flush=True)
