@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import json
+import logging
 import os
 import shutil
 import subprocess
@@ -105,6 +106,11 @@ def _runner(backend: str):
 
     r = get_runner("ghdl")
     r.env["GHDL_BACKEND"] = backend
+    # the simulator's own output goes to the log files; the runner's messages ("Simulation
+    # failed", also after a Ctrl-C) would add lines to the one-line error on the terminal
+    r.log.propagate = False
+    if not r.log.handlers:
+        r.log.addHandler(logging.NullHandler())
     return r
 
 
