@@ -341,7 +341,7 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
                 curve = {"codes": codes, "hdl": data, "ref": ref}
             summary["sweep"] = every["about"]
         else:
-            if progress:
+            if progress and sys.stderr.isatty():
                 print(f"simulating {b} ...", file=sys.stderr, flush=True)
             results.append(run_bench(design, b, build_dir, seed=seed))
     summary["benches"] = {r.bench: {"tests": r.tests, "failures": r.failures, "failed": r.failed_tests,
