@@ -34,14 +34,19 @@ tools:
 test: venv tools
 	$(BIN)/python -m pytest -q
 
-# Main job: train (unless MODEL= is given), generate VHDL, co-simulate every bench, summarise.
+# Main job: train (unless MODEL= is given), generate VHDL, verify every input code (RTL sweep,
+# reactive benches, post-synthesis netlist), summarise.  DESIGN=dir verifies that generated
+# directory as it is (its model: MODEL=, default the checked-in default model).
+DESIGN   ?=
 sim: venv tools
 	@mkdir -p $(BUILD)
-ifeq ($(strip $(MODEL)),)
+ifneq ($(strip $(DESIGN)),)
+	$(BIN)/flann sim $(DESIGN) --model $(or $(strip $(MODEL)),$(DEFAULT_MODEL)) --netlist --plot $(BUILD)/sim.png
+else ifeq ($(strip $(MODEL)),)
 	$(BIN)/flann train data/paper_table1.csv $(TRAIN_ARGS) -o $(BUILD)/model.json
-	$(BIN)/flann sim $(BUILD)/model.json --plot $(BUILD)/sim.png
+	$(BIN)/flann sim $(BUILD)/model.json --netlist --plot $(BUILD)/sim.png
 else
-	$(BIN)/flann sim $(MODEL) --plot $(BUILD)/sim.png
+	$(BIN)/flann sim $(MODEL) --netlist --plot $(BUILD)/sim.png
 endif
 
 # Regenerate the checked-in hdl/ from the checked-in default model.
@@ -49,7 +54,7 @@ gen: venv
 	$(BIN)/flann gen $(DEFAULT_MODEL) -o hdl --device $(DEVICE)
 
 synth: venv tools
-	$(BIN)/flann synth hdl --device $(DEVICE)
+	$(BIN)/flann synth hdl --device $(DEVICE) --model $(DEFAULT_MODEL)
 
 paper: venv
 	$(BIN)/flann paper --plot $(BUILD)/paper

@@ -6,6 +6,7 @@ and from the DS001 capacities typed in below, not from the code under test.
 
 import json
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -134,3 +135,81 @@ def test_ghdl_crash_is_reported_as_such():
     )
     msg = str(_ghdl_errors(stderr, "flann_top"))
     assert "GHDL crashed" in msg and "netlists-memories.adb:334" in msg and "found ROM" not in msg
+
+
+# -- the RTL / Verilog-netlist disagreement (GHDL 2.0's Verilog writer) -----------------------
+def test_repair_ghdl_verilog_on_the_writers_two_errata():
+    """Text as GHDL 2.0 prints it: a 36-bit constant as a string, an arithmetic shift as >>."""
+    from flann.implement.synth import repair_ghdl_verilog
+
+    ghdl = ('  assign n120_o = n115_o + "000000000001000111001010110000010101";\n'
+            "  assign n579_o = $signed(n577_o) >> 31'b0000000000000000000000000001010;\n"
+            "  assign n130_o = code_r << 31'b0000000000000000000000000000001;\n"
+            "  assign n115_o = acc_v >> 31'b0000000000000000000000000000001;\n")
+    text, consts, shifts = repair_ghdl_verilog(ghdl)
+    assert (consts, shifts) == (1, 1)
+    assert "n115_o + 36'b000000000001000111001010110000010101;" in text
+    assert "$signed(n577_o) >>> 31'b" in text
+    # logical shifts stay logical
+    assert "code_r << 31'b" in text and "acc_v >> 31'b" in text
+
+
+def _iverilog_codes(verilog: Path, tmp: Path, codes) -> dict:
+    """Simulate a GHDL-written flann_top under Icarus Verilog for ``codes``; code -> (data, sat)."""
+    tb = tmp / "tb.v"
+    stim = "\n".join(f"    run({c});" for c in codes)
+    tb.write_text(f"""`timescale 1ns/1ps
+module tb;
+  reg clk = 0, rst = 1, in_valid = 0;
+  reg [11:0] in_data = 0;
+  wire in_ready, out_valid, out_sat;
+  wire [15:0] out_data;
+  flann_top dut(.clk(clk), .rst(rst), .in_valid(in_valid), .in_ready(in_ready), .in_data(in_data),
+                .out_valid(out_valid), .out_data(out_data), .out_sat(out_sat));
+  always #5 clk = ~clk;
+  task run(input integer c);
+    begin
+      in_data = c; in_valid = 1;
+      @(posedge clk); while (!in_ready) @(posedge clk);
+      #1 in_valid = 0;
+      @(posedge clk); while (!out_valid) @(posedge clk);
+      $display("%0d %0d %0d", c, $signed(out_data), out_sat);
+    end
+  endtask
+  initial begin
+    @(posedge clk); @(posedge clk); #1 rst = 0;
+{stim}
+    $finish;
+  end
+endmodule
+""")
+    exe = tmp / "sim.vvp"
+    subprocess.run(["iverilog", "-g2012", "-o", str(exe), str(verilog), str(tb)], check=True, capture_output=True)
+    out = subprocess.run(["vvp", "-n", str(exe)], check=True, capture_output=True, text=True).stdout
+    rows = [ln.split() for ln in out.splitlines() if ln and ln[0] in "-0123456789"]
+    return {int(c): (int(d), int(s)) for c, d, s in rows}
+
+
+@pytest.mark.synth
+@pytest.mark.skipif(shutil.which("iverilog") is None, reason="needs iverilog (scripts/ensure_tools.sh)")
+def test_ghdl_verilog_of_the_default_design_agrees_with_the_twin(tmp_path):
+    """Reproduction: GHDL's Verilog as printed gives 32767 for code -2048 (RTL: -14903); the
+    repaired Verilog, the one Yosys maps, agrees with the twin."""
+    from flann.hardware.fixed.render import load
+    from flann.hardware.fixed.twin import FlannTop
+    from flann.implement.synth import complete_pmux_cases, ghdl_to_verilog, read_manifest, repair_ghdl_verilog
+
+    repo = Path(__file__).resolve().parents[2]
+    work = tmp_path / "w"
+    verilog = ghdl_to_verilog(read_manifest(repo / "hdl"), work)
+    codes = [-2048, -1825, -1000, -1, 0, 1, 777, 1857, 2047]
+    out, sat = FlannTop(load(repo / "data" / "default_model.json")).process(codes)
+    want = {c: (int(o), int(s)) for c, o, s in zip(codes, out, sat)}
+    assert want[-2048] == (-14903, 1)  # the figure of the RTL simulation
+    assert _iverilog_codes(verilog, tmp_path, codes) == want
+    assert repair_ghdl_verilog(verilog.read_text())[1:] == (0, 0)  # nothing left to repair
+    # GHDL's own text, not repaired: the disagreement this test guards against
+    raw = subprocess.run(["ghdl", "--synth", "--std=93c", f"--workdir={work / 'ghdl'}", "--out=verilog",
+                          "flann_top"], capture_output=True, text=True, check=True).stdout
+    (tmp_path / "raw.v").write_text(complete_pmux_cases(raw)[0])
+    assert _iverilog_codes(tmp_path / "raw.v", tmp_path, [-2048]) == {-2048: (32767, 1)}

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import subprocess
@@ -13,7 +12,6 @@ import pytest
 from flann.numeric.float18 import FLOAT18
 from flann.hardware.float18.render import BLOCKS, render_blocks
 
-SIM_DIR = Path(__file__).resolve().parents[2] / "gen" / "flann" / "verify" / "benches"
 # random vectors per block bench; FLANN_F18_N=200000 for a long run
 N_RANDOM = int(os.environ.get("FLANN_F18_N", "15000"))
 
@@ -61,16 +59,14 @@ def test_rendered_blocks_analyse_and_are_deterministic(tmp_path):
 @pytest.mark.sim
 @pytest.mark.parametrize("kind", sorted(BLOCKS))
 def test_block_matches_twin_under_ghdl(kind, tmp_path):
-    from cocotb_test.simulator import run
+    from flann.verify.runner import run_cocotb
 
     files = _write(tmp_path)
     entity = f"flann_f18_{kind}"
-    spec = {"kind": kind, "format": FLOAT18.to_dict(), "seed": 1000 + sorted(BLOCKS).index(kind),
-            "n_random": N_RANDOM}
-    run(simulator="ghdl", toplevel=entity, toplevel_lang="vhdl", module=f"test_f18_{kind}",
-        vhdl_sources=[str(files[f"{entity}.vhd"])], python_search=[str(SIM_DIR)],
-        compile_args=["--std=93c"], sim_build=str(tmp_path / "sim_build"),
-        extra_env={"FLANN_F18_SPEC": json.dumps(spec)})
+    spec = {"kind": kind, "format": FLOAT18.to_dict(), "n_random": N_RANDOM}
+    r = run_cocotb([files[f"{entity}.vhd"]], entity, f"test_f18_{kind}", tmp_path / "sim_build", spec,
+                   seed=1000 + sorted(BLOCKS).index(kind))
+    assert r.ok, f"{entity}: {r.failed_tests} (see {tmp_path / 'sim_build'})"
 
 
 # -- top level: every input code ------------------------------------------------------------

@@ -1,17 +1,20 @@
-"""GHDL + cocotb co-simulation of the generated VHDL (benches in sim/, run via flann.verify.runner).
+"""GHDL + cocotb co-simulation of the generated VHDL (benches in flann.verify.benches, one runner).
 
-Budget: the exhaustive run of the default design dominates (~4.7 M clock cycles, see
-bench/bench_sim.py for the codes/s figure); everything else uses small random + corner sets.
+Budget: the exhaustive sweep of the default design dominates (4096 codes x 611 cycles, stimulus
+and response in VHDL; codes/s in bench/bench_sim.py); everything else uses small random + corner sets.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from flann.hardware.fixed.render import generate
-from flann.verify.runner import run_bench
+from flann.cli import main
+from flann.verify.design import from_directory, from_model
+from flann.verify.runner import run_bench, sweep
 
 pytestmark = pytest.mark.sim
 
@@ -20,39 +23,33 @@ MODEL = REPO / "data" / "default_model.json"
 DEFAULT = {"device": "xc2s200-pq208-5"}
 
 
-def _design(tmp_path_factory, name, opts):
-    d = tmp_path_factory.mktemp(name)
-    generate(MODEL, d / "hdl", **opts)
-    return d
-
-
 @pytest.fixture(scope="module")
 def default_design(tmp_path_factory):
-    return _design(tmp_path_factory, "default", DEFAULT)
-
-
-def _run(design, bench, opts, **kw):
-    return run_bench(design / "hdl", bench, model=MODEL, options=opts, build_dir=design / "build", **kw)
+    d = tmp_path_factory.mktemp("default")
+    return from_model(MODEL, d, DEFAULT), d
 
 
 def test_default_design_every_input_code_bit_exact(default_design):
-    r = _run(default_design, "top", DEFAULT, testcase="top_every_code", extra={"codes": "all"})
-    rec = r.records["top_every_code"]
-    assert r.ok, f"failed: {r.failed_tests} (see {default_design}/build/top/sim.log)"
-    assert len(rec["codes"]) == 4096 and sorted(rec["codes"]) == list(range(-2048, 2048))
-    assert rec["mismatches"] == 0
+    design, d = default_design
+    r = sweep(design, d / "build")
+    assert r["bench"].ok, f"failed: {r['bench'].failed_tests} (see {d}/build/sweep)"
+    assert r["codes"].tolist() == list(range(-2048, 2048))
+    # independent of the twin: within the stated bound of the float model
+    ref = design.spec.float_reference(r["codes"]) / design.spec.output_lsb_mm
+    assert np.abs(r["data"] - ref).max() <= max(1.0, design.spec.analysis["bound_total_lsb"])
 
 
 def test_default_design_handshake_reset_saturation(default_design):
-    r = _run(default_design, "top", DEFAULT, extra={"codes": 20, "handshake_samples": 40},
-             testcase="top_handshake_random_gaps|top_reset_mid_sample|top_out_of_range_saturates")
+    design, d = default_design
+    r = run_bench(design, "top", d / "build", extra={"handshake_samples": 40})
     assert r.tests == 3 and r.ok, f"failed: {r.failed_tests}"
 
 
 @pytest.mark.parametrize("block", ["norm", "expansion", "multiplier", "adder"])
 def test_default_design_each_block_vs_twin(default_design, block):
-    r = _run(default_design, block, DEFAULT, seed=3)
-    assert r.tests == 1 and r.ok, f"{block} failed (see {default_design}/build/{block}/sim.log)"
+    design, d = default_design
+    r = run_bench(design, block, d / "build", seed=3)
+    assert r.tests == 1 and r.ok, f"{block} failed (see {d}/build/{block})"
     assert r.records[block]["mismatches"] == 0
 
 
@@ -63,40 +60,55 @@ def test_default_design_each_block_vs_twin(default_design, block):
     ({"input_bits": 14, "mult_digit_bits": 4}, ["top", "norm"]),
 ], ids=["lut", "3lanes", "14bit"])
 def test_other_architectures(tmp_path_factory, opts, benches):
-    d = _design(tmp_path_factory, "arch", opts)
+    d = tmp_path_factory.mktemp("arch")
+    design = from_model(MODEL, d, opts)
+    r = sweep(design, d / "build", codes=(-40, 40))
+    assert r["bench"].ok and r["codes"].size == 81, f"{opts}: {r['bench'].failed_tests}"
     for b in benches:
-        r = _run(d, b, opts, extra={"codes": 80, "handshake_samples": 12, "block_samples": 40,
-                                     "block_phases": 4, "block_runs": 2})
+        r = run_bench(design, b, d / "build", extra={"handshake_samples": 12, "block_samples": 40,
+                                                    "block_phases": 4, "block_runs": 2})
         assert r.ok, f"{opts} {b}: {r.failed_tests}"
 
 
 def test_adder_saturates_both_ways(tmp_path_factory):
     # a finer output LSB makes the accumulator reach past the 16-bit output range
-    opts = {"output_lsb_mm": 0.001, "output_bits": 16}
-    d = _design(tmp_path_factory, "sat", opts)
-    r = _run(d, "adder", opts)
+    d = tmp_path_factory.mktemp("sat")
+    design = from_model(MODEL, d, {"output_lsb_mm": 0.001, "output_bits": 16})
+    r = run_bench(design, "adder", d / "build")
     assert r.ok, r.failed_tests
     assert r.records["adder"]["sat_cases"] >= 2
 
 
-def test_bench_detects_a_wrong_design(tmp_path_factory):
-    """HDL rounding its products to other widths than the twin's: the scoreboard must fail."""
-    d = _design(tmp_path_factory, "wrong", {"product_frac_bits": 3})
-    r = _run(d, "top", {"product_frac_bits": 4}, testcase="top_every_code", extra={"codes": 30})
-    assert r.tests == 1 and r.failures == 1
-    assert r.records["top_every_code"]["mismatches"] > 0
+def test_sweep_detects_a_wrong_design(tmp_path_factory):
+    """HDL rounding its products to other widths than the twin's: the sweep bench must fail."""
+    d = tmp_path_factory.mktemp("wrong")
+    hdl = from_model(MODEL, d / "wrong", {"product_frac_bits": 3})
+    twin = from_model(MODEL, d / "right", {"product_frac_bits": 4})
+    mixed = type(hdl)(hdl.directory, hdl.manifest, twin.model, twin.options, twin.spec)
+    r = sweep(mixed, d / "build", codes=(0, 30))
+    assert r["bench"].tests == 1 and r["bench"].failures == 1
+    assert r["bench"].records["sweep_0"]["mismatches"] > 0
 
 
-def test_flann_sim_cli_json_and_plot(tmp_path, capsys):
+def test_design_directory_is_verified_as_generated(tmp_path, capsys, small_model):
+    """`flann sim DIR`: the 9-bit design in DIR is what is verified (not a 12-bit regeneration)."""
+    model = small_model(11)
+    assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "9"]) == 0
+    capsys.readouterr()
+    design = from_directory(tmp_path / "d", model)
+    assert design.spec.input_bits == 9 and design.directory == (tmp_path / "d").resolve()
+    code = main(["sim", str(tmp_path / "d"), "--model", str(model), "--json", "--build", str(tmp_path / "b")])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["codes_tested"] == 512 and out["mismatches"] == 0
+    # another model than the manifest's: refused with one line
+    other = small_model(7, "m7.json")
+    assert main(["sim", str(tmp_path / "d"), "--model", str(other)]) == 2
+    assert "not the model" in capsys.readouterr().err
+
+
+def test_flann_sim_cli_json_and_plot(tmp_path, capsys, small_model):
     """`flann sim --json` on a small design (11 terms, 8-bit input: every code is 256 samples)."""
-    import json
-
-    from flann.cli import main
-
-    from test_hw_spec import table1_model
-
-    model = tmp_path / "m11.json"
-    table1_model(11).save(model)
+    model = small_model(11)
     png = tmp_path / "fig" / "sim.png"
     code = main(["sim", str(model), "--json", "--plot", str(png), "--input-bits", "8",
                  "--build", str(tmp_path / "build")])

@@ -32,13 +32,13 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
-from ..hardware.fixed.render import generate, load
 from ..hardware.fixed.spec import derive_spec
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import F18Top, derive_f18_spec
 from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
-from ..verify.runner import run_bench
+from ..verify.design import open_design
+from ..verify.runner import sweep
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
 STAGE_TEXT = {
@@ -457,9 +457,11 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     plt.close(fig)
 
 
-def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64) -> dict:
+def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64,
+              design_model=None) -> dict:
     """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
-    HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``."""
+    HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``.
+    ``model_path`` may be a design directory (fixed point; ``design_model`` = its model)."""
     build_dir = Path(build_dir)
     if result.fmt == "float18":
         # internal stages (terms, products, running sums) captured at a spread of codes
@@ -468,14 +470,12 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_s
         codes, hdl_mm, mism, top = r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"]
         stages = r["stages"]
     else:
-        generate(model_path, build_dir / "hdl", **options)
-        br = run_bench(build_dir / "hdl", "top", model=model_path, options=options, build_dir=build_dir)
-        rec = br.records.get("top_every_code")
-        if rec is None:
-            raise FlannError(f"fixed-point simulation produced no records (see {build_dir})")
-        spec = load(model_path, **options)
-        codes = np.asarray(rec["codes"], dtype=np.int64)
-        data = np.asarray(rec["data"], dtype=np.int64)
+        design = open_design(model_path, build_dir, options, model=design_model)
+        sw = sweep(design, build_dir)
+        if sw["codes"].size == 0:
+            raise FlannError(f"fixed-point simulation produced no outputs (see {build_dir})")
+        spec = design.spec
+        codes, data = sw["codes"], sw["data"]
         mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
         hdl_mm, top = data * spec.output_lsb_mm, "flann_top"
         stages = None       # the fixed design's blocks are checked by its own block benches

@@ -1,4 +1,10 @@
-"""``flann sim model.json [--json] [--plot OUT.png]``: generate, co-simulate every bench, summarise."""
+"""``flann sim MODEL|DIR [--netlist] [--json] [--plot OUT.png]``: verify a design by simulation.
+
+MODEL: generate with the flags given, then verify.  DIR: verify exactly the design in DIR (its own
+VHDL files; the twin rebuilt from the manifest and ``--model``).  Every input code goes through
+the VHDL sweep harness (GHDL, one shard per core), the reactive and block benches run under
+cocotb; ``--netlist`` also simulates the Yosys-mapped Spartan-II netlist over every code.
+"""
 
 from __future__ import annotations
 
@@ -10,15 +16,28 @@ from pathlib import Path
 from ..errors import FlannError
 from ..fileio import atomic_write_json
 from ..hardware import options as gen_options
+from ..verify.design import open_design
+from ..verify.runner import plot, simulate
+from ..verify.shards import terminal_progress
 
-HELP = "co-simulate the generated VHDL under GHDL/cocotb"
+HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
 
 FIELDS = ("codes_tested", "mismatches", "max_err_lsb", "max_err_mm", "cycles_per_sample",
           "samples_per_s_at_50mhz")
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", help="model.json (flann-model/1)")
+    parser.add_argument("model", metavar="MODEL|DIR",
+                        help="model.json (flann-model/1; generated with the flags below) or a design "
+                             "directory written by flann gen -o DIR (verified as it is)")
+    parser.add_argument("--model", dest="design_model", metavar="MODEL.json", default=None,
+                        help="with DIR: the model DIR was generated from (checked against the manifest's sha256)")
+    parser.add_argument("--netlist", action="store_true",
+                        help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
+                             "netlist over every input code (Verilator, Yosys's Xilinx cell models)")
+    parser.add_argument("--engine", choices=("ghdl", "verilator"), default="ghdl",
+                        help="every input code through: ghdl = the VHDL under GHDL (default); verilator = GHDL's "
+                             "synthesised netlist compiled by Verilator (~50x faster), the VHDL on a sample")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     parser.add_argument("--plot", metavar="OUT.png", default=None,
                         help="HDL vs golden model across the input range and their difference (PNG)")
@@ -29,19 +48,15 @@ def add_arguments(parser) -> None:
     gen_options.add_arguments(parser)
 
 
-def _progress(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
-
-
 def run(args) -> int:
-    from ..verify.runner import plot, simulate
-
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
     opts = gen_options.from_args(args).to_kwargs()
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
-        build = Path(args.build) if args.build else Path(tmp)
-        res = simulate(args.model, build, options=opts, seed=args.seed, progress=_progress)
+        build = Path(args.build).resolve() if args.build else Path(tmp)
+        design = open_design(args.model, build, opts, model=args.design_model)
+        res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
+                       progress=terminal_progress)
         s = res["summary"]
         if args.plot and res["curve"] is not None:
             plot(res["curve"], res["spec"], args.plot)
@@ -50,7 +65,13 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(s, indent=2))
     else:
-        print(f"input codes tested      {s['codes_tested']}")
+        print(f"design                  {s['design']}")
+        sw = s.get("sweep") or {}
+        how = sw.get("backend") or "Verilator on GHDL's synthesised netlist"
+        print(f"input codes tested      {s['codes_tested']}"
+              + (f" ({sw['codes_per_s']} codes/s, {how}, {sw['shards']} shard(s))" if sw else ""))
+        if sw.get("vhdl_sample"):
+            print(f"  VHDL under GHDL       {sw['vhdl_sample']['codes']} codes (sample)")
         print(f"bit mismatches vs twin  {s['mismatches']}")
         if s["max_err_lsb"] is not None:
             print(f"max |HDL - float model| {s['max_err_lsb']:.4f} LSB = {s['max_err_mm']:.6f} mm "
@@ -60,6 +81,10 @@ def run(args) -> int:
         for name, b in s["benches"].items():
             state = "ok" if b["failures"] == 0 and b["tests"] > 0 else f"FAILED {b['failed']}"
             print(f"  bench {name:<11} {b['tests']} test(s) {b['seconds']:>6.1f} s  {state}")
+        if "netlist" in s:
+            n = s["netlist"]
+            print(f"netlist (Yosys xcv)     {n['codes_tested']} codes, {n['mismatches']} mismatches "
+                  f"({n['simulator']}, {n['seconds']:.0f} s)")
         if args.plot:
             print(f"plot: {args.plot}")
     if not s["all_passed"] or s["mismatches"]:

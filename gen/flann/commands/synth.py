@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import json
 import sys
+import tempfile
+from pathlib import Path
 
+from ..errors import FlannError
 from ..implement import synth
 from ..hardware.target import DEVICES, parse_part
 
@@ -24,6 +27,32 @@ def add_arguments(p):
     p.add_argument("--abc", choices=synth.ABC_MODES, default="full",
                    help="LUT mapping: full = synth_xilinx as is (default); fast = abc -fast (large designs)")
     p.add_argument("--work", metavar="DIR", help="keep GHDL/Yosys intermediate files (netlist, yosys.log) here")
+    p.add_argument("--model", metavar="MODEL.json", default=None,
+                   help="the model DIR was generated from: the mapped netlist is then simulated over every input "
+                        "code against the twin (Verilator) and a disagreeing design is refused")
+    p.add_argument("--no-netlist-check", action="store_true", help="do not simulate the mapped netlist")
+
+
+def _check_netlist(args, netlist: Path) -> None:
+    """Refuse a design whose mapped netlist disagrees with its twin (needs the model)."""
+    from ..verify.design import from_directory
+    from ..verify.netlist import check_synthesized
+
+    man = synth.read_manifest(args.directory)
+    spec = man.data.get("spec") if isinstance(man.data.get("spec"), dict) else {}
+    if man.top != "flann_top" or spec.get("number_format") != "fixed":
+        return  # the twin and the netlist driver are those of a generated fixed-point flann_top
+    if args.model is None and not man.data.get("model"):
+        print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
+              file=sys.stderr)
+        return
+    design = from_directory(args.directory, args.model)
+    if not args.json:
+        print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
+    res = check_synthesized(design, netlist)
+    if res["mismatches"]:
+        raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res['mismatches']} of "
+                         f"{res['codes_tested']} input codes (first: {res['first_mismatches']}); not handing it on")
 
 
 def run(args) -> int:
@@ -32,7 +61,11 @@ def run(args) -> int:
     if not args.no_lint:
         man = synth.read_manifest(args.directory)
         synth.check_lint(man.files, args.vsg_config, start=args.directory)
-    report = synth.synthesize(args.directory, args.device, work=args.work, progress=not args.json, abc=args.abc)
+    with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
+        work = Path(args.work) if args.work else Path(tmp)
+        report = synth.synthesize(args.directory, args.device, work=work, progress=not args.json, abc=args.abc)
+        if not args.no_netlist_check:
+            _check_netlist(args, work / synth.NETLIST)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:

@@ -22,7 +22,11 @@ FORMATS = ("fixed", "float18")
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", help="model.json (flann-model/1)")
+    parser.add_argument("model", metavar="MODEL|DIR",
+                        help="model.json (flann-model/1), or a fixed-point design directory written by "
+                             "flann gen -o DIR (traced with the options in its manifest)")
+    parser.add_argument("--model", dest="design_model", metavar="MODEL.json", default=None,
+                        help="with DIR: the model DIR was generated from (checked against the manifest's sha256)")
     parser.add_argument("--format", choices=FORMATS, default="fixed",
                         help="number format of the datapath (default %(default)s)")
     parser.add_argument("--compare", action="store_true",
@@ -43,10 +47,28 @@ def _options(args, fmt: str) -> dict:
     return opts.to_kwargs()
 
 
+def _design_dir(args):
+    """A design directory: trace exactly that design (its manifest's options and model)."""
+    from pathlib import Path
+
+    from ..errors import FlannError
+    from ..verify.design import from_directory
+
+    if not Path(args.model).is_dir():
+        return None
+    if args.format != "fixed" or args.compare:
+        raise FlannError(f"{args.model}: a design directory is traced as it is (fixed point, no --compare)")
+    return from_directory(args.model, args.design_model)
+
+
 def run(args) -> int:
-    model = load_model(args.model)
+    design = _design_dir(args)
+    model = load_model(design.model if design else args.model)
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
-    results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
+    if design:
+        results = {"fixed": run_trace(model, "fixed", **design.options)}
+    else:
+        results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
     if args.hdl:
         import sys
         import tempfile
@@ -56,7 +78,10 @@ def run(args) -> int:
         for f, r in results.items():
             print(f"simulating the {f} design over every input code ...", file=sys.stderr)
             with tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:
-                check_hdl(r, args.model, _options(args, f), tmp)
+                if design:
+                    check_hdl(r, design.directory, design.options, tmp, design_model=design.model)
+                else:
+                    check_hdl(r, args.model, _options(args, f), tmp)
     points = None
     if args.at:
         rec = read_recordings(args.at)

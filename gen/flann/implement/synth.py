@@ -295,9 +295,34 @@ def complete_pmux_cases(verilog: str) -> tuple[str, int]:
     return _PMUX_RE.subn(fix, verilog)
 
 
+# GHDL 2.0's Verilog writer (netlists-disp_verilog.adb) prints two net kinds so that Verilog
+# reads another circuit than the VHDL describes:
+#  * a constant wider than 32 bits (Const_Bit) as a string literal "0101..." (Verilog takes
+#    each character as 8 bits of ASCII), e.g. the 36- and 42-bit constants of flann_norm;
+#  * an arithmetic shift right (Id_Asr, numeric_std shift_right of a signed) as
+#    `$signed(x) >> n`, a logical shift in Verilog, so negative values turn large positive.
+# Later GHDL releases print N'b... and >>>.  Both forms are fixed in the text GHDL wrote
+# (one net per statement, so the rewrite cannot straddle statements); the netlist
+# simulation (flann.verify.netlist) checks the result against the twin.
+_STRING_CONST_RE = re.compile(r'"([01xzXZ]+)"')
+_ASR_RE = re.compile(r"(\$signed\((?:\\\S+ |[A-Za-z_][A-Za-z0-9_$]*)\)) >> ")
+
+
+def repair_ghdl_verilog(verilog: str) -> tuple[str, int, int]:
+    """Undo GHDL 2.0's Verilog-writer errata (wide constants as strings, >> for arithmetic
+    shifts); returns (text, constants fixed, shifts fixed)."""
+    text, n_const = _STRING_CONST_RE.subn(lambda m: f"{len(m.group(1))}'b{m.group(1).lower()}", verilog)
+    text, n_asr = _ASR_RE.subn(r"\1 >>> ", text)
+    if '"' in text:
+        line = next(ln for ln in text.splitlines() if '"' in ln)
+        raise FlannError(f"GHDL's Verilog has a literal this flow cannot read: {line.strip()}")
+    return text, n_const, n_asr
+
+
 def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
     """Analyse and synthesise the manifest's files with GHDL; return the Verilog netlist."""
     ghdl = _need_tool("ghdl")
+    work = Path(work).resolve()  # GHDL runs with work as cwd: a relative --workdir would nest
     lib = work / "ghdl"
     lib.mkdir(parents=True, exist_ok=True)
     files = [str(f.resolve()) for f in man.files]
@@ -314,11 +339,15 @@ def ghdl_to_verilog(man: Manifest, work: Path) -> Path:
         raise _ghdl_errors(s.stderr, man.top)
     out = work / f"{man.top}.v"
     text, _ = complete_pmux_cases(s.stdout)
+    text, _, _ = repair_ghdl_verilog(text)
     out.write_text(text)
     return out
 
 
 ABC_MODES = ("full", "fast")
+
+
+NETLIST = "netlist.v"  # the mapped Spartan-II netlist, written next to stat.json
 
 
 def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.json") -> str:
@@ -332,7 +361,8 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
     if abc not in ABC_MODES:
         raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
     head = [f"read_verilog {verilog}"]
-    tail = ["check", f"tee -q -o {stat} stat -json"]
+    # the netlist the counts describe, for post-synthesis simulation (flann.verify.netlist)
+    tail = ["check", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}"]
     if abc == "full":
         return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top}"] + tail)
     return "; ".join(head + [
@@ -351,6 +381,7 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
 def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
     """Run Yosys synth_xilinx -family xcv; return (cells by type, warnings that matter)."""
     yosys = _need_tool("yosys")
+    work = Path(work).resolve()
     stat = work / "stat.json"
     log = work / "yosys.log"
     script = yosys_script(verilog.name, top, abc, stat.name)
@@ -412,7 +443,8 @@ def synthesize(directory: str | Path, device: str | None = None, work: str | Pat
     _need_tool("ghdl")
     _need_tool("yosys")
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
-        wdir = Path(work) if work is not None else Path(tmp)
+        # absolute: GHDL and Yosys run with the work directory as cwd
+        wdir = Path(work).resolve() if work is not None else Path(tmp)
         wdir.mkdir(parents=True, exist_ok=True)
         if progress:
             print(f"synth: ghdl --synth --std=93c {man.top} ({len(man.files)} files)", file=sys.stderr)

@@ -1,4 +1,4 @@
-"""Run the float18 top-level cocotb bench (``sim/test_f18_top.py``) under GHDL.
+"""Run the float18 top-level cocotb bench (``benches/test_f18_top.py``) through the one runner.
 
 ``run_top(model, build_dir, codes=None, **options)`` generates the float18 design,
 computes the twin's outputs, simulates the given input codes (default: every code) and
@@ -9,13 +9,12 @@ file, the outputs from the bench's records.
 from __future__ import annotations
 
 import json
-import logging
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import FlannError
-from .benches import BENCH_DIR
+from .runner import run_cocotb
 from ..hardware.float18.render import generate
 from ..hardware.float18.spec import F18Top, derive_f18_spec
 from ..golden.model import FlannModel, load_model, model_sha256
@@ -24,12 +23,6 @@ from ..golden.model import FlannModel, load_model, model_sha256
 def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **options) -> dict:
     """Simulate flann_f18_top; returns codes, HDL out/sat, twin out/sat, mismatches, latency,
     and for ``stage_codes`` the internal stages captured by cocotb compared with the twin's."""
-    import shutil
-
-    if shutil.which("ghdl") is None:
-        raise FlannError("ghdl not found on PATH (install GHDL 2.x, mcode backend: `make tools`)")
-    from cocotb_test.simulator import run as cocotb_run
-
     build_dir = Path(build_dir)
     if isinstance(model, FlannModel):
         fmodel, sha = model, ""
@@ -40,32 +33,17 @@ def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **optio
     top = F18Top(fspec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     out, sat = top.process(codes)
-    exp = build_dir / "expected.json"
     rec = build_dir / "hdl_outputs.json"
     if rec.exists():
         rec.unlink()
-    exp.write_text(json.dumps({"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
-                               "latency": man["latency_cycles"], "in_bits": man["input_bits"],
-                               "seed": seed, "records": str(rec.resolve()),
-                               "stage_codes": [int(c) for c in stage_codes]}))
-    logger = logging.getLogger("cocotb")
-    saved = logger.handlers[:], logger.propagate
-    handler = logging.FileHandler(build_dir / "sim.log")
-    logger.handlers, logger.propagate = [handler], False
-    failed = False
-    try:
-        cocotb_run(simulator="ghdl", toplevel=man["top"], toplevel_lang="vhdl", module="test_f18_top",
-                   vhdl_sources=[str(build_dir / "hdl" / f) for f in man["files"]],
-                   python_search=[str(BENCH_DIR)], compile_args=["--std=93c"],
-                   sim_build=str(build_dir / "sim_build"),
-                   extra_env={"FLANN_F18_TOP": str(exp.resolve())})
-    except SystemExit:
-        failed = True                      # mismatches are counted from the records below
-    finally:
-        logger.handlers, logger.propagate = saved
-        handler.close()
+    cfg = {"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
+           "latency": man["latency_cycles"], "in_bits": man["input_bits"],
+           "records": str(rec.resolve()), "stage_codes": [int(c) for c in stage_codes]}
+    res = run_cocotb([build_dir / "hdl" / f for f in man["files"]], man["top"], "test_f18_top",
+                     build_dir / "sim_build", cfg, name="float18_top", seed=seed)
+    failed = not res.ok
     if not rec.is_file():
-        raise FlannError(f"float18 simulation produced no outputs (see {build_dir / 'sim.log'})")
+        raise FlannError(f"float18 simulation produced no outputs (see {build_dir / 'sim_build'})")
     got = json.loads(rec.read_text())
     hcodes = np.asarray(got["codes"], dtype=np.int64)
     order = np.argsort(hcodes)

@@ -1,18 +1,28 @@
-"""Run the cocotb benches in ``sim/`` under GHDL (through cocotb-test) and summarise.
+"""One simulation runner: cocotb 2.1's own ``cocotb_tools.runner`` under GHDL, for every bench.
 
-Layer 5: ``run_bench`` runs one bench module against a generated HDL directory; pass/fail
-comes from cocotb's results file.  ``simulate`` is ``flann sim``: generate into a build
-directory, run every bench, and return the summary (codes tested, mismatches, error vs the
-float model, cycles per sample, samples/s at 50 MHz).
+``run_cocotb`` builds and runs one cocotb module (benches shipped in :mod:`flann.verify.benches`,
+imported by package name, so an installed ``flann sim`` works from any directory); the bench
+configuration travels as one JSON file named in ``FLANN_BENCH_CONFIG``; pass/fail comes from
+cocotb's results file.  ``sweep`` is the exhaustive check: the VHDL harness ``flann_sweep.vhd``
+steps through every input code with stimulus and response in VHDL (no Python per sample),
+split into one shard per core, each judged against the twin by ``test_sweep.py``.
+``simulate`` is ``flann sim``: the sweep, the reactive benches (handshake gaps, reset mid
+sample, saturation) and the block benches, summarised.
+
+GHDL backend: LLVM (Debian ``ghdl-llvm``, about 2.6x faster than mcode on these designs) when
+installed, else mcode; the Debian ``ghdl`` wrapper picks it from ``GHDL_BACKEND``.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import os
 import shutil
+import subprocess
 import sys
+import threading
 import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -21,40 +31,42 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
-from .benches import BENCH_DIR
-from ..hardware.fixed.render import generate, load, read_manifest
 from ..hardware.fixed.spec import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
+from .benches import BENCH_DIR, CONFIG_ENV
+from .design import Design
+from .netlist import check_netlist, check_rtl_netlist
+from .shards import count_lines, cores, merge, read_results, split
 
-# bench name -> (toplevel entity, cocotb module in sim/)
+# bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
 BENCHES = {
-    "top": ("flann_harness", "test_top"),  # sim/flann_harness.vhd: VHDL clock around flann_top
-    "norm": ("flann_norm", "test_blocks"),
-    "expansion": ("flann_expansion", "test_blocks"),
-    "multiplier": ("flann_multiplier", "test_blocks"),
-    "adder": ("flann_adder", "test_blocks"),
+    "sweep": ("flann_sweep", "test_sweep", None),  # every code, stimulus and response in VHDL
+    "top": ("flann_harness", "test_top", None),   # reactive: gaps, reset mid sample, saturation
+    "norm": ("flann_norm", "test_blocks", "norm_vs_twin"),
+    "expansion": ("flann_expansion", "test_blocks", "expansion_vs_twin"),
+    "multiplier": ("flann_multiplier", "test_blocks", "multiplier_vs_twin"),
+    "adder": ("flann_adder", "test_blocks", "adder_vs_twin"),
 }
-# test functions of test_blocks.py per block entity
-BLOCK_TESTS = {
-    "norm": "norm_vs_twin",
-    "expansion": "expansion_vs_twin",
-    "multiplier": "multiplier_vs_twin",
-    "adder": "adder_vs_twin",
-}
+HARNESSES = {"flann_sweep": "flann_sweep.vhd", "flann_harness": "flann_harness.vhd"}
+BENCH_PACKAGE = "flann.verify.benches"
+CLK_NS = 10
 
 
 def sim_dir() -> Path:
-    """The cocotb benches, shipped inside the package."""
+    """The cocotb benches and VHDL harnesses, shipped inside the package."""
     return BENCH_DIR
 
 
-def check_tools() -> None:
+@functools.lru_cache(maxsize=None)
+def ghdl_backend() -> str:
+    """'llvm' when ghdl-llvm is installed and the ghdl wrapper honours GHDL_BACKEND, else 'mcode'."""
     if shutil.which("ghdl") is None:
-        raise FlannError("ghdl not found on PATH (install GHDL 2.x, mcode backend: `make tools`)")
-    try:
-        import cocotb_test.simulator  # noqa: F401
-    except ImportError:
-        raise FlannError("cocotb-test is not installed (pip install -e '.[dev]')") from None
+        raise FlannError("ghdl not found on PATH (Debian package ghdl; `make tools` installs it)")
+    if shutil.which("ghdl-llvm") is None:
+        return "mcode"
+    r = subprocess.run(["ghdl", "--version"], capture_output=True, text=True,
+                       env={**os.environ, "GHDL_BACKEND": "llvm"})
+    return "llvm" if "llvm" in r.stdout.lower() else "mcode"
 
 
 @dataclass
@@ -72,139 +84,279 @@ class BenchResult:
         return self.failures == 0 and self.tests > 0
 
 
-def _parse_results(path: Path) -> tuple[int, int, list, dict]:
-    if not path.is_file():
-        return 0, 1, ["(simulation ended without a results file)"], {}
-    tree = ET.parse(path)
+def _parse_results(paths) -> tuple[int, int, list, dict]:
     tests = failures = 0
-    failed = []
-    times = {}
-    for tc in tree.iter("testcase"):
-        tests += 1
-        times[tc.get("name")] = float(tc.get("time", "nan"))
-        if tc.find("failure") is not None or tc.find("error") is not None:
-            failures += 1
-            failed.append(tc.get("name"))
+    failed, times = [], {}
+    for path in paths:
+        if not Path(path).is_file():
+            tests, failures = tests + 1, failures + 1
+            failed.append(f"(no results file: {Path(path).parent.name})")
+            continue
+        for tc in ET.parse(path).iter("testcase"):
+            tests += 1
+            times[tc.get("name")] = times.get(tc.get("name"), 0.0) + float(tc.get("time", "nan"))
+            if tc.find("failure") is not None or tc.find("error") is not None:
+                failures += 1
+                failed.append(tc.get("name"))
     return tests, failures, failed, times
 
 
-def run_bench(hdl_dir, bench: str, *, model, options: dict, build_dir, seed: int = 1,
-              testcase: str | None = None, extra: dict | None = None, quiet: bool = True) -> BenchResult:
-    """Run one bench (key of BENCHES) on the HDL in ``hdl_dir``; never raises on test failure."""
-    check_tools()
-    from cocotb_test.simulator import run as cocotb_run
+def _runner(backend: str):
+    from cocotb_tools.runner import get_runner  # lazy: cocotb is a dev dependency
 
-    if bench not in BENCHES:
-        raise FlannError(f"bench {bench!r}: must be one of {', '.join(BENCHES)}")
-    toplevel, module = BENCHES[bench]
-    if testcase is None and bench in BLOCK_TESTS:
-        testcase = BLOCK_TESTS[bench]
-    hdl_dir = Path(hdl_dir).resolve()
-    man = read_manifest(hdl_dir)
-    build = Path(build_dir).resolve() / bench
-    if build.exists():
-        shutil.rmtree(build)
-    build.mkdir(parents=True)
-    records = build / "records"
-    cfg = {"model": str(Path(model).resolve()), "options": options, "manifest": man, "seed": seed,
-           "records_dir": str(records), **(extra or {})}
-    cfg_path = build / "bench_config.json"
-    cfg_path.write_text(json.dumps(cfg, indent=1))
-    results = build / "results.xml"
-    env = {"FLANN_BENCH_CONFIG": str(cfg_path), "COCOTB_RESULTS_FILE": str(results),
-           "COCOTB_LOG_LEVEL": os.environ.get("COCOTB_LOG_LEVEL", "WARNING" if quiet else "INFO")}
-    saved = os.environ.get("COCOTB_RESULTS_FILE")
-    os.environ["COCOTB_RESULTS_FILE"] = str(results)
-    sources = [str(hdl_dir / f) for f in man["files"]]
-    params = {}
-    sim_args = ["--ieee-asserts=disable"]
-    if toplevel == "flann_harness":
-        sources.append(str(sim_dir() / "flann_harness.vhd"))
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"]}
-        # the VHDL clock never stops by itself: bound the run generously (a test still running
-        # at this time is reported as failed by cocotb)
-        n = (1 << man["input_bits"]) if cfg.get("codes", "all") == "all" else int(cfg["codes"]) + 20
-        n += 3 * int(cfg.get("handshake_samples", 60)) + 60
-        sim_args.append(f"--stop-time={(n * man['cycles_per_sample'] * 3 + 10000) * 10}ns")
-        cfg["harness"] = True
-        cfg_path.write_text(json.dumps(cfg, indent=1))
-    t0 = time.monotonic()
-    # cocotb-test logs the simulator's output through the "cocotb" logger: keep it in sim.log
-    logger = logging.getLogger("cocotb")
-    handler = logging.FileHandler(build / "sim.log")
-    handler.setFormatter(logging.Formatter("%(levelname)s %(message)s"))
-    saved_handlers, saved_prop = logger.handlers[:], logger.propagate
-    logger.handlers = [handler]
-    if not quiet:
-        logger.handlers.append(logging.StreamHandler(sys.stderr))
-    logger.propagate = False
+    r = get_runner("ghdl")
+    r.env["GHDL_BACKEND"] = backend
+    # the simulator's own output goes to the log files; the runner's messages ("Simulation
+    # failed", also after a Ctrl-C) would add lines to the one-line error on the terminal
+    r.log.propagate = False
+    if not r.log.handlers:
+        r.log.addHandler(logging.NullHandler())
+    return r
+
+
+def build(sources, toplevel: str, build_dir, backend: str | None = None) -> str:
+    """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used
+    (default mcode: the cocotb benches are short, and mcode compiles in a second)."""
+    backend = backend or "mcode"
+    build_dir = Path(build_dir).resolve()
+    build_dir.mkdir(parents=True, exist_ok=True)
+    args = ["--std=93c"] + (["-O2"] if backend == "llvm" else [])
     try:
-        cocotb_run(
-            simulator="ghdl", toplevel=toplevel, module=module, toplevel_lang="vhdl",
-            vhdl_sources=sources, python_search=[str(sim_dir())], parameters=params,
-            sim_build=str(build / "ghdl"), compile_args=["--std=93c"],
-            sim_args=sim_args, extra_env=env, testcase=testcase, waves=False,
+        _runner(backend).build(sources=[Path(s).resolve() for s in sources], hdl_toplevel=toplevel,
+                               build_dir=build_dir, build_args=args, always=True,
+                               log_file=build_dir / "build.log")
+    except (RuntimeError, SystemExit):
+        raise FlannError(f"GHDL could not build {toplevel}: {_first_error(build_dir / 'build.log')}") from None
+    return backend
+
+
+def _first_error(log: Path) -> str:
+    text = log.read_text(errors="replace") if log.is_file() else ""
+    return next((ln.strip() for ln in text.splitlines() if "error" in ln.lower()), f"see {log}")
+
+
+def _test(build_dir: Path, toplevel: str, module: str, backend: str, cfg_path: Path, tag: str,
+          parameters: dict, plusargs: list, testcase: str | None, seed: int) -> Path:
+    """Run one simulation of a built design; returns its results file (never raises on failure)."""
+    results = build_dir / f"results_{tag}.xml"
+    try:
+        _runner(backend).test(
+            test_module=f"{BENCH_PACKAGE}.{module}", hdl_toplevel=toplevel, hdl_toplevel_lang="vhdl",
+            build_dir=build_dir,
+            parameters=parameters, plusargs=["--ieee-asserts=disable", *plusargs], testcase=testcase,
+            seed=seed, results_xml=str(results), log_file=build_dir / f"sim_{tag}.log",
+            extra_env={CONFIG_ENV: str(cfg_path), "GHDL_BACKEND": backend,
+                       "COCOTB_LOG_LEVEL": os.environ.get("COCOTB_LOG_LEVEL", "WARNING")},
         )
-    except SystemExit:
-        pass  # failures are read from the results file below
-    finally:
-        logger.handlers, logger.propagate = saved_handlers, saved_prop
-        handler.close()
-        if saved is None:
-            os.environ.pop("COCOTB_RESULTS_FILE", None)
-        else:
-            os.environ["COCOTB_RESULTS_FILE"] = saved
-    seconds = time.monotonic() - t0
+    except (RuntimeError, SystemExit):
+        pass  # failures are read from the results file
+    return results
+
+
+def run_cocotb(sources, toplevel: str, module: str, build_dir, config: dict, *, name: str = "bench",
+               parameters: dict | None = None, plusargs=(), testcase: str | None = None, seed: int = 1,
+               backend: str | None = None) -> BenchResult:
+    """Build ``sources`` and run the cocotb module ``module`` once; the one way every bench runs."""
+    build_dir = Path(build_dir).resolve()
+    if build_dir.exists():
+        shutil.rmtree(build_dir)
+    records = build_dir / "records"
+    cfg = {**config, "seed": seed, "records_dir": str(records)}
+    t0 = time.monotonic()
+    backend = build(sources, toplevel, build_dir, backend)
+    cfg_path = build_dir / "bench_config.json"
+    cfg_path.write_text(json.dumps(cfg))
+    res = _test(build_dir, toplevel, module, backend, cfg_path, "0", dict(parameters or {}), list(plusargs),
+                testcase, seed)
+    return _result(name, [res], records, time.monotonic() - t0)
+
+
+def _result(name: str, results, records: Path, seconds: float) -> BenchResult:
     tests, failures, failed, times = _parse_results(results)
-    recs = {}
-    if records.is_dir():
-        for p in sorted(records.glob("*.json")):
-            recs[p.stem] = json.loads(p.read_text())
-    return BenchResult(bench, tests, failures, seconds, recs, failed, times)
+    recs = {p.stem: json.loads(p.read_text()) for p in sorted(records.glob("*.json"))} if records.is_dir() else {}
+    return BenchResult(name, tests, failures, seconds, recs, failed, times)
 
 
-def simulate(model_path, build_dir, *, options: dict | None = None, seed: int = 1,
-             benches=tuple(BENCHES), progress=None) -> dict:
-    """Generate, run the benches, and summarise (the fields of `flann sim --json`)."""
-    options = dict(options or {})
-    build_dir = Path(build_dir)
-    hdl = build_dir / "hdl"
-    man = generate(model_path, hdl, **options)
-    spec = load(model_path, **options)
-    results = []
-    for b in benches:
+def _bench_config(design: Design) -> dict:
+    return {"model": str(design.model), "options": design.options, "manifest": design.manifest}
+
+
+def _sources(design: Design, toplevel: str) -> list[Path]:
+    files = list(design.files)
+    if toplevel in HARNESSES:
+        files.append(BENCH_DIR / HARNESSES[toplevel])
+    return files
+
+
+def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase: str | None = None,
+              extra: dict | None = None, backend: str | None = None) -> BenchResult:
+    """Run one bench (key of BENCHES, not the sweep) on ``design``; never raises on test failure."""
+    if bench not in BENCHES or bench == "sweep":
+        raise FlannError(f"bench {bench!r}: must be one of {', '.join(b for b in BENCHES if b != 'sweep')}")
+    toplevel, module, tc = BENCHES[bench]
+    man = design.manifest
+    params, plus = {}, []
+    if toplevel == "flann_harness":
+        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"]}
+        # the harness's clock never stops: bound the run (a test still running is reported failed)
+        n = 3 * int((extra or {}).get("handshake_samples", 60)) + 80
+        plus.append(f"--stop-time={(n * man['cycles_per_sample'] * 3 + 10000) * CLK_NS}ns")
+    cfg = {**_bench_config(design), **(extra or {}), "harness": toplevel == "flann_harness"}
+    return run_cocotb(_sources(design, toplevel), toplevel, module, Path(build_dir) / bench, cfg, name=bench,
+                      parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
+
+
+def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
+          backend: str | None = None, progress=None) -> dict:
+    """Input codes through the VHDL sweep harness, in shards run side by side (one per core).
+
+    ``codes``: None = every input code; (lo, hi) = that range; a list or array = those codes
+    (handed to the harness in a file).  Returns {"bench": BenchResult, "codes", "data", "sat",
+    "latency" (arrays in the order simulated), "backend", "shards", "seconds", "build_seconds"}.
+    ``progress(done, total, elapsed_s)`` is called about twice a second while the shards run.
+    """
+    man = design.manifest
+    half = 1 << (man["input_bits"] - 1)
+    listed = codes is not None and not isinstance(codes, tuple)
+    if listed:
+        todo = np.asarray(codes, dtype=np.int64)
+        total = int(todo.size)
+    else:
+        lo, hi = codes if codes is not None else (-half, half - 1)
+        total = hi - lo + 1
+    n_shards = shards or min(cores(), max(1, total // 256))
+    build_dir = Path(build_dir).resolve() / "sweep"
+    if build_dir.exists():
+        shutil.rmtree(build_dir)
+    records = build_dir / "records"
+    t0 = time.monotonic()
+    # LLVM spends ~10 s more than mcode compiling and runs ~2.6x faster: worth it for long runs only
+    backend = backend or (ghdl_backend() if total * man["cycles_per_sample"] > 2_000_000 else "mcode")
+    backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
+    t_build = time.monotonic() - t0
+    shard_cfg = []
+    if listed:
+        for k, chunk in enumerate(c for c in np.array_split(todo, n_shards) if c.size):
+            cf = build_dir / f"codes_{k}.txt"
+            cf.write_text("".join(f"{int(c)}\n" for c in chunk))
+            shard_cfg.append({"codes": [int(c) for c in chunk], "codes_file": str(cf)})
+    else:
+        shard_cfg = [{"lo": a, "hi": b} for a, b in split(lo, hi, n_shards)]
+    for k, s in enumerate(shard_cfg):  # one configuration file per shard (the bench's only channel)
+        s.update(name=f"sweep_{k}", file=str(build_dir / f"sweep_{k}.txt"))
+        (build_dir / f"bench_config_{k}.json").write_text(
+            json.dumps({**_bench_config(design), "records_dir": str(records), "shard": s}))
+    results: list = [None] * len(shard_cfg)
+
+    def one(k: int) -> None:
+        s = shard_cfg[k]
+        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"],
+                  "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
+        if "codes_file" in s:
+            params["codes_file_g"] = s["codes_file"]
+        results[k] = _test(build_dir, "flann_sweep", "test_sweep", backend, build_dir / f"bench_config_{k}.json",
+                           str(k), params, [], None, 1)
+
+    threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(shard_cfg))]
+    t1 = time.monotonic()
+    for t in threads:
+        t.start()
+    files = [Path(s["file"]) for s in shard_cfg]
+    while any(t.is_alive() for t in threads):
+        for t in threads:
+            t.join(0.5)
+            break
         if progress:
-            progress(f"simulating {b} ...")
-        results.append(run_bench(hdl, b, model=model_path, options=options, build_dir=build_dir, seed=seed))
-    top = next((r for r in results if r.bench == "top"), None)
-    summary = {
+            progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    seconds = time.monotonic() - t1
+    bench = _result("sweep", [r for r in results if r is not None], records, time.monotonic() - t0)
+    got = merge([read_results(f) for f in files])
+    return {"bench": bench, **got, "backend": backend, "shards": len(shard_cfg), "seconds": seconds,
+            "build_seconds": t_build}
+
+
+ENGINES = ("ghdl", "verilator")
+
+
+def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple[dict, dict]:
+    """Every input code: (the VHDL sweep's result, the outputs of every code with a description).
+
+    engine "ghdl": the VHDL itself under GHDL, every code.  engine "verilator": every code through
+    GHDL's synthesis of the VHDL compiled by Verilator (the netlist Yosys maps), and the VHDL
+    under GHDL on a sample (random windows, the clamp edges, both ends of the range), so the
+    compiled netlist is tied to the VHDL's own simulation on every run.
+    """
+    man = design.manifest
+    if engine == "ghdl":
+        sw = sweep(design, build_dir, progress=progress("sweep") if progress else None)
+        about = {"engine": "ghdl", "backend": f"ghdl-{sw['backend']}", "shards": sw["shards"],
+                 "seconds": round(sw["seconds"], 1), "build_seconds": round(sw["build_seconds"], 1),
+                 "codes_per_s": round(sw["codes"].size / sw["seconds"], 1) if sw["seconds"] else None}
+        return sw, {**{k: sw[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
+    if engine != "verilator":
+        raise FlannError(f"engine {engine!r}: must be one of {', '.join(ENGINES)}")
+    nl = check_rtl_netlist(design, build_dir / "rtl_netlist", progress=progress("sweep") if progress else None)
+    lo, hi = int(nl["codes"].min()), int(nl["codes"].max())
+    rng = np.random.default_rng(int(man["model_sha256"][:8], 16) if man.get("model_sha256") else 1)
+    c_lo, c_hi = man["clamp_codes"]
+    sample = {lo, lo + 1, hi - 1, hi, -1, 0, 1}
+    sample |= {c + d for c in (c_lo, c_hi) for d in range(-3, 4)}
+    sample |= {int(c) for c in rng.integers(lo, hi + 1, 200)}
+    sw = sweep(design, build_dir, codes=sorted(c for c in sample if lo <= c <= hi))
+    about = {"engine": "verilator", "netlist": "ghdl --synth --out=verilog (repaired), Verilator",
+             "shards": nl["shards"], "seconds": round(nl["seconds"], 1), "build_seconds": round(nl["build_seconds"], 1),
+             "codes_per_s": round(nl["codes"].size / nl["seconds"], 1) if nl["seconds"] else None,
+             "vhdl_sample": {"codes": int(sw["codes"].size), "backend": f"ghdl-{sw['backend']}",
+                             "bench_ok": sw["bench"].ok}}
+    return sw, {**{k: nl[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
+
+
+def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
+             engine: str = "ghdl", progress=None) -> dict:
+    """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
+    GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches,
+    optionally the post-synthesis netlist; returns {"summary", "curve", "spec"} (summary =
+    `flann sim --json`)."""
+    build_dir = Path(build_dir)
+    spec, man = design.spec, design.manifest
+    results, summary = [], {
         "codes_tested": 0, "mismatches": None, "max_err_lsb": None, "max_err_mm": None,
         "cycles_per_sample": man["cycles_per_sample"],
         "samples_per_s_at_50mhz": round(CLOCK_HZ / man["cycles_per_sample"], 1),
     }
-    rec = top.records.get("top_every_code") if top else None
     curve = None
-    if rec:
-        codes = np.array(rec["codes"], dtype=np.int64)
-        data = np.array(rec["data"], dtype=np.int64)
-        sat = np.array(rec["sat"], dtype=bool)
-        twin_out, twin_sat = FlannTop(spec).process(codes)
-        ref = spec.float_reference(codes) / spec.output_lsb_mm
-        err = np.abs(data - ref)
-        summary.update(
-            codes_tested=int(codes.size),
-            mismatches=max(int(np.count_nonzero((data != twin_out) | (sat != twin_sat))),
-                           int(rec.get("mismatches", 0))),
-            max_err_lsb=round(float(err.max()), 4),
-            max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6),
-        )
-        curve = {"codes": codes, "hdl": data, "ref": ref}
+    for b in benches:
+        if b == "sweep":
+            sw, every = _every_code(design, build_dir, engine, progress)
+            results.append(sw["bench"])
+            codes, data, sat = every["codes"], every["data"], every["sat"]
+            if codes.size:
+                twin_out, twin_sat = FlannTop(spec).process(codes)
+                ref = spec.float_reference(codes) / spec.output_lsb_mm
+                err = np.abs(data - ref)
+                bad = (data != twin_out) | (sat != twin_sat) | (every["latency"] != man["latency_cycles"])
+                summary.update(codes_tested=int(codes.size), mismatches=int(np.count_nonzero(bad)),
+                               max_err_lsb=round(float(err.max()), 4),
+                               max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6))
+                curve = {"codes": codes, "hdl": data, "ref": ref}
+            summary["sweep"] = every["about"]
+        else:
+            if progress and sys.stderr.isatty():
+                print(f"simulating {b} ...", file=sys.stderr, flush=True)
+            results.append(run_bench(design, b, build_dir, seed=seed))
     summary["benches"] = {r.bench: {"tests": r.tests, "failures": r.failures, "failed": r.failed_tests,
                                     "seconds": round(r.seconds, 1)} for r in results}
-    summary["all_passed"] = all(r.ok for r in results)
+    all_ok = all(r.ok for r in results)
+    if netlist:
+        nl = check_netlist(design, build_dir / "netlist", progress=progress("netlist") if progress else None)
+        summary["netlist"] = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"],
+                              "simulator": nl["simulator"], "seconds": round(nl["seconds"], 1)}
+        all_ok = all_ok and nl["mismatches"] == 0 and nl["codes_tested"] > 0
+    summary["all_passed"] = all_ok
     summary["latency_cycles"] = man["latency_cycles"]
     summary["output_lsb_mm"] = man["output_lsb_mm"]
     summary["model_sha256"] = man["model_sha256"]
+    summary["design"] = str(design.directory)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
@@ -243,4 +395,5 @@ def plot(curve: dict, spec, path) -> None:
         tmp.unlink(missing_ok=True)
 
 
-__all__ = ["run_bench", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir"]
+__all__ = ["run_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
+           "ghdl_backend"]

@@ -3,13 +3,12 @@
 driver (random bubbles on in_valid) -> DUT -> monitor (out_valid/out_y each edge)
 model  (the Python twin's cycle model) -> scoreboard (in order, bit-exact, valid flag too)
 
-The spec comes as JSON in FLANN_F18_SPEC: {"kind", "format": {...}, "seed", "n_random"}.
+The spec comes in the bench configuration (flann.verify.benches.config):
+{"kind", "format": {...}, "seed", "n_random"}.
 """
 
 from __future__ import annotations
 
-import json
-import os
 import random
 
 import cocotb
@@ -17,12 +16,13 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.numeric.float18 import F18Add, F18Mul, FloatFormat
+from flann.verify.benches import config
 
 TWINS = {"mul": F18Mul, "add": F18Add}
 
 
 def load_spec() -> dict:
-    spec = json.loads(os.environ["FLANN_F18_SPEC"])
+    spec = config()
     f = spec["format"]
     spec["fmt"] = FloatFormat(exp_bits=f["exp_bits"], frac_bits=f["frac_bits"], bias=f["bias"],
                               name=f["name"])

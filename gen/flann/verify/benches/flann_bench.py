@@ -1,7 +1,7 @@
 """Shared cocotb test-bench pieces for the generated FLANN VHDL (cocotb 2.x, GHDL).
 
 GHDL's VPI cannot read generics, so the runner (flann.verify.runner) writes a JSON config and
-points ``FLANN_BENCH_CONFIG`` at it: model path + generator options (to rebuild the same
+names it in ``FLANN_BENCH_CONFIG`` (flann.verify.benches.config): model path + generator options (to rebuild the same
 Spec and bit-true twin), the manifest, the seed and where to write the bench's records.
 
 Shape (as cocotb's own examples): a driver, a monitor, a model (the twin), a scoreboard
@@ -12,7 +12,6 @@ checking in order, a small bench class wiring them; the ``@cocotb.test`` functio
 from __future__ import annotations
 
 import json
-import os
 import random
 from collections import deque
 from pathlib import Path
@@ -24,16 +23,10 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Event, FallingEdge, RisingEdge
 
 from flann.hardware.fixed.render import load
+from flann.verify.benches import config
 from flann.hardware.fixed.twin import FlannTop
 
 CLK_NS = 10
-
-
-def config() -> dict:
-    path = os.environ.get("FLANN_BENCH_CONFIG")
-    if not path:
-        raise RuntimeError("FLANN_BENCH_CONFIG is not set (run the benches through flann.verify.runner)")
-    return json.loads(Path(path).read_text())
 
 
 def load_spec(cfg: dict):

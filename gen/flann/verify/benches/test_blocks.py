@@ -12,7 +12,7 @@ import numpy as np
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.hardware.fixed.twin import FlannAdder, FlannExpansion, FlannMultiplier, FlannNorm
-from flann_bench import config, load_spec, reset, rng, start_clock, write_record
+from flann.verify.benches.flann_bench import config, load_spec, reset, rng, start_clock, write_record
 
 
 def _lanes(value, n: int, width: int) -> list[int]:

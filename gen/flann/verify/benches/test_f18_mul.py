@@ -1,7 +1,7 @@
 """cocotb tests of flann_f18_mul against its twin F18Mul (bit-exact, cycle by cycle)."""
 
 import cocotb
-from f18_bench import Bench, stimuli
+from flann.verify.benches.f18_bench import Bench, stimuli
 
 
 @cocotb.test()

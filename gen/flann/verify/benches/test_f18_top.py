@@ -1,7 +1,7 @@
 """cocotb: flann_f18_top against its twin F18Top over a list of input codes (bit-exact).
 
-The expected outputs come from the twin, computed by the pytest side and passed as a JSON
-file named in FLANN_F18_TOP (GHDL's VPI cannot read generics):
+The expected outputs come from the twin, computed by the runner and passed in the bench
+configuration (flann.verify.benches.config; GHDL's VPI cannot read generics):
 {"codes": [...], "out": [...], "sat": [...], "latency": N, "in_bits": B, "seed": S,
  "records": optional path where the HDL's outputs are written as JSON,
  "stage_codes": optional codes at which the internal stages are captured too}
@@ -12,19 +12,19 @@ converted term (term_f at term_valid), product (prod_f at prod_valid) and runnin
 """
 
 import json
-import os
 import random
 
 import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
+from flann.verify.benches import config
+
 
 class TopBench:
     def __init__(self, dut):
         self.dut = dut
-        with open(os.environ["FLANN_F18_TOP"]) as fh:
-            self.spec = json.load(fh)
+        self.spec = config()
         self.rng = random.Random(self.spec["seed"])
         dut._log.info(f"seed {self.spec['seed']}, {len(self.spec['codes'])} codes")
         self.mask = (1 << self.spec["in_bits"]) - 1

@@ -1,52 +1,11 @@
-"""flann_top benches: exhaustive bit-exact check, handshake, reset, saturation."""
+"""flann_top reactive benches: handshake gaps, reset mid sample, saturation (every code: test_sweep.py)."""
 
 from __future__ import annotations
 
 import cocotb
-import numpy as np
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
 
-from flann_bench import TopBench, reset, write_record
-
-
-def _codes(bench: TopBench) -> list[int]:
-    """Every code (default) or a seeded random subset plus all corners (cfg 'codes')."""
-    s = bench.spec
-    sel = bench.cfg.get("codes", "all")
-    every = list(range(s.code_min, s.code_max + 1))
-    if sel == "all":
-        return every
-    corners = {s.code_min, s.code_min + 1, -1, 0, 1, s.code_max - 1, s.code_max,
-               s.clamp_lo - 1, s.clamp_lo, s.clamp_lo + 1, s.clamp_hi - 1, s.clamp_hi, s.clamp_hi + 1}
-    corners = [c for c in sorted(corners) if s.code_min <= c <= s.code_max]
-    return corners + bench.rng.sample(every, min(int(sel), len(every)))
-
-
-@cocotb.test()
-async def top_every_code(dut):
-    """Every input code back to back: bit-exact vs the twin, latency as in the manifest."""
-    bench = TopBench(dut)
-    await bench.start()
-    codes = _codes(bench)
-    await bench.run_codes(codes)
-    await bench.drain()
-    sb = bench.sb
-    write_record(bench.cfg, "top_every_code", {
-        "codes": [r[0] for r in sb.records], "data": [r[1] for r in sb.records],
-        "sat": [r[2] for r in sb.records], "mismatches": sb.mismatches,
-        "latencies": sorted(set(sb.latencies)), "sim_time_ns": cocotb.utils.get_sim_time(unit="ns"),
-    })
-    assert sb.checked == len(codes), f"{sb.checked} outputs for {len(codes)} samples"
-    assert sb.ok, f"{sb.mismatches} mismatches, {sb.unexpected} unexpected outputs"
-    assert set(sb.latencies) == {bench.spec.latency_cycles}, f"latencies {sorted(set(sb.latencies))}"
-    # independent of the twin: within 1 output LSB of the float model
-    s = bench.spec
-    codes_a = np.array([r[0] for r in sb.records])
-    ref = s.float_reference(codes_a) / s.output_lsb_mm
-    err = float(np.max(np.abs(np.array([r[1] for r in sb.records]) - ref)))
-    dut._log.info("max |HDL - float| = %.4f LSB over %d codes", err, len(codes_a))
-    bound = max(1.0, s.analysis["bound_total_lsb"])  # the stated bound (<= 1 for default widths)
-    assert err <= bound, f"max |HDL - float model| = {err:.3f} LSB > {bound:.3f}"
+from flann.verify.benches.flann_bench import TopBench, reset
 
 
 @cocotb.test()

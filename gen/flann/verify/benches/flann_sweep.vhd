@@ -1,0 +1,119 @@
+-- Simulation-only harness: every input code from code_lo_g to code_hi_g (or, when codes_file_g
+-- names a file, the codes listed there, one per line) through flann_top, back to back, one text
+-- line per sample ("code data sat latency") in out_file_g.  Stimulus,
+-- clock and response stay in VHDL: the cocotb bench (test_sweep.py) is woken once, at done,
+-- and checks the whole file against the twin.  Widths and range come in as generics.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use std.textio.all;
+
+entity flann_sweep is
+  generic (
+    in_bits_g    : positive := 12;
+    out_bits_g   : positive := 16;
+    code_lo_g    : integer  := -2048;
+    code_hi_g    : integer  := 2047;
+    codes_file_g : string   := "";
+    out_file_g   : string   := "sweep.txt";
+    half_ns_g    : positive := 5
+  );
+  port (
+    done : out std_logic
+  );
+end entity flann_sweep;
+
+architecture sim of flann_sweep is
+  signal clk       : std_logic := '0';
+  signal running   : boolean   := true;
+  signal rst       : std_logic := '1';
+  signal in_valid  : std_logic := '0';
+  signal in_ready  : std_logic;
+  signal in_data   : std_logic_vector(in_bits_g - 1 downto 0) := (others => '0');
+  signal out_valid : std_logic;
+  signal out_data  : std_logic_vector(out_bits_g - 1 downto 0);
+  signal out_sat   : std_logic;
+  signal cycle     : natural := 0;
+begin
+  -- the clock stops after the last sample, so the simulation ends by itself
+  clk <= not clk after half_ns_g * 1 ns when running else clk;
+
+  i_dut : entity work.flann_top
+    port map (
+      clk       => clk,
+      rst       => rst,
+      in_valid  => in_valid,
+      in_ready  => in_ready,
+      in_data   => in_data,
+      out_valid => out_valid,
+      out_data  => out_data,
+      out_sat   => out_sat
+    );
+
+  p_cycle : process (clk)
+  begin
+    if rising_edge(clk) then
+      cycle <= cycle + 1;
+    end if;
+  end process p_cycle;
+
+  -- offer each code until an edge with in_ready high takes it, wait for its result, write it
+  p_run : process
+    file f       : text open write_mode is out_file_g;
+    file cf      : text;
+    variable st  : file_open_status;
+    variable l   : line;
+    variable cl  : line;
+    variable c   : integer;
+    variable t0  : natural;
+    variable ok  : boolean;
+    variable lst : boolean := codes_file_g'length > 0;
+  begin
+    done <= '0';
+    if lst then
+      file_open(st, cf, codes_file_g, read_mode);
+      assert st = open_ok report "cannot open " & codes_file_g severity failure;
+    end if;
+    wait until rising_edge(clk);
+    wait until rising_edge(clk);
+    rst <= '0';
+    c := code_lo_g;
+    loop
+      if lst then
+        exit when endfile(cf);
+        readline(cf, cl);
+        read(cl, c, ok);
+        next when not ok;
+      else
+        exit when c > code_hi_g;
+      end if;
+      in_data  <= std_logic_vector(to_signed(c, in_bits_g));
+      in_valid <= '1';
+      loop
+        wait until rising_edge(clk);
+        exit when in_ready = '1';
+      end loop;
+      t0       := cycle;
+      in_valid <= '0';
+      wait until rising_edge(clk) and out_valid = '1';
+      write(l, c);
+      write(l, ' ');
+      write(l, to_integer(signed(out_data)));
+      write(l, ' ');
+      if out_sat = '1' then
+        write(l, 1);
+      else
+        write(l, 0);
+      end if;
+      write(l, ' ');
+      -- out_valid rose after the previous edge: that edge is the one the latency counts
+      write(l, cycle - t0 - 1);
+      writeline(f, l);
+      c := c + 1;
+    end loop;
+    file_close(f);  -- flushed before the bench reads it
+    running <= false;
+    done    <= '1';
+    wait;
+  end process p_run;
+end architecture sim;

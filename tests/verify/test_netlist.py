@@ -1,0 +1,48 @@
+"""Post-synthesis simulation (Yosys synth_xilinx -family xcv netlist under Verilator) and Ctrl-C."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from flann.implement.synth import complete_pmux_cases, ghdl_to_verilog, read_manifest
+from flann.verify.design import from_model
+from flann.verify.netlist import check_netlist
+
+pytestmark = [pytest.mark.sim, pytest.mark.synth,
+              pytest.mark.skipif(not all(shutil.which(t) for t in ("ghdl", "yosys", "verilator")),
+                                 reason="needs ghdl, yosys, verilator (scripts/ensure_tools.sh)")]
+
+
+def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
+    design = from_model(small_model(11), tmp_path / "d", {"input_bits": 8})
+    r = check_netlist(design, tmp_path / "nl")
+    assert r["codes_tested"] == 256 and r["mismatches"] == 0, r
+    assert Path(r["netlist"]).read_text().count("LUT") > 10  # the mapped cells, not RTL
+    # GHDL's Verilog as GHDL prints it (no repair) disagrees with the twin: the check sees it
+    work = tmp_path / "raw"
+    ghdl_to_verilog(read_manifest(design.directory), work)
+    raw = subprocess.run(["ghdl", "--synth", "--std=93c", f"--workdir={work / 'ghdl'}", "--out=verilog",
+                          "flann_top"], capture_output=True, text=True, check=True).stdout
+    (work / "raw.v").write_text(complete_pmux_cases(raw)[0])
+    bad = check_netlist(design, tmp_path / "nl_raw", netlist=work / "raw.v")
+    assert bad["codes_tested"] == 256 and bad["mismatches"] > 0
+
+
+def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):
+    model = small_model(11)
+    flann = Path(sys.executable).with_name("flann")
+    p = subprocess.Popen([str(flann), "sim", str(model), "--input-bits", "10"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True, cwd=tmp_path)
+    time.sleep(6)  # inside the build or the sweep
+    os.killpg(p.pid, signal.SIGINT)  # what Ctrl-C on a terminal does: the whole process group
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    assert err.strip().splitlines() == ["error: interrupted"], err
