@@ -318,8 +318,10 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
 
 
 def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles=("lut", "shiftadd"),
-            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast") -> list[Row]:
-    """Generate, synthesise and score each candidate; the seed architecture last."""
+            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast",
+            adc: dict | None = None) -> list[Row]:
+    """Generate, synthesise and score each candidate; the seed architecture last.  ``adc``:
+    input_bits / input_lsb_v of the converter, as flann gen takes them."""
     import warnings as _w
 
     from ..hardware.fixed import render as hdlgen
@@ -338,7 +340,7 @@ def explore(model_path, device: str = "xc2s200-pq208-5", lanes=(1, 2, 4), styles
                 print(f"explore [{k}/{len(combos)}] lanes={lane} mult={style} widths={preset}",
                       file=sys.stderr)
             try:
-                base = dict(lanes=lane, mult_style=style)
+                base = dict(lanes=lane, mult_style=style, **(adc or {}))
                 with _w.catch_warnings(record=True) as caught:
                     _w.simplefilter("always")
                     opts = {**base, **_width_options(model_path, preset, base)}
