@@ -213,3 +213,21 @@ def test_ghdl_verilog_of_the_default_design_agrees_with_the_twin(tmp_path):
                           "flann_top"], capture_output=True, text=True, check=True).stdout
     (tmp_path / "raw.v").write_text(complete_pmux_cases(raw)[0])
     assert _iverilog_codes(tmp_path / "raw.v", tmp_path, [-2048]) == {-2048: (32767, 1)}
+
+
+@pytest.mark.synth
+@pytest.mark.skipif(shutil.which("verilator") is None, reason="needs verilator (scripts/ensure_tools.sh)")
+def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, monkeypatch):
+    """Without the Verilog repair (GHDL's text as printed) the mapped netlist is wrong: refused."""
+    from flann.implement import synth
+
+    repo = Path(__file__).resolve().parents[2]
+    model = tmp_path / "m.json"
+    assert main(["train", str(repo / "data" / "paper_table1.csv"), "--terms", "11", "--method", "lstsq",
+                 "-o", str(model)]) == 0
+    assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "8"]) == 0
+    capsys.readouterr()
+    monkeypatch.setattr(synth, "repair_ghdl_verilog", lambda text: (text, 0, 0))
+    rc, out, err = _run(capsys, tmp_path / "d", "--model", model, "--no-lint", "--abc", "fast", "--json")
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and "disagrees with its twin" in err

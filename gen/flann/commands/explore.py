@@ -32,6 +32,10 @@ def add_arguments(p):
                    help="add the float18 rows: the serial float18 design and the seed's arithmetic in float18")
     p.add_argument("--abc", choices=("fast", "full"), default="fast",
                    help="yosys LUT mapping (default fast: abc -fast; full = synth_xilinx as is, slow)")
+    p.add_argument("--input-bits", type=int, default=None, metavar="B",
+                   help="ADC width in bits, as for flann gen (default: flann gen's)")
+    p.add_argument("--input-lsb-v", type=float, default=None, metavar="V",
+                   help="volts per ADC code, as for flann gen (default: flann gen's)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
@@ -45,6 +49,7 @@ def run(args) -> int:
     rows = explore.explore(
         args.model, args.device, lanes=_ints(args.lanes), styles=tuple(args.mult.split(",")),
         widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=True, abc=args.abc,
+        adc={k: v for k, v in (("input_bits", args.input_bits), ("input_lsb_v", args.input_lsb_v)) if v is not None},
     )
     if args.float18:
         rows += explore.float18_rows(args.model, args.device, abc=args.abc)

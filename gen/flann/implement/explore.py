@@ -81,8 +81,10 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
 
 
 def explore(model_path, device: str = DEFAULT_PART, lanes=(1, 2, 4), styles=("lut", "shiftadd"),
-            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast") -> list[Row]:
-    """Generate, synthesise and score each candidate; the seed architecture last."""
+            widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast",
+            adc: dict | None = None) -> list[Row]:
+    """Generate, synthesise and score each candidate; the seed architecture last.  ``adc``:
+    input_bits / input_lsb_v of the converter, as flann gen takes them."""
     parse_part(device)
     rows: list[Row] = []
     combos = [(l, s, w) for w in widths for s in styles for l in lanes]
@@ -94,7 +96,7 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=(1, 2, 4), styles=("lu
                 print(f"explore [{k}/{len(combos)}] lanes={lane} mult={style} widths={preset}",
                       file=sys.stderr)
             try:
-                base = dict(lanes=lane, mult_style=style)
+                base = dict(lanes=lane, mult_style=style, **(adc or {}))
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")
                     opts = {**base, **_width_options(model_path, preset, base)}
