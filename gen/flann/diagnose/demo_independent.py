@@ -105,6 +105,11 @@ def resolved(case: IndependentCase, d: Draw) -> dict:
             peak_hi = float(np.max(F.output_v(replace(d.sensor, effects={}), np.array(d.travel_mm))))
             peak_lo = float(np.min(F.output_v(replace(d.sensor, effects={}), np.array(d.travel_mm))))
             p = {"high_v": p["high_fraction"] * peak_hi, "low_v": p["low_fraction"] * peak_lo}
+        if e == "leadscrew" and "max_period_fraction" in p:
+            # a lead-screw error is told from the sensor's smooth shape by a period short
+            # against the stroke: on a short stroke the period shrinks with it
+            span = d.travel_mm[1] - d.travel_mm[0]
+            p["period_mm"] = min(p["period_mm"], p.pop("max_period_fraction") * span)
         out[e] = p
     return out
 
@@ -203,8 +208,10 @@ CASES: tuple[IndependentCase, ...] = (
                     "the lower end of the curve (equal readings on the rail)",
                     {"rails": {"high_fraction": 0.97, "low_fraction": 0.99}}, seed=9,
                     main="rails"),
-    IndependentCase("leadscrew_periodic below noise", "10 um, 2 mm period",
-                    {"leadscrew": {"amplitude_mm": 0.01, "period_mm": 2.0, "phase_rad": 0.3}},
+    IndependentCase("leadscrew_periodic below noise",
+                    "10 um, 2 mm period (at most 1/10 of the stroke)",
+                    {"leadscrew": {"amplitude_mm": 0.01, "period_mm": 2.0, "phase_rad": 0.3,
+                                   "max_period_fraction": 0.1}},
                     seed=10, main="leadscrew"),
     IndependentCase("quadrature_null at the tip of a V", "q = 40 mV, amplitude output",
                     {"quadrature": {"quadrature_v": 0.04}}, seed=11, rectified=True,

@@ -31,7 +31,10 @@ from scipy.optimize import least_squares
 
 from ..physics.effects import EFFECTS, Context, Signal
 from ..physics.simulate import simulate_output_v
-from .select import Fit
+from .select import Fit, make_folds
+
+# candidate numbers of smooth shape terms (chosen by cross-validation)
+SHAPE_TERMS = (0, 2, 3, 4, 6)
 
 # Effects the diagnosis tries, in catalogue order (secondary_loading is left out: with
 # unknown geometry its position-dependent gain is a shape change, not a signature).
@@ -105,7 +108,7 @@ class OddBasis:
 
     def describe(self) -> str:
         return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm), "
-                "complexity chosen by 5-fold cross-validation")
+                "complexity chosen by 5-fold cross-validation with the named effects in place")
 
 
 class PhysicsFamily:
@@ -115,7 +118,7 @@ class PhysicsFamily:
                  gain0: float, origin0: float, scale: float = 1.0,
                  disc: OddBasis | None = None, origin_from_travel: bool = False):
         self.sensor = sensor.replace(effects={})
-        self._disc_ref = None
+        self._disc_ref = disc      # half-range and rectification of the shape term
         self.disc = disc
         self.origin_from_travel = origin_from_travel
         self.data = data
@@ -434,9 +437,7 @@ class PhysicsFamily:
         if "adc_clipping" not in effects:
             return self._fit(effects, idx, start, "both", k0)
         if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
-            sides = {"adc_clipping.rail_high_v": "high", "adc_clipping.rail_low_v": "low"}
-            have = [sides[n] for n in start.names if n in sides]
-            return self._fit(effects, idx, start, have[0] if len(have) == 1 else "both", k0)
+            return self._fit(effects, idx, start, self._sides(start), k0)
         ks = [k0] + [k for k in self.fewer_terms if k < k0]
         fits = [self._fit(effects, idx, start, side, k)
                 for side in ("high", "low", "both") for k in ks]
@@ -445,11 +446,94 @@ class PhysicsFamily:
 
     fewer_terms = (0, 2)
 
+    def set_shape_range(self, half_range_mm: float, rectified: bool) -> None:
+        """Where the smooth shape term lives (the recorded half-range of core positions)."""
+        self._disc_ref = OddBasis(half_range_mm, 1, rectified)
+
     def _basis(self, k: int):
-        if self.disc is None and k == 0:
-            return None
         ref = self._disc_ref
         return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified)
+
+    @staticmethod
+    def _sides(fit: Fit | None) -> str:
+        if fit is None:
+            return "both"
+        have = [s for n, s in (("adc_clipping.rail_high_v", "high"),
+                               ("adc_clipping.rail_low_v", "low")) if n in fit.names]
+        return have[0] if len(have) == 1 else "both"
+
+    def choose_terms(self, effects, idx: np.ndarray, start: Fit | None = None,
+                     ) -> tuple[int, dict, Fit]:
+        """Number of smooth shape terms for the model with ``effects``, by 5-fold
+        cross-validation; returns (terms, out-of-fold RMS by terms, the fit with them).
+
+        Chosen with the effects in place: a large even effect (a zero shift, say) hides
+        the odd misfit of the shape until it is fitted, and the misfit then pushes a
+        second, spurious effect in.  Each number of terms is fitted (nonlinear) on all
+        points; the folds then refit the model linearised about that fit (every parameter
+        and shape coefficient re-adjusts through its Jacobian column), so the shape term's
+        interaction with the null position is kept and a fold costs one small least
+        squares.  The smallest number within 1 % of the best out-of-fold error is taken."""
+        effects = tuple(effects)
+        sides = self._sides(start)
+        if self._disc_ref is None:
+            return 0, {}, self._fit(effects, idx, start, sides, 0)
+        folds = make_folds(np.arange(idx.size))
+        table, fits = {}, {}
+        for k in SHAPE_TERMS:
+            if idx.size - len(self.specs(effects, sides)) - k < 10:
+                continue
+            f = self._fit(effects, idx, start, sides, k)
+            if not f.ok:
+                continue
+            # each number of terms starts where the previous one ended, and keeps the
+            # better of the two (more terms can always do what fewer did)
+            prev = fits[max(fits)] if fits else None
+            if prev is not None:
+                g = self._fit(effects, idx, prev, sides, k)
+                if g.ok and g.rss < f.rss:
+                    f = g
+            X = self._jacobian(f, idx)
+            err = 0.0
+            for test in folds:
+                train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
+                c = np.linalg.lstsq(X[train], f.resid[train], rcond=1e-10)[0]
+                e = f.resid[test] - X[test] @ c
+                err += float(e @ e)
+            table[k] = math.sqrt(err / idx.size)
+            fits[k] = f
+        if not table:
+            return 0, {}, self._fit(effects, idx, start, sides, 0)
+        best = min(table.values())
+        k = min(k for k, v in table.items() if v <= best * 1.01)
+        return k, table, fits[k]
+
+    def _jacobian(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
+        """d(model)/d(parameters, shape coefficients) at ``fit`` (finite differences)."""
+        k = self._k_of(fit)
+        coef = fit.extra.get("coef")
+        coef = np.zeros(k) if coef is None else np.asarray(coef, float)
+        with self._with_k(k):
+            y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef)
+            cols = []
+            for j, th in enumerate(fit.theta):
+                h = 1e-6 * max(abs(th), 1e-3)
+                t1 = fit.theta.copy()
+                t1[j] += h
+                cols.append((self.evaluate(t1, fit.names, idx, coef=coef) - y0) / h)
+            for j in range(k):
+                c1 = coef.copy()
+                c1[j] += 1.0
+                cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1) - y0)
+        return np.stack(cols, 1)
+
+    def refine(self, effects, fit: Fit, idx: np.ndarray) -> Fit:
+        """``fit`` with the shape term's complexity chosen again now that ``effects`` are
+        in the model (see :meth:`choose_terms`)."""
+        k, table, f = self.choose_terms(effects, idx, fit)
+        self.disc = self._basis(k)
+        f.extra["cv_table"] = table
+        return f
 
     @property
     def disc(self):
@@ -458,8 +542,6 @@ class PhysicsFamily:
     @disc.setter
     def disc(self, value):
         self._disc = value if value is not None and value.k > 0 else None
-        if self._disc is not None:
-            self._disc_ref = self._disc
 
     def _with_k(self, k: int):
         """Context: the shape term with ``k`` terms while a fit or prediction runs."""

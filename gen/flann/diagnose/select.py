@@ -86,6 +86,11 @@ class Family(Protocol):
 
     def data_y(self, idx: np.ndarray) -> np.ndarray: ...
 
+    def refine(self, effects: Sequence[str], fit: Fit, idx: np.ndarray) -> Fit:
+        """Re-choose the family's own complexity (a discrepancy term) once ``effects`` are
+        accepted; returns the refitted model."""
+        ...
+
 
 @dataclass
 class Step:
@@ -148,7 +153,8 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
     oof_cache: dict[tuple[str, ...], np.ndarray] = {}
 
     def oof(effects, start):
-        key = tuple(effects)
+        # the family's own complexity (start.extra) is part of the model
+        key = (tuple(effects), start.extra.get("k_shape"))
         if key not in oof_cache:
             oof_cache[key] = oof_errors(family, effects, idx, folds, start)
         return oof_cache[key]
@@ -195,7 +201,7 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
         if accepted is None:
             break
         current.append(accepted.name)
-        best = accepted.fit
+        best = accepted.fit = family.refine(current, accepted.fit, idx)
         steps.append(accepted)
 
     dropped: list[str] = []
