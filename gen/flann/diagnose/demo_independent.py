@@ -191,7 +191,9 @@ CASES: tuple[IndependentCase, ...] = (
                     layout="from 0"),
     IndependentCase("control: rectified output", "none; amplitude of the difference", seed=3,
                     layout="centred", rectified=True),
-    IndependentCase("null_offset below noise", "offset 3 mV = 0.75 x noise",
+    IndependentCase("null_offset below noise", "offset 3 mV = 0.75 x noise; the null is free "
+                    "(travel not centred), so only where the slope rolls off does it differ "
+                    "from a moved null",
                     {"offset": {"offset_v": 0.003}}, seed=4, main="offset"),
     IndependentCase("zero_shift, travel centred", "null 0.6 mm from the centre of the travel",
                     {"zero_shift": {"shift_mm": 0.6}}, seed=5, layout="centred",
@@ -216,7 +218,8 @@ CASES: tuple[IndependentCase, ...] = (
     IndependentCase("quadrature_null at the tip of a V", "q = 40 mV, amplitude output",
                     {"quadrature": {"quadrature_v": 0.04}}, seed=11, rectified=True,
                     layout="centred", main="quadrature"),
-    IndependentCase("two at once: backlash + null_offset", "dead band 30 um and offset 4 mV",
+    IndependentCase("two at once: backlash + null_offset", "dead band 30 um and offset 4 mV "
+                    "(null free: the offset differs from a moved null only at the roll-off)",
                     {"backlash": {"deadband_mm": 0.03}, "offset": {"offset_v": 0.004}}, seed=12,
                     main="backlash"),
     IndependentCase("two at once: thermal_drift + rails", "-0.02 %/degC one-way rise and "

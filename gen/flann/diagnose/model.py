@@ -36,6 +36,12 @@ from .select import Fit, make_folds
 # candidate numbers of smooth shape terms (chosen by cross-validation)
 SHAPE_TERMS = (0, 2, 3, 4, 6)
 
+# secondary_imbalance's extra, diagnosis-only parameter (not in the catalogue): how much
+# the sum of the secondaries bends along the stroke beyond the calibrated simulation's,
+# as a factor 1 + c (core / half-range)^2 on the imbalance's contribution
+SUM_CURVATURE = "sum_curvature"
+NEUTRAL_EXTRA = {"secondary_imbalance": {SUM_CURVATURE: 0.0}}
+
 # Effects the diagnosis tries, in catalogue order (secondary_loading is left out: with
 # unknown geometry its position-dependent gain is a shape change, not a signature).
 CANDIDATES = ("null_offset", "quadrature_null", "zero_shift", "secondary_imbalance",
@@ -172,7 +178,8 @@ class PhysicsFamily:
             elif e == "zero_shift":
                 out.append(ParamSpec("zero_shift.shift_mm", -span / 2, span / 2, "mm"))
             elif e == "secondary_imbalance":
-                out.append(ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""))
+                out += [ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""),
+                        ParamSpec("secondary_imbalance.sum_curvature", -2.0, 2.0, "")]
             elif e == "backlash":
                 out.append(ParamSpec("backlash.deadband_mm", 0.0, span / 10, "mm"))
             elif e == "thermal_drift":
@@ -192,6 +199,11 @@ class PhysicsFamily:
             else:
                 raise ValueError(f"unknown candidate {e}")
         return out
+
+    def _half_range(self) -> float:
+        if self._disc_ref is not None:
+            return self._disc_ref.half
+        return max(float(np.max(np.abs((self.data.x - self.origin0) * self.scale))), 1e-9)
 
     def max_period(self) -> float:
         """A lead-screw period must be short against the stroke: the smooth shape term
@@ -219,7 +231,7 @@ class PhysicsFamily:
             e, p = name.split(".", 1)
             eff.setdefault(e, {})[p] = float(v)
         for e, params in eff.items():
-            full = EFFECTS[e].neutral()
+            full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
             if e == "thermal_drift":
                 full["reference_temperature_c"] = self.t_ref
             full.update(params)
@@ -229,6 +241,7 @@ class PhysicsFamily:
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
     _CLIPPED = {"secondary_imbalance.imbalance_fraction": 0.9,
+                "secondary_imbalance.sum_curvature": 3.0,
                 "thermal_drift.coefficient_per_c": 0.2}
 
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
@@ -264,6 +277,7 @@ class PhysicsFamily:
         self.nfev += 1
         gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
         d = self.data
+        curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
         s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
         core = (d.x[idx] - self.origin0) * self.scale
@@ -274,6 +288,14 @@ class PhysicsFamily:
         # is hit whenever no position effect is on; a change of origin enters to first
         # order through the slope (it is ~1e-3 mm inside the effect fits).
         y = simulate_output_v(s, core, direction=direction, temperature_c=temp, time_s=time)
+        if curvature:
+            # the imbalance's even part follows the sum of the secondaries, whose change
+            # along the stroke the calibrated simulation knows only roughly: let it bend
+            without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
+            y0 = simulate_output_v(s.replace(effects=without), core, direction=direction,
+                                   temperature_c=temp, time_s=time)
+            u = core / self._half_range()
+            y = y + curvature * u ** 2 * (y - y0)
         if self.shape is not None:
             modes = self._modes_at(idx, core)
             if origin != self.origin0:
@@ -483,16 +505,11 @@ class PhysicsFamily:
         for k in SHAPE_TERMS:
             if idx.size - len(self.specs(effects, sides)) - k < 10:
                 continue
-            f = self._fit(effects, idx, start, sides, k)
+            # each number of terms starts where the previous one ended (more terms can
+            # always do what fewer did; a cold start may fall into another minimum)
+            f = self._fit(effects, idx, fits[max(fits)] if fits else start, sides, k)
             if not f.ok:
                 continue
-            # each number of terms starts where the previous one ended, and keeps the
-            # better of the two (more terms can always do what fewer did)
-            prev = fits[max(fits)] if fits else None
-            if prev is not None:
-                g = self._fit(effects, idx, prev, sides, k)
-                if g.ok and g.rss < f.rss:
-                    f = g
             X = self._jacobian(f, idx)
             err = 0.0
             for test in folds:

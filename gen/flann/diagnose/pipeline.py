@@ -16,7 +16,7 @@ from ..recordings import Recordings, monotonic_span
 from . import data as D
 from .calibrate import calibrate, initial_origin
 from .explain import explain
-from .model import Data, PhysicsFamily
+from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
 from .select import Fit, forward_select
 
 # the travel is "centred on 0 mm" when |min + max| <= this fraction of the span
@@ -309,7 +309,8 @@ def _se(fit: Fit, name: str) -> float:
 def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
     """The fitted model's output with ``effect`` switched off (its parameters neutral)."""
     theta = fit.theta.copy()
-    neutral = {**EFFECTS[effect].neutral(), "rail_high_v": math.inf, "rail_low_v": -math.inf}
+    neutral = {**EFFECTS[effect].neutral(), **NEUTRAL_EXTRA.get(effect, {}),
+               "rail_high_v": math.inf, "rail_low_v": -math.inf}
     for i, n in enumerate(fit.names):
         if n.startswith(effect + "."):
             theta[i] = neutral[n.split(".", 1)[1]]
