@@ -91,7 +91,8 @@ class IndependentCase:
         return sorted(NAMES[e] for e in self.effects)
 
 
-def _rise_then_hold(t, duration):
+def rise_then_hold(t, duration):
+    """Temperature (degC) rising 20 -> 40 during the outward pass, then held."""
     half = duration / 2 if duration > 0 else 1.0
     return 20.0 + 20.0 * np.clip(t / half, 0.0, 1.0)
 
@@ -125,7 +126,7 @@ def recording(case: IndependentCase, seed: int | None = None, scale: float = 1.0
     rec = F.simulate_recording(m, d.travel_mm, d.step_mm, NOISE_V, seed=s,
                                origin_mm=d.origin_mm, both_directions=d.both_directions or
                                "backlash" in eff or case.thermal,
-                               temperature=_rise_then_hold if case.thermal else None,
+                               temperature=rise_then_hold if case.thermal else None,
                                source=f"independent model: {case.name}")
     return rec, d, eff
 
