@@ -179,7 +179,7 @@ class PhysicsFamily:
                 out.append(ParamSpec("zero_shift.shift_mm", -span / 2, span / 2, "mm"))
             elif e == "secondary_imbalance":
                 out += [ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""),
-                        ParamSpec("secondary_imbalance.sum_curvature", -2.0, 2.0, "")]
+                        ParamSpec("secondary_imbalance.sum_curvature", -0.9, 3.0, "")]
             elif e == "backlash":
                 out.append(ParamSpec("backlash.deadband_mm", 0.0, span / 10, "mm"))
             elif e == "thermal_drift":
@@ -240,9 +240,10 @@ class PhysicsFamily:
 
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
-    _CLIPPED = {"secondary_imbalance.imbalance_fraction": 0.9,
-                "secondary_imbalance.sum_curvature": 3.0,
-                "thermal_drift.coefficient_per_c": 0.2}
+    # (lower, upper); the sum's bend keeps 1 + c u^2 > 0 so the imbalance keeps its sign
+    _CLIPPED = {"secondary_imbalance.imbalance_fraction": (-0.9, 0.9),
+                "secondary_imbalance.sum_curvature": (-0.9, 3.0),
+                "thermal_drift.coefficient_per_c": (-0.2, 0.2)}
 
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
         """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
@@ -251,7 +252,7 @@ class PhysicsFamily:
             if n in self._ONE_SIDED:
                 th[i] = abs(th[i])
             elif n in self._CLIPPED:
-                th[i] = float(np.clip(th[i], -self._CLIPPED[n], self._CLIPPED[n]))
+                th[i] = float(np.clip(th[i], *self._CLIPPED[n]))
         return th
 
     @staticmethod
@@ -508,6 +509,9 @@ class PhysicsFamily:
             # each number of terms starts where the previous one ended (more terms can
             # always do what fewer did; a cold start may fall into another minimum)
             f = self._fit(effects, idx, fits[max(fits)] if fits else start, sides, k)
+            if (start is not None and start.ok and self._k_of(start) == k
+                    and tuple(start.effects) == effects and start.rss < f.rss):
+                f = start      # the chain found a worse minimum than the fit it came from
             if not f.ok:
                 continue
             X = self._jacobian(f, idx)
