@@ -202,3 +202,17 @@ def test_describe_plot(tmp_path):
     png = tmp_path / "anatomy.png"
     assert main(["simulate", "data/sensors/miniature_reversed.toml", "--describe", "--plot", str(png)]) == 0
     assert png.stat().st_size > 10_000
+
+
+def test_plot_that_fails_to_render_leaves_no_file(tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    from flann.physics.plots import plot_anatomy
+
+    def broken(self, *a, **k):
+        raise RuntimeError("renderer failed")
+
+    monkeypatch.setattr(Figure, "savefig", broken)
+    with pytest.raises(RuntimeError):
+        plot_anatomy(default_sensor(), tmp_path / "anatomy.png")
+    assert list(tmp_path.iterdir()) == []

@@ -291,26 +291,16 @@ def false_alarm_rate(case: Case, reps: int = 20, progress=None) -> dict:
 LIMIT_EFFECTS = ("quadrature_null", "backlash", "leadscrew_periodic")
 
 
-def detection_limit(case: Case, scales=(0.25, 0.5, 1.0, 2.0), reps: int = 20,
+def detection_limit(case: Case, scales=(2.0, 1.0, 0.5, 0.25), reps: int = IND.LIMIT_REPS,
                     points: int | None = None, progress=None) -> dict:
     """Detection rate of the case's effect vs its size (at the case's noise): the smallest
-    tried size found (and named right) in >= 95 % of ``reps`` seeds."""
-    rows = []
-    limit = None
-    for sc in scales:
-        hits = 0
-        for r in range(reps):
-            res = run_case(case, scale=sc, seed=1000 + r, points=points)
-            hits += res.right
-        rate = hits / reps
-        e, p = case.main
-        size = resolved_effects(case)[e][p] * sc
-        rows.append({"size": size, "rate": rate})
-        if progress:
-            progress(f"limit {case.name}: {p} = {size:g}: {hits}/{reps}")
-        if rate >= 0.95 and limit is None:
-            limit = size
+    tried size found (and named right) in >= 95 % of ``reps`` seeds (see
+    :func:`flann.diagnose.demo_independent.rate_search`)."""
     e, p = case.main
+    base = resolved_effects(case)[e][p]
+    rows, limit = IND.rate_search(
+        lambda size, r: run_case(case, scale=size / base, seed=1000 + r, points=points).right,
+        [base * sc for sc in scales], reps, progress=progress, label=case.name)
     n_points = len(simulate_case(case, points=points))
     return {"case": case.name, "effect": e, "parameter": p, "noise_v": case.noise_v,
             "points": n_points, "reps": reps, "rates": rows, "limit": limit}
@@ -356,7 +346,7 @@ def demo_table(results: DemoResults) -> str:
                      "95 % limit |")
         lines.append("|---|---|---|---|---|---|")
         for lim in results.limits:
-            rates = ", ".join(f"{r['size']:g}: {r['rate'] * 100:.0f}%" for r in lim["rates"])
+            rates = _rates_text(lim)
             lines.append(f"| {lim['effect']} | {lim['parameter']} | {lim['noise_v'] * 1e3:g} | "
                          f"{lim['points']} | {rates} | "
                          f"{_limit_text(lim)} |")
@@ -373,13 +363,18 @@ def independent_table(results: DemoResults) -> str:
         lines += ["", f"False alarms on {a['reps']} random controls of the independent model: "
                       f"{a['false_alarms']} ({a['named'] or 'none'})"]
     if results.independent_limits:
-        lines += ["", "| effect | parameter | detection rate by size (20 random geometries each) "
-                      "| 95 % limit |", "|---|---|---|---|"]
+        lines += ["", "| effect | parameter | found / seeds by size (20 random geometries, "
+                      "largest first) | 95 % limit |", "|---|---|---|---|"]
         for lim in results.independent_limits:
-            rates = ", ".join(f"{r['size']:.3g}: {r['rate'] * 100:.0f}%" for r in lim["rates"])
+            rates = _rates_text(lim)
             lines.append(f"| {lim['effect']} | {lim['parameter']} | {rates} | "
                          f"{_limit_text(lim)} |")
     return "\n".join(lines) + "\n"
+
+
+def _rates_text(lim: dict) -> str:
+    """``size: hits/tried`` per size (a size stops once 95 % is out of reach)."""
+    return ", ".join(f"{r['size']:.3g}: {r['hits']}/{r['tried']}" for r in lim["rates"])
 
 
 def _limit_text(lim: dict) -> str:

@@ -31,7 +31,16 @@ from scipy.optimize import least_squares
 
 from ..physics.effects import EFFECTS, Context, Signal
 from ..physics.simulate import simulate_output_v
-from .select import Fit
+from .select import Fit, make_folds
+
+# candidate numbers of smooth shape terms (chosen by cross-validation)
+SHAPE_TERMS = (0, 2, 3, 4, 6, 8, 10)
+
+# secondary_imbalance's extra, diagnosis-only parameter (not in the catalogue): how much
+# the sum of the secondaries bends along the stroke beyond the calibrated simulation's,
+# as a factor 1 + c (core / half-range)^2 on the imbalance's contribution
+SUM_CURVATURE = "sum_curvature"
+NEUTRAL_EXTRA = {"secondary_imbalance": {SUM_CURVATURE: 0.0}}
 
 # Effects the diagnosis tries, in catalogue order (secondary_loading is left out: with
 # unknown geometry its position-dependent gain is a shape change, not a signature).
@@ -105,7 +114,7 @@ class OddBasis:
 
     def describe(self) -> str:
         return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm), "
-                "complexity chosen by 5-fold cross-validation")
+                "complexity chosen by 5-fold cross-validation with the named effects in place")
 
 
 class PhysicsFamily:
@@ -115,7 +124,7 @@ class PhysicsFamily:
                  gain0: float, origin0: float, scale: float = 1.0,
                  disc: OddBasis | None = None, origin_from_travel: bool = False):
         self.sensor = sensor.replace(effects={})
-        self._disc_ref = None
+        self._disc_ref = disc      # half-range and rectification of the shape term
         self.disc = disc
         self.origin_from_travel = origin_from_travel
         self.data = data
@@ -169,7 +178,8 @@ class PhysicsFamily:
             elif e == "zero_shift":
                 out.append(ParamSpec("zero_shift.shift_mm", -span / 2, span / 2, "mm"))
             elif e == "secondary_imbalance":
-                out.append(ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""))
+                out += [ParamSpec("secondary_imbalance.imbalance_fraction", -0.5, 0.5, ""),
+                        ParamSpec("secondary_imbalance.sum_curvature", -0.9, 3.0, "")]
             elif e == "backlash":
                 out.append(ParamSpec("backlash.deadband_mm", 0.0, span / 10, "mm"))
             elif e == "thermal_drift":
@@ -189,6 +199,11 @@ class PhysicsFamily:
             else:
                 raise ValueError(f"unknown candidate {e}")
         return out
+
+    def _half_range(self) -> float:
+        if self._disc_ref is not None:
+            return self._disc_ref.half
+        return max(float(np.max(np.abs((self.data.x - self.origin0) * self.scale))), 1e-9)
 
     def max_period(self) -> float:
         """A lead-screw period must be short against the stroke: the smooth shape term
@@ -216,7 +231,7 @@ class PhysicsFamily:
             e, p = name.split(".", 1)
             eff.setdefault(e, {})[p] = float(v)
         for e, params in eff.items():
-            full = EFFECTS[e].neutral()
+            full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
             if e == "thermal_drift":
                 full["reference_temperature_c"] = self.t_ref
             full.update(params)
@@ -225,8 +240,10 @@ class PhysicsFamily:
 
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
-    _CLIPPED = {"secondary_imbalance.imbalance_fraction": 0.9,
-                "thermal_drift.coefficient_per_c": 0.2}
+    # (lower, upper); the sum's bend keeps 1 + c u^2 > 0 so the imbalance keeps its sign
+    _CLIPPED = {"secondary_imbalance.imbalance_fraction": (-0.9, 0.9),
+                "secondary_imbalance.sum_curvature": (-0.9, 3.0),
+                "thermal_drift.coefficient_per_c": (-0.2, 0.2)}
 
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
         """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
@@ -235,7 +252,7 @@ class PhysicsFamily:
             if n in self._ONE_SIDED:
                 th[i] = abs(th[i])
             elif n in self._CLIPPED:
-                th[i] = float(np.clip(th[i], -self._CLIPPED[n], self._CLIPPED[n]))
+                th[i] = float(np.clip(th[i], *self._CLIPPED[n]))
         return th
 
     @staticmethod
@@ -261,6 +278,7 @@ class PhysicsFamily:
         self.nfev += 1
         gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
         d = self.data
+        curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
         s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
         core = (d.x[idx] - self.origin0) * self.scale
@@ -271,6 +289,14 @@ class PhysicsFamily:
         # is hit whenever no position effect is on; a change of origin enters to first
         # order through the slope (it is ~1e-3 mm inside the effect fits).
         y = simulate_output_v(s, core, direction=direction, temperature_c=temp, time_s=time)
+        if curvature:
+            # the imbalance's even part follows the sum of the secondaries, whose change
+            # along the stroke the calibrated simulation knows only roughly: let it bend
+            without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
+            y0 = simulate_output_v(s.replace(effects=without), core, direction=direction,
+                                   temperature_c=temp, time_s=time)
+            u = core / self._half_range()
+            y = y + curvature * u ** 2 * (y - y0)
         if self.shape is not None:
             modes = self._modes_at(idx, core)
             if origin != self.origin0:
@@ -434,9 +460,7 @@ class PhysicsFamily:
         if "adc_clipping" not in effects:
             return self._fit(effects, idx, start, "both", k0)
         if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
-            sides = {"adc_clipping.rail_high_v": "high", "adc_clipping.rail_low_v": "low"}
-            have = [sides[n] for n in start.names if n in sides]
-            return self._fit(effects, idx, start, have[0] if len(have) == 1 else "both", k0)
+            return self._fit(effects, idx, start, self._sides(start), k0)
         ks = [k0] + [k for k in self.fewer_terms if k < k0]
         fits = [self._fit(effects, idx, start, side, k)
                 for side in ("high", "low", "both") for k in ks]
@@ -445,11 +469,115 @@ class PhysicsFamily:
 
     fewer_terms = (0, 2)
 
+    def set_shape_range(self, half_range_mm: float, rectified: bool) -> None:
+        """Where the smooth shape term lives (the recorded half-range of core positions)."""
+        self._disc_ref = OddBasis(half_range_mm, 1, rectified)
+
     def _basis(self, k: int):
-        if self.disc is None and k == 0:
-            return None
         ref = self._disc_ref
         return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified)
+
+    @staticmethod
+    def _sides(fit: Fit | None) -> str:
+        if fit is None:
+            return "both"
+        have = [s for n, s in (("adc_clipping.rail_high_v", "high"),
+                               ("adc_clipping.rail_low_v", "low")) if n in fit.names]
+        return have[0] if len(have) == 1 else "both"
+
+    def choose_terms(self, effects, idx: np.ndarray, start: Fit | None = None,
+                     ) -> tuple[int, dict, Fit]:
+        """Number of smooth shape terms for the model with ``effects``, by 5-fold
+        cross-validation; returns (terms, out-of-fold RMS by terms, the fit with them).
+
+        Chosen with the effects in place: a large even effect (a zero shift, say) hides
+        the odd misfit of the shape until it is fitted, and the misfit then pushes a
+        second, spurious effect in.  Each number of terms is fitted (nonlinear) on all
+        points; the folds then refit the model linearised about that fit (every parameter
+        and shape coefficient re-adjusts through its Jacobian column), so the shape term's
+        interaction with the null position is kept and a fold costs one small least
+        squares.  The smallest number within 1 % of the best out-of-fold error is taken."""
+        effects = tuple(effects)
+        sides = self._sides(start)
+        if self._disc_ref is None:
+            return 0, {}, self._fit(effects, idx, start, sides, 0)
+        folds = make_folds(np.arange(idx.size))
+        table, fits = {}, {}
+        for k in SHAPE_TERMS:
+            if idx.size - len(self.specs(effects, sides)) - k < 10:
+                continue
+            # each number of terms starts where the previous one ended (more terms can
+            # always do what fewer did; a cold start may fall into another minimum)
+            f = self._fit(effects, idx, fits[max(fits)] if fits else start, sides, k)
+            if (start is not None and start.ok and self._k_of(start) == k
+                    and tuple(start.effects) == effects and start.rss < f.rss):
+                f = start      # the chain found a worse minimum than the fit it came from
+            if not f.ok:
+                continue
+            X = self._jacobian(f, idx)
+            err = 0.0
+            for test in folds:
+                train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
+                c = np.linalg.lstsq(X[train], f.resid[train], rcond=1e-10)[0]
+                e = f.resid[test] - X[test] @ c
+                err += float(e @ e)
+            table[k] = math.sqrt(err / idx.size)
+            fits[k] = f
+        if not table:
+            return 0, {}, self._fit(effects, idx, start, sides, 0)
+        best = min(table.values())
+        tied = sorted(k for k, v in table.items() if v <= best * 1.01)
+        self.equivalent_terms = tuple(tied)
+        return tied[0], table, fits[tied[0]]
+
+    # numbers of shape terms that cross-validate as well as the chosen one (set by
+    # choose_terms for the model last chosen)
+    equivalent_terms: tuple[int, ...] = ()
+
+    def least_evidence(self, effects, candidate: str, idx: np.ndarray, without: Fit,
+                       with_: Fit) -> float:
+        """The largest ΔBIC of adding ``candidate`` over the shape terms that cross-validate
+        as well as the chosen ones.  A shape of equal quality that makes the candidate
+        unnecessary means the shape can make it: with a large zero shift, two broad terms
+        let the shift trade against an offset (0.6 mm became 0.33 mm + -117 mV), while three
+        to six terms, as good by cross-validation, need no offset."""
+        worst = with_.bic - without.bic
+        k_now = self._k_of(without)
+        for k in self.equivalent_terms:
+            if k == k_now:
+                continue
+            f0 = self._fit(tuple(effects), idx, without, self._sides(without), k)
+            f1 = self._fit(tuple(effects) + (candidate,), idx, with_, self._sides(with_), k)
+            if f0.ok and f1.ok:
+                worst = max(worst, f1.bic - f0.bic)
+        return worst
+
+    def _jacobian(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
+        """d(model)/d(parameters, shape coefficients) at ``fit`` (finite differences)."""
+        k = self._k_of(fit)
+        coef = fit.extra.get("coef")
+        coef = np.zeros(k) if coef is None else np.asarray(coef, float)
+        with self._with_k(k):
+            y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef)
+            cols = []
+            for j, th in enumerate(fit.theta):
+                h = 1e-6 * max(abs(th), 1e-3)
+                t1 = fit.theta.copy()
+                t1[j] += h
+                cols.append((self.evaluate(t1, fit.names, idx, coef=coef) - y0) / h)
+            for j in range(k):
+                c1 = coef.copy()
+                c1[j] += 1.0
+                cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1) - y0)
+        return np.stack(cols, 1)
+
+    def refine(self, effects, fit: Fit, idx: np.ndarray) -> Fit:
+        """``fit`` with the shape term's complexity chosen again now that ``effects`` are
+        in the model (see :meth:`choose_terms`)."""
+        k, table, f = self.choose_terms(effects, idx, fit)
+        self.disc = self._basis(k)
+        f.extra["cv_table"] = table
+        return f
 
     @property
     def disc(self):
@@ -458,8 +586,6 @@ class PhysicsFamily:
     @disc.setter
     def disc(self, value):
         self._disc = value if value is not None and value.k > 0 else None
-        if self._disc is not None:
-            self._disc_ref = self._disc
 
     def _with_k(self, k: int):
         """Context: the shape term with ``k`` terms while a fit or prediction runs."""

@@ -16,11 +16,9 @@ from ..recordings import Recordings, monotonic_span
 from . import data as D
 from .calibrate import calibrate, initial_origin
 from .explain import explain
-from .model import Data, OddBasis, PhysicsFamily
-from .select import Fit, forward_select, make_folds
+from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
+from .select import Fit, forward_select
 
-# candidate numbers of smooth shape terms (chosen by cross-validation)
-SHAPE_TERMS = (0, 2, 3, 4, 6)
 # the travel is "centred on 0 mm" when |min + max| <= this fraction of the span
 CENTRED = 0.1
 
@@ -182,10 +180,9 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     if progress:
         progress("choosing the smooth shape term")
     core_half = float(np.max(np.abs((x[fit_idx] - family.origin0) * family.scale)))
-    k_shape, cv_table = choose_shape_terms(family, fit_idx, core_half,
-                                           rectified=sensor.demodulator_kind == "amplitude")
-    if k_shape:
-        family.disc = OddBasis(core_half, k_shape, rectified=sensor.demodulator_kind == "amplitude")
+    family.set_shape_range(core_half, rectified=sensor.demodulator_kind == "amplitude")
+    k_shape, cv_table, _ = family.choose_terms([], fit_idx)
+    family.disc = family._basis(k_shape)
 
     # -- name the missing physics --------------------------------------------------------
     candidates = tuple(c for c in family.candidates if not (rails and c == "adc_clipping"))
@@ -261,14 +258,20 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
         if cal.scale != 1.0:
             base_params["displacement_scale"] = _param(cal.scale, math.nan,
                                                        "sensor mm per recorded unit")
-    shape_rms = float(np.sqrt(np.mean(shape_v[fit_idx] ** 2)))
+    # the shape of this sensor as fitted together with the named effects (its complexity
+    # re-chosen once they are in: see PhysicsFamily.choose_terms)
+    k_final = family._k_of(final)
+    basis_final = family._basis(k_final)
+    shape_f = family.shape_term(final, all_idx)[fit_idx]
     shape_desc = {
-        "terms": int(k_shape),
-        "description": (family.disc.describe() if family.disc is not None else
+        "terms": int(k_final),
+        "terms_without_effects": int(k_shape),
+        "description": (basis_final.describe() if basis_final is not None else
                         "none: cross-validation prefers the calibrated simulation alone"),
-        "rms_v": shape_rms,
-        "peak_v": float(np.max(np.abs(shape_v[fit_idx]))) if fit_idx.size else 0.0,
-        "cv_rms_v_by_terms": {str(k): v for k, v in cv_table.items()},
+        "rms_v": float(np.sqrt(np.mean(shape_f ** 2))) if fit_idx.size else 0.0,
+        "peak_v": float(np.max(np.abs(shape_f))) if fit_idx.size else 0.0,
+        "cv_rms_v_by_terms": {str(k): v for k, v in
+                              final.extra.get("cv_table", cv_table).items()},
         "meaning": ("a smooth, odd, direction- and time-independent difference between this "
                     "sensor's curve and the simulated one: the shape of this sensor, not an "
                     "effect"),
@@ -299,44 +302,6 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
         fit_idx=fit_idx)
 
 
-def choose_shape_terms(family: PhysicsFamily, idx: np.ndarray, half_range: float,
-                       rectified: bool) -> tuple[int, dict]:
-    """Number of smooth shape terms by 5-fold cross-validation.
-
-    Linearised about the fitted baseline (gain, origin and geometry modes re-adjust to
-    first order through their Jacobian columns), so each candidate costs one small least
-    squares per fold instead of a nonlinear fit.  The smallest number within 1 % of the
-    best out-of-fold error is taken."""
-    fit0 = family.fit([], idx)
-    r0 = fit0.resid
-    cols = []
-    for j, th in enumerate(fit0.theta):
-        h = 1e-6 * max(abs(th), 1e-3)
-        t1 = fit0.theta.copy()
-        t1[j] += h
-        cols.append((family.evaluate(t1, fit0.names, idx) - (family.data_y(idx) - r0)) / h)
-    J = np.stack(cols, 1)
-    core = (family.data.x[idx] - family.origin0) * family.scale
-    folds = make_folds(np.arange(idx.size))
-    table = {}
-    for k in SHAPE_TERMS:
-        if idx.size - J.shape[1] - k < 10:
-            continue
-        X = J if k == 0 else np.hstack([J, OddBasis(half_range, k, rectified).evaluate(core)])
-        err = 0.0
-        for test in folds:
-            train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
-            c = np.linalg.lstsq(X[train], r0[train], rcond=1e-10)[0]
-            e = r0[test] - X[test] @ c
-            err += float(e @ e)
-        table[k] = math.sqrt(err / idx.size)
-    if not table:
-        return 0, {}
-    best = min(table.values())
-    k = min(k for k, v in table.items() if v <= best * 1.01)
-    return k, table
-
-
 def _se(fit: Fit, name: str) -> float:
     return float(fit.stderr[fit.names.index(name)])
 
@@ -344,7 +309,8 @@ def _se(fit: Fit, name: str) -> float:
 def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
     """The fitted model's output with ``effect`` switched off (its parameters neutral)."""
     theta = fit.theta.copy()
-    neutral = {**EFFECTS[effect].neutral(), "rail_high_v": math.inf, "rail_low_v": -math.inf}
+    neutral = {**EFFECTS[effect].neutral(), **NEUTRAL_EXTRA.get(effect, {}),
+               "rail_high_v": math.inf, "rail_low_v": -math.inf}
     for i, n in enumerate(fit.names):
         if n.startswith(effect + "."):
             theta[i] = neutral[n.split(".", 1)[1]]

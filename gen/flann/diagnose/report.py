@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
-import os
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
+from ..fileio import atomic_save_figure
 from .data import running_mean, window_size
 
 
@@ -185,30 +181,7 @@ def plot(dg, path) -> None:
     fig.suptitle(f"flann diagnose: {dg.source} (shaded: located mismatch, dashed: ±2 noise)",
                  fontsize=10)
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    _atomic_write_bytes(path, buf.getvalue())
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def _atomic_write_bytes(path, data: bytes) -> None:
-    """Write via a temporary file and rename (never a half-written PNG), with the mode an
-    ordinary open() would give (mkstemp creates 0600)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+        atomic_save_figure(fig, path)
+    finally:
+        plt.close(fig)

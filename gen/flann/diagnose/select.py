@@ -14,6 +14,10 @@ earns its keep by both criteria:
   of ``FOLDS`` training folds (fixed seed) and predicts the left-out fold; the paired
   out-of-fold squared errors must improve with a one-sided t statistic above ``CV_T``.
 
+* **Equally good complexities**: a family with its own complexity (the shape term's number
+  of terms) may have several that cross-validate equally well; the effect must lower BIC by
+  the margin at every one of them, since one that makes the effect unnecessary can make it.
+
 After the forward pass, one backward pass drops any accepted effect that no longer
 earns BIC_MARGIN given the others (a proxy picked early for a later, truer effect).
 """
@@ -86,6 +90,16 @@ class Family(Protocol):
 
     def data_y(self, idx: np.ndarray) -> np.ndarray: ...
 
+    def refine(self, effects: Sequence[str], fit: Fit, idx: np.ndarray) -> Fit:
+        """Re-choose the family's own complexity (a discrepancy term) once ``effects`` are
+        accepted; returns the refitted model."""
+        ...
+
+    def least_evidence(self, effects: Sequence[str], candidate: str, idx: np.ndarray,
+                       without: Fit, with_: Fit) -> float:
+        """The weakest ΔBIC for ``candidate`` over the family's equally good complexities."""
+        ...
+
 
 @dataclass
 class Step:
@@ -148,7 +162,8 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
     oof_cache: dict[tuple[str, ...], np.ndarray] = {}
 
     def oof(effects, start):
-        key = tuple(effects)
+        # the family's own complexity (start.extra) is part of the model
+        key = (tuple(effects), start.extra.get("k_shape"))
         if key not in oof_cache:
             oof_cache[key] = oof_errors(family, effects, idx, folds, start)
         return oof_cache[key]
@@ -184,6 +199,10 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
             sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
             t = float(np.mean(d) / (sd / math.sqrt(d.size))) if sd > 0 else 0.0
             trials[j].cv_t = t
+            if t > cv_t and family.least_evidence(current, c, idx, best, f) >= -bic_margin:
+                trials[j].note = ("a shape term that cross-validates as well makes it "
+                                  "unnecessary")
+                continue
             if t > cv_t:
                 trials[j].accepted = True
                 gain = float(np.mean(d) / max(np.mean(e0 ** 2), 1e-300))
@@ -195,7 +214,7 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
         if accepted is None:
             break
         current.append(accepted.name)
-        best = accepted.fit
+        best = accepted.fit = family.refine(current, accepted.fit, idx)
         steps.append(accepted)
 
     dropped: list[str] = []

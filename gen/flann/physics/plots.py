@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -12,6 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..fileio import atomic_save_figure  # noqa: E402
 from ..recordings import Recordings  # noqa: E402
 from .fit import FitResult  # noqa: E402
 from .lvdt import coupling_table, flux_profile, ideal_output_v  # noqa: E402
@@ -20,17 +19,8 @@ from .simulate import contributions_v  # noqa: E402
 
 
 def _save(fig, path: str | Path) -> None:
-    """Write the PNG atomically (no half-written file on error)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=110)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        atomic_save_figure(fig, path)
     finally:
         plt.close(fig)
 
