@@ -71,6 +71,11 @@ class Result:
     twin_vs_float_lsb: float | None = None
     warnings: list = field(default_factory=list)
 
+    def fail(self, reason: str) -> None:
+        """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
+        self.status = "failed"
+        self.reason = "".join(c if c.isprintable() else repr(c)[1:-1] for c in " ".join(str(reason).split()))
+
     def row(self) -> dict:
         def f(x, nd=6):
             return "" if x is None else f"{x:.{nd}g}"
@@ -209,9 +214,9 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings, basis)
         res.status, res.reason = "ok", ""
     except FlannError as exc:
-        res.status, res.reason = "failed", str(exc)
+        res.fail(str(exc))
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
-        res.status, res.reason = "failed", f"{exc.__class__.__name__}: {exc}"
+        res.fail(f"{exc.__class__.__name__}: {exc}")
     return res
 
 
@@ -268,8 +273,8 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     todo = []
     for i, p in enumerate(paths):
         if p.stem in seen:  # two files would write the same folder
-            results[i] = Result(sensor=p.stem, recording=str(p),
-                                reason=f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
+            results[i] = Result(sensor=p.stem, recording=str(p))
+            results[i].fail(f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
         else:
             seen[p.stem] = i
             todo.append(i)
@@ -283,6 +288,8 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
             if progress:
                 _progress(len(results), len(paths), failed, t0)
     else:
+        from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
+
         with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), initializer=_worker_init) as pool:
             futs = {pool.submit(calibrate_one, paths[i], *args): i for i in todo}
             for fut in as_completed(futs):
