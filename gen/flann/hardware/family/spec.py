@@ -52,7 +52,9 @@ def _words(bits: int) -> int:
 
 @dataclass(frozen=True)
 class Field:
-    """One per-sensor value in the weight memory: ``words`` words from ``addr``, LSW first."""
+    """One per-sensor value in the weight memory: ``words`` words from ``addr``, most significant
+    word first (sign-extended into the whole field), so the normaliser loads a field by shifting
+    each word in from the right."""
 
     name: str
     addr: int
@@ -92,14 +94,15 @@ class FamilySpec:
         out = [Field("weights", 0, s.steps, s.weight_fmt.width, True,
                      f"trig weight j = 0..{s.steps - 1} (model term j + 1), output LSB x 2^{s.weight_fmt.frac_bits}")]
         addr = s.steps
+        # in the order the normaliser consumes them: clamp, the linear product, then the phase
         for name, bits, signed, meaning in (
             ("clamp_lo", B, True, "lowest input code used (lower codes clamp, out_sat)"),
             ("clamp_hi", B, True, "highest input code used"),
+            ("k1", LW, True, f"linear weight per code w0 lsb/(scale q) x 2^{s.product_fmt.frac_bits + s.lin_guard}"),
+            ("k0", LW, True, f"bias + w0 b in accumulator units x 2^{s.lin_guard} + 2^{s.lin_guard - 1} (rounding)"),
             ("ka", NV, False, f"phase per input code: (lsb / input_scale) x 2^{s.phase_bits - 1 + s.norm_guard}, mod 2^{NV}"),
             ("kb", NV, False, f"phase offset -input_offset/input_scale x 2^{s.phase_bits - 1 + s.norm_guard} "
                               f"+ 2^{s.norm_guard - 1} (rounding), mod 2^{NV}"),
-            ("k1", LW, True, f"linear weight per code w0 lsb/(scale q) x 2^{s.product_fmt.frac_bits + s.lin_guard}"),
-            ("k0", LW, True, f"bias + w0 b in accumulator units x 2^{s.lin_guard} + 2^{s.lin_guard - 1} (rounding)"),
         ):
             out.append(Field(name, addr, _words(bits), bits, signed, meaning))
             addr += _words(bits)
@@ -126,9 +129,19 @@ class FamilySpec:
         return 1 << self.addr_bits
 
     @property
+    def norm_width(self) -> int:
+        """Width of the normaliser's shared constant register and accumulator (both products)."""
+        return max(self.norm_bits, self.spec.lin_width)
+
+    @property
     def latency_cycles(self) -> int:
-        """The fixed datapath's latency plus the parameter fetch (one word per cycle) and hand-over."""
-        return self.spec.latency_cycles + self.param_words + 2
+        """The fixed datapath's latency, with the normaliser's ``input_bits + 1`` cycles replaced
+        by flann_family_norm's: one cycle per parameter word, one to read the first word of each
+        of its two fetches, ``input_bits`` per product and the hand-over."""
+        s = self.spec
+        norm_fixed = s.input_bits + 1
+        norm_family = self.param_words + 2 + 2 * s.input_bits
+        return s.latency_cycles - norm_fixed + norm_family
 
     @property
     def cycles_per_sample(self) -> int:
@@ -145,7 +158,7 @@ class FamilySpec:
                        "product_bits": s.product_fmt.width, "acc_bits": s.acc_fmt.width,
                        "term_bound": s.term_bound},
             "memory": {"data_bits": DATA_BITS, "addr_bits": self.addr_bits, "depth": self.mem_depth,
-                       "used_words": self.used_words, "word_order": "least significant word first",
+                       "used_words": self.used_words, "word_order": "most significant word first",
                        "fields": [f.to_dict() for f in self.fields]},
             "formats": {"input_code": f"sint<{s.input_bits}> x {s.input_lsb_v} V",
                         "output_code": f"sint<{s.out_fmt.width}> x {s.output_lsb_mm} mm",
