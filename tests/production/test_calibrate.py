@@ -75,9 +75,10 @@ def test_weight_image_reproduces_the_recording(batch):
         assert np.max(np.abs(out * s.output_lsb_mm - ref)) <= s.output_lsb_mm
         err = float(np.max(np.abs(out * s.output_lsb_mm - rec.displacement_mm)))
         assert err == pytest.approx(float(batch["rows"][p.stem]["max_error_mm"]), rel=1e-4)
-        # the .mem file holds the same words
-        mem = (d / "weights.mem").read_text().split("@0000", 1)[1].split()
-        assert [int(w, 16) for w in mem] == words
+        # the .mem file holds the same words as the block RAM does: 16-bit halves, low half first
+        mem = [int(h, 16) for h in (d / "weights.mem").read_text().split("@0000", 1)[1].split()]
+        assert len(mem) == 2 * len(words) and max(mem) < 2 ** 16
+        assert [lo | hi << 16 for lo, hi in zip(mem[0::2], mem[1::2])] == words
 
 
 def test_duplicate_names_and_missing_design(batch, tmp_path, capsys):

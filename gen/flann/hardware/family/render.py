@@ -21,7 +21,7 @@ from ...golden.model import FlannModel, load_model
 from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..fixed import render as fixed
-from .spec import DATA_BITS, FamilySpec, family_from_dict
+from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict
 from .twin import FlannFamilyMem
 
 TOP = "flann_family_top"
@@ -61,8 +61,8 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
     s = fam.spec
     base = fixed.contexts(s)
     words = FlannFamilyMem.encode(fam, s)
-    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits, init_name=init_name,
-               words=[bits_literal(w, DATA_BITS, False) for w in words])
+    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, half_bits=HALF_BITS, addr_bits=fam.addr_bits,
+               init_name=init_name, halves=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)])
     n = base["flann_norm"]
     norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
                 acc_v_bits=n["acc_v_bits"], lin_width=n["acc_l_bits"], guard_v=n["guard_v"],

@@ -33,8 +33,19 @@ from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
 from ..fixed.spec import Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
 
-DATA_BITS = 32  # two RAMB4_S16 side by side (Spartan-II block RAM: 256 x 16 each)
-MEM_DEPTH_MAX = 256
+DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
+# The memory is one Spartan-II block RAM (RAMB4_S16_S16, 256 x 16): word k is held as two
+# halves, bits 15:0 at block address 2k and bits 31:16 at 2k + 1, read through its two ports
+# at once.  One block instead of two side by side leaves a block for the sin/cos tables.
+HALF_BITS = 16
+BRAM_HALVES = 256
+MEM_DEPTH_MAX = BRAM_HALVES * HALF_BITS // DATA_BITS
+
+
+def bram_image(words) -> list[int]:
+    """The block RAM's contents for memory words: (bits 15:0, bits 31:16) of each word in turn."""
+    mask = (1 << HALF_BITS) - 1
+    return [h for w in words for h in (int(w) & mask, (int(w) >> HALF_BITS) & mask)]
 DEFAULT_MARGIN = 0.5
 # the forced generator options every member is derived with (stored in the manifest)
 FORCED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "phase_bits", "table_addr_bits",
@@ -294,7 +305,8 @@ def _check_memory(fam: FamilySpec) -> None:
         raise SpecError(f"weights need {s.weight_fmt.width} bits, the memory word has {DATA_BITS}: "
                         "use fewer --weight-frac-bits or a smaller margin")
     if fam.used_words > MEM_DEPTH_MAX:
-        raise SpecError(f"{fam.used_words} memory words needed, two RAMB4_S16 hold {MEM_DEPTH_MAX}: fewer terms")
+        raise SpecError(f"{fam.used_words} memory words needed, one RAMB4 holds {MEM_DEPTH_MAX} of {DATA_BITS} "
+                        "bits: fewer terms")
 
 
 def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
@@ -353,4 +365,4 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
 
 
 __all__ = ["FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
-           "DATA_BITS", "DEFAULT_MARGIN", "FORCED"]
+           "bram_image", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED"]
