@@ -31,7 +31,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
-from ..fixed.spec import Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
+from ..fixed.spec import BRAM_BITS, Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
 
 DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
 # The memory is one Spartan-II block RAM (RAMB4_S16_S16, 256 x 16): word k is held as two
@@ -295,7 +295,10 @@ def _envelope(s: Spec, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt) -> 
     adv = -(-weight_fmt.width // K) + 1
     fam = replace(fam, adv_period=adv)
     analysis = dict(s.analysis)
-    analysis["estimate"] = estimate_resources(fam)
+    est = estimate_resources(fam)
+    # the weights live in the weight memory (one block RAM), not in a ROM
+    rom = math.ceil(s.steps * weight_fmt.width / BRAM_BITS) if s.steps * weight_fmt.width > 2048 else 0
+    analysis["estimate"] = {**est, "brams": est["brams"] - rom + 1}
     return replace(fam, analysis=analysis)
 
 
