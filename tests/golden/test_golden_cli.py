@@ -100,8 +100,21 @@ def test_predict_writes_every_row(tmp_path, capsys):
     out = tmp_path / "p.csv"
     assert run(["predict", hand_model(tmp_path), data, "-o", out], capsys)[0] == 0
     rows = list(csv.DictReader(out.open()))
-    assert list(rows[0]) == ["voltage_v", "displacement_mm", "predicted_mm"]
+    assert list(rows[0]) == ["voltage_v", "displacement_mm", "predicted_mm", "clamped"]
     assert [float(r["predicted_mm"]) for r in rows] == [-3.5, 0.5, 2.5]
+    assert [r["clamped"] for r in rows] == ["0", "0", "0"]
+
+
+def test_predict_clamps_outside_the_trained_range_like_the_hardware(tmp_path, capsys):
+    # trained range [-2, 2] V, y = 0.5 + 2 v: 3 V and -7 V are clamped to 2 V and -2 V
+    data = tmp_path / "v.csv"
+    data.write_text("voltage_v\n3\n-7\n1\n")
+    out = tmp_path / "p.csv"
+    code, _, err = run(["predict", hand_model(tmp_path), data, "-o", out], capsys)
+    assert code == 0 and "2 of 3 voltages outside" in err and "clamped" in err
+    assert out.read_text() == "voltage_v,predicted_mm,clamped\n3,4.5,1\n-7,-3.5,1\n1,2.5,0\n"
+    code, _, err = run(["predict", hand_model(tmp_path), data, "-o", out, "--extrapolate"], capsys)
+    assert out.read_text() == "voltage_v,predicted_mm\n3,6.5,\n-7,-13.5,\n1,2.5,\n".replace(",\n", "\n")
 
 
 def test_predict_without_displacement_column(tmp_path, capsys):
@@ -109,7 +122,7 @@ def test_predict_without_displacement_column(tmp_path, capsys):
     data.write_text("voltage_v\n-2\n1\n")
     out = tmp_path / "p.csv"
     assert run(["predict", hand_model(tmp_path), data, "-o", out], capsys)[0] == 0
-    assert out.read_text() == "voltage_v,predicted_mm\n-2,-3.5\n1,2.5\n"
+    assert out.read_text() == "voltage_v,predicted_mm,clamped\n-2,-3.5,0\n1,2.5,0\n"
 
 
 def test_eval_json_by_hand(tmp_path, capsys):

@@ -80,6 +80,50 @@ def test_templates_only_place_computed_text(model_file):
         assert "{{" not in t and "{%" not in t
 
 
+@pytest.mark.parametrize("entity,signal,fmt", [
+    ("flann_adder", "acc", "acc_fmt"), ("flann_adder", "data_r", "out_fmt"), ("flann_norm", "lin_r", "lin_fmt"),
+])
+def test_signals_are_declared_in_their_formats_width_and_sign(model_file, entity, signal, fmt):
+    spec = derive_spec(load_model(model_file), lanes=2)
+    decl = re.search(rf"signal {signal}\s+: (signed|unsigned)\((\d+) downto 0\);", render(spec)[f"{entity}.vhd"])
+    f = getattr(spec, fmt)
+    assert decl and int(decl[2]) + 1 == f.width and (decl[1] == "signed") == f.signed
+
+
+FIXED_TEMPLATES = REPO / "gen" / "flann" / "hardware" / "fixed" / "templates"
+
+
+@pytest.mark.parametrize("entity,variants", [("flann_expansion", "expansion/interp"),
+                                             ("flann_multiplier", "multiplier")])
+def test_every_variant_fragment_has_its_place(entity, variants):
+    """A fragment file no entity places, or a place no variant fills, is a misspelt name."""
+    placed = set(re.findall(r'fragments ~ "/([\w.]+)"', (FIXED_TEMPLATES / f"{entity}.vhd.j2").read_text()))
+    provided = {f.name for f in (FIXED_TEMPLATES / variants).glob("*/*.vhd.j2")}
+    assert placed and placed == provided
+
+
+@pytest.mark.parametrize("opts,expansion_has,expansion_lacks", [
+    ({}, ["icnt <= icnt - 1;", "slope_rom_c", "par(l) <= not par(l);"], [" * signed('0' & s2_slope(l))"]),
+    ({"mult_style": "lut"}, [" * signed('0' & s2_slope(l))", "slope_rom_c"], ["icnt"]),
+    ({"interp": False, "table_addr_bits": 8}, ["s2_slope(l) <= (others => '0');"], ["slope_rom_c", "prod :="]),
+    # an even lane count: a lane's terms are all sin or all cos, its parity never flips
+    ({"lanes": 2}, ["slope_rom_c"], ["par(l) <= not par(l);"]),
+], ids=["serial", "array", "plain", "lanes2"])
+def test_each_architecture_choice_places_its_own_fragment(model_file, opts, expansion_has, expansion_lacks):
+    text = render(derive_spec(load_model(model_file), **opts))["flann_expansion.vhd"]
+    for s in expansion_has:
+        assert s in text, s
+    for s in expansion_lacks:
+        assert s not in text, s
+
+
+def test_an_exact_accumulator_skips_the_rounding_shift(model_file, recwarn):
+    m = load_model(model_file)
+    assert "shift_right(resize(acc" in render(derive_spec(m))["flann_adder.vhd"]
+    exact = render(derive_spec(m, product_frac_bits=0))["flann_adder.vhd"]
+    assert "shift_right" not in exact and "y := resize(acc, " in exact
+
+
 CONFIGS = [{}, {"mult_style": "lut"}, {"lanes": 2}, {"lanes": 3, "check_device": False},
            {"interp": False, "table_addr_bits": 8}, {"input_bits": 14, "clamp": False}]
 

@@ -71,6 +71,9 @@ def test_bits_needed_and_literals():
         bits_literal(8, 4)
     with pytest.raises(SpecError):
         FixedFormat(0, 0)
+    # the VHDL type a format's integers travel in: 8 signed bits, 4 unsigned bits
+    assert FixedFormat(8, 3).vhdl_type == "signed(7 downto 0)"
+    assert FixedFormat(4, 0, signed=False).vhdl_type == "unsigned(3 downto 0)"
 
 
 # ---- spec ------------------------------------------------------------------------------

@@ -16,7 +16,7 @@ def folding(x):
 
 def test_duplicate_displacement_with_other_voltage_in_same_direction():
     text = "displacement_mm,voltage_v\n0,0.0\n5,1.0\n5,1.2\n10,2.0\n"
-    with pytest.raises(RecordingsError, match=r"rows 2 and 3: displacement 5 mm appears twice"):
+    with pytest.raises(RecordingsError, match=r"lines 3 and 4: displacement 5 mm appears twice"):
         prepare_for_fit(parse_recordings(text, "d.csv"))
 
 

@@ -1,3 +1,6 @@
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -64,3 +67,89 @@ def test_repeats_are_refused_without_time_or_beyond_noise(offset, with_time):
     rec = parse_recordings(_sweeps_text(offset, with_time=with_time), source="r.csv")
     with pytest.raises(RecordingsError, match="appears twice"):
         prepare_for_fit(rec)
+
+
+# -- files as people export them ---------------------------------------------------------
+EXCEL_LIKE = ("\ufeff# bench 3, LVDT #17\r\n"
+              "Displacement (in);Voltage (mV);Temperature (°C)\r\n"
+              "-0,5;-1234,5;21,5\r\n"
+              "0;0,25;21,5\r\n"
+              "0,5;1250;21,6\r\n")
+
+
+def test_spreadsheet_export_bom_crlf_semicolon_decimal_comma_units(tmp_path, capsys):
+    p = tmp_path / "export.csv"
+    p.write_bytes(EXCEL_LIKE.encode("utf-8"))
+    rec = read_recordings(p)
+    # inches -> mm (25.4 mm/in), millivolts -> volts, worked out by hand
+    np.testing.assert_allclose(rec.displacement_mm, [-12.7, 0.0, 12.7], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(rec.voltage_v, [-1.2345, 0.00025, 1.25], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rec.temperature_c, [21.5, 21.5, 21.6])
+    assert rec.comments == ("bench 3, LVDT #17",)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    for word in ("byte-order mark", "semicolon", "decimal comma", "'Displacement (in)' as displacement_mm",
+                 "'Voltage (mV)' as voltage_v"):
+        assert word in err[0]
+
+
+def test_latin1_tab_separated_export(tmp_path, capsys):
+    p = tmp_path / "logger.txt"
+    p.write_bytes("position_mm\tvoltage_mv\tTemperature (°C)\n1,5\t100\t20\n2,5\t200\t20\n".encode("latin-1"))
+    rec = read_recordings(p)
+    np.testing.assert_allclose(rec.displacement_mm, [1.5, 2.5])
+    np.testing.assert_allclose(rec.voltage_v, [0.1, 0.2])
+    assert "Latin-1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("header, factor_x, factor_v", [
+    ("x_mm,voltage_v", 1.0, 1.0),
+    ("position_mm,Voltage (V)", 1.0, 1.0),
+    ("Displacement [mm],voltage_mv", 1.0, 1e-3),
+    ("displacement_in,Voltage (mV)", 25.4, 1e-3),
+    ("Position (cm),U (V)", 10.0, 1.0),
+    ("displacement_um,voltage_uv", 1e-3, 1e-6),
+])
+def test_header_aliases_and_units(header, factor_x, factor_v):
+    rec = parse_recordings(f"{header}\n2,3\n4,5\n")
+    np.testing.assert_allclose(rec.displacement_mm, np.array([2.0, 4.0]) * factor_x, rtol=1e-15)
+    np.testing.assert_allclose(rec.voltage_v, np.array([3.0, 5.0]) * factor_v, rtol=1e-15)
+
+
+def test_canonical_file_says_nothing(tmp_path, capsys):
+    p = tmp_path / "r.csv"
+    p.write_text("displacement_mm,voltage_v\n1,2\n3,4\n")
+    assert read_recordings(p).recognised == ""
+    assert capsys.readouterr().err == ""
+
+
+def test_unknown_header_is_one_line_listing_accepted_names(tmp_path):
+    p = tmp_path / "bad.csv"
+    p.write_text("Weg (mm);Spannung (V)\n1;2\n")
+    r = subprocess.run([sys.executable, "-m", "flann.cli", "train", str(p), "-o", str(tmp_path / "m.json")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ")
+    assert "'Weg (mm)'" in lines[0] and "Displacement (mm)" in lines[0] and "voltage_mv" in lines[0]
+    assert "Traceback" not in r.stderr and not (tmp_path / "m.json").exists()
+
+
+def test_voltage_without_unit_is_not_guessed():
+    with pytest.raises(RecordingsError, match=r"missing column\(s\) voltage_v.*'voltage'"):
+        parse_recordings("displacement_mm,voltage\n1,2\n")
+
+
+def test_errors_name_the_file_line_not_the_data_row():
+    text = "# provenance\n\ndisplacement_mm,voltage_v\n1,2\n# a note\n2,abc\n"
+    with pytest.raises(RecordingsError, match=r"line 6, column 'voltage_v'"):
+        parse_recordings(text, source="x.csv")
+    with pytest.raises(RecordingsError, match=r"line 4, column 'direction'"):
+        parse_recordings("#\n\ndisplacement_mm,voltage_v,direction\n1,2,0\n")
+    with pytest.raises(RecordingsError, match=r"line 3 has 3 cells"):
+        parse_recordings("displacement_mm,voltage_v\n1,2\n1,2,3\n")
+
+
+def test_same_column_twice_under_two_names():
+    with pytest.raises(RecordingsError, match="duplicate column"):
+        parse_recordings("x_mm,displacement_mm,voltage_v\n1,1,2\n")

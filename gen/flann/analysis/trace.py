@@ -25,12 +25,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
+from ..hardware.fixed.render import generate, load
+from ..hardware.fixed.spec import derive_spec
+from ..hardware.fixed.twin import FlannTop
+from ..hardware.float18.spec import F18Top, derive_f18_spec
+from ..numeric.float18 import FLOAT18
+from ..verify.float18 import run_top
+from ..verify.runner import run_bench
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
 STAGE_TEXT = {
@@ -89,8 +97,6 @@ class Source:
 
 # -- building the stage data --------------------------------------------------------------
 def stages_fixed(spec, codes=None) -> Stages:
-    from ..hardware.fixed.twin import FlannTop
-
     top = FlannTop(spec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     t = top.trace(codes)
@@ -126,8 +132,6 @@ def stages_fixed(spec, codes=None) -> Stages:
 
 
 def stages_float18(fspec, codes=None) -> Stages:
-    from ..hardware.float18.spec import F18Top
-
     top = F18Top(fspec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     t = top.trace(codes)
@@ -394,6 +398,7 @@ def _ulp(x: float, sig_bits: int) -> float:
 # -- plot ---------------------------------------------------------------------------------
 def plot_trace(result: TraceResult, path, title: str = "") -> None:
     """Error per stage vs input voltage (PNG)."""
+    # matplotlib is heavy and only needed for plots: imported when one is drawn
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -427,6 +432,7 @@ def plot_trace(result: TraceResult, path, title: str = "") -> None:
 def plot_compare(results: dict, path, points: dict | None = None, title: str = "") -> None:
     """Total error (hardware - golden) of several formats on the same axes, as the seed's
     Fig. 6(b); ``points``: {fmt: at_voltages() rows} drawn as markers."""
+    # matplotlib: imported when a plot is drawn (see plot_trace)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -454,24 +460,14 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
 def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64) -> dict:
     """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
     HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``."""
-    from pathlib import Path
-
     build_dir = Path(build_dir)
     if result.fmt == "float18":
-        from ..verify.float18 import run_top
-
-        from ..numeric.float18 import FLOAT18
-
         # internal stages (terms, products, running sums) captured at a spread of codes
         stage_codes = result.codes[np.linspace(0, result.codes.size - 1, stage_samples).astype(int)]
         r = run_top(model_path, build_dir, stage_codes=stage_codes, **options)
         codes, hdl_mm, mism, top = r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"]
         stages = r["stages"]
     else:
-        from ..hardware.fixed.render import generate, load
-        from ..verify.runner import run_bench
-        from ..hardware.fixed.twin import FlannTop
-
         generate(model_path, build_dir / "hdl", **options)
         br = run_bench(build_dir / "hdl", "top", model=model_path, options=options, build_dir=build_dir)
         rec = br.records.get("top_every_code")
@@ -495,10 +491,8 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_s
 
 def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options) -> TraceResult:
     if fmt == "fixed":
-        from ..hardware.fixed.spec import derive_spec
         st = stages_fixed(derive_spec(model, **spec_options), codes)
     elif fmt == "float18":
-        from ..hardware.float18.spec import derive_f18_spec
         st = stages_float18(derive_f18_spec(model, **spec_options), codes)
     else:
         raise FlannError(f"--format {fmt!r}: allowed fixed, float18")

@@ -1,4 +1,8 @@
-"""``flann eval``: accuracy of a model on recordings (compensated vs the raw sensor)."""
+"""``flann eval``: accuracy of a model on recordings (compensated vs the raw sensor).
+
+``--design DIR`` adds the generated design's accuracy: its bit-true twin on the recordings'
+voltages quantised to the design's ADC codes, against the physical limit of that converter.
+"""
 
 from __future__ import annotations
 
@@ -8,8 +12,9 @@ from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_rep
                        raw_output_mm)
 from ..errors import FlannError
 from ..golden.model import load_model
+from ..hardware.accuracy import design_spec, hardware_accuracy, plot_errors
 from ..recordings import read_recordings
-from .predict import warn_outside_range
+from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
 
@@ -24,6 +29,13 @@ def add_arguments(p) -> None:
                    help="stroke-fraction band in %% of full scale (default %(default)g)")
     p.add_argument("--full-scale-mm", type=float, default=None,
                    help="full scale (mm); default half the recordings' displacement span")
+    p.add_argument("--design", metavar="DIR", default=None,
+                   help="also the accuracy of the design `flann gen MODEL -o DIR` wrote: its bit-true "
+                        "twin on the voltages as ADC codes, and the physical limit (half an ADC LSB "
+                        "over the local slope)")
+    p.add_argument("--plot", metavar="OUT.png", default=None,
+                   help="error vs displacement: raw sensor, float model, hardware (needs --design) "
+                        "and the physical limit")
 
 
 def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
@@ -36,17 +48,32 @@ def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm
         raise FlannError(f"{rec.source}: need at least 2 rows to evaluate, got {len(rec)}")
     fs = full_scale_mm(rec.displacement_mm) if fs_mm is None else float(fs_mm)
     x = rec.displacement_mm
-    compensated = error_report(model.predict(rec.voltage_v), x, tol, band, fs, rec.direction)
+    # outside the trained range the voltage is clamped, as the hardware does
+    compensated = error_report(predict_clamped(model, rec.voltage_v)[0], x, tol, band, fs, rec.direction)
     raw = error_report(raw_output_mm(rec.voltage_v, x), x, tol, band, fs, rec.direction)
     return {"points": len(rec), "full_scale_mm": fs, "tolerance_pct_fs": tol,
             "band_pct_fs": band, "compensated": compensated, "raw": raw}
 
 
 def run(args) -> int:
+    if args.plot and not args.plot.lower().endswith(".png"):
+        raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
+    if args.plot and not args.design:
+        raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_model(args.model)
     rec = read_recordings(args.recordings)
-    warn_outside_range(model, rec.voltage_v, rec.source)
+    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
+    if args.design:
+        spec = design_spec(args.model, args.design)
+        hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"])
+        pts = hw.pop("_points")
+        res["hardware"] = hw
+        if args.plot:
+            raw = raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm
+            plot_errors(args.plot, pts["x"], raw, pts["float"], pts["hardware"], pts["limit"],
+                        title=f"{rec.source}: error vs displacement ({spec.input_bits}-bit ADC, "
+                              f"{spec.output_lsb_mm:g} mm output LSB)")
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
@@ -54,14 +81,28 @@ def run(args) -> int:
     print(f"{rec.source}: {res['points']} points, full scale {fs:g} mm "
           f"(linearity tol +-{args.tol:g} % FS = {args.tol * fs / 100:g} mm, "
           f"band +-{args.band:g} % FS = {args.band * fs / 100:g} mm)")
-    print(f"{'':28s}{'compensated':>14s}{'raw (LS line)':>16s}")
     rows = [("max error (mm)", "max_error_mm", "{:.4g}"),
             ("RMS error (mm)", "rms_error_mm", "{:.4g}"),
             ("max error (% FS)", "max_error_pct_fs", "{:.4g}"),
             ("RMS error (% FS)", "rms_error_pct_fs", "{:.4g}"),
             ("% of linearity range", "linearity_pct", "{:.2f}"),
             (f"stroke within +-{args.band:g} % FS", "stroke_fraction_within_band", "{:.2%}")]
+    hw = res.get("hardware")
+    if hw:
+        print(f"{'':28s}{'compensated':>14s}{'raw (LS line)':>16s}{'hardware':>12s}")
+    else:
+        print(f"{'':28s}{'compensated':>14s}{'raw (LS line)':>16s}")
     for label, key, fmt in rows:
         print(f"{label:28s}{fmt.format(res['compensated'][key]):>14s}"
-              f"{fmt.format(res['raw'][key]):>16s}")
+              f"{fmt.format(res['raw'][key]):>16s}" + (f"{fmt.format(hw[key]):>12s}" if hw else ""))
+    if hw:
+        lim = hw["physical_limit_mm"]
+        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V, output LSB "
+              f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; "
+              f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm")
+        print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
+              f"max error / limit: hardware {hw['ratio_to_limit']:.2f}, float "
+              f"{hw['float_ratio_to_limit']:.2f}")
+    if args.plot:
+        print(f"plot: {args.plot}")
     return 0

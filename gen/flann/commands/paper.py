@@ -12,6 +12,7 @@ from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
 from ..golden.train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
 from ..golden import paper
+from ..hardware.accuracy import fixed_point_cost
 
 HELP = "reproduce the seed paper's tables and figures"
 
@@ -86,7 +87,7 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
     print(f"Between the {len(rec)} points: leave-one-out, and a dense sweep of v compared with "
           "the monotone PCHIP interpolant of the points:")
     default = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="range")
-    auto, choice = fit_auto(rec.voltage_v, rec.displacement_mm)
+    auto, choice = fit_auto(rec.voltage_v, rec.displacement_mm, cost=fixed_point_cost)
     designs = (("51 terms, paper LMS", details["models"][51], details["loo"][51]),
                ("51 terms, lstsq, range (default design)", default,
                 paper.lstsq_loo_errors(rec, 51, "range")),
@@ -113,7 +114,7 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
                 print(f"{t:5d} {eta:6g} " + " ".join(
                     f"{c:7.2f}" if c is not None else f"{'-':>7s}" for c in cells))
     if args.dense:
-        d = paper.dense_demo()
+        d = paper.dense_demo(cost=fixed_point_cost)
         print(f"Tool default (--terms auto) on dense physics-like data (tanh S-curve, "
               f"{d['noise_v'] * 1e3:g} mV noise; 601 training points, 600 held-out points "
               f"between them): {d['terms']} terms, normalisation {d['normalisation']}, "

@@ -1,10 +1,18 @@
-"""``flann predict``: apply a model to recordings, write voltage_v, displacement_mm, predicted_mm."""
+"""``flann predict``: apply a model to recordings, write voltage_v, displacement_mm, predicted_mm, clamped.
+
+Outside the trained voltage range the model is not extrapolated: like the hardware (which
+clamps the ADC code to the trained range), the voltage is clamped to the nearest end of the
+range and the row is flagged (``clamped`` = 1).  ``--extrapolate`` evaluates the expansion
+there instead (the trigonometric terms are periodic: the result is rarely meaningful).
+"""
 
 from __future__ import annotations
 
 import csv
 import io
 import warnings
+
+import numpy as np
 
 from ..fileio import atomic_write_text
 from ..golden.model import load_model
@@ -17,28 +25,49 @@ def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
     p.add_argument("recordings", help="CSV with voltage_v (displacement_mm copied when given)")
     p.add_argument("-o", "--output", required=True, help="CSV to write")
+    p.add_argument("--extrapolate", action="store_true",
+                   help="evaluate the model outside its trained voltage range instead of clamping "
+                        "to it as the hardware does")
 
 
-def warn_outside_range(model, voltage_v, source: str) -> None:
-    lo, hi = model.voltage_range_v
-    outside = (voltage_v < lo) | (voltage_v > hi)
+def outside_range(model, voltage_v) -> np.ndarray:
+    lo, hi = sorted(model.voltage_range_v)
+    v = np.asarray(voltage_v, dtype=float)
+    return (v < lo) | (v > hi)
+
+
+def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True) -> None:
+    outside = outside_range(model, voltage_v)
     if outside.any():
-        warnings.warn(f"{source}: {int(outside.sum())} of {voltage_v.size} voltages outside the "
-                      f"model's trained range [{lo:g}, {hi:g}] V: extrapolated", stacklevel=2)
+        lo, hi = sorted(model.voltage_range_v)
+        what = "extrapolated" if extrapolated else "clamped to the range as the hardware does (column clamped = 1)"
+        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} voltages outside the "
+                      f"model's trained range [{lo:g}, {hi:g}] V: {what}", stacklevel=2)
+
+
+def predict_clamped(model, voltage_v) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement mm, clamped flags): the voltage clamped to the trained range first."""
+    lo, hi = sorted(model.voltage_range_v)
+    v = np.asarray(voltage_v, dtype=float)
+    return model.predict(np.clip(v, lo, hi)), outside_range(model, v)
 
 
 def run(args) -> int:
     model = load_model(args.model)
     rec = read_recordings(args.recordings, required=("voltage_v",))
-    warn_outside_range(model, rec.voltage_v, rec.source)
+    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=args.extrapolate)
     cols = {"voltage_v": rec.voltage_v}
     if rec.displacement_mm is not None:
         cols["displacement_mm"] = rec.displacement_mm
-    cols["predicted_mm"] = model.predict(rec.voltage_v)
+    if args.extrapolate:
+        cols["predicted_mm"] = model.predict(rec.voltage_v)
+        flags = None
+    else:
+        cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v)
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
-    w.writerow(list(cols))
-    for row in zip(*cols.values()):
-        w.writerow([f"{c:.9g}" for c in row])
+    w.writerow(list(cols) + (["clamped"] if flags is not None else []))
+    for i, row in enumerate(zip(*cols.values())):
+        w.writerow([f"{c:.9g}" for c in row] + ([int(flags[i])] if flags is not None else []))
     atomic_write_text(args.output, out.getvalue())
     return 0

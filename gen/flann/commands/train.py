@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
-                     fit_lms, fit_lstsq)
+                            fit_lms, fit_lstsq)
+from ..hardware.accuracy import fixed_point_cost
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -80,10 +82,16 @@ def run(args) -> int:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
         check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
-        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance)
+        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
+                                 cost=fixed_point_cost)
+        t = model.training
         print(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-              f"held-out error (cross-validation, {model.training['cv_folds']} folds): "
+              f"held-out error (cross-validation, {t['cv_folds']} folds): "
               f"RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+        if "traded" in t:
+            print(f"auto: {t['selected_by']}: {t['traded']}", file=sys.stderr)
+        elif "hardware_why" in t:
+            print(f"auto: no candidate builds in fixed point ({t['hardware_why']})", file=sys.stderr)
     else:
         norm = args.normalise or "range"
         check_fit_input(rec.voltage_v, rec.displacement_mm, args.terms, rec.source)
@@ -100,5 +108,10 @@ def run(args) -> int:
             print(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
                   f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
                   + _heldout_text(rec, args.terms, norm, args.ridge, explicit), file=sys.stderr)
+    if args.terms != "auto":
+        hw = fixed_point_cost(model)
+        if not hw["buildable"]:
+            warnings.warn(f"this model cannot be built in fixed point ({hw['why']}); "
+                          "--terms auto selects a buildable one")
     model.save(args.output)
     return 0

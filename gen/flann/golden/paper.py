@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..fileio import atomic_save_figure
 from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
@@ -144,8 +145,9 @@ def s_curve(displacement_mm, noise_v: float = 0.0, seed: int = 0) -> np.ndarray:
     return v
 
 
-def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS) -> dict:
-    """The tool's default (``--terms auto``) on a dense physics-like sweep.
+def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS, cost=None) -> dict:
+    """The tool's default (``--terms auto``; ``cost`` as ``flann train`` gives it) on a dense
+    physics-like sweep.
 
     Training: 601 points, 0.1 mm steps over +-30 mm, noise seed 1.  Test: 600 points
     between the training points (0.05 mm offset), noise seed 2 -- never seen in training.
@@ -154,7 +156,7 @@ def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS
     x_test = x_train[:-1] + 0.05
     v_train = s_curve(x_train, noise_v, seed=1)
     v_test = s_curve(x_test, noise_v, seed=2)
-    model, choice = fit_auto(v_train, x_train)
+    model, choice = fit_auto(v_train, x_train, cost=cost)
     fs = full_scale_mm(x_train)
     after = error_report(model.predict(v_test), x_test, band_pct_fs=band_pct_fs, fs_mm=fs)
     a, b = np.polyfit(v_train, x_train, 1)   # the raw sensor's line, from the training sweep
@@ -208,7 +210,7 @@ def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     for ax in axes.flat:
         ax.grid(True)
     fig.tight_layout()
-    fig.savefig(outdir / "fig5.png", dpi=80)
+    atomic_save_figure(fig, outdir / "fig5.png", dpi=80)
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -219,7 +221,7 @@ def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     ax.legend()
     ax.grid(True)
     fig.tight_layout()
-    fig.savefig(outdir / "between_points_51.png", dpi=80)
+    atomic_save_figure(fig, outdir / "between_points_51.png", dpi=80)
     plt.close(fig)
     return ["fig5.png", "between_points_51.png"]
 

@@ -13,7 +13,10 @@ All three return a :class:`flann.golden.model.FlannModel` whose output is
   more terms than points the problem is under-determined and the minimum-norm interpolant
   is returned (the paper fits 51 and 61 terms to 13 points).
 * :func:`fit_auto` -- chooses terms, normalisation and ridge by K-fold cross-validation and
-  reports the held-out error (never the training error).
+  reports the held-out error (never the training error).  Of the candidates whose held-out
+  mean squared error is within one standard error of the best (the one-standard-error rule)
+  it takes the cheapest by a cost the caller gives (``flann train``: the fixed-point design's
+  cost, so the model is buildable and its weights small); the record says what was traded.
 
 Normalisation: ``"range"`` maps the data's voltage range to [-1, 1] (offset = midpoint,
 scale = half span); ``"half"`` maps it to [-0.5, 0.5] (scale = span: the trigonometric terms,
@@ -37,7 +40,12 @@ PAPER_TERMS = (11, 25, 51, 61)
 NORMALISATIONS = ("range", "half", "none")
 MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
 AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
-AUTO_RIDGES = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0)
+# 'range' puts one full period of the fundamental over the recorded range (the linear term
+# carries the trend): a well-conditioned, near-orthogonal expansion.  'half' fits the ends
+# more freely but its terms are nearly collinear; its candidates compete on held-out error
+# and fixed-point cost.  Raw volts ('none') alias many periods over the range: never chosen.
+AUTO_NORMS = ("range", "half")
+AUTO_RIDGES = (0.0, 1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0)
 AUTO_MAX_FOLDS = 10
 
 
@@ -257,6 +265,11 @@ class CvResult:
     ridge: float
     rms_mm: float
     max_mm: float
+    se_mse: float = 0.0  # standard error of the held-out MSE over the folds (mm^2)
+
+    @property
+    def mse(self) -> float:
+        return self.rms_mm ** 2
 
 
 def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
@@ -277,7 +290,7 @@ def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
     return [np.sort(inner[i::k]) for i in range(k)]
 
 
-def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
+def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=AUTO_NORMS,
                    ridges=AUTO_RIDGES, k: int | None = None) -> list[CvResult]:
     """Held-out RMS and max error (mm) for every (terms, norm, ridge) candidate.
 
@@ -310,35 +323,116 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=NORM
             if not np.all(np.isfinite(e)):   # numerically broken candidate: never chosen
                 results.append(CvResult(t, norm, r, math.inf, math.inf))
                 continue
-            results.append(CvResult(t, norm, r, float(np.sqrt(np.mean(e**2))),
-                                    float(np.max(np.abs(e)))))
+            # standard error of the CV estimate from the spread of the folds' MSEs (the
+            # one-standard-error rule of Hastie, Tibshirani & Friedman, ESL 7.10)
+            fold_mse = np.array([np.mean(errs[(t, r)][held] ** 2) for held in folds])
+            results.append(CvResult(t, norm, r, float(np.sqrt(np.mean(e**2))), float(np.max(np.abs(e))),
+                                    float(np.std(fold_mse, ddof=1) / np.sqrt(len(folds)))))
     return results
 
 
 def pick(results: list[CvResult]) -> CvResult:
-    """Smallest held-out RMS; within 2 % of it, prefer fewer terms, then larger ridge."""
+    """Without a cost: smallest held-out RMS; within 2 % of it, fewer terms, then larger ridge."""
     best = min(r.rms_mm for r in results)
     ok = [r for r in results if r.rms_mm <= best * 1.02 + 1e-12]
     return min(ok, key=lambda r: (r.terms, -r.ridge, NORMALISATIONS.index(r.norm)))
 
 
-def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=NORMALISATIONS,
-             ridges=AUTO_RIDGES, training: dict | None = None) -> tuple[FlannModel, CvResult]:
-    """Choose (terms, norm, ridge) by cross-validation, then fit on all points."""
+def within_one_se(results: list[CvResult]) -> list[CvResult]:
+    """Candidates whose held-out MSE is within one standard error of the best's (best first)."""
+    finite = [r for r in results if math.isfinite(r.rms_mm)]
+    best = min(finite, key=lambda r: r.mse)
+    return sorted((r for r in finite if r.mse <= best.mse + best.se_mse + 1e-300),
+                  key=lambda r: (r.mse, r.terms))
+
+
+def _key(r: CvResult) -> dict:
+    return {"terms": r.terms, "normalisation": r.norm, "ridge": r.ridge,
+            "heldout_rms_error_mm": r.rms_mm, "heldout_max_error_mm": r.max_mm}
+
+
+def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NORMS,
+             ridges=AUTO_RIDGES, training: dict | None = None,
+             cost=None) -> tuple[FlannModel, CvResult]:
+    """Choose (terms, norm, ridge) by cross-validation, then fit on all points.
+
+    ``cost(model) -> {"buildable": bool, "cost": float, "why": str, ...}`` (lower is
+    cheaper): with it, the one-standard-error set is searched for the cheapest buildable
+    model; when none in it builds, the best-scoring buildable candidate of all is taken.
+    Without it, :func:`pick` (fewest terms within 2 % of the best RMS).
+    """
     v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
     if v.size < 4:
         raise RecordingsError(
             f"{v.size} points: too few for cross-validation (auto needs at least 4); "
             "give --terms N explicitly"
         )
-    results = cross_validate(v, displacement_mm, terms_list, norms, ridges)
-    choice = pick(results)
+    results = cross_validate(v, x, terms_list, norms, ridges)
     info = {"selected_by": "cross-validation",
             "cv_folds": len(cv_folds(v)),
-            "cv_heldout_rms_error_mm": choice.rms_mm,
-            "cv_heldout_max_error_mm": choice.max_mm,
             "cv_candidates": len(results)}
+    if cost is None:
+        choice = pick(results)
+    else:
+        choice, _model, info_hw = _cheapest(v, x, results, cost)
+        info.update(info_hw)
+    info.update({"cv_heldout_rms_error_mm": choice.rms_mm,
+                 "cv_heldout_max_error_mm": choice.max_mm})
     info.update(training or {})
-    model = fit_lstsq(v, displacement_mm, choice.terms, norm=choice.norm, ridge=choice.ridge,
-                      training=info)
+    model = fit_lstsq(v, x, choice.terms, norm=choice.norm, ridge=choice.ridge, training=info)
     return model, choice
+
+
+def _cheapest(v, x, results: list[CvResult], cost) -> tuple[CvResult, FlannModel, dict]:
+    """The cheapest buildable candidate within one standard error of the best buildable one.
+
+    Candidates are visited in order of held-out MSE until one builds (normally the best);
+    every candidate within one standard error of that one is then costed and the cheapest
+    buildable taken (ties: lower held-out error).
+    """
+    order = sorted((r for r in results if math.isfinite(r.rms_mm)), key=lambda r: (r.mse, r.terms))
+    best = order[0]
+
+    def fit(r):   # as it will be written: its held-out error sets the default output LSB
+        return fit_lstsq(v, x, r.terms, norm=r.norm, ridge=r.ridge,
+                         training={"cv_heldout_rms_error_mm": r.rms_mm})
+
+    costs: dict[CvResult, tuple[FlannModel, dict]] = {}
+
+    def costed(r):
+        if r not in costs:
+            m = fit(r)
+            costs[r] = (m, cost(m))
+        return costs[r]
+
+    anchor = next((r for r in order if costed(r)[1]["buildable"]), None)
+    if anchor is None:
+        m, c = costed(best)
+        return best, m, {"selected_by": "cross-validation (no candidate builds in fixed point)",
+                         "hardware_why": c["why"]}
+    pool = [r for r in order if r.mse <= anchor.mse + anchor.se_mse]
+    ok = [(r, *costed(r)) for r in pool if costed(r)[1]["buildable"]]
+    rule = ("one-standard-error rule, cheapest in fixed point" if anchor == best else
+            "the best held-out candidates do not build in fixed point: one-standard-error rule "
+            "around the best buildable one, cheapest in fixed point")
+    best_c = costed(best)[1]
+    choice, model, c = min(ok, key=lambda t: (t[2]["cost"], t[0].mse))
+    if best_c["buildable"]:
+        other = (f"{best_c['cost']:.0f} LUT4-eq., {best.terms} terms, "
+                 f"{best_c['weight_bits']}-bit weights")
+    else:
+        other = f"does not build: {best_c['why'].split(': the model')[0]}"
+    traded = (f"held-out RMS {choice.rms_mm:.4g} mm (best {best.rms_mm:.4g} mm, one standard error "
+              f"{math.sqrt(anchor.mse + anchor.se_mse) - anchor.rms_mm:.2g} mm) for "
+              f"{c['cost']:.0f} LUT4-equivalents, {choice.terms} terms, {c['weight_bits']}-bit "
+              f"weights (best: {other})")
+    info = {"selected_by": rule,
+            "one_se_candidates": len(pool),
+            "candidates_costed": len(costs),
+            "best_heldout": _key(best),
+            "chosen": _key(choice),
+            "fixed_point": {k: c[k] for k in ("cost", "luts", "brams", "weight_bits", "term_bits",
+                                               "phase_bits", "output_lsb_mm")},
+            "traded": traded if choice != best else "nothing: the best candidate is also the cheapest"}
+    return choice, model, info

@@ -87,6 +87,11 @@ class FixedFormat:
         return np.asarray(ints, dtype=float) * self.lsb
 
     # -- text ---------------------------------------------------------------------------
+    @property
+    def vhdl_type(self) -> str:
+        """The numeric_std type holding this format's integers, e.g. ``signed(19 downto 0)``."""
+        return f"{'signed' if self.signed else 'unsigned'}({self.width - 1} downto 0)"
+
     def literal(self, value: int) -> str:
         """VHDL bit-string literal of ``value`` (checked to fit)."""
         return bits_literal(value, self.width, self.signed)

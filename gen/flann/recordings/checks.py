@@ -11,6 +11,9 @@ from ..errors import RecordingsError
 from .csvio import Recordings
 
 MIN_FIT_POINTS = 3
+# An LVDT conditioner's output (and any ADC input) is at most a few tens of volts: a larger
+# number under a volts header is almost surely millivolts.
+MAX_PLAUSIBLE_V = 60.0
 
 
 @dataclass(frozen=True)
@@ -127,6 +130,12 @@ def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float
                          message=msg, noise_v=noise, threshold_v=thr)
 
 
+def _pair(rec: Recordings, j: int, i: int) -> str:
+    """'lines 3 and 4' (file lines) or 'rows 2 and 3' for recordings not read from a file."""
+    a, b = rec.line_of(j), rec.line_of(i)
+    return f"{a.split()[0]}s {a.split()[1]} and {b.split()[1]}"
+
+
 def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01) -> None:
     """One voltage per displacement per direction: a repeat with another voltage is refused.
 
@@ -151,11 +160,21 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
         if j != i and abs(rec.voltage_v[j] - v) > tol:
             where = "" if rec.direction is None else f" in direction {int(d):+d}"
             raise RecordingsError(
-                f"{rec.source}: rows {j + 1} and {i + 1}: displacement {x:g} mm appears twice"
+                f"{rec.source}: {_pair(rec, j, i)}: displacement {x:g} mm appears twice"
                 f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
                 "average repeats or give each sweep its direction (+1/-1)"
                 + (f" (repeats may differ by {tol:.3g} V)" if tol else "")
             )
+
+
+def check_units(rec: Recordings) -> None:
+    """Voltages no sensor conditioner gives are refused: millivolts under a volts header."""
+    vmax = float(np.max(np.abs(rec.voltage_v)))
+    if vmax > MAX_PLAUSIBLE_V:
+        raise RecordingsError(
+            f"{rec.source}: voltage_v reaches {vmax:.6g} V, more than any LVDT conditioner or ADC "
+            f"gives (> {MAX_PLAUSIBLE_V:g} V): if these are millivolts, name the column voltage_mv "
+            "or 'Voltage (mV)'")
 
 
 def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None) -> Recordings:
@@ -164,6 +183,7 @@ def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None =
         raise RecordingsError(
             f"{rec.source}: {len(rec)} point(s); need at least {MIN_FIT_POINTS} to fit a model"
         )
+    check_units(rec)
     check_duplicates(rec)
     span = monotonic_span(rec, noise_v=noise_v)
     if span.foldback:

@@ -4,6 +4,12 @@ Format (see README "Recordings format"): a header line; required columns
 ``displacement_mm`` and ``voltage_v``; optional ``direction`` (+1 increasing, -1
 decreasing), ``time_s``, ``temperature_c``, ``excitation_hz``.  Lines starting with ``#``
 are comments (provenance).  Other columns are ignored with a warning.
+
+Files as spreadsheets and loggers export them are read too: a UTF-8 byte-order mark, CRLF
+line ends, a semicolon or tab separator (sniffed from the header) with decimal commas,
+Latin-1 text, and headers that carry their unit (``Displacement (mm)``, ``x_mm``,
+``Voltage (mV)``, ``displacement_in``...): values are converted to the canonical unit and
+what was recognised is said in one line on stderr.  Error messages give the *file* line.
 """
 
 from __future__ import annotations
@@ -12,6 +18,8 @@ import csv
 import hashlib
 import io
 import math
+import re
+import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,10 +32,56 @@ from ..fileio import atomic_write_text
 REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
 
+# canonical column -> (names of the quantity, {unit: factor to the canonical unit}).
+# A header is "<name>_<unit>", "<name> (<unit>)" or "<name> [<unit>]", any case.
+QUANTITIES: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
+    "displacement_mm": (("displacement", "position", "x", "disp", "pos", "travel", "stroke"),
+                        {"mm": 1.0, "um": 1e-3, "µm": 1e-3, "cm": 10.0, "m": 1000.0,
+                         "in": 25.4, "inch": 25.4, "mil": 0.0254}),
+    "voltage_v": (("voltage", "volt", "v", "u", "vout", "output", "output voltage", "lvdt output"),
+                  {"v": 1.0, "mv": 1e-3, "uv": 1e-6, "µv": 1e-6}),
+    "direction": (("direction", "dir"), {"": 1.0}),
+    "time_s": (("time", "t"), {"s": 1.0, "ms": 1e-3, "min": 60.0}),
+    "temperature_c": (("temperature", "temp"), {"c": 1.0, "°c": 1.0, "degc": 1.0}),
+    "excitation_hz": (("excitation", "frequency", "freq"), {"hz": 1.0, "khz": 1e3}),
+}
+_WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
+              re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"))
+SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma"}
+
+
+def accepted_names() -> str:
+    """The header forms understood, for error messages (one line)."""
+    def units(col):
+        return ", ".join(u for u in QUANTITIES[col][1] if u.isascii())
+    d_names = "/".join(QUANTITIES["displacement_mm"][0][:5])
+    v_names = "/".join(QUANTITIES["voltage_v"][0][:4])
+    return (f"displacement_mm, x_mm, position_mm, 'Displacement (mm)' ({d_names}, unit "
+            f"{units('displacement_mm')}); voltage_v, voltage_mv, 'Voltage (V)' ({v_names}, "
+            f"unit {units('voltage_v')}); optional {', '.join(OPTIONAL)}")
+
+
+def recognise_header(name: str) -> tuple[str, float] | None:
+    """(canonical column, factor) for a header cell, or None when it is not understood."""
+    h = " ".join(name.strip().strip('"').strip("'").split()).lower()
+    if h in QUANTITIES:
+        return h, 1.0
+    candidates = [(h, "")] + [(m["q"].strip(), m["u"].strip()) for m in
+                              (rx.match(h) for rx in _WITH_UNIT) if m]
+    for q, u in candidates:
+        q = q.replace("_", " ")
+        for col, (names, units) in QUANTITIES.items():
+            if q in names and u in units:
+                return col, units[u]
+    return None
+
 
 @dataclass(frozen=True)
 class Recordings:
-    """Columns as float arrays of equal length; optional ones are ``None`` when absent."""
+    """Columns as float arrays of equal length; optional ones are ``None`` when absent.
+
+    ``lines`` holds the file line of each row (for messages; ``None`` when not from a file).
+    """
 
     displacement_mm: np.ndarray
     voltage_v: np.ndarray
@@ -38,6 +92,8 @@ class Recordings:
     source: str = "<memory>"
     sha256: str = ""
     comments: tuple[str, ...] = field(default_factory=tuple)
+    lines: np.ndarray | None = field(default=None, repr=False)
+    recognised: str = ""
 
     def __len__(self) -> int:
         return int(self.voltage_v.size)
@@ -46,93 +102,156 @@ class Recordings:
         out = {name: getattr(self, name) for name in REQUIRED + OPTIONAL}
         return {k: v for k, v in out.items() if v is not None}
 
+    def line_of(self, row: int) -> str:
+        """'line N' (file line) of 0-based data row ``row``, or 'row N' (1-based) without a file."""
+        if self.lines is None:
+            return f"row {row + 1}"
+        return f"line {int(self.lines[row])}"
+
     def subset(self, mask_or_index) -> "Recordings":
         """Rows selected by a boolean mask or index array (same columns)."""
         kw = {name: (None if arr is None else np.asarray(arr)[mask_or_index])
               for name, arr in ((n, getattr(self, n)) for n in REQUIRED + OPTIONAL)}
-        return Recordings(**kw, source=self.source, sha256=self.sha256, comments=self.comments)
+        lines = None if self.lines is None else np.asarray(self.lines)[mask_or_index]
+        return Recordings(**kw, source=self.source, sha256=self.sha256, comments=self.comments,
+                          lines=lines, recognised=self.recognised)
 
 
-def _parse_float(text: str, column: str, row: int, source: str) -> float:
+def _parse_float(text: str, column: str, where: str, source: str) -> float:
     try:
         value = float(text)
     except ValueError:
         raise RecordingsError(
-            f"{source}: row {row}, column '{column}': '{text}' is not a number"
+            f"{source}: {where}, column '{column}': '{text}' is not a number"
         ) from None
     if not math.isfinite(value):
-        raise RecordingsError(f"{source}: row {row}, column '{column}': value {text} is not finite")
+        raise RecordingsError(f"{source}: {where}, column '{column}': value {text} is not finite")
     return value
 
 
+def _sniff_separator(header_line: str) -> str:
+    counts = {sep: header_line.count(sep) for sep in SEPARATORS}
+    for sep in (";", "\t"):   # a header holding these is not comma-separated
+        if counts[sep]:
+            return sep
+    return ","
+
+
+def _header_map(header: list[str], required, source: str):
+    """{canonical column: (index, factor)}, notes on conversions, unknown headers."""
+    found: dict[str, tuple[int, float]] = {}
+    notes, unknown = [], []
+    for i, h in enumerate(header):
+        hit = recognise_header(h)
+        if hit is None:
+            unknown.append(h)
+            continue
+        col, factor = hit
+        if col in found:
+            raise RecordingsError(
+                f"{source}: duplicate column(s) {col} ('{header[found[col][0]]}' and '{h}')")
+        found[col] = (i, factor)
+        if h != col:
+            notes.append(f"'{h}' as {col}" + (f" (x {factor:g})" if factor != 1.0 else ""))
+    missing = [c for c in required if c not in found]
+    if missing:
+        what = f"; not understood: {', '.join(repr(u) for u in unknown)}" if unknown else ""
+        raise RecordingsError(
+            f"{source}: missing column(s) {', '.join(missing)} (header has: {', '.join(header)}"
+            f"{what}); accepted: {accepted_names()}"
+        )
+    return found, notes, unknown
+
+
 def parse_recordings(text: str, source: str = "<memory>",
-                     required: tuple[str, ...] = REQUIRED) -> Recordings:
+                     required: tuple[str, ...] = REQUIRED, encoding_note: str = "") -> Recordings:
     """Parse CSV text.  ``required=("voltage_v",)`` lets ``displacement_mm`` be absent
     (then ``None``): only for commands that do not need it (``flann predict``)."""
-    comments = []
-    lines = []
-    for line in text.splitlines():
+    sha = hashlib.sha256(text.encode()).hexdigest()
+    notes = [encoding_note] if encoding_note else []
+    if text.startswith("\ufeff"):
+        text = text[1:]
+        notes.append("UTF-8 byte-order mark")
+    comments, body = [], []   # body: (file line number, text)
+    for line_no, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped:
             continue
         if stripped.startswith("#"):
             comments.append(stripped.lstrip("#").strip())
             continue
-        lines.append(line)
-    if not lines:
+        body.append((line_no, line))
+    if not body:
         raise RecordingsError(f"{source}: no header line (expected columns {', '.join(REQUIRED)})")
-    reader = csv.reader(io.StringIO("\n".join(lines)))
-    header = [h.strip() for h in next(reader)]
-    missing = [c for c in required if c not in header]
-    if missing:
-        raise RecordingsError(
-            f"{source}: missing column(s) {', '.join(missing)} (header has: {', '.join(header)})"
-        )
-    dupes = sorted({h for h in header if header.count(h) > 1})
-    if dupes:
-        raise RecordingsError(f"{source}: duplicate column(s) {', '.join(dupes)}")
-    unknown = [h for h in header if h not in REQUIRED + OPTIONAL]
+    sep = _sniff_separator(body[0][1])
+    header = [h.strip() for h in next(csv.reader([body[0][1]], delimiter=sep))]
+    found, col_notes, unknown = _header_map(header, required, source)
     if unknown:
         warnings.warn(f"{source}: ignoring unknown column(s) {', '.join(unknown)}", stacklevel=2)
-    wanted = [c for c in REQUIRED + OPTIONAL if c in header]
-    index = {c: header.index(c) for c in wanted}
+    wanted = [c for c in REQUIRED + OPTIONAL if c in found]
     data: dict[str, list[float]] = {c: [] for c in wanted}
-    for row_no, row in enumerate(reader, start=1):
+    line_numbers: list[int] = []
+    decimal_comma = False
+    for line_no, row in ((n, r) for n, line in body[1:] for r in csv.reader([line], delimiter=sep)):
         if not any(cell.strip() for cell in row):
             continue
+        where = f"line {line_no}"
         if len(row) != len(header):
             raise RecordingsError(
-                f"{source}: row {row_no} has {len(row)} cells, header has {len(header)}"
+                f"{source}: {where} has {len(row)} cells, header (line {body[0][0]}) has {len(header)}"
             )
         for c in wanted:
-            data[c].append(_parse_float(row[index[c]].strip(), c, row_no, source))
+            i, factor = found[c]
+            cell = row[i].strip()
+            if sep != "," and "," in cell:
+                cell, decimal_comma = cell.replace(",", "."), True
+            data[c].append(_parse_float(cell, header[i], where, source) * factor)
+        line_numbers.append(line_no)
     if not data["voltage_v"]:
         raise RecordingsError(f"{source}: no data rows")
     arrays = {c: np.asarray(v, dtype=float) for c, v in data.items()}
+    lines = np.asarray(line_numbers, dtype=np.int64)
     if "direction" in arrays:
         bad = ~np.isin(arrays["direction"], (-1.0, 1.0))
         if bad.any():
-            row = int(np.flatnonzero(bad)[0]) + 1
+            k = int(np.flatnonzero(bad)[0])
             raise RecordingsError(
-                f"{source}: row {row}, column 'direction': {arrays['direction'][row - 1]:g} "
+                f"{source}: line {lines[k]}, column 'direction': {arrays['direction'][k]:g} "
                 "is not +1 or -1"
             )
-    sha = hashlib.sha256(text.encode()).hexdigest()
+    if sep != ",":
+        notes.append(f"{SEPARATORS[sep]}-separated" + (" with decimal comma" if decimal_comma else ""))
+    notes += col_notes
     arrays.setdefault("displacement_mm", None)
-    return Recordings(**arrays, source=source, sha256=sha, comments=tuple(comments))
+    return Recordings(**arrays, source=source, sha256=sha, comments=tuple(comments), lines=lines,
+                      recognised=", ".join(notes))
 
 
-def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED) -> Recordings:
+def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
+                    announce: bool = True) -> Recordings:
+    """Read a recordings file; when it is not in the canonical form, one stderr line says
+    how it was read (``announce``)."""
     path = Path(path)
+    note = ""
     try:
-        text = path.read_text()
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise RecordingsError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise RecordingsError(f"{path}: is a directory, expected a CSV file") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
         raise RecordingsError(f"{path}: cannot read ({exc.__class__.__name__})") from None
-    return parse_recordings(text, source=str(path), required=required)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        if b"\x00" in raw:
+            raise RecordingsError(f"{path}: binary or UTF-16 file, expected CSV text "
+                                  "(export as CSV UTF-8)") from None
+        text, note = raw.decode("latin-1"), "Latin-1 text"   # spreadsheets on Windows
+    rec = parse_recordings(text, source=str(path), required=required, encoding_note=note)
+    if announce and rec.recognised:
+        print(f"{path}: read {rec.recognised}", file=sys.stderr)
+    return rec
 
 
 def format_recordings(rec: Recordings, comments: tuple[str, ...] | list[str] = (),

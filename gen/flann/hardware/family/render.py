@@ -14,12 +14,12 @@ import hashlib
 import json
 from pathlib import Path
 
-from ... import __version__
 from ...errors import FlannError
 from ...fileio import atomic_directory
 from ...golden.model import FlannModel, load_model
 from ...numeric.fixed import bits_literal
 from ...textgen import template
+from ..header import header
 from ..fixed import render as fixed
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict
 from .twin import FlannFamilyMem
@@ -84,20 +84,18 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
             "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_family_top": top}
 
 
-def spec_lines(fam: FamilySpec) -> list[str]:
+def header_spec(fam: FamilySpec) -> dict:
+    """The fixed datapath's spec plus the family's sizing, for the shared header."""
     d = fam.to_dict()
-    lines = fixed.spec_lines(fam.spec)
-    lines.append(f"family = {json.dumps({k: d[k] for k in ('margin', 'members', 'terms', 'widths')})}")
-    return lines
+    return dict(fam.spec.to_dict(), family={k: d[k] for k in ("margin", "members", "terms", "widths")})
 
 
 def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
     ctx = contexts(fam, init_name or "(first member)")
     out = {}
     for name, title, folder in ENTITIES:
-        header = dict(file=f"{name}.vhd", title=title, command="flann gen --family", version=__version__,
-                      model_sha256=fam.spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(fam))
-        out[f"{name}.vhd"] = template(f"{folder}/{name}.vhd.j2").render(h=header, **ctx[name])
+        h = header(f"{name}.vhd", title, "flann gen --family", header_spec(fam), fam.spec.model_sha256)
+        out[f"{name}.vhd"] = template(f"{folder}/{name}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 

@@ -1,26 +1,28 @@
 """Render the VHDL-93 entities of a :class:`~flann.hardware.fixed.spec.Spec` and write ``manifest.json``.
 
 Layer 3: one context dict per entity, computed here (widths, literals checked to fit,
-names), one template per entity in ``flann/templates``; templates only place text.
+names), one template per entity in ``hardware/fixed/templates``; templates only place text,
+and an architecture choice the spec makes picks a fragment from a sub-folder there.
 Output is deterministic: no timestamps, a header with generator version, model sha256
 and the spec, so regenerating gives identical bytes.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from ... import __version__
 from ...errors import SpecError
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..header import header
 from ..manifest import MANIFEST, read_manifest, write_design
 from ..options import GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
+# the entities' templates; a variant the spec chooses is a fragment in a sub-folder
+TEMPLATES = "hardware/fixed/templates"
 # compile order
 ENTITIES = (
     ("flann_norm", "input clamp and normalisation (serial code x constant)"),
@@ -37,10 +39,6 @@ def _ubits(n: int) -> int:
     return max(1, int(n).bit_length())
 
 
-def spec_lines(spec: Spec) -> list[str]:
-    return [f"{k} = {json.dumps(v)}" for k, v in spec.to_dict().items()]
-
-
 def contexts(spec: Spec) -> dict[str, dict]:
     """Template context of every entity."""
     s = spec
@@ -51,9 +49,10 @@ def contexts(spec: Spec) -> dict[str, dict]:
     lin_bits = s.lin_fmt.width
     NV = P + s.norm_guard
 
-    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits)
+    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits,
+                  term_type=s.term_fmt.vhdl_type)
     norm = dict(
-        code_bits=B, phase_bits=P, lin_bits=lin_bits, acc_v_bits=NV, acc_l_bits=s.lin_width,
+        code_bits=B, phase_bits=P, lin_bits=lin_bits, lin_type=s.lin_fmt.vhdl_type, acc_v_bits=NV, acc_l_bits=s.lin_width,
         guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
         ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
@@ -66,14 +65,17 @@ def contexts(spec: Spec) -> dict[str, dict]:
     slope_bits, kx, slope_reg = s.slope_rom_bits, s.interp_digit, s.slope_reg_bits
     icnt_bits = _ubits(slope_reg // kx + 1)
     expansion = dict(
-        common, delta_even=de, delta_odd=do, lanes_odd=(L % 2 == 1),
+        common, delta_even=de, delta_odd=do,
+        fragments=f"{TEMPLATES}/expansion/interp/{s.interp_style}",
+        parity=f"{TEMPLATES}/expansion/parity/{'alternate' if s.lane_kind_alternates else 'fixed'}.vhd.j2",
+        slope_round=f"{TEMPLATES}/expansion/slope_round/{'half_up' if s.slope_guard > 0 else 'exact'}.vhd.j2",
+        interp_note="; a slope table corrects to first order inside a bin" if s.interp else "",
         mult_bits=_ubits(max([de, do, *starts])),
         start_mults=", ".join(f"{l} => {x}" for l, x in enumerate(starts)),
         start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
         quarter=bits_literal(1 << (P - 2), P, False),
         table_depth=1 << A, addr_bits=A, offset_bits=s.offset_bits, dq_bits=s.dq_bits,
-        value_bits=s.value_fmt.width, slope_bits=slope_bits, interp=s.interp,
-        serial_interp=s.serial_interp, interp_digit=kx, slope_reg_bits=slope_reg,
+        value_bits=s.value_fmt.width, value_type=s.value_fmt.vhdl_type, slope_bits=slope_bits, interp_digit=kx, slope_reg_bits=slope_reg,
         interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
         prod_bits=s.interp_prod_bits,
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
@@ -87,7 +89,8 @@ def contexts(spec: Spec) -> dict[str, dict]:
     K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, style=s.mult_style, fragments=f"hardware/fixed/templates/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        weight_type=s.weight_fmt.vhdl_type, product_type=s.product_fmt.vhdl_type,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
@@ -100,7 +103,9 @@ def contexts(spec: Spec) -> dict[str, dict]:
     Pf = s.product_fmt.frac_bits
     adder = dict(
         common, acc_bits=AB, out_bits=s.out_fmt.width, acc_frac=Pf,
-        acc_half=(1 << (Pf - 1)) if Pf > 0 else 0, output_lsb_mm=s.output_lsb_mm,
+        acc_type=s.acc_fmt.vhdl_type, out_type=s.out_fmt.vhdl_type,
+        acc_half=(1 << (Pf - 1)) if Pf > 0 else 0,
+        round=f"{TEMPLATES}/adder/round/{'half_up' if Pf > 0 else 'exact'}.vhd.j2", output_lsb_mm=s.output_lsb_mm,
         out_max=bits_literal(s.out_fmt.max_int, AB + 1), out_min=bits_literal(s.out_fmt.min_int, AB + 1),
     )
     if s.out_fmt.width > AB + 1:
@@ -120,9 +125,8 @@ def render(spec: Spec) -> dict[str, str]:
     ctx = contexts(spec)
     out = {}
     for name, title in ENTITIES:
-        header = dict(file=f"{name}.vhd", title=title, command="flann gen", version=__version__,
-                      model_sha256=spec.model_sha256 or "(not from a file)", spec_lines=spec_lines(spec))
-        out[f"{name}.vhd"] = template(f"hardware/fixed/templates/{name}.vhd.j2").render(h=header, **ctx[name])
+        h = header(f"{name}.vhd", title, "flann gen", spec.to_dict(), spec.model_sha256)
+        out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ... import __version__
+from .. import adc
 from .. import target as spartan2
 from ...errors import SpecError
 from ...numeric.fixed import FixedFormat, bits_needed
@@ -158,6 +159,11 @@ class Spec:
         """Harmonic of lane ``lane``'s first term (j = lane)."""
         return self.trig_term(lane)[1]
 
+    @property
+    def lane_kind_alternates(self) -> bool:
+        """Whether a lane's next term is of the other kind (sin <-> cos) than its current one."""
+        return self.trig_term(self.lanes)[0] != self.trig_term(0)[0]
+
     # -- expansion architecture ---------------------------------------------------------
     @property
     def offset_bits(self) -> int:
@@ -173,6 +179,14 @@ class Spec:
         """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope
         product is formed serially then (one cycle copies the slope, the rest iterate)."""
         return self.interp and self.mult_style == "shiftadd" and self.adv_period >= 3
+
+    @property
+    def interp_style(self) -> str:
+        """The expansion's table interpolation: 'plain' (none), 'array' (an offset x slope
+        array multiplier) or 'serial' (the same product formed serially between advances)."""
+        if not self.interp:
+            return "plain"
+        return "serial" if self.serial_interp else "array"
 
     @property
     def interp_digit(self) -> int:
@@ -267,8 +281,11 @@ class Spec:
 
 
 # ------------------------------------------------------------------------------------------
-def _check_int(name: str, value, lo: int, hi: int) -> int:
+def _check_int(name: str, value, lo: int, hi: int, derived: str = "") -> int:
+    """``derived``: why a width the user did not give came out of range (said instead)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= int(value) <= hi:
+        if derived:
+            raise SpecError(f"derived {name} = {value!r} is outside {lo}..{hi}: {derived}")
         raise SpecError(f"{name} = {value!r}: must be an integer in {lo}..{hi}")
     return int(value)
 
@@ -309,7 +326,10 @@ def derive_spec(
     if number_format != "fixed":
         raise SpecError(f"number format {number_format!r}: only 'fixed' is generated")
     part, _pkg, _speed = parse_device(device)
-    B = _check_int("input_bits", input_bits, 4, 16)
+    plan = adc.plan_adc(model, input_bits, input_lsb_v, clamp)  # ranges, units, wide ADCs
+    for note in plan.notes:
+        warnings.warn(note)
+    B, input_lsb_v = _check_int("input_bits", plan.input_bits, 4, 16), plan.input_lsb_v
     L = _check_int("lanes", lanes, 1, max(1, model.terms - 1))
     if mult_style not in MULT_STYLES:
         raise SpecError(f"mult_style {mult_style!r}: must be one of {', '.join(MULT_STYLES)}")
@@ -343,7 +363,7 @@ def derive_spec(
     if output_lsb_mm is None:
         if output_bits is None:
             step = (float(y.max() - y.min()) or 1.0) / max(1, codes.size - 1)
-            output_lsb_mm = nice_125(step / 4, up=False)
+            output_lsb_mm = nice_125(adc.default_output_step_mm(model, step), up=False)
         else:
             ob = _check_int("output_bits", output_bits, 4, 32)
             output_lsb_mm = nice_125(ymax * 1.05 / ((1 << (ob - 1)) - 1), up=True)
@@ -352,7 +372,7 @@ def derive_spec(
     q = float(output_lsb_mm)
     need_out = bits_needed(-math.ceil(ymax * 1.05 / q), math.ceil(ymax * 1.05 / q))
     if output_bits is None:
-        output_bits = need_out
+        output_bits = max(4, need_out)
     Bout = _check_int("output_bits", output_bits, 4, 32)
     if Bout < bits_needed(-math.ceil(ymax / q + 1), math.ceil(ymax / q + 1)):
         raise SpecError(
@@ -361,6 +381,10 @@ def derive_spec(
         )
 
     # ---- error-budget widths -----------------------------------------------------------
+    # said when a width the user did not ask for comes out of range
+    hint = adc.pathological_hint(model, q)
+    given = {k for k, v in dict(phase_bits=phase_bits, term_frac_bits=term_frac_bits,
+                                weight_frac_bits=weight_frac_bits).items() if v is not None}
     w = np.asarray(model.weights, dtype=float)
     wt = w[1:] / q  # trig weights in output LSB
     m = np.array([term_kind(i)[1] for i in range(1, model.terms)], dtype=float)
@@ -374,13 +398,13 @@ def derive_spec(
     if phase_bits is None:
         F = math.ceil(math.log2(math.pi * (1.5 * Swm + Sw) / (2 * BUDGET["phase"])))
         phase_bits = F + 1
-    P = _check_int("phase_bits", phase_bits, 6, 40)
+    P = _check_int("phase_bits", phase_bits, 6, 40, derived="" if "phase_bits" in given else hint)
     F = P - 1
     e_t = BUDGET["table"] / Sw  # allowed error per term (term units)
     if term_frac_bits is None:
         # value and correction rounding: 2 x 2^-(Tf+1) <= e_t / 2
         term_frac_bits = max(4, math.ceil(-math.log2(e_t / 2)))
-    Tf = _check_int("term_frac_bits", term_frac_bits, 4, 30)
+    Tf = _check_int("term_frac_bits", term_frac_bits, 4, 30, derived="" if "term_frac_bits" in given else hint)
     if table_addr_bits is None:
         if interp:  # residual of first-order interpolation (pi/2 2^-(A+1))^2 / 2 <= e_t / 4
             A = math.ceil(math.log2(math.pi / 2 / math.sqrt(e_t / 2)) - 1)
@@ -406,7 +430,7 @@ def derive_spec(
 
     if weight_frac_bits is None:
         weight_frac_bits = max(0, math.ceil(math.log2(N * term_max / 2.0 ** Tf / (2 * BUDGET["weights"]))))
-    Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30)
+    Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30, derived="" if "weight_frac_bits" in given else hint)
     w_int = np.floor(wt * 2.0 ** Wf + 0.5).astype(np.int64)
     wmax = int(np.max(np.abs(w_int))) if w_int.size else 1
     weight_fmt = FixedFormat(bits_needed(-wmax, wmax), bits_needed(-wmax, wmax) - Wf)
@@ -447,7 +471,8 @@ def derive_spec(
     for name, width in (("lin accumulator", lin_width), ("normaliser", P + Gn), ("accumulator", acc_fmt.width),
                         ("product", term_fmt.width + weight_fmt.width)):
         if width > 62:
-            raise SpecError(f"{name} would need {width} bits (> 62): reduce the requested widths")
+            raise SpecError(f"{name} would need {width} bits (> 62): "
+                            + ("reduce the requested widths" if given else hint))
 
     K = _check_int("mult_digit_bits", mult_digit_bits, 1, weight_fmt.width)
     # shift-add: ceil(W/K) cycles per product, then the advance that hands it on

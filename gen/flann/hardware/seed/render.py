@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import json
-
 from ... import __version__
 from ...numeric.fixed import bits_literal
 from ...textgen import template
+from ..header import header
 from ..manifest import write_design
 from .spec import ENTITY, SeedSpec
 
@@ -18,7 +17,8 @@ def context(s: SeedSpec) -> dict:
     wd = s.widths
     wf = s.word_fmt
     return dict(
-        entity=ENTITY, terms=s.terms, n_adders=s.n_adders, word=W, latency=s.latency_cycles,
+        entity=ENTITY, terms=s.terms, n_adders=s.n_adders, word=W, word_type=wf.vhdl_type,
+        latency=s.latency_cycles,
         in_bits=s.input_bits, shift=s.shift, norm_guard=s.norm_guard,
         clamp_lo=bits_literal(s.clamp_lo, s.input_bits), clamp_hi=bits_literal(s.clamp_hi, s.input_bits),
         ka=bits_literal(s.ka, wd["ka_bits"]), kb=bits_literal(s.kb, wd["norm_bits"]),
@@ -33,17 +33,12 @@ def context(s: SeedSpec) -> dict:
     )
 
 
-def header(s: SeedSpec) -> dict:
-    return dict(
-        file=SEED_FILE, title="the seed paper's FLANN architecture, fully parallel, for comparison only",
-        command="flann explore", version=__version__, model_sha256=s.model_sha256 or "(not from a file)",
-        spec_lines=[f"{k} = {json.dumps(v)}" for k, v in s.to_dict().items()],
-    )
-
-
 def render(s: SeedSpec) -> dict[str, str]:
     """{file name: VHDL text}."""
-    text = template("hardware/seed/templates/seed_parallel.vhd.j2").render(h=header(s), **context(s))
+    text = template("hardware/seed/templates/seed_parallel.vhd.j2").render(
+        h=header(SEED_FILE, "the seed paper's FLANN architecture, fully parallel, for comparison only",
+                 "flann explore", s.to_dict(), s.model_sha256),
+        **context(s))
     return {SEED_FILE: text}
 
 

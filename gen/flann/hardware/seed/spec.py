@@ -116,11 +116,13 @@ class SeedSpec:
 
     @property
     def levels(self) -> list[dict]:
-        """Adder tree levels: input offset, output offset, pairs, odd pass-through."""
+        """Adder tree levels: input offset, output offset, pairs, and the pass-through
+        registers ({"src", "dst"} node indices) that carry an odd node to the next level."""
         out, inp, n, nxt = [], 0, self.terms, self.terms
         while n > 1:
             pairs, odd = n // 2, n % 2
-            out.append({"inp": inp, "out": nxt, "pairs": pairs, "odd": bool(odd)})
+            passes = [{"src": inp + 2 * pairs, "dst": nxt + pairs}] if odd else []
+            out.append({"inp": inp, "out": nxt, "pairs": pairs, "passes": passes})
             inp, n = nxt, pairs + odd
             nxt = inp + n
         return out

@@ -1,0 +1,197 @@
+"""Hardware in view: what a model costs in fixed point, and how accurate the built design is.
+
+* :func:`fixed_point_cost` -- what ``flann train`` asks when it selects among candidate
+  models: can ``flann gen`` build it, and at what cost (LUT4 equivalents).
+* :func:`design_spec` -- the :class:`Spec` of a generated design, rebuilt from the model and
+  the design's ``manifest.json`` (and checked against it).
+* :func:`hardware_accuracy` -- the bit-true twin of that design on recordings (voltages
+  quantised to the design's ADC codes) against the true displacement, next to the float
+  model and the physical limit of the converter (half an ADC LSB over the local slope).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FlannError, SpecError
+from ..golden.metrics import error_report
+from ..golden.model import FlannModel, load_model, model_sha256
+from .adc import MAX_DESIGN_INPUT_BITS
+from .fixed.render import read_manifest
+from .fixed.spec import Spec, derive_spec
+from .fixed.twin import FlannTop
+
+COST_BITS = (MAX_DESIGN_INPUT_BITS, 12)   # a model must build at the default and the widest ADC
+
+
+def fixed_point_cost(model: FlannModel) -> dict:
+    """Cost of the model in fixed point at the generator's defaults, and whether it builds.
+
+    ``cost`` is the estimated LUT4 count + the weight ROM in LUT4 equivalents (16 bits each)
+    + 64 per block RAM: it grows with the weights' dynamic range (weight and term widths)
+    and with the number of terms.  ``buildable`` is False when ``flann gen`` would refuse the
+    model at 16 or at 12 input bits (the reason is in ``why``).
+    """
+    spec = None
+    for bits in COST_BITS:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                spec = derive_spec(model, input_bits=bits)
+        except SpecError as exc:
+            return {"buildable": False, "why": f"{bits}-bit input: {exc}", "cost": math.inf}
+    est = spec.analysis["estimate"]
+    rom_luts = math.ceil(spec.steps * spec.weight_fmt.width / 16)
+    return {"buildable": True, "why": "",
+            "cost": float(est["luts"] + rom_luts + 64 * est["brams"]), "luts": est["luts"],
+            "brams": est["brams"], "weight_bits": spec.weight_fmt.width,
+            "term_bits": spec.term_fmt.width, "phase_bits": spec.phase_bits,
+            "output_lsb_mm": spec.output_lsb_mm, "cycles_per_sample": spec.cycles_per_sample}
+
+
+
+
+# -- a generated design, rebuilt ---------------------------------------------------------
+_FMT = re.compile(r"^[su]fix<(\d+),(-?\d+),")
+
+
+def _frac_bits(described: str, field: str) -> int:
+    m = _FMT.match(str(described))
+    if not m:
+        raise FlannError(f"manifest spec field {field!r} = {described!r}: not a fixed-point format")
+    return int(m.group(1)) - int(m.group(2))
+
+
+def design_spec(model_path, design_dir) -> Spec:
+    """The Spec of the design in ``design_dir`` for the model file ``model_path``.
+
+    The generator options are read back from the design's manifest.json and the spec is
+    derived again; it must reproduce the manifest's spec field for field (else the design
+    came from another model or generator version and must be regenerated).
+    """
+    man = read_manifest(design_dir)
+    model = load_model(model_path)
+    sha = model_sha256(model_path)
+    if man.get("model_sha256") != sha:
+        raise FlannError(f"{design_dir}: generated from another model (sha256 {str(man.get('model_sha256'))[:12]}, "
+                         f"{Path(model_path).name} is {sha[:12]}): run flann gen {model_path} -o {design_dir}")
+    want = man.get("spec") or {}
+    if want.get("number_format") != "fixed":
+        raise FlannError(f"{design_dir}: number format {want.get('number_format')!r}: "
+                         "--design reads fixed-point designs (flann gen --format fixed)")
+    try:
+        opts = dict(device=want["device"], input_bits=want["input_bits"], input_lsb_v=want["input_lsb_v"],
+                    output_bits=man["output_bits"], output_lsb_mm=want["output_lsb_mm"], lanes=want["lanes"],
+                    mult_style=want["mult_style"], mult_digit_bits=want["mult_digit_bits"],
+                    interp=want["interp"], phase_bits=want["phase_bits"],
+                    table_addr_bits=want["table_addr_bits"],
+                    term_frac_bits=_frac_bits(want["term"], "term"),
+                    weight_frac_bits=_frac_bits(want["weight"], "weight"),
+                    product_frac_bits=_frac_bits(want["product"], "product"))
+    except KeyError as exc:
+        raise FlannError(f"{design_dir}/manifest.json: missing field {exc.args[0]!r}: regenerate the design") from None
+    for clamp in (True, False):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            spec = derive_spec(model, model_sha256=sha, clamp=clamp, check_device=False, **opts)
+        got = json.loads(json.dumps(spec.to_dict()))
+        if got == want:
+            return spec
+    diff = sorted(k for k in want if got.get(k) != want[k])
+    raise FlannError(f"{design_dir}: the manifest's spec differs from the one derived again ({', '.join(diff)}): "
+                     "generated by another version of flann; regenerate the design")
+
+
+# -- hardware accuracy against the physical limit ------------------------------------------
+def adc_codes(spec: Spec, voltage_v) -> np.ndarray:
+    """Voltages as the design's ADC delivers them: nearest code, saturated to its range."""
+    c = np.floor(np.asarray(voltage_v, dtype=float) / spec.input_lsb_v + 0.5)
+    return np.clip(c, spec.code_min, spec.code_max).astype(np.int64)
+
+
+def physical_limit_mm(model: FlannModel, voltage_v, input_lsb_v: float) -> np.ndarray:
+    """Half an ADC LSB over the sensor's local slope at each voltage: the error a perfect
+    compensator behind this converter still has.  The slope dv/dx is that of the model's
+    inverse (its dx/dv, by central differences over the trained range)."""
+    vlo, vhi = sorted(model.voltage_range_v)
+    grid = np.linspace(vlo, vhi, 4001)
+    dxdv = np.abs(np.gradient(model.predict(grid), grid))
+    v = np.clip(np.asarray(voltage_v, dtype=float), vlo, vhi)
+    return 0.5 * input_lsb_v * np.interp(v, grid, dxdv)
+
+
+def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm) -> dict:
+    """The bit-true twin on the recordings' voltages (as ADC codes) against the displacement.
+
+    Returns the ``"hardware"`` block of ``flann eval --design --json`` plus per-point arrays
+    (``_points``) for the plot.
+    """
+    x = rec.displacement_mm
+    codes = adc_codes(spec, rec.voltage_v)
+    out, sat = FlannTop(spec).process(codes)
+    hw_mm = out * spec.output_lsb_mm
+    fl_mm = spec.model.predict(rec.voltage_v)
+    limit = physical_limit_mm(spec.model, rec.voltage_v, spec.input_lsb_v)
+    e_hw, e_fl = hw_mm - x, fl_mm - x
+    rep = error_report(hw_mm, x, tol, band, fs_mm, rec.direction)
+    lim_max = float(limit.max())
+    rep.update({
+        "input_bits": spec.input_bits, "input_lsb_v": spec.input_lsb_v,
+        "output_lsb_mm": spec.output_lsb_mm,
+        "points_clamped": int(np.count_nonzero(sat)),
+        "max_abs_hardware_minus_float_mm": float(np.max(np.abs(hw_mm - fl_mm))),
+        # the datapath's own error: the float model at the same (clamped) ADC codes
+        "max_abs_hardware_minus_float_at_codes_mm": float(np.max(np.abs(hw_mm - spec.float_reference(codes)))),
+        "physical_limit_mm": {"max": lim_max, "median": float(np.median(limit)),
+                              "min": float(limit.min())},
+        "ratio_to_limit": float(np.max(np.abs(e_hw)) / lim_max),
+        "float_ratio_to_limit": float(np.max(np.abs(e_fl)) / lim_max),
+        "worst_pointwise_ratio": float(np.max(np.abs(e_hw) / limit)),
+    })
+    rep["_points"] = {"x": x, "hardware": e_hw, "float": e_fl, "limit": limit}
+    return rep
+
+
+def plot_errors(path, x, raw_err, float_err, hw_err, limit, title: str = "") -> None:
+    """Error vs displacement: raw sensor, float model, hardware, +- the physical limit (PNG)."""
+    import matplotlib  # lazy: plotting is optional and slow to import
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    order = np.argsort(x, kind="stable")
+    xs = np.asarray(x)[order]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True,
+                                 gridspec_kw={"height_ratios": [1, 2]})
+    a1.plot(xs, np.asarray(raw_err)[order], ".", ms=2, color="0.5", label="raw sensor (least-squares line)")
+    a1.set_ylabel("error (mm)")
+    a1.legend(loc="best", fontsize=8)
+    a1.set_title(title or "error vs displacement")
+    lim = np.asarray(limit)[order]
+    a2.fill_between(xs, -lim, lim, color="C2", alpha=0.2, lw=0, label="physical limit (½ ADC LSB / slope)")
+    a2.plot(xs, np.asarray(float_err)[order], ".", ms=2.5, color="C0", label="float model")
+    a2.plot(xs, np.asarray(hw_err)[order], ".", ms=2, color="C3", label="hardware (bit-true twin, ADC codes)")
+    a2.set_ylabel("error (mm)")
+    a2.set_xlabel("displacement (mm)")
+    a2.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    try:
+        fig.savefig(tmp, dpi=120)
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        tmp.unlink(missing_ok=True)
+
+
+__all__ = ["fixed_point_cost", "design_spec", "adc_codes", "physical_limit_mm", "hardware_accuracy",
+           "plot_errors"]

@@ -1,0 +1,162 @@
+"""The converter in front of the datapath: what range it covers, how many bits the design takes,
+the default output LSB, and why a model cannot be built in fixed point.
+
+Called by :func:`flann.hardware.fixed.spec.derive_spec` before it sizes the datapath, so that
+ranges and units that cannot be right are stopped with a message naming the user's option
+(``--input-bits``, ``--input-lsb-v``, ``--output-lsb-mm``) or the model's property that caused
+them, instead of surfacing as an out-of-range derived width.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SpecError
+from ..golden.model import FlannModel
+
+MAX_DESIGN_INPUT_BITS = 16   # widest ADC code the datapath takes (serial normaliser, guard bits)
+MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
+SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)
+DEFAULT_INPUT_MARGIN = 1.10  # default input LSB: trained range + 10 %
+
+
+@dataclass(frozen=True)
+class AdcPlan:
+    """How the ADC's codes enter the design.
+
+    ``adc_bits``/``adc_lsb_v`` are the converter as the user gave it; the design takes its top
+    ``input_bits`` bits (``dropped`` low bits discarded), so one design code is ``input_lsb_v``.
+    """
+
+    adc_bits: int
+    adc_lsb_v: float
+    input_bits: int
+    input_lsb_v: float
+    dropped: int
+    notes: tuple[str, ...] = ()
+
+
+def default_input_lsb(model: FlannModel, bits: int) -> float:
+    """Volts per code covering the trained range + 10 %, 3 significant digits (rounded up)."""
+    vlo, vhi = sorted(model.voltage_range_v)
+    x = max(abs(vlo), abs(vhi), 1e-12) * DEFAULT_INPUT_MARGIN / (1 << (bits - 1))
+    e = math.floor(math.log10(x)) - 2
+    return float(f"{math.ceil(x / 10.0 ** e) * 10.0 ** e:.12g}")
+
+
+def _opts(bits, lsb_v, lsb_given: bool) -> str:
+    return f"--input-bits {bits}" + (f" --input-lsb-v {lsb_v:g}" if lsb_given else "")
+
+
+def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True) -> AdcPlan:
+    """Check the converter against the trained voltage range; drop low bits of wide ADCs.
+
+    * an ADC wider than 16 bits (24-bit sigma-delta conditioners are usual) is accepted: the
+      design takes the top 16 bits, the message states the coarser LSB and what it costs in mm;
+    * a trained range the ADC cannot represent is an error naming both ranges (a unit mistake:
+      millivolts read as volts, or a wrong --input-lsb-v);
+    * a trained range holding fewer than 16 codes is an error naming --input-lsb-v;
+    * a trained range using under 1/16 of the ADC's range is said (resolution thrown away).
+    """
+    if isinstance(input_bits, bool) or not isinstance(input_bits, (int, np.integer)) or \
+            not 4 <= int(input_bits) <= 32:
+        raise SpecError(f"input_bits = {input_bits!r} (--input-bits): must be an integer in 4..32 (the design "
+                        f"takes at most the top {MAX_DESIGN_INPUT_BITS})")
+    bits = int(input_bits)
+    lsb_given = input_lsb_v is not None
+    if lsb_given and not (isinstance(input_lsb_v, (int, float)) and math.isfinite(input_lsb_v)
+                          and input_lsb_v > 0):
+        raise SpecError(f"input_lsb_v = {input_lsb_v!r} (--input-lsb-v): must be a positive number of volts")
+    lsb = float(input_lsb_v) if lsb_given else default_input_lsb(model, bits)
+    vlo, vhi = sorted(model.voltage_range_v)
+    lo_v, hi_v = -(1 << (bits - 1)) * lsb, ((1 << (bits - 1)) - 1) * lsb
+    opts = _opts(bits, lsb, lsb_given)
+    notes = []
+    if clamp and (vlo < lo_v - lsb or vhi > hi_v + lsb):
+        raise SpecError(
+            f"the trained voltage range {vlo:.6g}..{vhi:.6g} V does not fit the ADC's range "
+            f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): check the recordings' voltage unit "
+            "(millivolts under a voltage_v header? name the column voltage_mv) or the ADC options")
+    codes = (vhi - vlo) / lsb
+    if codes < MIN_TRAINED_CODES:
+        raise SpecError(
+            f"input_lsb_v = {lsb:g} V (--input-lsb-v) gives the trained range {vlo:.6g}..{vhi:.6g} V only "
+            f"{codes:.3g} ADC codes (need >= {MIN_TRAINED_CODES}): the input LSB is too coarse "
+            "for this sensor (volts per code, not the full scale?)")
+    check_output_range(model)
+    used = (vhi - vlo) / (hi_v - lo_v)
+    if used < SMALL_FRACTION:
+        notes.append(
+            f"the trained range {vlo:.6g}..{vhi:.6g} V uses {100 * used:.2g} % of the ADC's "
+            f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): about {math.log2(1 / used):.1f} of its bits "
+            "carry no signal; check the voltage unit or the conditioner's gain")
+    dropped = max(0, bits - MAX_DESIGN_INPUT_BITS)
+    eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
+    if dropped:
+        slope = max_mm_per_v(model)
+        notes.append(
+            f"{bits}-bit ADC: the design takes its top {eff_bits} bits (drops {dropped} low bits; "
+            f"wire the ADC's bits {bits - 1}..{dropped} to in_data): input LSB {lsb:.4g} -> "
+            f"{eff_lsb:.4g} V, adding up to {0.5 * eff_lsb * slope:.3g} mm of quantisation error "
+            f"at the steepest point (was {0.5 * lsb * slope:.3g} mm)")
+    return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
+
+
+def check_output_range(model: FlannModel, points: int = 2001) -> None:
+    """A model whose output over its own voltage range is far outside its displacement range
+    is not a compensator (a file edited by hand, or weights that do not cancel as they should)."""
+    vlo, vhi = sorted(model.voltage_range_v)
+    y = model.predict(np.linspace(vlo, vhi, points))
+    xlo, xhi = sorted(model.displacement_range_mm)
+    reach = max(abs(xlo), abs(xhi), xhi - xlo)
+    if not np.all(np.isfinite(y)) or float(np.max(np.abs(y))) > 100 * reach:
+        raise SpecError(
+            f"the model's output reaches {float(np.max(np.abs(y))):.3g} mm over its trained voltage range "
+            f"{vlo:.6g}..{vhi:.6g} V, but it was trained on {xlo:.6g}..{xhi:.6g} mm: not a usable model "
+            "(edited by hand?); retrain it with `flann train`")
+
+
+def max_mm_per_v(model: FlannModel, points: int = 2001) -> float:
+    """Largest |d displacement / d voltage| of the model over its trained range (mm/V)."""
+    vlo, vhi = sorted(model.voltage_range_v)
+    v = np.linspace(vlo, vhi, points)
+    return float(np.max(np.abs(np.gradient(model.predict(v), v))))
+
+
+def model_accuracy_mm(model: FlannModel) -> float | None:
+    """The model's own held-out RMS error (mm) when its training record has one."""
+    for key in ("cv_heldout_rms_error_mm", "heldout_rms_error_mm"):
+        val = model.training.get(key) if isinstance(model.training, dict) else None
+        if isinstance(val, (int, float)) and math.isfinite(val) and val > 0:
+            return float(val)
+    return None
+
+
+def default_output_step_mm(model: FlannModel, code_step_mm: float) -> float:
+    """What the default output LSB must resolve: a quarter of the output change per input
+    code, but no finer than a quarter of the model's own held-out RMS error (bits below the
+    model's accuracy only widen the datapath)."""
+    acc = model_accuracy_mm(model)
+    return max(code_step_mm, acc if acc is not None else 0.0) / 4
+
+
+def weight_range_text(model: FlannModel, output_lsb_mm: float) -> str:
+    """'sum |w| = ... output LSB, largest |w| ...': the model property that sizes the datapath."""
+    w = np.abs(np.asarray(model.weights[1:], dtype=float))
+    return (f"the model's sin/cos weights sum to {w.sum():.3g} mm (largest {w.max():.3g} mm, "
+            f"{w.sum() / output_lsb_mm:.3g} output LSB of {output_lsb_mm:g} mm)")
+
+
+def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
+    """Why a derived width is out of range for this model and what to do, one clause."""
+    return (f"{weight_range_text(model, output_lsb_mm)}: nearly collinear terms cancelling each "
+            "other; retrain with `flann train` (default auto keeps the weights buildable) or a "
+            "larger --ridge, or give a coarser --output-lsb-mm")
+
+
+__all__ = ["AdcPlan", "plan_adc", "default_input_lsb", "default_output_step_mm", "max_mm_per_v",
+           "model_accuracy_mm", "pathological_hint", "weight_range_text",
+           "MAX_DESIGN_INPUT_BITS"]

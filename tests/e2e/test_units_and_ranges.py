@@ -1,0 +1,109 @@
+"""Units and ranges that cannot be right are stopped before a design is built; wide ADCs accepted.
+
+The sensor here is a line plus a cubic written in the test: 4.0 V at +-10 mm.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from flann.cli import main
+from flann.golden.model import FlannModel
+
+
+def run(argv, capsys):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def sensor_csv(path, scale=1.0, header="displacement_mm,voltage_v", noise_v=0.0, n=81):
+    x = np.linspace(-10, 10, n)
+    v = (0.45 * x - 0.0005 * x**3 + np.random.default_rng(1).normal(0, noise_v, n)) * scale  # 4 V at 10 mm
+    path.write_text(header + "\n" + "\n".join(f"{a:.6g},{b:.9g}" for a, b in zip(x, v)) + "\n")
+    return path
+
+
+@pytest.fixture
+def model(tmp_path, capsys):
+    m = tmp_path / "m.json"
+    assert run(["train", sensor_csv(tmp_path / "r.csv"), "-o", m], capsys)[0] == 0
+    return m
+
+
+def one_error_line(err):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    return lines[0]
+
+
+def test_millivolts_under_a_volts_header_are_refused(tmp_path, capsys):
+    rec = sensor_csv(tmp_path / "mv.csv", scale=1000.0)
+    rc, _, err = run(["train", rec, "-o", tmp_path / "m.json"], capsys)
+    assert rc == 2 and "voltage_mv" in one_error_line(err) and "4000 V" in err
+    assert not (tmp_path / "m.json").exists()
+    # the same numbers under a millivolt header train
+    rec = sensor_csv(tmp_path / "mv2.csv", scale=1000.0, header="displacement_mm,Voltage (mV)")
+    assert run(["train", rec, "-o", tmp_path / "m.json"], capsys)[0] == 0
+
+
+def test_trained_range_outside_the_adc_names_both_ranges(tmp_path, capsys, model):
+    # 12 bits x 1 mV covers -2.048..2.047 V; the sensor gives -4..4 V
+    rc, _, err = run(["gen", model, "-o", tmp_path / "hdl", "--input-bits", 12, "--input-lsb-v", 0.001],
+                     capsys)
+    line = one_error_line(err)
+    assert rc == 2 and "-4..4 V" in line and "-2.048..2.047 V" in line and "--input-lsb-v 0.001" in line
+    assert not (tmp_path / "hdl").exists()
+
+
+def test_small_fraction_of_the_adc_is_said(tmp_path, capsys, model):
+    # 16 bits x 10 mV covers +-327 V: the sensor's 8 V uses 1.2 % of it
+    rc, _, err = run(["gen", model, "-o", tmp_path / "hdl", "--input-bits", 16, "--input-lsb-v", 0.01],
+                     capsys)
+    assert rc == 0 and "uses 1.2 % of the ADC" in err
+
+
+def test_coarse_input_lsb_names_the_option(tmp_path, capsys, model):
+    rc, _, err = run(["gen", model, "-o", tmp_path / "hdl", "--input-lsb-v", 10], capsys)
+    line = one_error_line(err)
+    assert rc == 2 and "--input-lsb-v" in line and "output_bits" not in line
+
+
+def test_24_bit_adc_drops_low_bits_and_says_what_it_costs(tmp_path, capsys, model):
+    lsb24 = 10.0 / 2**24    # +-5 V converter
+    rc, out, err = run(["gen", model, "-o", tmp_path / "hdl", "--input-bits", 24, "--input-lsb-v", lsb24,
+                        "--json"], capsys)
+    assert rc == 0, err
+    man = json.loads(out)
+    assert man["input_bits"] == 16 and man["input_lsb_v"] == pytest.approx(lsb24 * 256)
+    assert "drops 8 low bits" in err and "bits 23..8" in err
+    # the stated cost: half the new LSB over the steepest slope (0.45 - 0.0015 x^2 V/mm at 10 mm)
+    steepest_mm_per_v = 1 / (0.45 - 0.0015 * 100)
+    said = float(err.split("adding up to ")[1].split(" mm")[0])
+    assert said == pytest.approx(0.5 * lsb24 * 256 * steepest_mm_per_v, rel=0.02)
+
+
+def test_pathological_model_one_line_with_cause(tmp_path, capsys):
+    # half-period normalisation, 61 terms, no ridge: nearly collinear terms whose huge weights
+    # cancel (what auto used to write); asked for explicitly, train warns and gen explains
+    rec, m = sensor_csv(tmp_path / "r.csv", noise_v=0.001, n=401), tmp_path / "half.json"
+    rc, _, err = run(["train", rec, "-o", m, "--terms", 61, "--normalise", "half"], capsys)
+    assert rc == 0 and "cannot be built in fixed point" in err
+    assert max(abs(w) for w in json.loads(m.read_text())["weights"]) > 1e6
+    rc, _, err = run(["gen", m, "-o", tmp_path / "hdl"], capsys)
+    line = one_error_line(err)
+    assert rc == 2 and "weights sum to" in line and "retrain" in line
+    assert not (tmp_path / "hdl").exists()
+
+
+def test_model_whose_output_leaves_its_range_is_refused(tmp_path, capsys):
+    w = [20.0] + [3e9, -3e9 + 1.0] + [0.0] * 8
+    m = FlannModel(weights=tuple(w), voltage_range_v=(-4.0, 4.0), displacement_range_mm=(-10.0, 10.0),
+                   input_scale_v=8.0)
+    p = tmp_path / "ext.json"
+    m.save(p)
+    rc, _, err = run(["gen", p, "-o", tmp_path / "hdl"], capsys)
+    assert rc == 2 and "not a usable model" in one_error_line(err)
