@@ -50,8 +50,9 @@ from . import images
 from .certificate import render_certificate
 
 RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the design
-# The diagnosis sees at most this many points (bin means): about 1 s of CPU per sensor
-# instead of 2-5 s for 2,000 points, with the same effects named on the simulated batch.
+# The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
+# nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
+# sensors tried (docs/production.md); fewer points save little, the fits dominate.
 DIAGNOSIS_POINTS = 250
 SUMMARY = "summary.csv"
 SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit", "limit_mm",
