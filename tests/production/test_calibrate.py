@@ -88,3 +88,14 @@ def test_duplicate_names_and_missing_design(batch, tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_bad_options_stop_before_any_work(batch, tmp_path, capsys):
+    p, design = batch["good"][0], batch["design"]
+    bad_toml = tmp_path / "bad.toml"
+    bad_toml.write_text("x = [\n")
+    for extra in (["--diagnosis-points", "-1"], ["--sensor", str(bad_toml)], ["-j", "0"]):
+        assert main(["calibrate", str(p), "-o", str(tmp_path / "o"), "--design", str(design), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("error: ") == 3 and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
