@@ -145,14 +145,17 @@ class FamilySpec:
         return max(self.norm_bits, self.spec.lin_width)
 
     @property
+    def norm_latency(self) -> int:
+        """flann_family_norm, accepting edge to out_valid: one cycle per parameter word, one to
+        read the first word of each of its two fetches, ``input_bits`` per product."""
+        return self.param_words + 2 + 2 * self.spec.input_bits
+
+    @property
     def latency_cycles(self) -> int:
-        """The fixed datapath's latency, with the normaliser's ``input_bits + 1`` cycles replaced
-        by flann_family_norm's: one cycle per parameter word, one to read the first word of each
-        of its two fetches, ``input_bits`` per product and the hand-over."""
+        """The fixed datapath's latency with flann_norm's ``input_bits + 1`` cycles replaced by
+        flann_family_norm's."""
         s = self.spec
-        norm_fixed = s.input_bits + 1
-        norm_family = self.param_words + 2 + 2 * s.input_bits
-        return s.latency_cycles - norm_fixed + norm_family
+        return s.latency_cycles - (s.input_bits + 1) + self.norm_latency
 
     @property
     def cycles_per_sample(self) -> int:

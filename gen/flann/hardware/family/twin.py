@@ -103,7 +103,7 @@ class FlannFamilyNorm(FlannNorm):
 
     def __init__(self, fam: FamilySpec, mem: FlannFamilyMem):
         super().__init__(mem.spec())
-        self.latency = fam.param_words + 2 + 2 * fam.spec.input_bits
+        self.latency = fam.norm_latency
 
 
 class FlannFamilyMultiplier(FlannMultiplier):
