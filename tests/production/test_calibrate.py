@@ -50,8 +50,8 @@ def test_batch_reports_bad_rows_and_goes_on(batch):
 def test_certificate_is_self_contained(batch):
     for p in batch["good"]:
         html = (batch["out"] / p.stem / "certificate.html").read_text()
-        assert "data:image/png;base64," in html
-        assert "<img" in html and 'src="http' not in html and "<script" not in html
+        assert html.count("<svg") == 1 and html.count("<polyline") == 4  # raw, compensated, +-limit
+        assert 'src="http' not in html and 'href="http' not in html and "<script" not in html
         man_hash = json.loads((batch["out"] / p.stem / "model.json").read_text())  # readable model
         assert man_hash["terms"] == load_design(batch["design"]).terms
         assert "physical limit" in html and "design sha256" in html
@@ -75,9 +75,10 @@ def test_weight_image_reproduces_the_recording(batch):
         assert np.max(np.abs(out * s.output_lsb_mm - ref)) <= s.output_lsb_mm
         err = float(np.max(np.abs(out * s.output_lsb_mm - rec.displacement_mm)))
         assert err == pytest.approx(float(batch["rows"][p.stem]["max_error_mm"]), rel=1e-4)
-        # the .mem file holds the same words
-        mem = (d / "weights.mem").read_text().split("@0000", 1)[1].split()
-        assert [int(w, 16) for w in mem] == words
+        # the .mem file holds the same words as the block RAM does: 16-bit halves, low half first
+        mem = [int(h, 16) for h in (d / "weights.mem").read_text().split("@0000", 1)[1].split()]
+        assert len(mem) == 2 * len(words) and max(mem) < 2 ** 16
+        assert [lo | hi << 16 for lo, hi in zip(mem[0::2], mem[1::2])] == words
 
 
 def test_duplicate_names_and_missing_design(batch, tmp_path, capsys):
@@ -86,4 +87,15 @@ def test_duplicate_names_and_missing_design(batch, tmp_path, capsys):
     assert rc == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_bad_options_stop_before_any_work(batch, tmp_path, capsys):
+    p, design = batch["good"][0], batch["design"]
+    bad_toml = tmp_path / "bad.toml"
+    bad_toml.write_text("x = [\n")
+    for extra in (["--diagnosis-points", "-1"], ["--sensor", str(bad_toml)], ["-j", "0"]):
+        assert main(["calibrate", str(p), "-o", str(tmp_path / "o"), "--design", str(design), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("error: ") == 3 and "Traceback" not in err
     assert not (tmp_path / "o").exists()

@@ -9,7 +9,10 @@ the bit-true twin of the family design stands for it):
    input code: |twin - float model| against the error bound of the formats;
 3. hardware error on the recording (the twin at the recording's input codes) against the
    physical limit: half an input LSB divided by the local slope dv/dx, worst over the stroke;
-4. run the diagnosis (:func:`flann.diagnose.diagnose`) for warnings;
+4. run the diagnosis (:func:`flann.diagnose.diagnose`) for warnings, on a budget
+   (:func:`diagnosis_sample`: at most ``DIAGNOSIS_POINTS`` bin means of consecutive rows of
+   one pass; the diagnosis' cost is its nonlinear fits, a fixed number per candidate effect,
+   and averaging keeps its power for effects that vary over more than a bin);
 5. write ``OUTDIR/<sensor>/``: model.json, weights.hex, weights.mem, weights.bmm and
    certificate.html, all or nothing.
 
@@ -29,6 +32,7 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -41,11 +45,15 @@ from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash, load_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
-from ..recordings import read_recordings
+from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
 from . import images
 from .certificate import render_certificate
 
 RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the design
+# The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
+# nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
+# sensors tried (docs/production.md); fewer points save little, the fits dominate.
+DIAGNOSIS_POINTS = 250
 SUMMARY = "summary.csv"
 SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit", "limit_mm",
                   "raw_max_error_mm", "twin_vs_float_lsb", "recording")
@@ -63,6 +71,11 @@ class Result:
     raw_max_error_mm: float | None = None
     twin_vs_float_lsb: float | None = None
     warnings: list = field(default_factory=list)
+
+    def fail(self, reason: str) -> None:
+        """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
+        self.status = "failed"
+        self.reason = "".join(c if c.isprintable() else repr(c)[1:-1] for c in " ".join(str(reason).split()))
 
     def row(self) -> dict:
         def f(x, nd=6):
@@ -117,26 +130,67 @@ def check_sensor(rec, fam: FamilySpec) -> dict:
             "limit_mm": limit, "rec": rec}
 
 
-def _diagnosis(rec, sensor) -> list[str]:
-    """The diagnosis' findings as sentences (warnings for the certificate, never a failure)."""
+def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
+    """The recording the diagnosis sees, and one sentence saying how it was reduced.
+
+    At most ``points`` rows: means of ``k`` consecutive rows inside one pass (a bin never
+    spans a turn of direction), so the noise of a bin mean is 1/sqrt(k) of a reading's and
+    an effect that varies slowly over a bin keeps its size; rows in no order are sampled
+    evenly instead.  ``points`` None or 0, or a short recording: every row."""
+    from ..diagnose.data import find_passes  # with the diagnosis (scipy): only when calibrating
+
+    n = len(rec)
+    if not points or n <= points:
+        return rec, f"every one of the {n} points"
+    k = -(-n // int(points))
+    x = np.asarray(rec.displacement_mm, dtype=float)
+    passes = find_passes(x, None if rec.direction is None else np.asarray(rec.direction, dtype=float))
+    if not passes.ordered:
+        idx = np.unique(np.linspace(0, n - 1, int(points)).round().astype(np.int64))
+        return rec.subset(idx), f"{idx.size} of the {n} points, evenly sampled (the rows are in no order)"
+    groups = [run[i:i + k] for run in passes.runs for i in range(0, run.size, k)]
+    cols = {}
+    for name in REQUIRED + OPTIONAL:
+        a = getattr(rec, name)
+        cols[name] = None if a is None else np.array([float(np.mean(np.asarray(a, dtype=float)[g]))
+                                                      for g in groups])
+    width = float(np.median([np.ptp(x[g]) for g in groups if g.size > 1] or [0.0]))
+    small = Recordings(**cols, source=rec.source, sha256=rec.sha256, comments=rec.comments)
+    return small, (f"{len(small)} means of up to {k} consecutive points of one pass (about {width:.2g} mm "
+                   f"each) from the {n} points: effects varying over less than that are averaged out, "
+                   "noise figures are those of a mean")
+
+
+def _diagnosis(rec, sensor, points: int | None) -> tuple[list[str], str]:
+    """The diagnosis' findings as sentences (warnings for the certificate, never a failure)
+    and what it was run on."""
     from ..diagnose import diagnose  # heavy (scipy): only when calibrating
 
+    small, basis = diagnosis_sample(rec, points)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            dg = diagnose(rec, sensor=sensor)
+            dg = diagnose(small, sensor=sensor)
         except FlannError as exc:
-            return [f"diagnosis not possible: {exc}"]
+            return [f"diagnosis not possible: {exc}"], basis
     found = [f"{e.name}: {e.explanation}" for e in dg.effects]
     found += list(dg.notes)
     if dg.outliers:
         found.append(f"{len(dg.outliers)} outlier point(s)")
     found += [f"warning: {w.message}" for w in caught]
-    return found
+    return found, basis
+
+
+@lru_cache(maxsize=4)
+def _sensor(toml: str):
+    """The --sensor description, read once per process (a Sensor does not pickle)."""
+    from ..physics.sensor import load_sensor  # only with --sensor
+
+    return load_sensor(toml)
 
 
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
-                  max_error_mm: float | None = None) -> Result:
+                  max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row."""
     path = Path(path)
     res = Result(sensor=path.stem, recording=str(path))
@@ -156,28 +210,24 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         if max_error_mm is not None and res.max_error_mm > max_error_mm:
             raise FlannError(f"hardware max error {res.max_error_mm:.4g} mm > --max-error-mm {max_error_mm:g}")
-        sensor = None
-        if sensor_toml is not None:
-            from ..physics.sensor import load_sensor  # only with --sensor
-
-            sensor = load_sensor(sensor_toml)
-        findings = _diagnosis(rec, sensor)
-        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings)
+        sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
+        findings, basis = _diagnosis(rec, sensor, diagnosis_points)
+        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings, basis)
         res.status, res.reason = "ok", ""
     except FlannError as exc:
-        res.status, res.reason = "failed", str(exc)
+        res.fail(str(exc))
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
-        res.status, res.reason = "failed", f"{exc.__class__.__name__}: {exc}"
+        res.fail(f"{exc.__class__.__name__}: {exc}")
     return res
 
 
-def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings) -> None:
+def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings, basis: str) -> None:
     model, words = chk["model"], chk["words"]
     model_json = model.to_json()
     mhash = hashlib.sha256(model_json.encode()).hexdigest()
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
-    html = render_certificate(res, chk, fam, dhash, mhash, findings)
+    html = render_certificate(res, chk, fam, dhash, mhash, findings, basis)
     with atomic_directory(dest) as tmp:
         (tmp / "model.json").write_text(model_json, newline="")
         (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
@@ -201,9 +251,14 @@ def _worker_init() -> None:
 
 
 def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
-                    max_error_mm: float | None = None, progress: bool | None = None) -> list[Result]:
+                    max_error_mm: float | None = None, progress: bool | None = None,
+                    diagnosis_points: int | None = DIAGNOSIS_POINTS) -> list[Result]:
     """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording."""
     fam = load_design(design_dir)
+    if diagnosis_points is not None and diagnosis_points < 0:
+        raise FlannError(f"--diagnosis-points {diagnosis_points}: must be >= 0 (0 = every point)")
+    if sensor_toml is not None:  # a bad sensor file stops the batch before it starts
+        _sensor(str(sensor_toml))
     dhash = design_hash(design_dir)
     out_dir = Path(out_dir)
     paths = [Path(p) for p in paths]
@@ -219,14 +274,14 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     todo = []
     for i, p in enumerate(paths):
         if p.stem in seen:  # two files would write the same folder
-            results[i] = Result(sensor=p.stem, recording=str(p),
-                                reason=f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
+            results[i] = Result(sensor=p.stem, recording=str(p))
+            results[i].fail(f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
         else:
             seen[p.stem] = i
             todo.append(i)
     t0 = time.monotonic()
     failed = sum(1 for r in results.values() if r.status != "ok")
-    args = (out_dir, fam, dhash, sensor_toml, max_error_mm)
+    args = (out_dir, fam, dhash, sensor_toml, max_error_mm, diagnosis_points)
     if jobs == 1 or len(todo) == 1:
         for i in todo:
             results[i] = calibrate_one(paths[i], *args)
@@ -234,6 +289,8 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
             if progress:
                 _progress(len(results), len(paths), failed, t0)
     else:
+        from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
+
         with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), initializer=_worker_init) as pool:
             futs = {pool.submit(calibrate_one, paths[i], *args): i for i in todo}
             for fut in as_completed(futs):
@@ -259,4 +316,4 @@ def write_summary(path, results) -> None:
 
 
 __all__ = ["calibrate_batch", "calibrate_one", "check_sensor", "train_for_design", "physical_limit_mm",
-           "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES"]
+           "diagnosis_sample", "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES", "DIAGNOSIS_POINTS"]

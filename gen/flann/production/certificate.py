@@ -1,56 +1,18 @@
-"""The calibration certificate: one self-contained HTML file per sensor (plots as base64 PNG).
+"""The calibration certificate: one self-contained HTML file per sensor (the plot inline SVG).
 
 Every figure and value is computed here; the template only places text (values escaped).
 """
 
 from __future__ import annotations
 
-import base64
-import io
-
-import numpy as np
-
 from .. import __version__
 from ..textgen import template
+from .plot import error_plot_svg
 
 TEMPLATE = "production/templates/certificate.html.j2"
 
 
-def _png(fig) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=96)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
-
-
-def error_plot(chk: dict, sensor: str) -> str:
-    """Raw (least-squares line) and compensated (hardware twin) error vs displacement, with the limit."""
-    import matplotlib  # lazy: only when certificates are written
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    x = np.asarray(chk["rec"].displacement_mm, dtype=float)
-    o = np.argsort(x, kind="stable")
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 5.6), sharex=True)
-    a1.plot(x[o], chk["raw_err_mm"][o], lw=0.8, color="C3")
-    a1.set_ylabel("raw error (mm)")
-    a1.set_title(f"{sensor}: raw sensor (its least-squares line)", fontsize=10)
-    a2.plot(x[o], chk["hw_err_mm"][o], lw=0.8, color="C0", label="compensated (hardware twin)")
-    lim = chk["limit_mm"][o]
-    a2.plot(x[o], lim, ls=":", color="k", lw=1, label="physical limit (half LSB / slope)")
-    a2.plot(x[o], -lim, ls=":", color="k", lw=1)
-    a2.set_ylabel("compensated error (mm)")
-    a2.set_xlabel("displacement (mm)")
-    a2.legend(loc="best", fontsize=8)
-    a2.set_title("compensated by the FPGA design (bit-true twin)", fontsize=10)
-    fig.tight_layout()
-    try:
-        return _png(fig)
-    finally:
-        plt.close(fig)
-
-
-def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings) -> str:
+def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings, basis: str) -> str:
     s, spec = fam.spec, chk["spec"]
     figures = [
         ("Measured figures", [
@@ -79,10 +41,10 @@ def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings) ->
         ]),
     ]
     return template(TEMPLATE).render(
-        sensor=res.sensor, plot=error_plot(chk, res.sensor), tables=figures,
+        sensor=res.sensor, plot=error_plot_svg(chk, res.sensor), tables=figures, diagnosis_basis=basis,
         findings=list(findings) or ["no missing physics found"], warnings=res.warnings,
         verdict=f"max error {res.max_error_mm:.4g} mm = {res.ratio_to_limit:.3g} x the physical limit",
     )
 
 
-__all__ = ["render_certificate", "error_plot"]
+__all__ = ["render_certificate"]

@@ -4,11 +4,11 @@
 * ``weights.hex``: one word per line, ``DATA_BITS / 4`` hex digits, line k = address k, every
   address of the memory (``mem_depth`` lines); ``#`` lines are comments.  A loader writes
   line k at ``cfg_addr = k`` with ``cfg_we = 1``, one word per clock.
-* ``weights.mem``: Data2MEM's format: ``@ADDR`` (hex) then the words in hex, whitespace
-  separated.  The 32-bit word is split over two RAMB4_S16 (bits 31:16 and 15:0), which the
-  ``.bmm`` describes as one bus of two block RAMs.
-* ``weights.bmm``: the address space with placeholders for the two RAMB4 instance names
-  and their LOCs, to be filled from ISE's placement (``PLACED`` report or FPGA Editor); then
+* ``weights.mem``: Data2MEM's format: ``@ADDR`` (hex) then the block RAM's 16-bit words in
+  hex, whitespace separated, in block address order: the memory is one RAMB4_S16_S16 holding
+  word k as bits 15:0 at 2k and bits 31:16 at 2k + 1 (:func:`flann.hardware.family.spec.bram_image`).
+* ``weights.bmm``: that address space with placeholders for the RAMB4's instance name and
+  LOC, to be filled from ISE's placement (``PLACED`` report or FPGA Editor); then
   ``data2mem -bm weights.bmm -bd weights.mem -bt top.bit -o b new.bit`` writes a bitstream
   with this sensor's memory, without synthesis, place or route.
 """
@@ -16,9 +16,10 @@
 from __future__ import annotations
 
 from ..errors import FlannError
-from ..hardware.family.spec import DATA_BITS, FamilySpec
+from ..hardware.family.spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
+MEM_DIGITS = HALF_BITS // 4
 
 
 def hex_text(words, header: list[str] = ()) -> str:
@@ -44,27 +45,28 @@ def parse_hex(text: str, source: str = "<hex>") -> list[int]:
 
 
 def mem_text(words, header: list[str] = ()) -> str:
-    """Data2MEM .mem: word addresses of the 32-bit bus, 8 words a line."""
+    """Data2MEM .mem: the block RAM's 16-bit words from address 0, 8 a line."""
+    halves = bram_image(words)
     lines = [f"// {h}" for h in header] + ["@0000"]
-    for k in range(0, len(words), 8):
-        lines.append(" ".join(format(int(w), f"0{HEX_DIGITS}X") for w in words[k:k + 8]))
+    for k in range(0, len(halves), 8):
+        lines.append(" ".join(format(h, f"0{MEM_DIGITS}X") for h in halves[k:k + 8]))
     return "\n".join(lines) + "\n"
 
 
 def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     """Data2MEM block memory map of the weight memory (instance names and LOCs to fill in)."""
-    top = (fam.mem_depth * DATA_BITS // 8) - 1
+    top = (fam.mem_depth * DATA_BITS // 8) - 1  # bytes: 2 x mem_depth halves of 16 bits
     lines = [f"// {h}" for h in header] + [
-        "// Fill in the two RAMB4 instance paths and LOCs from ISE's placement of i_mem",
+        "// Fill in the RAMB4 instance path and LOC from ISE's placement of i_mem",
         "// (e.g. from the .ncd with FPGA Editor, or the PLACED lines of `data2mem -bm ... -bx`).",
+        f"// Word k of the memory map is bits {HALF_BITS - 1}:0 at 16-bit address 2k, bits {DATA_BITS - 1}:{HALF_BITS} at 2k + 1.",
         f"ADDRESS_SPACE flann_family_mem RAMB4 [0x00000000:0x{top:08X}]",
         "  BUS_BLOCK",
-        "    <INSTANCE_HI> [31:16] LOC = <LOC_HI>;",
-        "    <INSTANCE_LO> [15:0] LOC = <LOC_LO>;",
+        f"    <INSTANCE> [{HALF_BITS - 1}:0] LOC = <LOC>;",
         "  END_BUS_BLOCK;",
         "END_ADDRESS_SPACE;",
     ]
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["hex_text", "parse_hex", "mem_text", "bmm_text", "HEX_DIGITS"]
+__all__ = ["hex_text", "parse_hex", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]

@@ -21,7 +21,7 @@ from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..header import header
 from ..fixed import render as fixed
-from .spec import DATA_BITS, FamilySpec, family_from_dict
+from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict
 from .twin import FlannFamilyMem
 
 TOP = "flann_family_top"
@@ -39,26 +39,35 @@ ENTITIES = (
 )
 
 
-def _slices(fam: FamilySpec) -> dict:
-    """hi/lo bit of every normaliser field inside the fetched words (lowest address lowest)."""
-    out = {}
+def _fetch_plan(fam: FamilySpec) -> dict:
+    """What each parameter word is to flann_family_norm, where its products start, and the
+    last word of its first fetch (clamp range, k1, k0; the second is ka, kb)."""
+    kinds, starts = [], []
     for f in fam.fields[1:]:
-        lo = (f.addr - fam.param_base) * DATA_BITS
-        out[f"{f.name}_lo"], out[f"{f.name}_hi"] = lo, lo + f.bits - 1
-    return out
+        if f.name in ("clamp_lo", "clamp_hi"):
+            ks = [f"kd_{f.name}"]
+        elif f.name in ("k1", "ka"):
+            ks = ["kd_k_first"] + ["kd_k_next"] * (f.words - 1)
+        else:  # k0, kb: the offsets, loaded into the accumulator; the product follows
+            ks = ["kd_a_first"] + ["kd_a_next"] * (f.words - 1)
+        kinds += ks
+        starts += ["0"] * (len(ks) - 1) + ["1" if f.name in ("k0", "kb") else "0"]
+    k0 = next(f for f in fam.fields if f.name == "k0")
+    return dict(kinds=kinds, starts="".join(starts), last_first=k0.addr + k0.words - 1 - fam.param_base,
+                pidx_bits=max(1, fam.param_words.bit_length()))
 
 
 def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
     s = fam.spec
     base = fixed.contexts(s)
     words = FlannFamilyMem.encode(fam, s)
-    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits, init_name=init_name,
-               words=[bits_literal(w, DATA_BITS, False) for w in words])
+    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, half_bits=HALF_BITS, addr_bits=fam.addr_bits,
+               init_name=init_name, halves=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)])
     n = base["flann_norm"]
     norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
-                acc_v_bits=n["acc_v_bits"], acc_l_bits=n["acc_l_bits"], guard_v=n["guard_v"],
-                guard_l=n["guard_l"], cnt_bits=n["cnt_bits"], cnt_init=n["cnt_init"], data_bits=DATA_BITS,
-                prm_bits=fam.param_words * DATA_BITS, **_slices(fam))
+                acc_v_bits=n["acc_v_bits"], lin_width=n["acc_l_bits"], guard_v=n["guard_v"],
+                guard_l=n["guard_l"], cnt_bits=n["cnt_bits"], data_bits=DATA_BITS, width=fam.norm_width,
+                param_base=fam.param_base, **_fetch_plan(fam))
     mu = base["flann_multiplier"]
     step_bits = mu["step_bits"]
     if step_bits > fam.addr_bits:
@@ -70,8 +79,7 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
                 shift_bits=mu["shift_bits"], data_bits=DATA_BITS)
     t = base["flann_top"]
     top = dict(t, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
-               param_words=fam.param_words, param_base=fam.param_base, step_bits=step_bits,
-               fcnt_bits=max(1, fam.param_words.bit_length()))
+               param_base=fam.param_base, step_bits=step_bits, pidx_bits=max(1, fam.param_words.bit_length()))
     return {"flann_family_mem": mem, "flann_family_norm": norm, "flann_expansion": base["flann_expansion"],
             "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_family_top": top}
 

@@ -31,10 +31,21 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
-from ..fixed.spec import Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
+from ..fixed.spec import BRAM_BITS, Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
 
-DATA_BITS = 32  # two RAMB4_S16 side by side (Spartan-II block RAM: 256 x 16 each)
-MEM_DEPTH_MAX = 256
+DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
+# The memory is one Spartan-II block RAM (RAMB4_S16_S16, 256 x 16): word k is held as two
+# halves, bits 15:0 at block address 2k and bits 31:16 at 2k + 1, read through its two ports
+# at once.  One block instead of two side by side leaves a block for the sin/cos tables.
+HALF_BITS = 16
+BRAM_HALVES = 256
+MEM_DEPTH_MAX = BRAM_HALVES * HALF_BITS // DATA_BITS
+
+
+def bram_image(words) -> list[int]:
+    """The block RAM's contents for memory words: (bits 15:0, bits 31:16) of each word in turn."""
+    mask = (1 << HALF_BITS) - 1
+    return [h for w in words for h in (int(w) & mask, (int(w) >> HALF_BITS) & mask)]
 DEFAULT_MARGIN = 0.5
 # the forced generator options every member is derived with (stored in the manifest)
 FORCED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "phase_bits", "table_addr_bits",
@@ -52,7 +63,9 @@ def _words(bits: int) -> int:
 
 @dataclass(frozen=True)
 class Field:
-    """One per-sensor value in the weight memory: ``words`` words from ``addr``, LSW first."""
+    """One per-sensor value in the weight memory: ``words`` words from ``addr``, most significant
+    word first (sign-extended into the whole field), so the normaliser loads a field by shifting
+    each word in from the right."""
 
     name: str
     addr: int
@@ -92,14 +105,15 @@ class FamilySpec:
         out = [Field("weights", 0, s.steps, s.weight_fmt.width, True,
                      f"trig weight j = 0..{s.steps - 1} (model term j + 1), output LSB x 2^{s.weight_fmt.frac_bits}")]
         addr = s.steps
+        # in the order the normaliser consumes them: clamp, the linear product, then the phase
         for name, bits, signed, meaning in (
             ("clamp_lo", B, True, "lowest input code used (lower codes clamp, out_sat)"),
             ("clamp_hi", B, True, "highest input code used"),
+            ("k1", LW, True, f"linear weight per code w0 lsb/(scale q) x 2^{s.product_fmt.frac_bits + s.lin_guard}"),
+            ("k0", LW, True, f"bias + w0 b in accumulator units x 2^{s.lin_guard} + 2^{s.lin_guard - 1} (rounding)"),
             ("ka", NV, False, f"phase per input code: (lsb / input_scale) x 2^{s.phase_bits - 1 + s.norm_guard}, mod 2^{NV}"),
             ("kb", NV, False, f"phase offset -input_offset/input_scale x 2^{s.phase_bits - 1 + s.norm_guard} "
                               f"+ 2^{s.norm_guard - 1} (rounding), mod 2^{NV}"),
-            ("k1", LW, True, f"linear weight per code w0 lsb/(scale q) x 2^{s.product_fmt.frac_bits + s.lin_guard}"),
-            ("k0", LW, True, f"bias + w0 b in accumulator units x 2^{s.lin_guard} + 2^{s.lin_guard - 1} (rounding)"),
         ):
             out.append(Field(name, addr, _words(bits), bits, signed, meaning))
             addr += _words(bits)
@@ -126,9 +140,22 @@ class FamilySpec:
         return 1 << self.addr_bits
 
     @property
+    def norm_width(self) -> int:
+        """Width of the normaliser's shared constant register and accumulator (both products)."""
+        return max(self.norm_bits, self.spec.lin_width)
+
+    @property
+    def norm_latency(self) -> int:
+        """flann_family_norm, accepting edge to out_valid: one cycle per parameter word, one to
+        read the first word of each of its two fetches, ``input_bits`` per product."""
+        return self.param_words + 2 + 2 * self.spec.input_bits
+
+    @property
     def latency_cycles(self) -> int:
-        """The fixed datapath's latency plus the parameter fetch (one word per cycle) and hand-over."""
-        return self.spec.latency_cycles + self.param_words + 2
+        """The fixed datapath's latency with flann_norm's ``input_bits + 1`` cycles replaced by
+        flann_family_norm's."""
+        s = self.spec
+        return s.latency_cycles - (s.input_bits + 1) + self.norm_latency
 
     @property
     def cycles_per_sample(self) -> int:
@@ -145,7 +172,7 @@ class FamilySpec:
                        "product_bits": s.product_fmt.width, "acc_bits": s.acc_fmt.width,
                        "term_bound": s.term_bound},
             "memory": {"data_bits": DATA_BITS, "addr_bits": self.addr_bits, "depth": self.mem_depth,
-                       "used_words": self.used_words, "word_order": "least significant word first",
+                       "used_words": self.used_words, "word_order": "most significant word first",
                        "fields": [f.to_dict() for f in self.fields]},
             "formats": {"input_code": f"sint<{s.input_bits}> x {s.input_lsb_v} V",
                         "output_code": f"sint<{s.out_fmt.width}> x {s.output_lsb_mm} mm",
@@ -271,7 +298,10 @@ def _envelope(s: Spec, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt) -> 
     adv = -(-weight_fmt.width // K) + 1
     fam = replace(fam, adv_period=adv)
     analysis = dict(s.analysis)
-    analysis["estimate"] = estimate_resources(fam)
+    est = estimate_resources(fam)
+    # the weights live in the weight memory (one block RAM), not in a ROM
+    rom = math.ceil(s.steps * weight_fmt.width / BRAM_BITS) if s.steps * weight_fmt.width > 2048 else 0
+    analysis["estimate"] = {**est, "brams": est["brams"] - rom + 1}
     return replace(fam, analysis=analysis)
 
 
@@ -281,7 +311,8 @@ def _check_memory(fam: FamilySpec) -> None:
         raise SpecError(f"weights need {s.weight_fmt.width} bits, the memory word has {DATA_BITS}: "
                         "use fewer --weight-frac-bits or a smaller margin")
     if fam.used_words > MEM_DEPTH_MAX:
-        raise SpecError(f"{fam.used_words} memory words needed, two RAMB4_S16 hold {MEM_DEPTH_MAX}: fewer terms")
+        raise SpecError(f"{fam.used_words} memory words needed, one RAMB4 holds {MEM_DEPTH_MAX} of {DATA_BITS} "
+                        "bits: fewer terms")
 
 
 def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
@@ -340,4 +371,4 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
 
 
 __all__ = ["FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
-           "DATA_BITS", "DEFAULT_MARGIN", "FORCED"]
+           "bram_image", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED"]

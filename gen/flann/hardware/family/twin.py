@@ -22,16 +22,17 @@ from .spec import DATA_BITS, FamilySpec
 
 
 def _to_words(value: int, bits: int, words: int) -> list[int]:
+    """A field's words, most significant first; a negative value is sign-extended into them."""
     v = int(value) & ((1 << bits) - 1)
-    if value < 0:  # sign-extend into the whole field
+    if value < 0:
         v = int(value) & ((1 << (words * DATA_BITS)) - 1)
-    return [(v >> (DATA_BITS * k)) & ((1 << DATA_BITS) - 1) for k in range(words)]
+    return [(v >> (DATA_BITS * k)) & ((1 << DATA_BITS) - 1) for k in reversed(range(words))]
 
 
 def _from_words(ws, bits: int, signed: bool) -> int:
     v = 0
-    for k, w in enumerate(ws):
-        v |= (int(w) & ((1 << DATA_BITS) - 1)) << (DATA_BITS * k)
+    for w in ws:
+        v = (v << DATA_BITS) | (int(w) & ((1 << DATA_BITS) - 1))
     v &= (1 << bits) - 1
     if signed and v >= 1 << (bits - 1):
         v -= 1 << bits
@@ -97,11 +98,12 @@ class FlannFamilyMem:
 
 
 class FlannFamilyNorm(FlannNorm):
-    """flann_family_norm: the fixed normaliser with its constants fetched from the memory."""
+    """flann_family_norm: the fixed normaliser's integers, its constants read from the memory
+    (modulo arithmetic in a shared register: the same results, bit for bit)."""
 
     def __init__(self, fam: FamilySpec, mem: FlannFamilyMem):
         super().__init__(mem.spec())
-        self.fetch_cycles = fam.param_words + 2
+        self.latency = fam.norm_latency
 
 
 class FlannFamilyMultiplier(FlannMultiplier):

@@ -130,9 +130,14 @@ async def family_write_mid_sample(dut):
     await bench.load(a_words)
     s = bench.fam.spec
     lat = bench.fam.latency_cycles
-    fetch = bench.fam.param_words
-    points = sorted({1, 2, fetch, fetch + 2, fetch + s.input_bits, lat // 2, lat - 2, lat - 1,
-                     bench.rng.randint(1, lat - 1)})
+    # every phase of flann_family_norm (first fetch, first product, second fetch, second
+    # product, hand-over), then the expansion / multiplier / adder pipeline
+    fam, B = bench.fam, s.input_bits
+    k0 = next(f for f in fam.fields if f.name == "k0")
+    first = k0.addr + k0.words - fam.param_base  # words of the first fetch (clamps, k1, k0)
+    norm_end = fam.norm_latency
+    points = sorted({1, 2, first, first + 2 + B // 2, first + 2 + B + 1, norm_end - B // 2, norm_end - 1,
+                     norm_end, lat // 2, lat - 2, lat - 1, bench.rng.randint(1, lat - 1)})
     addrs = list(range(len(b_words)))
     for k in points:
         dut.in_data.value = bench.rng.randint(s.code_min, s.code_max)

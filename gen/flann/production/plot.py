@@ -1,0 +1,118 @@
+"""The certificate's error plot as inline SVG (drawn directly: a certificate costs milliseconds,
+not the ~0.15-0.25 s of a matplotlib figure, which was a quarter of a sensor's budget).
+
+Two panels sharing the displacement axis: the raw sensor's error (its least-squares line)
+and the compensated error (the hardware twin) with the physical limit as +-dotted lines.
+Every coordinate, tick and label is computed here; the template only places them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..textgen import template
+
+TEMPLATE = "production/templates/error_plot.svg.j2"
+WIDTH, PANEL_H = 720, 250          # px
+LEFT, RIGHT, TOP, GAP, BOTTOM = 78, 16, 30, 48, 46
+COLOURS = {"raw": "#c0392b", "hw": "#1f5fa8", "limit": "#222222"}
+
+
+@dataclass(frozen=True)
+class Series:
+    points: str        # "x,y x,y ..." in px
+    colour: str
+    dash: str          # "" = solid
+    width: float
+
+
+@dataclass(frozen=True)
+class Tick:
+    pos: float         # px along its axis
+    label: str
+
+
+@dataclass(frozen=True)
+class Panel:
+    top: float
+    height: float
+    title: str
+    ylabel: str
+    series: tuple
+    yticks: tuple
+    zero: float | None  # px of y = 0 when inside the panel
+
+
+def nice_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
+    """About n round values covering [lo, hi] (1, 2, 5 x 10^k steps)."""
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+        span = abs(lo) or 1.0
+        lo, hi = lo - span / 2, hi + span / 2
+    raw = (hi - lo) / max(1, n)
+    mag = 10 ** math.floor(math.log10(raw))
+    step = next(m * mag for m in (1, 2, 5, 10) if m * mag >= raw)
+    first = math.floor(lo / step + 1e-9) * step
+    ticks, t = [], first
+    while t <= hi + step * 1e-6:
+        ticks.append(round(t / step) * step)
+        t += step
+    if ticks[-1] < hi - step * 1e-6:
+        ticks.append(ticks[-1] + step)
+    return ticks
+
+
+def _label(v: float, step: float) -> str:
+    digits = max(0, -int(math.floor(math.log10(step))) if step > 0 else 0)
+    return f"{v:.{digits}f}" if v != 0 else "0"
+
+
+def _scale(lo: float, hi: float, p0: float, p1: float):
+    k = (p1 - p0) / (hi - lo)
+    return lambda v: p0 + (np.asarray(v, dtype=float) - lo) * k
+
+
+def _points(px: np.ndarray, py: np.ndarray) -> str:
+    return " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px, py))
+
+
+def _panel(top: float, title: str, ylabel: str, x, lines, sx) -> Panel:
+    """lines: (values, colour, dash, width); the y range covers them all (and 0)."""
+    ys = np.concatenate([np.asarray(v, float) for v, *_ in lines] + [np.zeros(1)])
+    yt = nice_ticks(float(np.min(ys)), float(np.max(ys)))
+    sy = _scale(yt[0], yt[-1], top + PANEL_H, top)
+    step = yt[1] - yt[0] if len(yt) > 1 else 1.0
+    series = tuple(Series(_points(sx(x), sy(v)), c, d, w) for v, c, d, w in lines)
+    z = float(sy(0.0))
+    return Panel(top, PANEL_H, title, ylabel, series,
+                 tuple(Tick(float(sy(t)), _label(t, step)) for t in yt),
+                 z if yt[0] < 0 < yt[-1] else None)
+
+
+def error_plot_svg(chk: dict, sensor: str) -> str:
+    """Raw and compensated error vs displacement (mm), with the physical limit, as an <svg>."""
+    x = np.asarray(chk["rec"].displacement_mm, dtype=float)
+    o = np.argsort(x, kind="stable")
+    x = x[o]
+    xt = nice_ticks(float(x[0]), float(x[-1]), 8)
+    sx = _scale(xt[0], xt[-1], LEFT, WIDTH - RIGHT)
+    lim = np.asarray(chk["limit_mm"], float)[o]
+    raw = _panel(TOP, f"{sensor}: raw sensor (error from its least-squares line)", "raw error (mm)", x,
+                 [(chk["raw_err_mm"][o], COLOURS["raw"], "", 1.0)], sx)
+    hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design (bit-true twin)", "compensated error (mm)", x,
+                [(chk["hw_err_mm"][o], COLOURS["hw"], "", 1.0), (lim, COLOURS["limit"], "3,3", 1.2),
+                 (-lim, COLOURS["limit"], "3,3", 1.2)], sx)
+    xstep = xt[1] - xt[0] if len(xt) > 1 else 1.0
+    height = TOP + 2 * PANEL_H + GAP + BOTTOM
+    return template(TEMPLATE).render(
+        width=WIDTH, height=height, left=LEFT, right=WIDTH - RIGHT, panels=(raw, hw),
+        xticks=[Tick(float(sx(t)), _label(t, xstep)) for t in xt], xlabel="displacement (mm)",
+        legend=[("compensated (hardware twin)", COLOURS["hw"], ""),
+                ("physical limit (half an input LSB / slope)", COLOURS["limit"], "3,3")],
+        legend_y=TOP + PANEL_H + GAP + 14,
+    )
+
+
+__all__ = ["error_plot_svg", "nice_ticks"]
