@@ -84,6 +84,30 @@ def test_24_bit_adc_drops_low_bits_and_says_what_it_costs(tmp_path, capsys, mode
     steepest_mm_per_v = 1 / (0.45 - 0.0015 * 100)
     said = float(err.split("adding up to ")[1].split(" mm")[0])
     assert said == pytest.approx(0.5 * lsb24 * 256 * steepest_mm_per_v, rel=0.02)
+    # the manifest keeps the converter; eval --design quantises with it and takes its top bits
+    assert man["adc_bits"] == 24 and man["adc_lsb_v"] == pytest.approx(lsb24)
+    rc, out, err = run(["eval", model, sensor_csv(tmp_path / "held.csv", n=57), "--design", tmp_path / "hdl",
+                        "--json"], capsys)
+    assert rc == 0, err
+    hw = json.loads(out)["hardware"]
+    assert (hw["adc_bits"], hw["input_bits"], hw["dropped_low_bits"]) == (24, 16, 8)
+    # the physical limit is the 24-bit converter's, not the design's coarser input
+    assert hw["physical_limit_mm"]["max"] == pytest.approx(0.5 * lsb24 * steepest_mm_per_v, rel=0.05)
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_dropped_low_bits_are_not_wired():
+    from flann.hardware.accuracy import adc_codes
+    from flann.hardware.fixed.spec import derive_spec
+
+    m = FlannModel(weights=(2.0, 0.1, 0.0), input_offset_v=0.0, input_scale_v=4.0, voltage_range_v=(-4.0, 4.0),
+                   displacement_range_mm=(-10.0, 10.0))
+    lsb24 = 10.0 / 2**24
+    spec = derive_spec(m, input_bits=16, input_lsb_v=lsb24 * 256)
+    # 1.0 V is 1677721.6 LSB24 -> code 1677722; its top 16 bits are 1677722 >> 8 = 6553 (6553.6 rounded
+    # to the design's LSB would be 6554); -1.0 V: -1677722 >> 8 = -6554 (a floor, not towards zero)
+    assert adc_codes(spec, [1.0, -1.0], (24, lsb24)).tolist() == [6553, -6554]
+    assert adc_codes(spec, [1.0, -1.0]).tolist() == [6554, -6554]
 
 
 def test_pathological_model_one_line_with_cause(tmp_path, capsys):
