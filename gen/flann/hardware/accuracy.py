@@ -37,7 +37,9 @@ def fixed_point_cost(model: FlannModel) -> dict:
     ``cost`` is the estimated LUT4 count + the weight ROM in LUT4 equivalents (16 bits each)
     + 64 per block RAM: it grows with the weights' dynamic range (weight and term widths)
     and with the number of terms.  ``buildable`` is False when ``flann gen`` would refuse the
-    model at 16 or at 12 input bits (the reason is in ``why``).
+    model at 16 or at 12 input bits, or when the widths it allows cannot hold the hardware
+    within one output LSB of the float model (capped table or term widths: the model's
+    accuracy would be lost in the datapath); the reason is in ``why``.
     """
     spec = None
     for bits in COST_BITS:
@@ -47,6 +49,10 @@ def fixed_point_cost(model: FlannModel) -> dict:
                 spec = derive_spec(model, input_bits=bits)
         except SpecError as exc:
             return {"buildable": False, "why": f"{bits}-bit input: {exc}", "cost": math.inf}
+        if not spec.analysis["guaranteed_1lsb"]:
+            return {"buildable": False, "cost": math.inf,
+                    "why": f"{bits}-bit input: the default widths bound |hardware - float model| by "
+                           f"{spec.analysis['bound_total_lsb']:.3g} output LSB (> 1)"}
     est = spec.analysis["estimate"]
     rom_luts = math.ceil(spec.steps * spec.weight_fmt.width / 16)
     return {"buildable": True, "why": "",
