@@ -29,6 +29,7 @@ from .fixed.spec import Spec, derive_spec
 from .fixed.twin import FlannTop
 
 COST_BITS = (MAX_DESIGN_INPUT_BITS, 12)   # a model must build at the default and the widest ADC
+MAX_BOUND_LSB = 1.0   # worst-case |hardware - float model| at the default widths, output LSB
 
 
 def fixed_point_cost(model: FlannModel) -> dict:
@@ -49,10 +50,10 @@ def fixed_point_cost(model: FlannModel) -> dict:
                 spec = derive_spec(model, input_bits=bits)
         except SpecError as exc:
             return {"buildable": False, "why": f"{bits}-bit input: {exc}", "cost": math.inf}
-        if not spec.analysis["guaranteed_1lsb"]:
+        if spec.analysis["bound_total_lsb"] > MAX_BOUND_LSB:
             return {"buildable": False, "cost": math.inf,
                     "why": f"{bits}-bit input: the default widths bound |hardware - float model| by "
-                           f"{spec.analysis['bound_total_lsb']:.3g} output LSB (> 1)"}
+                           f"{spec.analysis['bound_total_lsb']:.3g} output LSB (> {MAX_BOUND_LSB:g})"}
     est = spec.analysis["estimate"]
     rom_luts = math.ceil(spec.steps * spec.weight_fmt.width / 16)
     return {"buildable": True, "why": "",
