@@ -131,3 +131,32 @@ def test_model_whose_output_leaves_its_range_is_refused(tmp_path, capsys):
     m.save(p)
     rc, _, err = run(["gen", p, "-o", tmp_path / "hdl"], capsys)
     assert rc == 2 and "not a usable model" in one_error_line(err)
+
+
+def _steep_ended_model(ridge):
+    """A sensor written here (saturating S-curve, 16-bit noise), 41 terms, half normalisation."""
+    from flann.golden.train import fit_lstsq
+
+    x = np.linspace(-2, 2, 261)
+    xs = np.concatenate([x, x[::-1]])
+    u = xs / 1.16
+    v = 5.7 * u / (1 + np.abs(u) ** 3.75) ** (1 / 3.75) + np.random.default_rng(3).normal(0, 3e-4, xs.size)
+    return fit_lstsq(v, xs, 41, norm="half", ridge=ridge, training={"cv_heldout_rms_error_mm": 4e-4})
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_a_model_whose_datapath_misses_the_float_model_is_not_buildable_for_auto():
+    from flann.hardware.accuracy import fixed_point_cost
+    from flann.hardware.fixed.spec import derive_spec
+    from flann.hardware.fixed.twin import FlannTop
+
+    loose, tight = _steep_ended_model(1e-14), _steep_ended_model(1e-8)
+    # the loose model builds, but its capped widths let the hardware leave the float model
+    spec = derive_spec(loose, input_bits=16)
+    codes = np.arange(spec.clamp_lo, spec.clamp_hi + 1)
+    out, _ = FlannTop(spec).process(codes)
+    miss = np.max(np.abs(out * spec.output_lsb_mm - spec.float_reference(codes))) / spec.output_lsb_mm
+    assert miss > 1.5, miss
+    cost = fixed_point_cost(loose)
+    assert not cost["buildable"] and "output LSB (> 1)" in cost["why"]
+    assert fixed_point_cost(tight)["buildable"]
