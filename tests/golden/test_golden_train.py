@@ -122,7 +122,7 @@ def test_auto_held_out_error_is_honest_on_new_points():
 
 def _cv(name, errors):
     e = np.asarray(errors, dtype=float)
-    return CvResult(len(name), name, 0.0, float(np.sqrt(np.mean(e**2))), float(np.max(np.abs(e))), 0.0, e)
+    return CvResult(len(name), name, 0.0, float(np.sqrt(np.mean(e**2))), float(np.max(np.abs(e))), e)
 
 
 def test_as_good_compares_on_the_same_held_out_points_by_hand():
