@@ -80,10 +80,35 @@ def test_24_bit_adc_drops_low_bits_and_says_what_it_costs(tmp_path, capsys, mode
     man = json.loads(out)
     assert man["input_bits"] == 16 and man["input_lsb_v"] == pytest.approx(lsb24 * 256)
     assert "drops 8 low bits" in err and "bits 23..8" in err
-    # the stated cost: half the new LSB over the steepest slope (0.45 - 0.0015 x^2 V/mm at 10 mm)
+    # the stated cost: the dropped bits floor the code, so up to one new LSB over the steepest
+    # slope (0.45 - 0.0015 x^2 V/mm at 10 mm)
     steepest_mm_per_v = 1 / (0.45 - 0.0015 * 100)
     said = float(err.split("adding up to ")[1].split(" mm")[0])
-    assert said == pytest.approx(0.5 * lsb24 * 256 * steepest_mm_per_v, rel=0.02)
+    assert said == pytest.approx(lsb24 * 256 * steepest_mm_per_v, rel=0.02)
+    # the manifest keeps the converter; eval --design quantises with it and takes its top bits
+    assert man["adc_bits"] == 24 and man["adc_lsb_v"] == pytest.approx(lsb24)
+    rc, out, err = run(["eval", model, sensor_csv(tmp_path / "held.csv", n=57), "--design", tmp_path / "hdl",
+                        "--json"], capsys)
+    assert rc == 0, err
+    hw = json.loads(out)["hardware"]
+    assert (hw["adc_bits"], hw["input_bits"], hw["dropped_low_bits"]) == (24, 16, 8)
+    # the physical limit is the 24-bit converter's, not the design's coarser input
+    assert hw["physical_limit_mm"]["max"] == pytest.approx(0.5 * lsb24 * steepest_mm_per_v, rel=0.05)
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_dropped_low_bits_are_not_wired():
+    from flann.hardware.accuracy import adc_codes
+    from flann.hardware.fixed.spec import derive_spec
+
+    m = FlannModel(weights=(2.0, 0.1, 0.0), input_offset_v=0.0, input_scale_v=4.0, voltage_range_v=(-4.0, 4.0),
+                   displacement_range_mm=(-10.0, 10.0))
+    lsb24 = 10.0 / 2**24
+    spec = derive_spec(m, input_bits=16, input_lsb_v=lsb24 * 256)
+    # 1.0 V is 1677721.6 LSB24 -> code 1677722; its top 16 bits are 1677722 >> 8 = 6553 (6553.6 rounded
+    # to the design's LSB would be 6554); -1.0 V: -1677722 >> 8 = -6554 (a floor, not towards zero)
+    assert adc_codes(spec, [1.0, -1.0], (24, lsb24)).tolist() == [6553, -6554]
+    assert adc_codes(spec, [1.0, -1.0]).tolist() == [6554, -6554]
 
 
 def test_pathological_model_one_line_with_cause(tmp_path, capsys):
@@ -107,3 +132,32 @@ def test_model_whose_output_leaves_its_range_is_refused(tmp_path, capsys):
     m.save(p)
     rc, _, err = run(["gen", p, "-o", tmp_path / "hdl"], capsys)
     assert rc == 2 and "not a usable model" in one_error_line(err)
+
+
+def _steep_ended_model(ridge):
+    """A sensor written here (saturating S-curve, 16-bit noise), 41 terms, half normalisation."""
+    from flann.golden.train import fit_lstsq
+
+    x = np.linspace(-2, 2, 261)
+    xs = np.concatenate([x, x[::-1]])
+    u = xs / 1.16
+    v = 5.7 * u / (1 + np.abs(u) ** 3.75) ** (1 / 3.75) + np.random.default_rng(3).normal(0, 3e-4, xs.size)
+    return fit_lstsq(v, xs, 41, norm="half", ridge=ridge, training={"cv_heldout_rms_error_mm": 4e-4})
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_a_model_whose_datapath_misses_the_float_model_is_not_buildable_for_auto():
+    from flann.hardware.accuracy import fixed_point_cost
+    from flann.hardware.fixed.spec import derive_spec
+    from flann.hardware.fixed.twin import FlannTop
+
+    loose, tight = _steep_ended_model(1e-14), _steep_ended_model(1e-8)
+    # the loose model builds, but its capped widths let the hardware leave the float model
+    spec = derive_spec(loose, input_bits=16)
+    codes = np.arange(spec.clamp_lo, spec.clamp_hi + 1)
+    out, _ = FlannTop(spec).process(codes)
+    miss = np.max(np.abs(out * spec.output_lsb_mm - spec.float_reference(codes))) / spec.output_lsb_mm
+    assert miss > 1.5, miss
+    cost = fixed_point_cost(loose)
+    assert not cost["buildable"] and "output LSB (> 1)" in cost["why"]
+    assert fixed_point_cost(tight)["buildable"]

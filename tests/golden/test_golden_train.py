@@ -7,7 +7,8 @@ import pytest
 
 from flann.errors import FlannError, RecordingsError
 from flann.golden.paper import s_curve
-from flann.golden.train import (design_matrix, check_fit_input, cv_folds, fit_auto, fit_lms, fit_lstsq,
+from flann.golden.train import (CvResult, as_good, design_matrix, check_fit_input, cv_folds, fit_auto,
+                                fit_lms, fit_lstsq,
                          lms_epochs, lms_leave_one_out, lms_sequential,
                          normalisation)
 
@@ -117,6 +118,23 @@ def test_auto_held_out_error_is_honest_on_new_points():
     x_new = np.linspace(-29.75, 29.75, 120)
     rms_new = np.sqrt(np.mean((model.predict(s_curve(x_new, 1e-3, seed=6)) - x_new) ** 2))
     assert 0.33 * choice.rms_mm < rms_new < 3.0 * choice.rms_mm
+
+
+def _cv(name, errors):
+    e = np.asarray(errors, dtype=float)
+    return CvResult(len(name), name, 0.0, float(np.sqrt(np.mean(e**2))), float(np.max(np.abs(e))), e)
+
+
+def test_as_good_compares_on_the_same_held_out_points_by_hand():
+    ref = _cv("r", [1.0, -1.0, 2.0, -2.0])                 # squared: 1 1 4 4
+    worse = _cv("w", [1.1, -1.1, 2.1, -2.1])               # d = .21 .21 .41 .41: mean .31, se .0577
+    same = _cv("s", [-1.0, 1.0, -2.0, 2.0])                # d = 0
+    noisy = _cv("n", [1.2, -0.8, 2.0, -2.0])               # d = .44 -.36 0 0: mean .02, se .1684
+    got = as_good([ref, worse, same, noisy], ref, z=0.5)
+    assert got == [ref, same, noisy]
+    # a candidate better on every point is always kept; a worse one only with a wide enough z
+    assert as_good([_cv("b", [0.5, 0.5, 1.0, 1.0])], ref, z=0.0) != []
+    assert as_good([worse], ref, z=5.3) == [] and as_good([worse], ref, z=5.4) == [worse]
 
 
 def test_training_is_deterministic():

@@ -12,7 +12,7 @@ from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_rep
                        raw_output_mm)
 from ..errors import FlannError
 from ..golden.model import load_model
-from ..hardware.accuracy import design_spec, hardware_accuracy, plot_errors
+from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
 from ..recordings import read_recordings
 from .predict import predict_clamped, warn_outside_range
 
@@ -66,7 +66,8 @@ def run(args) -> int:
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     if args.design:
         spec = design_spec(args.model, args.design)
-        hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"])
+        hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
+                               adc=design_adc(args.design))
         pts = hw.pop("_points")
         res["hardware"] = hw
         if args.plot:
@@ -97,7 +98,9 @@ def run(args) -> int:
               f"{fmt.format(res['raw'][key]):>16s}" + (f"{fmt.format(hw[key]):>12s}" if hw else ""))
     if hw:
         lim = hw["physical_limit_mm"]
-        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V, output LSB "
+        dropped = (f" (a {hw['adc_bits']}-bit ADC x {hw['adc_lsb_v']:g} V, {hw['dropped_low_bits']} low bits "
+                   "dropped)" if hw["dropped_low_bits"] else "")
+        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}, output LSB "
               f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; "
               f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "

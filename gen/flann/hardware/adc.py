@@ -100,8 +100,9 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
         notes.append(
             f"{bits}-bit ADC: the design takes its top {eff_bits} bits (drops {dropped} low bits; "
             f"wire the ADC's bits {bits - 1}..{dropped} to in_data): input LSB {lsb:.4g} -> "
-            f"{eff_lsb:.4g} V, adding up to {0.5 * eff_lsb * slope:.3g} mm of quantisation error "
-            f"at the steepest point (was {0.5 * lsb * slope:.3g} mm)")
+            f"{eff_lsb:.4g} V, adding up to {eff_lsb * slope:.3g} mm of quantisation error "
+            f"at the steepest point (was {0.5 * lsb * slope:.3g} mm; unwired low bits floor the "
+            "code: up to one input LSB, half of it on average as an offset)")
     return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
 
 

@@ -15,9 +15,10 @@ from ...errors import SpecError
 from ...textgen import template
 from ...numeric.fixed import bits_literal
 from ...golden.model import FlannModel, load_model, model_sha256
+from ..adc import AdcPlan, plan_adc
 from ..header import header
 from ..manifest import MANIFEST, read_manifest, write_design
-from ..options import GenOptions
+from ..options import NAMES as OPTION_NAMES, GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
@@ -130,12 +131,16 @@ def render(spec: Spec) -> dict[str, str]:
     return out
 
 
-def manifest(spec: Spec, files: list[str]) -> dict:
+def manifest(spec: Spec, files: list[str], adc_plan: AdcPlan | None = None) -> dict:
+    """``adc_plan``: the converter as the user gave it (wider than the design when low bits
+    are dropped); without it the design's input is the converter."""
     return {
         "top": TOP,
         "files": list(files),
         "input_bits": spec.input_bits,
         "input_lsb_v": spec.input_lsb_v,
+        "adc_bits": adc_plan.adc_bits if adc_plan else spec.input_bits,
+        "adc_lsb_v": adc_plan.adc_lsb_v if adc_plan else spec.input_lsb_v,
         "output_bits": spec.out_fmt.width,
         "output_lsb_mm": spec.output_lsb_mm,
         "latency_cycles": spec.latency_cycles,
@@ -163,12 +168,13 @@ def generate(model_path_or_model, out_dir, options: GenOptions | None = None, **
     Returns the manifest dict.  Nothing is written if any step fails.
     """
     spec = load(model_path_or_model, options, **overrides)
-    return write(spec, out_dir)
+    o = GenOptions.of(options, **{k: v for k, v in overrides.items() if k in OPTION_NAMES})
+    return write(spec, out_dir, plan_adc(spec.model, o.input_bits, o.input_lsb_v, o.clamp))
 
 
-def write(spec: Spec, out_dir) -> dict:
+def write(spec: Spec, out_dir, adc_plan: AdcPlan | None = None) -> dict:
     texts = render(spec)
-    return write_design(texts, manifest(spec, list(texts)), out_dir)
+    return write_design(texts, manifest(spec, list(texts), adc_plan), out_dir)
 
 
 __all__ = ["generate", "write", "render", "contexts", "manifest", "load", "read_manifest", "TOP",
