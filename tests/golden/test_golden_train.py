@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from flann.errors import FlannError, RecordingsError
+from flann.golden.model import expand
 from flann.golden.paper import s_curve
 from flann.golden.train import (CvResult, as_good, design_matrix, check_fit_input, cv_folds, fit_auto,
                                 fit_lms, fit_lstsq,
@@ -146,3 +147,43 @@ def test_training_is_deterministic():
     assert fit_lms(v, x, 5, eta=0.01, epochs=5).to_json() == \
         fit_lms(v, x, 5, eta=0.01, epochs=5).to_json()
     json.loads(a)
+
+
+# -- many rows (a logger's file): bounded time and memory, same answer ------------------------
+def _by_hand_lstsq(v_n, x, terms, ridge):
+    """Reference: the full design solved at once (normal equations with the ridge on the weights)."""
+    A = np.hstack([np.ones((v_n.size, 1)), expand(v_n, terms)])
+    P = np.eye(terms + 1) * v_n.size * ridge
+    P[0, 0] = 0.0
+    return np.linalg.solve(A.T @ A + P, A.T @ x)
+
+
+def test_blockwise_lstsq_gives_the_full_solution(monkeypatch):
+    import flann.golden.train as train
+
+    monkeypatch.setattr(train, "LSTSQ_BLOCK_ROWS", 97)     # 1000 rows in 11 uneven blocks
+    rng = np.random.default_rng(3)
+    v = np.sort(rng.uniform(-2.0, 3.0, 1000))
+    x = 10 * np.tanh(v) + rng.normal(0, 0.01, v.size)
+    m = train.fit_lstsq(v, x, 7, norm="range", ridge=1e-6)
+    v_n = (v - 0.5 * (v.min() + v.max())) / (0.5 * (v.max() - v.min()))
+    ref = _by_hand_lstsq(v_n, x, 7, 1e-6)
+    np.testing.assert_allclose([m.bias, *m.weights], ref, rtol=0, atol=1e-8)
+    rms = np.sqrt(np.mean((m.predict(v) - x) ** 2))
+    assert m.training["train_rms_error_mm"] == pytest.approx(rms, rel=1e-9)
+
+
+def test_auto_on_many_rows_chooses_on_a_spread_subset_and_fits_all(monkeypatch):
+    import flann.golden.train as train
+
+    monkeypatch.setattr(train, "AUTO_MAX_CV_POINTS", 150)
+    x = np.linspace(-30.0, 30.0, 1201)
+    v = s_curve(x, 1e-3, seed=7)
+    model, choice = train.fit_auto(v, x, terms_list=(1, 3, 5, 9), ridges=(0.0, 1e-6))
+    assert model.training["cv_points"] == 150
+    assert model.training["points"] == 1201                    # the choice is fitted on every row
+    assert model.voltage_range_v == (v.min(), v.max())         # extremes kept: same normalisation
+    sub = train.cv_subset(v)
+    assert sub.size == 150 and v.argmin() in sub and v.argmax() in sub
+    gaps = np.diff(np.sort(v[sub]))
+    assert gaps.max() < 3 * gaps.mean()                        # spread over the voltage range

@@ -86,7 +86,9 @@ def run(args) -> int:
                                  cost=fixed_point_cost)
         t = model.training
         print(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-              f"held-out error (cross-validation, {t['cv_folds']} folds): "
+              f"held-out error (cross-validation, {t['cv_folds']} folds"
+              + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
+              + "): "
               f"RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
         if "traded" in t:
             print(f"auto: {t['selected_by']}: {t['traded']}", file=sys.stderr)
