@@ -38,8 +38,16 @@ def _load(name: str):
     return importlib.import_module(f"flann.commands.{name.replace('-', '_')}")
 
 
+class _Parser(argparse.ArgumentParser):
+    """Wrong flags and values are bad input like any other: one line, exit code 2 (the
+    usage block argparse prints would bury the message; it is one ``--help`` away)."""
+
+    def error(self, message: str):
+        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="flann", description="LVDT linearisation with a FLANN: model, VHDL, simulation, physics."
     )
     parser.add_argument("--version", action="version", version=f"flann {__version__}")
