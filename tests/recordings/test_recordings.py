@@ -1,5 +1,6 @@
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -153,3 +154,20 @@ def test_errors_name_the_file_line_not_the_data_row():
 def test_same_column_twice_under_two_names():
     with pytest.raises(RecordingsError, match="duplicate column"):
         parse_recordings("x_mm,displacement_mm,voltage_v\n1,1,2\n")
+
+
+def test_excel_sep_line_names_the_separator(tmp_path):
+    # Excel's "CSV (semicolon)" export can start with a sep= line before the header
+    p = tmp_path / "excel.csv"
+    p.write_bytes(b"sep=;\r\nPosition (mm);Voltage (V)\r\n-1,5;-0,25\r\n0;0\r\n1,5;0,5\r\n")
+    rec = read_recordings(p, announce=False)
+    np.testing.assert_allclose(rec.displacement_mm, [-1.5, 0.0, 1.5])
+    np.testing.assert_allclose(rec.voltage_v, [-0.25, 0.0, 0.5])
+    assert rec.line_of(0) == "line 3"
+
+
+def test_trailing_separator_is_not_an_unknown_column():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rec = parse_recordings("displacement_mm,voltage_v,\n0,0,\n1,0.5,\n2,1,\n")
+    np.testing.assert_allclose(rec.voltage_v, [0.0, 0.5, 1.0])

@@ -48,6 +48,7 @@ QUANTITIES: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
 _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
               re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"))
 SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma"}
+_EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
 
 
 def accepted_names() -> str:
@@ -144,7 +145,8 @@ def _header_map(header: list[str], required, source: str):
     for i, h in enumerate(header):
         hit = recognise_header(h)
         if hit is None:
-            unknown.append(h)
+            if h:   # an unnamed column (a trailing separator) holds nothing to warn about
+                unknown.append(h)
             continue
         col, factor = hit
         if col in found:
@@ -183,7 +185,12 @@ def parse_recordings(text: str, source: str = "<memory>",
         body.append((line_no, line))
     if not body:
         raise RecordingsError(f"{source}: no header line (expected columns {', '.join(REQUIRED)})")
-    sep = _sniff_separator(body[0][1])
+    excel_sep = _EXCEL_SEP.match(body[0][1])
+    if excel_sep:   # Excel's "sep=;" first line names the separator; it is not the header
+        body = body[1:]
+        if not body:
+            raise RecordingsError(f"{source}: no header line after '{excel_sep.group(0).strip()}'")
+    sep = excel_sep.group("sep") if excel_sep else _sniff_separator(body[0][1])
     header = [h.strip() for h in next(csv.reader([body[0][1]], delimiter=sep))]
     found, col_notes, unknown = _header_map(header, required, source)
     if unknown:
