@@ -130,3 +130,21 @@ def test_weight_rom_holds_every_weight_word_by_word(tmp_path):
         assert got == _f18_encode(w), f"ROM word {i}: {got:018b} != float18({w})"
     start = re.search(r'constant start_c\s*:.*:= "([01]{18})"', text).group(1)
     assert int(start, 2) == _f18_encode(m.bias + m.weights[0] * (-m.input_offset_v / m.input_scale_v))
+
+
+def test_float18_builds_a_straight_line_model():
+    # small trig weights ask for narrow terms; the code shares their converter, so they widen
+    import numpy as np
+
+    from flann.golden.model import FlannModel
+    from flann.hardware.float18.spec import F18Top, derive_f18_spec
+
+    line = FlannModel(weights=(-12.5,), bias=0.75, input_offset_v=0.1, input_scale_v=2.0,
+                      voltage_range_v=(-1.9, 2.1), displacement_range_mm=(-12.0, 13.0))
+    spec = derive_f18_spec(line)
+    top = F18Top(spec)
+    codes = top.all_codes()
+    v = np.clip(codes, spec.base.clamp_lo, spec.base.clamp_hi) * spec.base.input_lsb_v
+    by_hand = 0.75 - 12.5 * (v - 0.1) / 2.0
+    # float18 keeps 11 fraction bits: a few units of 2^-11 relative on a +-16 mm output
+    assert np.max(np.abs(top.out_mm(codes) - by_hand)) < 16.0 * 2.0 ** -11 * 4

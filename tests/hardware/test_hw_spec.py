@@ -178,3 +178,27 @@ def test_shorter_table_without_interpolation_costs_accuracy(model):
     e_coarse = FlannTop(coarse).error_vs_float()["max_err_lsb"]
     assert e_fine <= 1.0 < e_coarse
     assert coarse.analysis["bound_total_lsb"] > 1.0
+
+
+def test_a_straight_line_model_builds_and_gives_the_line():
+    # `flann train --terms 1` writes a line: no sin/cos term, so the datapath gets a zero one
+    line = FlannModel(weights=(-12.5,), bias=0.75, input_offset_v=0.1, input_scale_v=2.0,
+                      voltage_range_v=(-1.9, 2.1), displacement_range_mm=(-12.0, 13.0))
+    spec = derive_spec(line)
+    codes = np.arange(spec.code_min, spec.code_max + 1)
+    out = FlannTop(spec).process(codes).out_data
+    v = np.clip(codes, spec.clamp_lo, spec.clamp_hi) * spec.input_lsb_v   # clamped to the trained range
+    by_hand = 0.75 - 12.5 * (v - 0.1) / 2.0
+    assert np.max(np.abs(out * spec.output_lsb_mm - by_hand)) <= spec.output_lsb_mm
+
+
+def test_trig_weights_under_an_output_lsb_take_the_narrowest_widths():
+    # a nearly straight sensor: widths below their minimum are the minimum, not an error
+    m = FlannModel(weights=(10.0, 1e-7, -2e-7), bias=0.0, input_offset_v=0.0, input_scale_v=1.0,
+                   voltage_range_v=(-1.0, 1.0), displacement_range_mm=(-10.0, 10.0))
+    spec = derive_spec(m)
+    assert spec.phase_bits == 6 and spec.weight_fmt.width >= spec.mult_digit_bits
+    codes = np.arange(spec.code_min, spec.code_max + 1)
+    out = FlannTop(spec).process(codes).out_data
+    v = np.clip(codes, spec.clamp_lo, spec.clamp_hi) * spec.input_lsb_v
+    assert np.max(np.abs(out * spec.output_lsb_mm - 10.0 * v)) <= spec.output_lsb_mm

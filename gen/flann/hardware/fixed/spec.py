@@ -326,6 +326,10 @@ def derive_spec(
     if number_format != "fixed":
         raise SpecError(f"number format {number_format!r}: only 'fixed' is generated")
     part, _pkg, _speed = parse_device(device)
+    if model.terms < 2:
+        # A straight line (trained with --terms 1): the datapath has at least one sin/cos lane,
+        # so the line gets sin(pi v_n) with weight 0 -- the same output, bit for bit.
+        model = replace(model, weights=(*model.weights, 0.0))
     plan = adc.plan_adc(model, input_bits, input_lsb_v, clamp)  # ranges, units, wide ADCs
     for note in plan.notes:
         warnings.warn(note)
@@ -333,8 +337,6 @@ def derive_spec(
     L = _check_int("lanes", lanes, 1, max(1, model.terms - 1))
     if mult_style not in MULT_STYLES:
         raise SpecError(f"mult_style {mult_style!r}: must be one of {', '.join(MULT_STYLES)}")
-    if model.terms < 2:
-        raise SpecError("model has 1 term: at least one sin/cos term is needed (terms >= 2)")
 
     vlo, vhi = sorted(model.voltage_range_v)
     cmin, cmax = -(1 << (B - 1)), (1 << (B - 1)) - 1
@@ -397,7 +399,8 @@ def derive_spec(
     # phase: error per lookup <= m*(1/2 + 1/4) LSB_v (rounding of v, of ka) + 1/2 LSB (mid-sample bias)
     if phase_bits is None:
         F = math.ceil(math.log2(math.pi * (1.5 * Swm + Sw) / (2 * BUDGET["phase"])))
-        phase_bits = F + 1
+        # trig weights under an output LSB need less than the narrowest phase: take that
+        phase_bits = max(6, F + 1)
     P = _check_int("phase_bits", phase_bits, 6, 40, derived="" if "phase_bits" in given else hint)
     F = P - 1
     e_t = BUDGET["table"] / Sw  # allowed error per term (term units)
@@ -432,7 +435,9 @@ def derive_spec(
         weight_frac_bits = max(0, math.ceil(math.log2(N * term_max / 2.0 ** Tf / (2 * BUDGET["weights"]))))
     Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30, derived="" if "weight_frac_bits" in given else hint)
     w_int = np.floor(wt * 2.0 ** Wf + 0.5).astype(np.int64)
-    wmax = int(np.max(np.abs(w_int))) if w_int.size else 1
+    # at least +-1: weights that all round to 0 (a straight line) still get a 2-bit word,
+    # which the default 2-bit shift-add digit needs
+    wmax = max(1, int(np.max(np.abs(w_int)))) if w_int.size else 1
     weight_fmt = FixedFormat(bits_needed(-wmax, wmax), bits_needed(-wmax, wmax) - Wf)
 
     if product_frac_bits is None:

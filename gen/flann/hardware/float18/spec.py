@@ -150,6 +150,12 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     # measures the float18 design itself.
     options.pop("check_device", None)
     base = derive_spec(model, mult_style="lut", check_device=False, **options)
+    short = base.input_bits - base.term_fmt.width
+    if short > 0 and "term_frac_bits" not in options:
+        # small trig weights need only narrow terms, but the code shares the term converter:
+        # widen the terms to the code's width (more precision than the budget asks)
+        base = derive_spec(model, mult_style="lut", check_device=False,
+                           term_frac_bits=base.term_fmt.frac_bits + short, **options)
     fmt = FLOAT18
     Tf = base.term_fmt.frac_bits
     if base.input_bits > fmt.sig_bits:
