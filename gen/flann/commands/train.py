@@ -11,7 +11,9 @@ from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
+from ..errors import SpecError
 from ..hardware.accuracy import fixed_point_cost
+from ..hardware.fixed.spec import derive_spec
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -61,6 +63,17 @@ def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
             f"max {res.max_mm:.4g} mm")
 
 
+def _check_generatable(model) -> None:
+    """A model `flann gen` would refuse at its defaults is not written: it could only mislead."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            derive_spec(model)
+    except SpecError as exc:
+        raise FlannError(f"the fitted model cannot be generated as hardware ({exc}); nothing written: "
+                         "use fewer --terms, a --ridge, or --terms auto (the default)") from None
+
+
 def run(args) -> int:
     rec = read_recordings(args.recordings)
     rec = prepare_for_fit(rec, trim=args.trim)
@@ -77,6 +90,7 @@ def run(args) -> int:
                   "data_sha256": rec.sha256}
     if rec.comments:
         provenance["data_provenance"] = rec.comments[0]
+    said = []   # printed once the model is known to be writable
     if args.terms == "auto":
         if args.method != "lstsq" or explicit is not None or args.normalise or args.ridge:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
@@ -85,15 +99,14 @@ def run(args) -> int:
         model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
                                  cost=fixed_point_cost)
         t = model.training
-        print(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-              f"held-out error (cross-validation, {t['cv_folds']} folds"
-              + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
-              + "): "
-              f"RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+        said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
+                    f"held-out error (cross-validation, {t['cv_folds']} folds"
+                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
+                    + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
         if "traded" in t:
-            print(f"auto: {t['selected_by']}: {t['traded']}", file=sys.stderr)
+            said.append(f"auto: {t['selected_by']}: {t['traded']}")
         elif "hardware_why" in t:
-            print(f"auto: no candidate builds in fixed point ({t['hardware_why']})", file=sys.stderr)
+            said.append(f"auto: no candidate builds in fixed point ({t['hardware_why']})")
     else:
         norm = args.normalise or "range"
         check_fit_input(rec.voltage_v, rec.displacement_mm, args.terms, rec.source)
@@ -101,15 +114,17 @@ def run(args) -> int:
             model = fit_lms(rec.voltage_v, rec.displacement_mm, args.terms, eta=args.eta,
                             epochs=args.epochs, norm=norm, offset_scale=explicit,
                             training=provenance)
-            print(f"lms: {args.terms} terms, eta {args.eta:g}, {args.epochs} epochs, final "
-                  f"epoch MSE {model.training['mse_per_epoch'][-1]:.4g} mm^2 (training error)",
-                  file=sys.stderr)
+            said.append(f"lms: {args.terms} terms, eta {args.eta:g}, {args.epochs} epochs, final "
+                        f"epoch MSE {model.training['mse_per_epoch'][-1]:.4g} mm^2 (training error)")
         else:
             model = fit_lstsq(rec.voltage_v, rec.displacement_mm, args.terms, norm=norm,
                               offset_scale=explicit, ridge=args.ridge, training=provenance)
-            print(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
-                  f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
-                  + _heldout_text(rec, args.terms, norm, args.ridge, explicit), file=sys.stderr)
+            said.append(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
+                        f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
+                        + _heldout_text(rec, args.terms, norm, args.ridge, explicit))
+    _check_generatable(model)
+    for line in said:
+        print(line, file=sys.stderr)
     if args.terms != "auto":
         hw = fixed_point_cost(model)
         if not hw["buildable"]:

@@ -117,7 +117,7 @@ def check_output_range(model: FlannModel, points: int = 2001) -> None:
         raise SpecError(
             f"the model's output reaches {float(np.max(np.abs(y))):.3g} mm over its trained voltage range "
             f"{vlo:.6g}..{vhi:.6g} V, but it was trained on {xlo:.6g}..{xhi:.6g} mm: not a usable model "
-            "(edited by hand?); retrain it with `flann train`")
+            "(over-fitted, or edited by hand); retrain it with `flann train`")
 
 
 def max_mm_per_v(model: FlannModel, points: int = 2001) -> float:
