@@ -202,3 +202,23 @@ def test_trig_weights_under_an_output_lsb_take_the_narrowest_widths():
     out = FlannTop(spec).process(codes).out_data
     v = np.clip(codes, spec.clamp_lo, spec.clamp_hi) * spec.input_lsb_v
     assert np.max(np.abs(out * spec.output_lsb_mm - 10.0 * v)) <= spec.output_lsb_mm
+
+
+def test_eval_runs_the_twin_once_per_distinct_code(model, monkeypatch):
+    # a logger's file repeats codes: the twin's per-term arrays grow with what it is given
+    from types import SimpleNamespace
+
+    from flann.hardware import accuracy
+
+    spec = derive_spec(model)
+    seen = []
+    real = FlannTop.process
+    monkeypatch.setattr(accuracy.FlannTop, "process", lambda self, c: (seen.append(len(c)), real(self, c))[1])
+    v = np.repeat(np.linspace(-5.0, 5.0, 40), 50)           # 2000 rows, 40 voltages
+    x = model.predict(v)
+    rec = SimpleNamespace(displacement_mm=x, voltage_v=v, direction=None)
+    rep = accuracy.hardware_accuracy(spec, rec, tol=2.0, band=0.1, fs_mm=30.0)
+    assert max(seen) <= 40
+    codes = np.clip(np.floor(v / spec.input_lsb_v + 0.5).astype(np.int64), spec.code_min, spec.code_max)
+    per_row = real(FlannTop(spec), codes).out_data * spec.output_lsb_mm   # every row, by itself
+    assert rep["max_error_mm"] == pytest.approx(np.max(np.abs(per_row - x)), abs=1e-12)
