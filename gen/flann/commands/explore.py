@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 from ..implement import explore
 from ..errors import FlannError
@@ -40,19 +41,20 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    progress = sys.stderr.isatty()   # progress lines on a terminal only, never into a log
     if args.seed_only:
-        rows = explore.seed_rows(args.model, args.device, abc=args.abc)
+        rows = explore.seed_rows(args.model, args.device, abc=args.abc, progress=progress)
         if args.float18:
-            rows += explore.float18_rows(args.model, args.device, abc=args.abc)
+            rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
         print(json.dumps([r.to_dict() for r in rows], indent=2) if args.json else explore.markdown(rows, args.device))
         return 0
     rows = explore.explore(
         args.model, args.device, lanes=_ints(args.lanes), styles=tuple(args.mult.split(",")),
-        widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=True, abc=args.abc,
+        widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=progress, abc=args.abc,
         adc={k: v for k, v in (("input_bits", args.input_bits), ("input_lsb_v", args.input_lsb_v)) if v is not None},
     )
     if args.float18:
-        rows += explore.float18_rows(args.model, args.device, abc=args.abc)
+        rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
     if args.json:
         print(json.dumps([r.to_dict() for r in rows], indent=2))
     else:
