@@ -65,3 +65,20 @@ def test_noise_wiggles_on_flat_ends_are_not_a_fold_back():
 def test_too_few_points():
     with pytest.raises(RecordingsError, match="need at least 3"):
         prepare_for_fit(parse_recordings("displacement_mm,voltage_v\n0,0\n1,1\n", "two.csv"))
+
+
+def test_up_and_down_sweep_without_direction_column_is_fine():
+    # the usual bench file: out and back, the turning point read twice, no direction column
+    x = np.arange(-10.0, 10.5, 1.0)
+    up, down = np.tanh(x / 8.0), np.tanh(x / 8.0) + 0.004      # 4 mV hysteresis
+    rows = [f"{a:g},{b:.6f}" for a, b in zip(x, up)] + [f"{a:g},{b:.6f}" for a, b in zip(x[::-1], down[::-1])]
+    rec = parse_recordings("displacement_mm,voltage_v\n" + "\n".join(rows) + "\n", "updown.csv")
+    assert len(prepare_for_fit(rec)) == 42
+
+
+def test_two_passes_the_same_way_are_still_repeats():
+    x = np.arange(-10.0, 10.5, 1.0)
+    rows = [f"{a:g},{np.tanh(a / 8.0) + off:.6f}" for off in (0.0, 0.3) for a in x]
+    rec = parse_recordings("displacement_mm,voltage_v\n" + "\n".join(rows) + "\n", "twice.csv")
+    with pytest.raises(RecordingsError, match=r"appears twice in direction \+1 \(sweeps told apart by the row order\)"):
+        prepare_for_fit(rec)

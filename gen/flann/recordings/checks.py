@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -136,7 +136,8 @@ def _pair(rec: Recordings, j: int, i: int) -> str:
     return f"{a.split()[0]}s {a.split()[1]} and {b.split()[1]}"
 
 
-def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01) -> None:
+def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01,
+                     inferred: bool = False) -> None:
     """One voltage per displacement per direction: a repeat with another voltage is refused.
 
     Recordings with a ``time_s`` column may hold repeated sweeps: there a repeat is refused
@@ -158,7 +159,8 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
         key = (float(d), float(x))
         j = seen.setdefault(key, i)
         if j != i and abs(rec.voltage_v[j] - v) > tol:
-            where = "" if rec.direction is None else f" in direction {int(d):+d}"
+            where = "" if rec.direction is None else f" in direction {int(d):+d}" + \
+                (" (sweeps told apart by the row order)" if inferred else "")
             raise RecordingsError(
                 f"{rec.source}: {_pair(rec, j, i)}: displacement {x:g} mm appears twice"
                 f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
@@ -177,14 +179,46 @@ def check_units(rec: Recordings) -> None:
             "or 'Voltage (mV)'")
 
 
+def sweep_direction(displacement_mm) -> np.ndarray | None:
+    """+1/-1 per row from the file order (a forward then a reverse sweep, ...), or None when
+    the rows are not in sweeps: a single sweep, no motion, or runs shorter than 4 points.
+
+    A row that repeats the previous displacement keeps the previous direction, except at a
+    turn, where the repeat (the same position read again on the way back) starts the new sweep.
+    """
+    x = np.asarray(displacement_mm, dtype=float)
+    step = np.sign(np.diff(x))
+    moving = np.flatnonzero(step)
+    if moving.size == 0:
+        return None
+    prev_dir = step[moving[np.maximum(np.searchsorted(moving, np.arange(step.size)) - 1, 0)]]
+    nxt = np.searchsorted(moving, np.arange(step.size))
+    next_dir = step[moving[np.minimum(nxt, moving.size - 1)]]
+    zero = step == 0
+    before = np.arange(step.size) < moving[0]
+    step[zero] = np.where(before[zero] | (prev_dir[zero] != next_dir[zero]), next_dir[zero], prev_dir[zero])
+    d = np.concatenate([[step[0]], step])
+    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0.0], d, [0.0]]))))
+    if runs.size < 2 or np.median(runs) < 4:
+        return None
+    return d
+
+
 def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None) -> Recordings:
-    """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span."""
+    """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span.
+
+    Without a direction column, sweeps are told apart by the file order (:func:`sweep_direction`)
+    for the checks: the same position on the way up and on the way back is not a repeat.
+    """
     if len(rec) < MIN_FIT_POINTS:
         raise RecordingsError(
             f"{rec.source}: {len(rec)} point(s); need at least {MIN_FIT_POINTS} to fit a model"
         )
     check_units(rec)
-    check_duplicates(rec)
+    inferred = rec.direction is None and (d := sweep_direction(rec.displacement_mm)) is not None
+    if inferred:
+        rec = replace(rec, direction=d)
+    check_duplicates(rec, inferred=inferred)
     span = monotonic_span(rec, noise_v=noise_v)
     if span.foldback:
         if not span.trimmable:
