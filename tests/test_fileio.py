@@ -40,3 +40,35 @@ def test_failed_write_leaves_nothing(tmp_path):
     with pytest.raises(RuntimeError):
         atomic_save_figure(Boom(), tmp_path / "x.png")
     assert list(tmp_path.iterdir()) == []
+
+
+# -- outputs the file system refuses: one line through the CLI, nothing written -------------
+@pytest.mark.parametrize("argv", [
+    ["train", "{table1}", "-o", "{blocker}/m.json"],
+    ["gen", "{model}", "-o", "{blocker}/hdl"],
+    ["predict", "{model}", "{table1}", "-o", "{blocker}/p.csv"],
+    ["train", "{table1}", "-o", "{tmp}"],                       # a directory as the file name
+])
+def test_unwritable_output_is_one_line(argv, tmp_path, capsys, table1_csv, default_model_json):
+    from flann.cli import main
+
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file where a directory is needed\n")
+    names = dict(table1=table1_csv, model=default_model_json, blocker=blocker, tmp=tmp_path)
+    rc = main([a.format(**names) for a in argv])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err[-1].startswith("error: ") and "Traceback" not in "".join(err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker"]
+
+
+def test_permission_refused_on_the_temporary_file(tmp_path, monkeypatch):
+    import tempfile
+
+    from flann.errors import FlannError
+
+    def refuse(*a, **k):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(FlannError, match="cannot write .permission denied"):
+        atomic_write_text(tmp_path / "x.txt", "x\n")

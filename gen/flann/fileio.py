@@ -15,6 +15,8 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from .errors import FlannError
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -22,18 +24,43 @@ def _umask() -> int:
     return mask
 
 
+def _cannot_write(path, exc: OSError) -> FlannError:
+    """An output the file system refuses is bad input like any other: one line naming it."""
+    if isinstance(exc, (FileExistsError, NotADirectoryError)):
+        why = "a part of the path is a file, not a directory"
+    elif isinstance(exc, PermissionError):
+        why = "permission denied"
+    else:
+        why = exc.strerror or exc.__class__.__name__
+    return FlannError(f"{path}: cannot write ({why})")
+
+
+def _parent_dir(path: Path) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _cannot_write(path, exc) from None
+
+
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    _parent_dir(path)
+    if path.is_dir():
+        raise FlannError(f"{path}: is a directory, expected a file name")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    except OSError as exc:
+        raise _cannot_write(path, exc) from None
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        if isinstance(exc, OSError):   # disk full, a quota: still one line
+            raise _cannot_write(path, exc) from None
         raise
 
 
@@ -61,16 +88,24 @@ def atomic_directory(path: str | os.PathLike):
     when the block exits cleanly; on error nothing in ``path`` is touched.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+    _parent_dir(path)
+    if path.exists() and not path.is_dir():
+        raise FlannError(f"{path}: exists and is not a directory")
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+    except OSError as exc:
+        raise _cannot_write(path, exc) from None
     try:
         yield tmp
-        path.mkdir(parents=True, exist_ok=True)
-        for item in sorted(tmp.rglob("*")):
-            if item.is_file():
-                dest = path / item.relative_to(tmp)
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(item, dest)
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+            for item in sorted(tmp.rglob("*")):
+                if item.is_file():
+                    dest = path / item.relative_to(tmp)
+                    dest.parent.mkdir(parents=True, exist_ok=True)
+                    os.replace(item, dest)
+        except OSError as exc:
+            raise _cannot_write(path, exc) from None
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
