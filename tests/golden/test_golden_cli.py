@@ -205,6 +205,16 @@ def test_train_bad_recordings(tmp_path, capsys, case, fragment):
     assert not out.exists()
 
 
+def test_train_auto_on_three_points_names_the_file_and_the_way_out(tmp_path, capsys):
+    data = tmp_path / "three.csv"
+    data.write_text("displacement_mm,voltage_v\n-1,-0.2\n0,0\n1,0.21\n")
+    out = tmp_path / "m.json"
+    assert_one_line_error(*run(["train", data, "-o", out], capsys), "three.csv: 3 points")
+    assert not out.exists()
+    rc, _, err = run(["train", data, "-o", out, "--terms", 2], capsys)
+    assert rc == 0 and out.exists(), err
+
+
 def test_train_missing_file(tmp_path, capsys):
     out = tmp_path / "m.json"
     assert_one_line_error(*run(["train", tmp_path / "nope.csv", "-o", out], capsys),
