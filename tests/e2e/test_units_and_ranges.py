@@ -173,3 +173,16 @@ def test_a_model_whose_datapath_misses_the_float_model_is_not_buildable_for_auto
     cost = fixed_point_cost(loose)
     assert not cost["buildable"] and "output LSB (> 1)" in cost["why"]
     assert fixed_point_cost(tight)["buildable"]
+
+
+def test_unipolar_converter_gets_the_way_to_use_it(tmp_path, capsys):
+    # a 0..5 V ADC around a 2.5 V mid-scale: the recorded voltages are all positive
+    rec = sensor_csv(tmp_path / "r.csv", scale=0.15)
+    text = rec.read_text().splitlines()
+    rows = [f"{a},{float(b) + 2.5:.9g}" for a, b in (ln.split(",") for ln in text[1:])]
+    rec.write_text("\n".join([text[0], *rows]) + "\n")
+    m = tmp_path / "m.json"
+    assert run(["train", rec, "-o", m], capsys)[0] == 0
+    rc, _, err = run(["gen", m, "-o", tmp_path / "hdl", "--input-bits", 12, "--input-lsb-v", 5 / 4096], capsys)
+    line = one_error_line(err)
+    assert rc == 2 and "unipolar 0..5 V" in line and "minus 2.5 V" in line and "top bit inverted" in line

@@ -76,10 +76,15 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
     opts = _opts(bits, lsb, lsb_given)
     notes = []
     if clamp and (vlo < lo_v - lsb or vhi > hi_v + lsb):
+        full = (1 << bits) * lsb
+        unipolar = (f"; a unipolar 0..{full:.6g} V converter? the design takes two's-complement "
+                    f"codes: train on the voltages minus {full / 2:.6g} V and feed it the codes with "
+                    "their top bit inverted") if vlo >= -lsb and vhi <= full else ""
         raise SpecError(
             f"the trained voltage range {vlo:.6g}..{vhi:.6g} V does not fit the ADC's range "
             f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): check the recordings' voltage unit "
-            "(millivolts under a voltage_v header? name the column voltage_mv) or the ADC options")
+            "(millivolts under a voltage_v header? name the column voltage_mv) or the ADC options"
+            + unipolar)
     codes = (vhi - vlo) / lsb
     if codes < MIN_TRAINED_CODES:
         raise SpecError(
