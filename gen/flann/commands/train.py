@@ -45,7 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="lstsq ridge penalty on mean squared error (default 0)")
     p.add_argument("--normalise", choices=NORMALISATIONS, default=None,
                    help="input normalisation for explicit --terms: 'range' (default: the "
-                        "data's voltage range -> [-1, 1]) or 'none' (raw volts, as the paper)")
+                        "data's voltage range -> [-1, 1]), 'half' (-> [-0.5, 0.5]) or 'none' "
+                        "(raw volts, as the paper)")
     p.add_argument("--input-offset-v", type=float, default=None,
                    help="explicit normalisation offset (V); needs --input-scale-v")
     p.add_argument("--input-scale-v", type=float, default=None,
