@@ -110,11 +110,23 @@ def test_latin1_tab_separated_export(tmp_path, capsys):
     ("displacement_in,Voltage (mV)", 25.4, 1e-3),
     ("Position (cm),U (V)", 10.0, 1.0),
     ("displacement_um,voltage_uv", 1e-3, 1e-6),
+    # ISO "quantity / unit", units spelled out, a space before the unit, other names
+    ("x / mm,U / mV", 1.0, 1e-3),
+    ("Displacement (in.),Voltage (Volts)", 25.4, 1.0),
+    ("distance_mm,Signal (millivolts)", 1.0, 1e-3),
+    ("position mm,Sensor output (V)", 1.0, 1.0),
+    ("Position (millimetres),voltage_volts", 1.0, 1.0),
 ])
 def test_header_aliases_and_units(header, factor_x, factor_v):
     rec = parse_recordings(f"{header}\n2,3\n4,5\n")
     np.testing.assert_allclose(rec.displacement_mm, np.array([2.0, 4.0]) * factor_x, rtol=1e-15)
     np.testing.assert_allclose(rec.voltage_v, np.array([3.0, 5.0]) * factor_v, rtol=1e-15)
+
+
+def test_comma_unit_header_in_a_semicolon_file():
+    rec = parse_recordings("Position, mm;Voltage, V\n1,5;0,25\n2,5;0,5\n")
+    np.testing.assert_allclose(rec.displacement_mm, [1.5, 2.5])
+    np.testing.assert_allclose(rec.voltage_v, [0.25, 0.5])
 
 
 def test_canonical_file_says_nothing(tmp_path, capsys):

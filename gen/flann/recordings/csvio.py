@@ -33,20 +33,28 @@ REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
 
 # canonical column -> (names of the quantity, {unit: factor to the canonical unit}).
-# A header is "<name>_<unit>", "<name> (<unit>)" or "<name> [<unit>]", any case.
+# A header is "<name>_<unit>", "<name> (<unit>)", "<name> [<unit>]", "<name> / <unit>" (ISO
+# style), "<name>, <unit>" or "<name> <unit>", any case; units may be spelled out.
 QUANTITIES: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
-    "displacement_mm": (("displacement", "position", "x", "disp", "pos", "travel", "stroke"),
-                        {"mm": 1.0, "um": 1e-3, "µm": 1e-3, "cm": 10.0, "m": 1000.0,
-                         "in": 25.4, "inch": 25.4, "mil": 0.0254}),
-    "voltage_v": (("voltage", "volt", "v", "u", "vout", "output", "output voltage", "lvdt output"),
-                  {"v": 1.0, "mv": 1e-3, "uv": 1e-6, "µv": 1e-6}),
+    "displacement_mm": (("displacement", "position", "x", "disp", "pos", "travel", "stroke",
+                         "distance", "dist"),
+                        {"mm": 1.0, "millimeter": 1.0, "millimeters": 1.0, "millimetre": 1.0,
+                         "millimetres": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "microns": 1e-3,
+                         "cm": 10.0, "m": 1000.0, "in": 25.4, "in.": 25.4, "inch": 25.4,
+                         "inches": 25.4, "mil": 0.0254}),
+    "voltage_v": (("voltage", "volt", "v", "u", "vout", "output", "output voltage", "lvdt output",
+                   "signal", "sensor output", "lvdt voltage", "lvdt"),
+                  {"v": 1.0, "volt": 1.0, "volts": 1.0, "mv": 1e-3, "millivolt": 1e-3,
+                   "millivolts": 1e-3, "uv": 1e-6, "µv": 1e-6}),
     "direction": (("direction", "dir"), {"": 1.0}),
     "time_s": (("time", "t"), {"s": 1.0, "ms": 1e-3, "min": 60.0}),
     "temperature_c": (("temperature", "temp"), {"c": 1.0, "°c": 1.0, "degc": 1.0}),
     "excitation_hz": (("excitation", "frequency", "freq"), {"hz": 1.0, "khz": 1e3}),
 }
 _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
-              re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"))
+              re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"),
+              re.compile(r"^(?P<q>.+?)\s*[/,]\s*(?P<u>[^/,]+)$"),
+              re.compile(r"^(?P<q>.+)\s+(?P<u>\S+)$"))
 SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma"}
 _EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
 
