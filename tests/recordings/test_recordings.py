@@ -129,6 +129,24 @@ def test_comma_unit_header_in_a_semicolon_file():
     np.testing.assert_allclose(rec.voltage_v, [0.25, 0.5])
 
 
+def test_whitespace_aligned_columns():
+    # a .txt/.dat export: columns aligned with spaces, units in brackets after the names
+    rec = parse_recordings("Displacement (mm)   Voltage [mV]   time_s\n  -1.5   -250.0   0\n"
+                           "   0.0      0.5   1\n   1.5    500.0   2\n")
+    np.testing.assert_allclose(rec.displacement_mm, [-1.5, 0.0, 1.5])
+    np.testing.assert_allclose(rec.voltage_v, [-0.25, 0.0005, 0.5])
+    np.testing.assert_allclose(rec.time_s, [0, 1, 2])
+    assert "whitespace-separated" in rec.recognised
+
+
+def test_quoted_decimal_commas_in_a_comma_file():
+    rec = parse_recordings('"displacement_mm","voltage_v"\n"1,5","0,25"\n"2","-0,5"\n')
+    np.testing.assert_allclose(rec.displacement_mm, [1.5, 2.0])
+    np.testing.assert_allclose(rec.voltage_v, [0.25, -0.5])
+    with pytest.raises(RecordingsError, match="'1.234,5' is not a number"):   # thousands: not guessed
+        parse_recordings("displacement_mm;voltage_v\n1.234,5;3\n")
+
+
 def test_canonical_file_says_nothing(tmp_path, capsys):
     p = tmp_path / "r.csv"
     p.write_text("displacement_mm,voltage_v\n1,2\n3,4\n")

@@ -55,7 +55,8 @@ _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
               re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"),
               re.compile(r"^(?P<q>.+?)\s*[/,]\s*(?P<u>[^/,]+)$"),
               re.compile(r"^(?P<q>.+)\s+(?P<u>\S+)$"))
-SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma"}
+SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma", " ": "whitespace"}
+_WS_HEADER = re.compile(r"[^\s(\[]+(?:\s*[(\[][^)\]]*[)\]])?")
 _EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
 
 
@@ -143,7 +144,13 @@ def _sniff_separator(header_line: str) -> str:
     for sep in (";", "\t"):   # a header holding these is not comma-separated
         if counts[sep]:
             return sep
+    if not counts[","] and len(header_line.split()) > 1:
+        return " "   # columns aligned with spaces (a .txt/.dat export): names without spaces
     return ","
+
+
+def _cells(line: str, sep: str) -> list[str]:
+    return line.split() if sep == " " else next(csv.reader([line], delimiter=sep))
 
 
 def _header_map(header: list[str], required, source: str):
@@ -199,7 +206,9 @@ def parse_recordings(text: str, source: str = "<memory>",
         if not body:
             raise RecordingsError(f"{source}: no header line after '{excel_sep.group(0).strip()}'")
     sep = excel_sep.group("sep") if excel_sep else _sniff_separator(body[0][1])
-    header = [h.strip() for h in next(csv.reader([body[0][1]], delimiter=sep))]
+    header = [h.strip() for h in _cells(body[0][1], sep)]
+    if sep == " ":   # "Displacement (mm) Voltage (V)": a unit in brackets belongs to the name before
+        header = _WS_HEADER.findall(body[0][1])
     found, col_notes, unknown = _header_map(header, required, source)
     if unknown:
         warnings.warn(f"{source}: ignoring unknown column(s) {', '.join(unknown)}", stacklevel=2)
@@ -207,7 +216,7 @@ def parse_recordings(text: str, source: str = "<memory>",
     data: dict[str, list[float]] = {c: [] for c in wanted}
     line_numbers: list[int] = []
     decimal_comma = False
-    for line_no, row in ((n, r) for n, line in body[1:] for r in csv.reader([line], delimiter=sep)):
+    for line_no, row in ((n, _cells(line, sep)) for n, line in body[1:]):
         if not any(cell.strip() for cell in row):
             continue
         where = f"line {line_no}"
@@ -218,7 +227,9 @@ def parse_recordings(text: str, source: str = "<memory>",
         for c in wanted:
             i, factor = found[c]
             cell = row[i].strip()
-            if sep != "," and "," in cell:
+            # a comma inside a cell is a decimal comma (in a comma-separated file only
+            # when quoted, "1,5"); with a point as well it is a thousands separator: refused
+            if "," in cell and "." not in cell and cell.count(",") == 1:
                 cell, decimal_comma = cell.replace(",", "."), True
             data[c].append(_parse_float(cell, header[i], where, source) * factor)
         line_numbers.append(line_no)
@@ -234,7 +245,7 @@ def parse_recordings(text: str, source: str = "<memory>",
                 f"{source}: line {lines[k]}, column 'direction': {arrays['direction'][k]:g} "
                 "is not +1 or -1"
             )
-    if sep != ",":
+    if sep != "," or decimal_comma:
         notes.append(f"{SEPARATORS[sep]}-separated" + (" with decimal comma" if decimal_comma else ""))
     notes += col_notes
     arrays.setdefault("displacement_mm", None)
