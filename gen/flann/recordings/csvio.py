@@ -6,8 +6,9 @@ decreasing), ``time_s``, ``temperature_c``, ``excitation_hz``.  Lines starting w
 are comments (provenance).  Other columns are ignored with a warning.
 
 Files as spreadsheets and loggers export them are read too: a UTF-8 byte-order mark, CRLF
-line ends, a semicolon or tab separator (sniffed from the header) with decimal commas,
-Latin-1 text, and headers that carry their unit (``Displacement (mm)``, ``x_mm``,
+line ends, a semicolon, tab or whitespace separator (sniffed from the header; Excel's
+``sep=`` first line) with decimal commas (quoted in a comma-separated file), Latin-1 text,
+and headers that carry their unit (``Displacement (mm)``, ``x_mm``, ``U / mV``,
 ``Voltage (mV)``, ``displacement_in``...): values are converted to the canonical unit and
 what was recognised is said in one line on stderr.  Error messages give the *file* line.
 """
