@@ -322,22 +322,33 @@ def cv_subset(voltage_v, limit: int | None = None) -> np.ndarray:
     return np.sort(order[np.unique(np.linspace(0, v.size - 1, limit).round().astype(np.int64))])
 
 
-def cv_folds(voltage_v, k: int | None = None) -> list[np.ndarray]:
+def cv_folds(voltage_v, k: int | None = None, groups=None) -> list[np.ndarray]:
     """Interleaved held-out folds over the points sorted by voltage.
 
     The lowest- and highest-voltage points are never held out: cross-validation measures
     error *inside* the calibrated voltage range (the model is not used beyond it).
+    ``groups`` (the displacement of each row): rows of one group are held out together, so
+    a position read again on another sweep cannot stand in for itself -- with repeated
+    sweeps (identical after the ADC) every held-out row would otherwise have its twin in the
+    training set and the held-out error would be that of an interpolation through it.
     """
     v = np.asarray(voltage_v, dtype=float)
-    order = np.argsort(v, kind="stable")
-    inner = order[1:-1]
+    if groups is None:
+        gid = np.arange(v.size)
+    else:
+        gid = np.unique(np.asarray(groups, dtype=float), return_inverse=True)[1].ravel()
+    n_groups = int(gid.max()) + 1 if gid.size else 0
+    mean_v = np.bincount(gid, weights=v, minlength=n_groups) / np.bincount(gid, minlength=n_groups)
+    ends = {int(gid[np.argmin(v)]), int(gid[np.argmax(v)])} if v.size else set()
+    order = [g for g in np.argsort(mean_v, kind="stable") if int(g) not in ends]
+    inner = np.asarray(order, dtype=np.int64)
     k = min(AUTO_MAX_FOLDS if k is None else k, inner.size)
     if k < 2:
         raise RecordingsError(
-            f"{v.size} points: too few for cross-validation (auto needs at least 4); "
-            "give --terms N explicitly"
+            f"{v.size} points ({n_groups} distinct positions): too few for cross-validation "
+            "(auto needs at least 4 distinct positions); give --terms N explicitly"
         )
-    return [np.sort(inner[i::k]) for i in range(k)]
+    return [np.flatnonzero(np.isin(gid, inner[i::k])) for i in range(k)]
 
 
 def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=AUTO_NORMS,
@@ -350,7 +361,7 @@ def cross_validate(voltage_v, displacement_mm, terms_list=AUTO_TERMS, norms=AUTO
     """
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
-    folds = cv_folds(v, k)
+    folds = cv_folds(v, k, groups=x)
     held_all = np.sort(np.concatenate(folds))
     results = []
     for norm in norms:
@@ -428,7 +439,7 @@ def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NO
     vs, xs = v[sub], x[sub]
     results = cross_validate(vs, xs, terms_list, norms, ridges)
     info = {"selected_by": "cross-validation",
-            "cv_folds": len(cv_folds(vs)),
+            "cv_folds": len(cv_folds(vs, groups=xs)),
             "cv_candidates": len(results)}
     if sub.size < v.size:
         info["cv_points"] = int(sub.size)
