@@ -127,6 +127,7 @@ def run(args) -> int:
                         f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
                         + _heldout_text(rec, args.terms, norm, args.ridge, explicit))
     _check_generatable(model)
+    model.save(args.output)   # first: the summary's reader (`| head`) may be gone
     for line in said:
         print(line, file=sys.stderr)
     if args.terms != "auto":
@@ -134,5 +135,4 @@ def run(args) -> int:
         if not hw["buildable"]:
             warnings.warn(f"this model cannot be built in fixed point ({hw['why']}); "
                           "--terms auto selects a buildable one")
-    model.save(args.output)
     return 0
