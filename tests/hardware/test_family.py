@@ -95,3 +95,15 @@ def test_gen_family_cli_errors(tmp_path, default_model_json, capsys):
     err = capsys.readouterr().err
     assert err.count("error: ") == 3 and "Traceback" not in err
     assert not any((tmp_path / n).exists() for n in "xyz")
+
+
+def test_gen_family_names_every_bad_member_in_one_line(tmp_path, default_model_json, capsys):
+    bad_text = tmp_path / "words.csv"
+    bad_text.write_text("displacement_mm,voltage_v\n0,abc\n")
+    missing = tmp_path / "gone.csv"
+    argv = ["gen", "--family", str(default_model_json), str(bad_text), str(missing), "-o", str(tmp_path / "d")]
+    assert main(argv) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: 2 of 3 family members")
+    assert "words.csv" in lines[0] and "gone.csv" in lines[0]
+    assert not (tmp_path / "d").exists()

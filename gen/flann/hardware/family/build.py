@@ -44,7 +44,15 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
         raise FlannError("--family needs at least one recordings CSV or model.json")
     if not 2 <= int(terms) <= 200:
         raise FlannError(f"--terms {terms}: must be 2..200")
-    models = [load_member(p, terms) for p in sources]
+    models, bad = [], []
+    for p in sources:   # every member is tried: the user learns of all bad files at once
+        try:
+            models.append(load_member(p, terms))
+        except FlannError as exc:
+            bad.append(str(exc))
+    if bad:
+        raise FlannError(f"{len(bad)} of {len(sources)} family members cannot be used "
+                         "(nothing written): " + "; ".join(bad))
     names = [Path(p).stem for p in sources]
     fam = derive_family(models, names=names, margin=margin, **options)
     return write(fam, out_dir, fam.spec.model, init_name=names[0])
