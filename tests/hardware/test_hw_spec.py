@@ -222,3 +222,14 @@ def test_eval_runs_the_twin_once_per_distinct_code(model, monkeypatch):
     codes = np.clip(np.floor(v / spec.input_lsb_v + 0.5).astype(np.int64), spec.code_min, spec.code_max)
     per_row = real(FlannTop(spec), codes).out_data * spec.output_lsb_mm   # every row, by itself
     assert rep["max_error_mm"] == pytest.approx(np.max(np.abs(per_row - x)), abs=1e-12)
+
+
+@pytest.mark.parametrize("opts, says, not_says", [
+    ({"input_bits": 4}, "--input-bits", "--input-lsb-v"),                 # the user gave only the width
+    ({"output_lsb_mm": 1e-9}, "--output-lsb-mm", "output_bits ="),         # a derived width, named by its cause
+    ({"lanes": 8, "check_device": True}, "fewer lanes", "mult_style=shiftadd"),   # already shift-add
+])
+def test_refusals_name_the_option_the_user_gave(model, opts, says, not_says):
+    with pytest.raises(SpecError) as exc:
+        derive_spec(model, **opts)
+    assert says in str(exc.value) and not_says not in str(exc.value)

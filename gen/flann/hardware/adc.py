@@ -86,6 +86,10 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             "(millivolts under a voltage_v header? name the column voltage_mv) or the ADC options"
             + unipolar)
     codes = (vhi - vlo) / lsb
+    if codes < MIN_TRAINED_CODES and not lsb_given:
+        raise SpecError(
+            f"input_bits = {bits} (--input-bits): the trained range {vlo:.6g}..{vhi:.6g} V spans only "
+            f"{codes:.3g} codes of a {bits}-bit ADC (need >= {MIN_TRAINED_CODES}): use a wider converter")
     if codes < MIN_TRAINED_CODES:
         raise SpecError(
             f"input_lsb_v = {lsb:g} V (--input-lsb-v) gives the trained range {vlo:.6g}..{vhi:.6g} V only "

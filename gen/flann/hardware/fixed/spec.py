@@ -375,6 +375,9 @@ def derive_spec(
     need_out = bits_needed(-math.ceil(ymax * 1.05 / q), math.ceil(ymax * 1.05 / q))
     if output_bits is None:
         output_bits = max(4, need_out)
+        if output_bits > 32:
+            raise SpecError(f"output_lsb_mm = {q:g} (--output-lsb-mm): the model's {ymax:.4g} mm then need "
+                            f"{output_bits} output bits (at most 32): give a coarser --output-lsb-mm")
     Bout = _check_int("output_bits", output_bits, 4, 32)
     if Bout < bits_needed(-math.ceil(ymax / q + 1), math.ceil(ymax / q + 1)):
         raise SpecError(
@@ -583,8 +586,10 @@ def check_fits(spec: Spec, part: str) -> None:
     if est["luts"] <= dev.luts and est["brams"] <= dev.brams:
         return
     fits = [d.name for d in spartan2.DEVICES if est["luts"] <= d.luts and est["brams"] <= d.brams]
+    cheaper = ["fewer terms"] + (["fewer lanes"] if spec.lanes > 1 else []) + \
+        (["mult_style=shiftadd"] if spec.mult_style != "shiftadd" else [])
     hint = f"smallest part that could hold it: {fits[0]}" if fits else \
-        "no Spartan-II holds it: fewer terms, fewer lanes or mult_style=shiftadd"
+        f"no Spartan-II holds it: {', '.join(cheaper[:-1])}{' or ' if len(cheaper) > 1 else ''}{cheaper[-1]}"
     raise SpecError(
         f"{spec.model.terms} terms x {spec.lanes} lane(s) ({spec.mult_style}) need about "
         f"{est['luts']} LUT4 and {est['brams']} block RAMs; {part} has {dev.luts} and {dev.brams} "
