@@ -56,6 +56,10 @@ _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
               re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"),
               re.compile(r"^(?P<q>.+?)\s*[/,]\s*(?P<u>[^/,]+)$"),
               re.compile(r"^(?P<q>.+)\s+(?P<u>\S+)$"))
+# a direction column as loggers write it, in words
+DIRECTION_WORDS = {"+": "1", "-": "-1", "up": "1", "down": "-1", "fwd": "1", "rev": "-1",
+                   "forward": "1", "reverse": "-1", "backward": "-1", "inc": "1", "dec": "-1",
+                   "increasing": "1", "decreasing": "-1"}
 SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma", " ": "whitespace"}
 _WS_HEADER = re.compile(r"[^\s(\[]+(?:\s*[(\[][^)\]]*[)\]])?")
 _EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
@@ -228,6 +232,8 @@ def parse_recordings(text: str, source: str = "<memory>",
         for c in wanted:
             i, factor = found[c]
             cell = row[i].strip()
+            if c == "direction":
+                cell = DIRECTION_WORDS.get(cell.lower(), cell)
             # a comma inside a cell is a decimal comma (in a comma-separated file only
             # when quoted, "1,5"); with a point as well it is a thousands separator: refused
             if "," in cell and "." not in cell and cell.count(",") == 1:
@@ -244,7 +250,7 @@ def parse_recordings(text: str, source: str = "<memory>",
             k = int(np.flatnonzero(bad)[0])
             raise RecordingsError(
                 f"{source}: line {lines[k]}, column 'direction': {arrays['direction'][k]:g} "
-                "is not +1 or -1"
+                "is not +1 or -1 (or up/down, forward/reverse)"
             )
     if sep != "," or decimal_comma:
         notes.append(f"{SEPARATORS[sep]}-separated" + (" with decimal comma" if decimal_comma else ""))
