@@ -82,3 +82,14 @@ def test_two_passes_the_same_way_are_still_repeats():
     rec = parse_recordings("displacement_mm,voltage_v\n" + "\n".join(rows) + "\n", "twice.csv")
     with pytest.raises(RecordingsError, match=r"appears twice in direction \+1 \(sweeps told apart by the row order\)"):
         prepare_for_fit(rec)
+
+
+def test_readings_repeated_at_each_step_within_noise_are_fine():
+    # three readings per position while the actuator dwells, 0.1 mV apart, no time column
+    x = np.repeat(np.arange(-10.0, 10.5, 1.0), 3)
+    v = np.tanh(x / 8.0) + np.tile([0.0, 1e-4, -1e-4], 21)
+    rec = Recordings(x, v, source="dwell.csv")
+    assert len(prepare_for_fit(rec)) == 63
+    v[31] += 0.3                                     # a reading far off its neighbours: refused
+    with pytest.raises(RecordingsError, match="appears twice"):
+        prepare_for_fit(Recordings(x, v, source="dwell.csv"))

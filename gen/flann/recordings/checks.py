@@ -140,24 +140,27 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
                      inferred: bool = False) -> None:
     """One voltage per displacement per direction: a repeat with another voltage is refused.
 
-    Recordings with a ``time_s`` column may hold repeated sweeps: there a repeat is refused
-    only when it differs by more than the noise allows, ``max(k_sigma * noise, floor_frac *
-    voltage span)`` with the noise estimated on the first pass; without ``time_s`` any
-    differing repeat is refused.
+    Readings repeated while the actuator dwells (the same displacement on consecutive rows)
+    and, with a ``time_s`` column, repeated sweeps are accepted when they differ by no more
+    than the noise allows, ``max(k_sigma * noise, floor_frac * voltage span)`` with the noise
+    estimated on the first reading of each position; any other differing repeat (a second
+    sweep the same way without ``time_s``: two files joined?) is refused.
     """
     direction = rec.direction if rec.direction is not None else np.zeros(len(rec))
-    tol = 0.0
-    if rec.time_s is not None:
-        keys = np.stack([direction, rec.displacement_mm], axis=1)
-        first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
-        sub = rec.subset(first)
-        order = np.lexsort((sub.displacement_mm, direction[first]))
-        tol = max(k_sigma * estimate_noise_v(sub.voltage_v[order]),
-                  floor_frac * float(np.ptp(rec.voltage_v)))
+    keys = np.stack([direction, rec.displacement_mm], axis=1)
+    first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
+    sub = rec.subset(first)
+    order = np.lexsort((sub.displacement_mm, direction[first]))
+    noise_tol = max(k_sigma * estimate_noise_v(sub.voltage_v[order]),
+                    floor_frac * float(np.ptp(rec.voltage_v)))
     seen: dict[tuple[float, float], int] = {}
+    last: dict[tuple[float, float], int] = {}
     for i, (d, x, v) in enumerate(zip(direction, rec.displacement_mm, rec.voltage_v)):
         key = (float(d), float(x))
         j = seen.setdefault(key, i)
+        dwell = last.get(key) == i - 1
+        last[key] = i
+        tol = noise_tol if (dwell or rec.time_s is not None) else 0.0
         if j != i and abs(rec.voltage_v[j] - v) > tol:
             where = "" if rec.direction is None else f" in direction {int(d):+d}" + \
                 (" (sweeps told apart by the row order)" if inferred else "")
