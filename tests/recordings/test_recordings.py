@@ -154,6 +154,18 @@ def test_direction_in_words():
         parse_recordings("displacement_mm,voltage_v,direction\n0,0,sideways\n")
 
 
+@pytest.mark.parametrize("text", [
+    "Displacement;Voltage;Temperature\nmm;mV;°C\n1,5;250;20\n2,5;500;20\n",
+    "time,position,output\ns,[in],[V]\n0,0.0590551181,0.25\n1,0.0984251969,0.5\n",
+    "displacement_mm,voltage_v\nmm,V\n1.5,0.25\n2.5,0.5\n",
+])
+def test_units_on_the_line_under_the_names(text):
+    rec = parse_recordings(text)
+    np.testing.assert_allclose(rec.displacement_mm, [1.5, 2.5], rtol=1e-9)
+    np.testing.assert_allclose(rec.voltage_v, [0.25, 0.5], rtol=1e-12)
+    assert rec.line_of(0) == "line 3"
+
+
 def test_canonical_file_says_nothing(tmp_path, capsys):
     p = tmp_path / "r.csv"
     p.write_text("displacement_mm,voltage_v\n1,2\n3,4\n")

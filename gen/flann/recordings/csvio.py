@@ -158,6 +158,19 @@ def _cells(line: str, sep: str) -> list[str]:
     return line.split() if sep == " " else next(csv.reader([line], delimiter=sep))
 
 
+def _unit_row(body, sep: str, width: int) -> list[str] | None:
+    """The line under the header when it holds units ("mm", "V", "[mV]") instead of numbers."""
+    if len(body) < 2:
+        return None
+    cells = [c.strip().strip("()[]").strip() for c in _cells(body[1][1], sep)]
+    if len(cells) != width or not any(cells):
+        return None
+    known = {u for _names, units in QUANTITIES.values() for u in units if u}
+    if all(not c or c.lower() in known for c in cells):
+        return cells
+    return None
+
+
 def _header_map(header: list[str], required, source: str):
     """{canonical column: (index, factor)}, notes on conversions, unknown headers."""
     found: dict[str, tuple[int, float]] = {}
@@ -214,6 +227,11 @@ def parse_recordings(text: str, source: str = "<memory>",
     header = [h.strip() for h in _cells(body[0][1], sep)]
     if sep == " ":   # "Displacement (mm) Voltage (V)": a unit in brackets belongs to the name before
         header = _WS_HEADER.findall(body[0][1])
+    units = _unit_row(body, sep, len(header))
+    if units is not None:   # loggers: names on one line, units on the next
+        header = [f"{h} ({u})" if u and recognise_header(h) is None else h
+                  for h, u in zip(header, units)]
+        body = body[:1] + body[2:]
     found, col_notes, unknown = _header_map(header, required, source)
     if unknown:
         warnings.warn(f"{source}: ignoring unknown column(s) {', '.join(unknown)}", stacklevel=2)
