@@ -116,6 +116,8 @@ def test_latin1_tab_separated_export(tmp_path, capsys):
     ("distance_mm,Signal (millivolts)", 1.0, 1e-3),
     ("position mm,Sensor output (V)", 1.0, 1.0),
     ("Position (millimetres),voltage_volts", 1.0, 1.0),
+    ("mm,mV", 1.0, 1e-3),                       # bare units: the quantity is unambiguous
+    ("[um],[V]", 1e-3, 1.0),
 ])
 def test_header_aliases_and_units(header, factor_x, factor_v):
     rec = parse_recordings(f"{header}\n2,3\n4,5\n")
@@ -164,6 +166,11 @@ def test_units_on_the_line_under_the_names(text):
     np.testing.assert_allclose(rec.displacement_mm, [1.5, 2.5], rtol=1e-9)
     np.testing.assert_allclose(rec.voltage_v, [0.25, 0.5], rtol=1e-12)
     assert rec.line_of(0) == "line 3"
+
+
+def test_bare_word_like_units_are_not_guessed():
+    with pytest.raises(RecordingsError, match="missing column"):
+        parse_recordings("in,out\n1,2\n")
 
 
 def test_canonical_file_says_nothing(tmp_path, capsys):

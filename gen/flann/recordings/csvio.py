@@ -60,6 +60,7 @@ _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
 DIRECTION_WORDS = {"+": "1", "-": "-1", "up": "1", "down": "-1", "fwd": "1", "rev": "-1",
                    "forward": "1", "reverse": "-1", "backward": "-1", "inc": "1", "dec": "-1",
                    "increasing": "1", "decreasing": "-1"}
+_WORDLIKE_UNITS = {"in", "in.", "m", "mil"}
 SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma", " ": "whitespace"}
 _WS_HEADER = re.compile(r"[^\s(\[]+(?:\s*[(\[][^)\]]*[)\]])?")
 _EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
@@ -88,6 +89,12 @@ def recognise_header(name: str) -> tuple[str, float] | None:
         for col, (names, units) in QUANTITIES.items():
             if q in names and u in units:
                 return col, units[u]
+    # a bare unit ("mm", "[V]", "mV") names the quantity when it can only be one of the two
+    # ("in", "m", "mil" alone are as likely words or indices as units)
+    unit = h.strip("()[] ")
+    for col in REQUIRED:
+        if unit in QUANTITIES[col][1] and unit not in _WORDLIKE_UNITS:
+            return col, QUANTITIES[col][1][unit]
     return None
 
 
