@@ -209,7 +209,11 @@ def test_train_auto_on_three_points_names_the_file_and_the_way_out(tmp_path, cap
     data = tmp_path / "three.csv"
     data.write_text("displacement_mm,voltage_v\n-1,-0.2\n0,0\n1,0.21\n")
     out = tmp_path / "m.json"
-    assert_one_line_error(*run(["train", data, "-o", out], capsys), "three.csv: 3 points")
+    assert_one_line_error(*run(["train", data, "-o", out], capsys), "three.csv: 3 distinct positions")
+    data.write_text("displacement_mm,voltage_v,direction\n-1,-0.2,1\n0,0,1\n1,0.21,1\n"
+                    "1,0.22,-1\n0,0.01,-1\n-1,-0.19,-1\n")            # two sweeps: still 3 positions
+    assert_one_line_error(*run(["train", data, "-o", out], capsys), "three.csv: 3 distinct positions")
+    data.write_text("displacement_mm,voltage_v\n-1,-0.2\n0,0\n1,0.21\n")
     assert not out.exists()
     rc, _, err = run(["train", data, "-o", out, "--terms", 2], capsys)
     assert rc == 0 and out.exists(), err

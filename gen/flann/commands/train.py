@@ -7,6 +7,8 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
@@ -97,9 +99,10 @@ def run(args) -> int:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
         check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
-        if len(rec) < 4:
-            raise FlannError(f"{rec.source}: {len(rec)} points are too few for --terms auto (its "
-                             "cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
+        positions = int(np.unique(rec.displacement_mm).size)
+        if positions < 4:
+            raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
+                             "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
         model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
                                  cost=fixed_point_cost)
         t = model.training
