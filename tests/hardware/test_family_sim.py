@@ -7,7 +7,7 @@ import shutil
 import pytest
 
 from flann.hardware.family.build import generate_family
-from flann.hardware.family.render import TOP, load_design
+from flann.hardware.family.render import load_design
 from flann.production.calibrate import check_sensor
 from flann.production.demo import write_batch
 from flann.production.images import hex_text
@@ -18,7 +18,7 @@ pytestmark = [pytest.mark.sim,
               pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
 
 
-def test_two_sensors_through_cfg_port(tmp_path, monkeypatch):
+def test_two_sensors_through_cfg_port(tmp_path):
     recs = write_batch(tmp_path / "rec", 3, seed=11, points=400)
     hdl = tmp_path / "hdl"
     generate_family(recs[:2], hdl, terms=9, input_bits=8)  # small input: every code stays short
@@ -29,10 +29,7 @@ def test_two_sensors_through_cfg_port(tmp_path, monkeypatch):
         h = tmp_path / f"{p.stem}.hex"
         h.write_text(hex_text(chk["words"]))
         images.append({"name": p.stem, "hex": str(h)})
-    # the runner's bench table has no family entry: register it for this test only
-    monkeypatch.setitem(runner.BENCHES, "family", (TOP, "test_flann_family_top"))
-    res = runner.run_bench(hdl, "family", model=hdl / "init_model.json", options={}, build_dir=tmp_path / "build",
-                           extra={"design": str(hdl), "images": images})
+    res = runner.run_family_bench(hdl, images, tmp_path / "build")
     assert res.tests == 3 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
     rec = res.records["family_every_code"]
     assert len(rec["codes"]) == 2 ** 8 and rec["mismatches"] == 0
