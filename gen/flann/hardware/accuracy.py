@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
 import warnings
 from pathlib import Path
@@ -21,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError, SpecError
+from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
 from ..golden.model import FlannModel, load_model, model_sha256
 from .adc import MAX_DESIGN_INPUT_BITS
@@ -214,15 +214,10 @@ def plot_errors(path, x, raw_err, float_err, hw_err, limit, title: str = "") -> 
     a2.set_xlabel("displacement (mm)")
     a2.legend(loc="best", fontsize=8)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.png")
     try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
+        atomic_save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
-        tmp.unlink(missing_ok=True)
 
 
 __all__ = ["fixed_point_cost", "design_spec", "design_adc", "adc_codes", "physical_limit_mm", "hardware_accuracy",

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
+from ..fileio import atomic_save_figure
 from ..hardware.fixed.spec import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.manifest import read_manifest
@@ -410,15 +411,10 @@ def plot(curve: dict, spec, path) -> None:
     a2.set_xlabel("input (V)")
     a2.set_title(f"(b) difference (1 LSB = {q} mm)")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.png")
     try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
+        atomic_save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
-        tmp.unlink(missing_ok=True)
 
 
 __all__ = ["run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
