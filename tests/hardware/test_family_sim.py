@@ -7,7 +7,7 @@ import shutil
 import pytest
 
 from flann.hardware.family.build import generate_family
-from flann.hardware.family.render import TOP, load_design, read_manifest
+from flann.hardware.family.render import load_design
 from flann.production.calibrate import check_sensor
 from flann.production.demo import write_batch
 from flann.production.images import hex_text
@@ -29,9 +29,7 @@ def test_two_sensors_through_cfg_port(tmp_path):
         h = tmp_path / f"{p.stem}.hex"
         h.write_text(hex_text(chk["words"]))
         images.append({"name": p.stem, "hex": str(h)})
-    files = [hdl / f for f in read_manifest(hdl)["files"]]
-    res = runner.run_cocotb(files, TOP, "test_flann_family_top", tmp_path / "build" / "family",
-                            {"design": str(hdl), "images": images}, name="family")
+    res = runner.run_family_bench(hdl, images, tmp_path / "build")
     assert res.tests == 3 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
     rec = res.records["family_every_code"]
     assert len(rec["codes"]) == 2 ** 8 and rec["mismatches"] == 0

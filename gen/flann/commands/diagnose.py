@@ -5,6 +5,14 @@ from __future__ import annotations
 import json
 import sys
 
+from ..diagnose import diagnose
+from ..diagnose.demo import demo_table, run_demo
+from ..diagnose.report import format_text, plot, to_json
+from ..errors import FlannError
+from ..fileio import atomic_write_json
+from ..physics.sensor import load_sensor
+from ..recordings import read_recordings
+
 HELP = "locate and name the physics missing between simulation and recordings"
 
 
@@ -37,14 +45,9 @@ def _progress(quiet: bool):
 
 
 def run(args) -> int:
-    from ..errors import FlannError
-    from ..fileio import atomic_write_json
-
     if args.demo:
         if args.recordings or args.sensor or args.plot:
             raise FlannError("--demo takes no recordings, --sensor or --plot (it simulates its own)")
-        from ..diagnose.demo import demo_table, run_demo
-
         results = run_demo(progress=_progress(args.quiet), limits=args.limits)
         if args.json:
             obj = [r.to_json() for r in results.cases] + [r.to_json() for r in results.independent]
@@ -63,15 +66,10 @@ def run(args) -> int:
 
     if not args.recordings:
         raise FlannError("diagnose needs a recordings CSV (or --demo)")
-    from ..diagnose import diagnose
-    from ..diagnose.report import format_text, plot, to_json
-    from ..recordings import read_recordings
 
     rec = read_recordings(args.recordings)
     sensor = None
     if args.sensor:
-        from ..physics.sensor import load_sensor
-
         sensor = load_sensor(args.sensor)
     dg = diagnose(rec, sensor=sensor, progress=_progress(args.quiet))
     if args.plot:

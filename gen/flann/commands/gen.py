@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from ..hardware import options as gen_options
-from ..hardware.family.command import add_family_arguments, run_family
+from .family import add_family_arguments, run_family
 from ..hardware.fixed.render import generate as generate_fixed
 from ..hardware.float18.render import generate as generate_float18
 from ..hardware.float18.spec import float18_options

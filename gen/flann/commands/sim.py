@@ -17,7 +17,7 @@ from ..errors import FlannError
 from ..fileio import atomic_write_json
 from ..hardware import options as gen_options
 from ..verify.design import open_design
-from ..verify.runner import plot, simulate
+from ..verify.runner import ENGINES, plot, simulate
 from ..verify.shards import terminal_progress
 
 HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
@@ -35,9 +35,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--netlist", action="store_true",
                         help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
                              "netlist over every input code (Verilator, Yosys's Xilinx cell models)")
-    parser.add_argument("--engine", choices=("ghdl", "verilator"), default="ghdl",
-                        help="every input code through: ghdl = the VHDL under GHDL (default); verilator = GHDL's "
-                             "synthesised netlist compiled by Verilator (~50x faster), the VHDL on a sample")
+    parser.add_argument("--engine", choices=ENGINES, default="auto",
+                        help="every input code through: ghdl = the VHDL under GHDL; verilator = GHDL's "
+                             "synthesised netlist compiled by Verilator (~25x faster), the VHDL on a sample; "
+                             "auto (default) = ghdl when that takes about a minute or less, else verilator")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     parser.add_argument("--plot", metavar="OUT.png", default=None,
                         help="HDL vs golden model across the input range and their difference (PNG)")

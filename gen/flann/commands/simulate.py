@@ -11,9 +11,15 @@ Without SENSOR.toml the seed paper's LVDT (data/sensors/paper_lvdt.toml) is used
 from __future__ import annotations
 
 import sys
+import warnings
 
 from ..errors import FlannError
 from ..fileio import atomic_write_json, atomic_write_text
+from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
+from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
+from ..physics.lvdt import describe
+from ..physics.sensor import default_sensor, format_sensor, load_sensor
+from ..physics.simulate import fold_back_mm, simulate_recordings
 from ..recordings import read_recordings, write_recordings
 
 HELP = "LVDT physics simulator: write recordings from a sensor file"
@@ -59,13 +65,11 @@ def add_arguments(p) -> None:
 
 
 def _sensor(args):
-    from ..physics.sensor import default_sensor, load_sensor
 
     return load_sensor(args.sensor) if args.sensor else default_sensor()
 
 
 def _list_effects() -> int:
-    from ..physics.effects import EFFECTS
 
     for e in EFFECTS.values():
         print(f"[effects.{e.name}]  ({e.stage} stage) {e.description}")
@@ -77,9 +81,6 @@ def _list_effects() -> int:
 
 
 def _describe(args) -> int:
-    from ..physics.effects import thermal_coefficient_from_copper
-    from ..physics.lvdt import describe
-    from ..physics.simulate import fold_back_mm
 
     s = _sensor(args)
     print(f"{s.name}: {s.description}" if s.description else s.name)
@@ -90,7 +91,7 @@ def _describe(args) -> int:
           "  output_fold_back_mm = none within 3 x stroke")
     print(f"  copper_thermal_coefficient_per_c = {thermal_coefficient_from_copper(s):.3g}")
     if args.plot:
-        from ..physics.plots import plot_anatomy
+        from ..physics.plots import plot_anatomy  # matplotlib: loaded only to plot
 
         plot_anatomy(s, args.plot)
     return 0
@@ -108,9 +109,7 @@ def run(args) -> int:
     for opt in ("params", "write_sensor", "json"):
         if getattr(args, opt):
             raise FlannError(f"simulate: --{opt.replace('_', '-')} needs --fit")
-    import warnings
 
-    from ..physics.simulate import fold_back_mm, simulate_recordings
 
     s = _sensor(args)
     if args.no_effects:
@@ -134,7 +133,7 @@ def run(args) -> int:
         f"effects: {effects}",
     )
     if args.plot:
-        from ..physics.plots import plot_simulation
+        from ..physics.plots import plot_simulation  # matplotlib: loaded only to plot
 
         plot_simulation(s, rec, args.plot)
     write_recordings(args.output, rec, comments=comments)
@@ -145,8 +144,6 @@ def run(args) -> int:
 def _run_fit(args) -> int:
     if args.output:
         raise FlannError("simulate --fit: -o is for simulation; use --write-sensor OUT.toml")
-    from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
-    from ..physics.sensor import format_sensor
 
     s = _sensor(args)
     rec = read_recordings(args.fit)
@@ -185,7 +182,7 @@ def _run_fit(args) -> int:
                           "residual_v": float(fit.residual_v[r])} for r in fit.excluded_rows],
         })
     if args.plot:
-        from ..physics.plots import plot_fit
+        from ..physics.plots import plot_fit  # matplotlib: loaded only to plot
 
         plot_fit(rec, fit, args.plot)
     return 0

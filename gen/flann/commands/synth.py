@@ -9,7 +9,9 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..implement import synth
-from ..hardware.target import DEVICES, parse_part
+from ..hardware.target import DEFAULT_PART, DEVICES, parse_part
+from ..verify.design import from_directory
+from ..verify.netlist import check_synthesized
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
@@ -19,7 +21,7 @@ def add_arguments(p):
     p.add_argument(
         "--device", default=None, metavar="PART",
         help="target part DEVICE-PACKAGE-SPEED, e.g. xc2s30-pq208-5 (default: the part in DIR/manifest.json, "
-        f"else {synth.DEFAULT_DEVICE}; devices " + ", ".join(d.name for d in DEVICES) + ")",
+        f"else {DEFAULT_PART}; devices " + ", ".join(d.name for d in DEVICES) + ")",
     )
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
@@ -35,9 +37,6 @@ def add_arguments(p):
 
 def _check_netlist(args, netlist: Path) -> None:
     """Refuse a design whose mapped netlist disagrees with its twin (needs the model)."""
-    from ..verify.design import from_directory
-    from ..verify.netlist import check_synthesized
-
     man = synth.read_manifest(args.directory)
     spec = man.data.get("spec") if isinstance(man.data.get("spec"), dict) else {}
     if man.top != "flann_top" or spec.get("number_format") != "fixed":

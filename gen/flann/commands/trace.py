@@ -10,12 +10,17 @@ Fig. 6(b)); ``--at CSV`` also lists the error at the recordings' input voltages.
 from __future__ import annotations
 
 import json
+import sys
+import tempfile
+from pathlib import Path
 
+from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
-from ..analysis.trace import plot_compare, plot_trace, run_trace
+from ..analysis.trace import check_hdl, plot_compare, plot_trace, run_trace
 from ..hardware import options as gen_options
 from ..hardware.float18.spec import float18_options
+from ..verify.design import from_directory
 
 HELP = "stage-by-stage error of hardware against the golden model"
 FORMATS = ("fixed", "float18")
@@ -49,11 +54,6 @@ def _options(args, fmt: str) -> dict:
 
 def _design_dir(args):
     """A design directory: trace exactly that design (its manifest's options and model)."""
-    from pathlib import Path
-
-    from ..errors import FlannError
-    from ..verify.design import from_directory
-
     if not Path(args.model).is_dir():
         return None
     if args.format != "fixed" or args.compare:
@@ -70,11 +70,6 @@ def run(args) -> int:
     else:
         results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
     if args.hdl:
-        import sys
-        import tempfile
-
-        from ..analysis.trace import check_hdl
-
         for f, r in results.items():
             print(f"simulating the {f} design over every input code ...", file=sys.stderr)
             with tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:

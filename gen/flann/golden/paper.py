@@ -14,14 +14,18 @@ compared with a monotone interpolant of the table), and the tool's own default
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
+
 import numpy as np
 
+from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
 from ..recordings import Recordings
-from .train import design_matrix, fit_auto, fit_lms, lms_leave_one_out
+from .train import design_matrix, fit_auto, fit_lms, fit_lstsq, lms_epochs, lms_leave_one_out
 
 # The paper's Table 1 (also in data/paper_table1.csv, checked equal by the tests).
 TABLE1_DISPLACEMENT_MM = np.arange(-30.0, 30.0 + 1, 5.0)
@@ -59,10 +63,6 @@ def lstsq_loo_errors(rec: Recordings, terms: int, norm: str = "range",
                      ridge: float = 0.0) -> np.ndarray:
     """Leave-one-out error (mm) of ``flann train --terms N --method lstsq`` (normalisation
     recomputed from the remaining points, as training on them would)."""
-    import warnings
-
-    from .train import fit_lstsq
-
     err = np.empty(len(rec))
     for i in range(len(rec)):
         keep = np.arange(len(rec)) != i
@@ -171,9 +171,7 @@ def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS
 def plot_fig5(outdir, rec: Recordings, details: dict) -> list[str]:
     """``fig5.png``: the paper's Fig. 5 panel for panel (3 x 3, (a)-(i)), and
     ``between_points_51.png``: the 51-term model between the table's points (beyond it)."""
-    from pathlib import Path
-
-    import matplotlib
+    import matplotlib  # loaded only to plot
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -231,9 +229,6 @@ def sensitivity(rec: Recordings | None = None, etas=(0.005, 0.01, 0.02, 0.03),
                 tol_pct_fs: float = DEFAULT_TOL_PCT_FS, terms_list=(11, 25, 51, 61)) -> dict:
     """% of linearity range for every (terms, eta, epochs): how much the unknown LMS
     settings move Table 2.  Epochs are run incrementally (one LMS run per (terms, eta))."""
-    from ..errors import FlannError
-    from .train import lms_epochs
-
     rec = table1() if rec is None else rec
     v, x = rec.voltage_v, rec.displacement_mm
     fs = full_scale_mm(x)

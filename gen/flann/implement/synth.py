@@ -21,10 +21,10 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..hardware.target import DEVICES, Part, parse_part
+from ..hardware.manifest import Manifest, read_manifest
+from ..hardware.target import DEFAULT_PART, DEVICES, Part, parse_part
 from ..errors import FlannError
 
-DEFAULT_DEVICE = "xc2s30-pq208-5"
 FAMILY = "xcv"
 
 # Yosys warnings that say nothing about the design (feature gaps of the xcv target).
@@ -45,40 +45,6 @@ _IO_CELLS = ("IBUF", "IBUFG", "OBUF", "OBUFT", "IOBUF")
 
 class SynthCheckError(FlannError):
     """The design synthesises to something that must not reach hardware (latch, multiple drivers)."""
-
-
-@dataclass(frozen=True)
-class Manifest:
-    directory: Path
-    top: str
-    files: tuple[Path, ...]
-    data: dict
-
-
-def read_manifest(directory: str | Path) -> Manifest:
-    directory = Path(directory)
-    path = directory / "manifest.json"
-    if not path.is_file():
-        raise FlannError(f"{path} not found: generate the design first (flann gen MODEL -o {directory})")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise FlannError(f"{path}: not valid JSON ({exc})") from None
-    if not isinstance(data, dict):
-        raise FlannError(f"{path}: expected a JSON object with 'top' and 'files'")
-    top = data.get("top")
-    files = data.get("files")
-    if not isinstance(top, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", top):
-        raise FlannError(f"{path}: field 'top' must name the top entity (a VHDL identifier), got {top!r}")
-    if not isinstance(files, list) or not files or not all(isinstance(f, str) for f in files):
-        raise FlannError(f"{path}: field 'files' must be a non-empty list of VHDL files in compile order")
-    paths = []
-    for f in files:
-        p = directory / f
-        if not p.is_file():
-            raise FlannError(f"{path}: listed file {f!r} does not exist in {directory}")
-        paths.append(p)
-    return Manifest(directory, top, tuple(paths), data)
 
 
 @dataclass(frozen=True)
@@ -424,10 +390,10 @@ def entity_breakdown(modules: dict[str, dict[str, int]]) -> dict[str, dict[str, 
 
 
 def manifest_device(man: Manifest) -> str:
-    """The part the design was generated for (manifest spec.device), else DEFAULT_DEVICE."""
+    """The part the design was generated for (manifest spec.device), else the generator's default part."""
     spec = man.data.get("spec")
     dev = spec.get("device") if isinstance(spec, dict) else None
-    return dev if isinstance(dev, str) and dev else DEFAULT_DEVICE
+    return dev if isinstance(dev, str) and dev else DEFAULT_PART
 
 
 def synthesize(directory: str | Path, device: str | None = None, work: str | Path | None = None,

@@ -31,8 +31,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
+from ..fileio import atomic_save_figure
 from ..hardware.fixed.spec import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
+from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CONFIG_ENV
 from .design import Design
 from .netlist import check_netlist, check_rtl_netlist
@@ -47,6 +49,7 @@ BENCHES = {
     "multiplier": ("flann_multiplier", "test_blocks", "multiplier_vs_twin"),
     "adder": ("flann_adder", "test_blocks", "adder_vs_twin"),
 }
+FAMILY_BENCH = "test_flann_family_top"  # flann gen --family designs (weights in memory)
 HARNESSES = {"flann_sweep": "flann_sweep.vhd", "flann_harness": "flann_harness.vhd"}
 BENCH_PACKAGE = "flann.verify.benches"
 CLK_NS = 10
@@ -206,6 +209,16 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
                       parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
 
 
+def run_family_bench(directory, images: list[dict], build_dir, *, seed: int = 1,
+                     backend: str | None = None) -> BenchResult:
+    """The family design in ``directory`` with sensors' weight images ({name, hex}) loaded
+    through its cfg_* port, each over every input code against that sensor's twin."""
+    man = read_manifest(directory)
+    cfg = {"design": str(Path(directory).resolve()), "images": images}
+    return run_cocotb(list(man.files), man.top, FAMILY_BENCH, Path(build_dir) / "family", cfg, name="family",
+                      seed=seed, backend=backend)
+
+
 def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
           backend: str | None = None, progress=None) -> dict:
     """Input codes through the VHDL sweep harness, in shards run side by side (one per core).
@@ -275,7 +288,22 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
             "build_seconds": t_build}
 
 
-ENGINES = ("ghdl", "verilator")
+ENGINES = ("auto", "ghdl", "verilator")
+# GHDL (LLVM) simulates the design at roughly 1e5 clock cycles/s per shard on this class of
+# machine: beyond a minute of that, every code goes through the compiled netlist instead.
+GHDL_CYCLES_PER_MINUTE = 6e6
+
+
+def choose_engine(design: Design, engine: str = "auto") -> str:
+    """``auto``: the VHDL under GHDL when every code fits in about a minute there (or Verilator is
+    missing), else GHDL's synthesised netlist compiled by Verilator with the VHDL on a sample."""
+    if engine not in ENGINES:
+        raise FlannError(f"engine {engine!r}: must be one of {', '.join(ENGINES)}")
+    if engine != "auto":
+        return engine
+    man = design.manifest
+    cycles = (1 << man["input_bits"]) * man["cycles_per_sample"] / max(1, cores())
+    return "verilator" if cycles > GHDL_CYCLES_PER_MINUTE and shutil.which("verilator") else "ghdl"
 
 
 def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple[dict, dict]:
@@ -287,14 +315,13 @@ def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple
     compiled netlist is tied to the VHDL's own simulation on every run.
     """
     man = design.manifest
+    engine = choose_engine(design, engine)
     if engine == "ghdl":
         sw = sweep(design, build_dir, progress=progress("sweep") if progress else None)
         about = {"engine": "ghdl", "backend": f"ghdl-{sw['backend']}", "shards": sw["shards"],
                  "seconds": round(sw["seconds"], 1), "build_seconds": round(sw["build_seconds"], 1),
                  "codes_per_s": round(sw["codes"].size / sw["seconds"], 1) if sw["seconds"] else None}
         return sw, {**{k: sw[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
-    if engine != "verilator":
-        raise FlannError(f"engine {engine!r}: must be one of {', '.join(ENGINES)}")
     nl = check_rtl_netlist(design, build_dir / "rtl_netlist", progress=progress("sweep") if progress else None)
     lo, hi = int(nl["codes"].min()), int(nl["codes"].max())
     rng = np.random.default_rng(int(man["model_sha256"][:8], 16) if man.get("model_sha256") else 1)
@@ -312,7 +339,7 @@ def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple
 
 
 def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
-             engine: str = "ghdl", progress=None) -> dict:
+             engine: str = "auto", progress=None) -> dict:
     """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
     GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches,
     optionally the post-synthesis netlist; returns {"summary", "curve", "spec"} (summary =
@@ -384,16 +411,11 @@ def plot(curve: dict, spec, path) -> None:
     a2.set_xlabel("input (V)")
     a2.set_title(f"(b) difference (1 LSB = {q} mm)")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp.png")
     try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
+        atomic_save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
-        tmp.unlink(missing_ok=True)
 
 
-__all__ = ["run_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]

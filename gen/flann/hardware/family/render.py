@@ -11,15 +11,14 @@ rebuilt from the directory alone).
 from __future__ import annotations
 
 import hashlib
-import json
 from pathlib import Path
 
 from ...errors import FlannError
-from ...fileio import atomic_directory
 from ...golden.model import FlannModel, load_model
 from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..header import header
+from ..manifest import write_design
 from ..fixed import render as fixed
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict
 from .twin import FlannFamilyMem
@@ -129,15 +128,7 @@ def design_hash(out_dir) -> str:
 def write(fam: FamilySpec, out_dir, init_model: FlannModel, init_name: str = "") -> dict:
     texts = render(fam, init_name)
     man = manifest(fam, list(texts))
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir) as tmp:
-        for name, text in texts.items():
-            (tmp / name).write_text(text, newline="")
-        (tmp / fixed.MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
-        (tmp / INIT_MODEL).write_text(init_model.to_json(), newline="")
-    return man
+    return write_design({**texts, INIT_MODEL: init_model.to_json()}, man, out_dir)
 
 
 def read_manifest(out_dir) -> dict:

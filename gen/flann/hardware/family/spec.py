@@ -32,6 +32,7 @@ from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
 from ..fixed.spec import BRAM_BITS, Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
+from ..target import DEFAULT_PART
 
 DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
 # The memory is one Spartan-II block RAM (RAMB4_S16_S16, 256 x 16): word k is held as two
@@ -208,7 +209,7 @@ def _scaled(model: FlannModel, k: float) -> FlannModel:
 
 def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT_MARGIN,
                   input_bits: int = 12, input_lsb_v: float | None = None, output_bits: int | None = None,
-                  output_lsb_mm: float | None = None, device: str = "xc2s200-pq208-5",
+                  output_lsb_mm: float | None = None, device: str = DEFAULT_PART,
                   mult_style: str = "shiftadd", mult_digit_bits: int = 2, interp: bool = True,
                   phase_bits: int | None = None, table_addr_bits: int | None = None,
                   term_frac_bits: int | None = None, weight_frac_bits: int | None = None,

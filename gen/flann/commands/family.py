@@ -1,12 +1,12 @@
-"""The ``--family`` option of ``flann gen``: its arguments and what it runs (kept here, beside the design)."""
+"""The ``--family`` option of ``flann gen``: its arguments and what it runs (not a subcommand of its own)."""
 
 from __future__ import annotations
 
 import json
 
-from ...errors import FlannError
-from .build import DEFAULT_TERMS, generate_family
-from .spec import DEFAULT_MARGIN
+from ..errors import FlannError
+from ..hardware.family.build import DEFAULT_TERMS, generate_family
+from ..hardware.family.spec import DEFAULT_MARGIN
 
 
 def add_family_arguments(parser) -> None:
