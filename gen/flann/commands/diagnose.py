@@ -31,11 +31,11 @@ def add_arguments(p) -> None:
                         "print the table")
     p.add_argument("--limits", action="store_true",
                    help="with --demo: also measure detection limits (slow: many simulations)")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal anyway)")
 
 
 def _progress(quiet: bool):
-    if quiet:
+    if quiet or not sys.stderr.isatty():  # progress is for a person watching, not for logs
         return None
 
     def show(msg: str) -> None:
