@@ -671,6 +671,17 @@ class PhysicsFamily:
                 cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1) - y0)
         return np.stack(cols, 1)
 
+    def rechoose(self, effects, idx: np.ndarray, fit: Fit) -> Fit:
+        """``fit`` with the number of shape terms chosen for ``effects`` (by
+        :meth:`choose_terms`), the family's current choice left as it was."""
+        disc, equivalent = self._disc, self.equivalent_terms
+        try:
+            _, table, f = self.choose_terms(effects, idx, fit)
+        finally:
+            self._disc, self.equivalent_terms = disc, equivalent
+        f.extra["cv_table"] = table
+        return f
+
     def refine(self, effects, fit: Fit, idx: np.ndarray) -> Fit:
         """``fit`` with the shape term's complexity chosen again now that ``effects`` are
         in the model (see :meth:`choose_terms`)."""
