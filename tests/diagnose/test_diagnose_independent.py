@@ -104,3 +104,15 @@ def test_rate_search_finds_the_same_limit_as_trying_everything():
         assert len(calls) <= 20 * len(sizes)
         for row in rows:
             assert row["hits"] == sum(row["size"] >= t for t in thresholds[:row["tried"]])
+
+
+def test_large_zero_shift_is_not_taken_by_an_imbalance():
+    # seed 7013 (a long-secondary sensor, one pass, 129 points): with the shape term's size
+    # chosen before the shift was fitted (its 66 mV even part hid the odd misfit), an
+    # imbalance whose bend also bends the odd part was named instead of the shift
+    case = next(c for c in IND.CASES if c.name.startswith("zero_shift"))
+    res = IND.run_case(case, seed=7013)
+    assert res.named == ["zero_shift"]
+    value, se = res.recovered
+    assert abs(value - 0.6) < 0.02
+    assert res.rms_after < 1.3 * IND.NOISE_V
