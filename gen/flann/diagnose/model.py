@@ -545,6 +545,15 @@ class PhysicsFamily:
         if start is not None and "k_shape" in start.extra:
             k0 = start.extra["k_shape"]
         if "adc_clipping" not in effects:
+            if ("leadscrew_periodic" in effects and k0 > 0 and not (
+                    start is not None and "leadscrew_periodic.period_mm" in start.names)):
+                # a ripple and the shape term's warp both move the position locally: the
+                # shape may have taken a lead screw before it was tried (a 20 um, 2 mm
+                # ripple on a 22 mm travel raised K to 6); BIC decides, as for a rail
+                fits = [self._fit(effects, idx, start, "both", k)
+                        for k in [k0] + [k for k in self.fewer_terms if k < k0]]
+                ok = [f for f in fits if f.ok] or fits
+                return min(ok, key=lambda f: f.bic)
             return self._fit(effects, idx, start, "both", k0)
         if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
             return self._fit(effects, idx, start, self._sides(start), k0)
