@@ -42,7 +42,7 @@ TIE_BIC = 2.0
 MIN_DOF = 5
 # candidates (the best by BIC) whose family complexity is chosen again before comparing,
 # if within this fraction of the best's ΔBIC of it (a re-choice moved a ΔBIC by ~20 of 660)
-RECHOOSE = 2
+RECHOOSE = 3
 RECHOOSE_NEAR = 0.25
 
 
