@@ -364,7 +364,7 @@ class PhysicsFamily:
 
     def _disc_at(self, idx: np.ndarray, core: np.ndarray):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
-        inside a fit the basis moves only with the null position, so the finite-difference
+        inside a fit the basis moves only with a zero shift, so the finite-difference
         steps of every other parameter reuse one factorisation (a least-squares solve per
         evaluation was most of the diagnosis' time on 2,000 points)."""
         key = ("disc", self.disc.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
@@ -486,19 +486,18 @@ class PhysicsFamily:
                 moved = base.copy()
                 moved[k_o] += h
                 cols.append(self.evaluate(np.r_[moved, 0.0], names, idx) - off)
+        core = (self.data.x[idx] - self.origin0) * self.scale
         if self.disc is not None:
-            core = (self.data.x[idx] - self.origin0) * self.scale
             cols.append(self.disc.evaluate(core))
         A = np.column_stack(cols)
         unit = on - off
-        core = (self.data.x[idx] - self.origin0) * self.scale
         u2 = (core / self._half_range()) ** 2
         X = np.column_stack([unit, u2 * unit]) / trial
-        X = X - A @ np.linalg.lstsq(A, X, rcond=1e-10)[0]
-        r = resid - A @ np.linalg.lstsq(A, resid, rcond=1e-10)[0]
+        X = X - A @ np.linalg.lstsq(A, X, rcond=RCOND)[0]
+        r = resid - A @ np.linalg.lstsq(A, resid, rcond=RCOND)[0]
         if not np.all(np.isfinite(X)) or not float(np.sum(X * X)) > 0:
             return {}
-        a, b = np.linalg.lstsq(X, r, rcond=1e-10)[0]
+        a, b = np.linalg.lstsq(X, r, rcond=RCOND)[0]
         e = float(np.clip(a, -0.5, 0.5))
         c = float(np.clip(b / a, *self._CLIPPED[f"secondary_imbalance.{SUM_CURVATURE}"])) \
             if abs(a) > 0 else 0.0
@@ -665,7 +664,9 @@ class PhysicsFamily:
         k = self._k_of(fit)
         coef = fit.extra.get("coef")
         basis = self._basis(k)
-        coef = np.zeros(0 if basis is None else basis.ncols) if coef is None else np.asarray(coef, float)
+        if coef is None:
+            coef = np.zeros(0 if basis is None else basis.ncols)
+        coef = np.asarray(coef, float)
         with self._with_k(k):
             y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef)
             cols = []
