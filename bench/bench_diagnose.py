@@ -5,8 +5,10 @@ Prints wall-clock and CPU time of diagnose() (calibration, noise, outliers, regi
 selection with cross-validation) for a control, a one-effect and a two-effect recording of
 2,000 points (one out-and-back sweep of the paper's LVDT, 5 mV noise), for the two slowest
 kinds of case on the independent forward model (a lead screw; thermal drift beside rails)
-stretched to 2,000 points, and for the whole `flann diagnose` command on the two-effect file
-(process start, CSV read, plot, JSON).
+stretched to 2,000 points, for the whole `flann diagnose` command on the two-effect file
+(process start, CSV read, plot, JSON), and for the production line's budgeted diagnosis
+(`flann calibrate`: 250 bin means of a 2,000-point sweep of a sensor with +-5 % geometry,
+diagnosed with the nominal sensor file; CPU per sensor, target well under 1.2 s).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from flann.diagnose import diagnose
 from flann.physics import filament as F
 from flann.physics.sensor import default_sensor
 from flann.physics.simulate import simulate_recordings
+from flann.production.calibrate import DIAGNOSIS_POINTS, diagnosis_sample
+from flann.production.demo import NOISE_V, varied_sensor
 from flann.recordings import write_recordings
 
 POINTS = 2000
@@ -80,7 +84,27 @@ def main() -> int:
           "(incl. start-up, plot, JSON)")
     print(f"worst diagnose() wall time: {worst:.2f} s (target < 10 s): "
           f"{'OK' if max(worst, cli) < 10 else 'OVER'}")
+    production()
     return 0
+
+
+def production(n: int = 8) -> None:
+    """The budgeted diagnosis `flann calibrate` runs per sensor (seed-1 batch, as
+    bench/bench_calibrate.py simulates it)."""
+    nominal = default_sensor()
+    cpu, named = [], 0
+    for k in range(n):
+        s = varied_sensor(k, seed=1, spread=0.05)
+        rec = simulate_recordings(s, step_mm=2 * s.stroke_mm / (POINTS / 2 - 1), noise_v=NOISE_V,
+                                  seed=100003 + k)
+        small = diagnosis_sample(rec, DIAGNOSIS_POINTS)[0]
+        c0 = time.process_time()
+        dg = diagnose(small, sensor=nominal)
+        cpu.append(time.process_time() - c0)
+        named += bool(dg.named)
+    print(f"{'production: ' + str(DIAGNOSIS_POINTS) + ' bin means, nominal sensor file':44s} "
+          f"{n:5d} sensors: {sum(cpu) / n:6.2f} s CPU mean, {max(cpu):.2f} s worst; "
+          f"sensors with an effect named: {named} of {n}")
 
 
 if __name__ == "__main__":

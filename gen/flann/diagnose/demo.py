@@ -363,7 +363,8 @@ def independent_table(results: DemoResults) -> str:
         lines += ["", f"False alarms on {a['reps']} random controls of the independent model: "
                       f"{a['false_alarms']} ({a['named'] or 'none'})"]
     if results.independent_limits:
-        lines += ["", "| effect | parameter | found / seeds by size (20 random geometries, "
+        reps = results.independent_limits[0]["reps"]
+        lines += ["", f"| effect | parameter | found / seeds by size ({reps} random geometries, "
                       "largest first) | 95 % limit |", "|---|---|---|---|"]
         for lim in results.independent_limits:
             rates = _rates_text(lim)

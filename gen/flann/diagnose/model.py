@@ -33,8 +33,19 @@ from ..physics.effects import EFFECTS, Context, Signal
 from ..physics.simulate import simulate_output_v
 from .select import Fit, make_folds
 
-# candidate numbers of smooth shape terms (chosen by cross-validation)
-SHAPE_TERMS = (0, 2, 3, 4, 6, 8, 10)
+# candidate numbers of smooth shape terms (chosen by cross-validation).  The grid goes
+# on while it pays: a sensor whose geometry is a few % off the simulated one (a production
+# line diagnosed with the nominal sensor file) leaves a misfit ~1,000x its noise, which
+# needs up to ~16 terms; the search stops after STOP_AFTER numbers in a row that do not
+# improve the best out-of-fold error by 1 %.
+SHAPE_TERMS = (0, 2, 3, 4, 6, 8, 10, 12, 14, 16)
+STOP_AFTER = 2
+# relative singular-value cut-off of the shape term's least squares
+RCOND = 1e-10
+# Levenberg-Marquardt stops when the relative change of the sum of squares (and of the
+# step) is below this: 1e-5 of the RSS moves BIC (n ln RSS) by 0.02 on 2,000 points, far
+# inside the 10 it must move by; tighter only wandered on (up to 4x the evaluations)
+TOL = 1e-5
 
 # secondary_imbalance's extra, diagnosis-only parameter (not in the catalogue): how much
 # the sum of the secondaries bends along the stroke beyond the calibrated simulation's,
@@ -92,29 +103,49 @@ class OddBasis:
     ``k`` differences of Gaussians ``g(u - c_j) - g(u + c_j)``, centres ``c_j = j U / k``
     over the recorded half-range ``U``, width ``U / k``: odd about the null, the same in
     both directions of travel and at every time, and too broad to draw a short period, a
-    flat rail or the rounded tip of a V.  Their coefficients are linear and solved in
-    closed form inside every fit (variable projection), so they cost no iterations.
+    flat rail or the rounded tip of a V.  With ``warp`` (a grid and the simulated slope on
+    it) the same k functions times the slope are added: a smooth warp of the displacement
+    axis, ``y(u + d(u)) - y(u) ~ slope(u) d(u)``.  A winding or core a few % longer moves
+    the knee where the curve bends into saturation; the misfit is then sharp at the knee
+    while the warp ``d`` is smooth, so a few warp terms take what plain terms would need
+    dozens for (and what they would leave as a ripple that looks like a lead screw).
+    Their coefficients are linear and solved in closed form inside every fit (variable
+    projection), so they cost no iterations.
     """
 
-    def __init__(self, half_range_mm: float, k: int, rectified: bool = False):
+    def __init__(self, half_range_mm: float, k: int, rectified: bool = False, warp=None):
         self.half = max(float(half_range_mm), 1e-9)
         self.k = int(k)
         self.rectified = rectified
+        self.warp = warp
         self.centres = self.half * np.arange(1, self.k + 1) / max(self.k, 1)
         self.width = self.half / max(self.k, 1)
+
+    @property
+    def ncols(self) -> int:
+        """Columns of the basis matrix (coefficients of the shape term)."""
+        return self.k * (1 if self.warp is None else 2)
 
     def evaluate(self, core_mm: np.ndarray) -> np.ndarray:
         """(n, k) basis matrix at the core positions."""
         u = np.asarray(core_mm, float)[:, None]
         c = self.centres[None, :]
         b = np.exp(-((u - c) / self.width) ** 2) - np.exp(-((u + c) / self.width) ** 2)
+        w = None
+        if self.warp is not None:
+            grid, slope = self.warp
+            # the simulated slope already carries the rectified curve's sign
+            w = b * np.interp(u[:, 0], grid, slope)[:, None]
         if self.rectified:   # an amplitude detector folds the odd shape into an even one
             b = b * np.where(u >= 0, 1.0, -1.0)
-        return b
+        return b if w is None else np.hstack([b, w])
 
     def describe(self) -> str:
-        return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm), "
-                "complexity chosen by 5-fold cross-validation with the named effects in place")
+        warp = (f", plus the same {self.k} times the simulated slope (a smooth warp of the "
+                "displacement axis)") if self.warp is not None else ""
+        return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm)"
+                f"{warp}, complexity chosen by 5-fold cross-validation with the named effects "
+                "in place")
 
 
 class PhysicsFamily:
@@ -310,29 +341,46 @@ class PhysicsFamily:
         hi = eff.get("adc_clipping", {}).get("rail_high_v", math.inf)
         lo = eff.get("adc_clipping", {}).get("rail_low_v", -math.inf)
         if self.disc is not None:
+            # the shape follows a zero shift (it may be large); the origin's own change
+            # inside a fit (~1e-3 mm) would only move it by a negligible amount, and keeping
+            # it fixed lets every evaluation reuse one factorisation of the basis
             shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
-            B = self._disc_at(idx, core - shift - (origin - self.origin0) * self.scale)
+            B, pinv = self._disc_at(idx, core - shift)
             if coef is None:
                 if target is None:
-                    coef = np.zeros(self.disc.k)
+                    coef = np.zeros(self.disc.ncols)
                 else:
                     free = (y < hi) & (y > lo)
-                    if free.sum() > self.disc.k:
-                        coef = np.linalg.lstsq(B[free], (target - y)[free], rcond=1e-10)[0]
+                    if free.all():
+                        coef = pinv() @ (target - y)
+                    elif free.sum() > self.disc.ncols:
+                        coef = np.linalg.lstsq(B[free], (target - y)[free], rcond=RCOND)[0]
                     else:
-                        coef = np.zeros(self.disc.k)
+                        coef = np.zeros(self.disc.ncols)
             y = y + B @ coef
         if "adc_clipping" in eff:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
-    def _disc_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+    def _disc_at(self, idx: np.ndarray, core: np.ndarray):
+        """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
+        inside a fit the basis moves only with a zero shift, so the finite-difference
+        steps of every other parameter reuse one factorisation (a least-squares solve per
+        evaluation was most of the diagnosis' time on 2,000 points)."""
         key = ("disc", self.disc.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         hit = self._shape_cache.get(key)
         if hit is None:
             if len(self._shape_cache) > 400:
                 self._shape_cache.clear()
-            hit = self.disc.evaluate(core)
+            B = self.disc.evaluate(core)
+            store: list = []
+
+            def pinv():
+                if not store:
+                    store.append(np.linalg.pinv(B, rcond=RCOND))
+                return store[0]
+
+            hit = (B, pinv)
             self._shape_cache[key] = hit
         return hit
 
@@ -388,6 +436,8 @@ class PhysicsFamily:
                                                           target=self.data_y(idx))
             want = {names[i].split(".", 1)[0] for i in missing}
             guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)), want)
+            if "secondary_imbalance" in want:
+                guesses.update(self._guess_imbalance(resid, idx, base_theta, base_names))
             for i in missing:
                 theta[i] = guesses.get(names[i], 0.0)
         return theta
@@ -417,6 +467,42 @@ class PhysicsFamily:
         if "leadscrew_periodic" in want:
             g.update(self._guess_leadscrew(x, resid, slope))
         return g
+
+    def _guess_imbalance(self, resid, idx, base_theta, base_names) -> dict[str, float]:
+        """The imbalance and the sum's bend by linear regression of the residual on the
+        imbalance's contribution D and on u^2 D (the model is e D (1 + c u^2)), less what
+        the shape term and the null position can take.  Starting from zero, the fit can
+        slide to the edge of the bend's range (clipped: no gradient) and stay there."""
+        trial = 0.01
+        names = list(base_names) + ["secondary_imbalance.imbalance_fraction"]
+        base = np.asarray(base_theta, float)
+        with self._with_k(0):
+            on = self.evaluate(np.r_[base, trial], names, idx)
+            off = self.evaluate(np.r_[base, 0.0], names, idx)
+            h = 1e-3
+            k_o = names.index("baseline.origin_mm") if "baseline.origin_mm" in names else None
+            cols = [off / max(float(np.max(np.abs(off))), 1e-12)]
+            if k_o is not None:
+                moved = base.copy()
+                moved[k_o] += h
+                cols.append(self.evaluate(np.r_[moved, 0.0], names, idx) - off)
+        core = (self.data.x[idx] - self.origin0) * self.scale
+        if self.disc is not None:
+            cols.append(self.disc.evaluate(core))
+        A = np.column_stack(cols)
+        unit = on - off
+        u2 = (core / self._half_range()) ** 2
+        X = np.column_stack([unit, u2 * unit]) / trial
+        X = X - A @ np.linalg.lstsq(A, X, rcond=RCOND)[0]
+        r = resid - A @ np.linalg.lstsq(A, resid, rcond=RCOND)[0]
+        if not np.all(np.isfinite(X)) or not float(np.sum(X * X)) > 0:
+            return {}
+        a, b = np.linalg.lstsq(X, r, rcond=RCOND)[0]
+        e = float(np.clip(a, -0.5, 0.5))
+        c = float(np.clip(b / a, *self._CLIPPED[f"secondary_imbalance.{SUM_CURVATURE}"])) \
+            if abs(a) > 0 else 0.0
+        return {"secondary_imbalance.imbalance_fraction": e,
+                f"secondary_imbalance.{SUM_CURVATURE}": c}
 
     def _guess_leadscrew(self, x, resid, slope) -> dict[str, float]:
         """Period, amplitude and phase from a periodogram of the position error resid/slope."""
@@ -458,6 +544,15 @@ class PhysicsFamily:
         if start is not None and "k_shape" in start.extra:
             k0 = start.extra["k_shape"]
         if "adc_clipping" not in effects:
+            if ("leadscrew_periodic" in effects and k0 > 0 and not (
+                    start is not None and "leadscrew_periodic.period_mm" in start.names)):
+                # a ripple and the shape term's warp both move the position locally: the
+                # shape may have taken a lead screw before it was tried (a 20 um, 2 mm
+                # ripple on a 22 mm travel raised K to 6); BIC decides, as for a rail
+                fits = [self._fit(effects, idx, start, "both", k)
+                        for k in [k0] + [k for k in self.fewer_terms if k < k0]]
+                ok = [f for f in fits if f.ok] or fits
+                return min(ok, key=lambda f: f.bic)
             return self._fit(effects, idx, start, "both", k0)
         if start is not None and any(n.startswith("adc_clipping.") for n in start.names):
             return self._fit(effects, idx, start, self._sides(start), k0)
@@ -471,11 +566,17 @@ class PhysicsFamily:
 
     def set_shape_range(self, half_range_mm: float, rectified: bool) -> None:
         """Where the smooth shape term lives (the recorded half-range of core positions)."""
-        self._disc_ref = OddBasis(half_range_mm, 1, rectified)
+        grid = np.linspace(-1.5 * half_range_mm, 1.5 * half_range_mm, 601)
+        s1 = self.sensor.replace(demodulator_gain_ratio=1.0)
+        h = 1e-3 * max(half_range_mm, 1e-6)
+        slope = (simulate_output_v(s1, grid + h) - simulate_output_v(s1, grid - h)) / (2 * h)
+        top = float(np.max(np.abs(slope)))
+        warp = (grid, slope / top) if top > 0 and np.all(np.isfinite(slope)) else None
+        self._disc_ref = OddBasis(half_range_mm, 1, rectified, warp)
 
     def _basis(self, k: int):
         ref = self._disc_ref
-        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified)
+        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified, ref.warp)
 
     @staticmethod
     def _sides(fit: Fit | None) -> str:
@@ -503,9 +604,13 @@ class PhysicsFamily:
             return 0, {}, self._fit(effects, idx, start, sides, 0)
         folds = make_folds(np.arange(idx.size))
         table, fits = {}, {}
+        stale = 0
         for k in SHAPE_TERMS:
-            if idx.size - len(self.specs(effects, sides)) - k < 10:
+            basis = self._basis(k)
+            if idx.size - len(self.specs(effects, sides)) - (basis.ncols if basis else 0) < 10:
                 continue
+            if stale >= STOP_AFTER:
+                break
             # each number of terms starts where the previous one ended (more terms can
             # always do what fewer did; a cold start may fall into another minimum)
             f = self._fit(effects, idx, fits[max(fits)] if fits else start, sides, k)
@@ -522,6 +627,8 @@ class PhysicsFamily:
                 e = f.resid[test] - X[test] @ c
                 err += float(e @ e)
             table[k] = math.sqrt(err / idx.size)
+            stale = stale + 1 if len(table) > 1 and table[k] > 0.99 * min(
+                v for j, v in table.items() if j != k) else 0
             fits[k] = f
         if not table:
             return 0, {}, self._fit(effects, idx, start, sides, 0)
@@ -556,7 +663,10 @@ class PhysicsFamily:
         """d(model)/d(parameters, shape coefficients) at ``fit`` (finite differences)."""
         k = self._k_of(fit)
         coef = fit.extra.get("coef")
-        coef = np.zeros(k) if coef is None else np.asarray(coef, float)
+        basis = self._basis(k)
+        if coef is None:
+            coef = np.zeros(0 if basis is None else basis.ncols)
+        coef = np.asarray(coef, float)
         with self._with_k(k):
             y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef)
             cols = []
@@ -565,11 +675,22 @@ class PhysicsFamily:
                 t1 = fit.theta.copy()
                 t1[j] += h
                 cols.append((self.evaluate(t1, fit.names, idx, coef=coef) - y0) / h)
-            for j in range(k):
+            for j in range(coef.size):
                 c1 = coef.copy()
                 c1[j] += 1.0
                 cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1) - y0)
         return np.stack(cols, 1)
+
+    def rechoose(self, effects, idx: np.ndarray, fit: Fit) -> Fit:
+        """``fit`` with the number of shape terms chosen for ``effects`` (by
+        :meth:`choose_terms`), the family's current choice left as it was."""
+        disc, equivalent = self._disc, self.equivalent_terms
+        try:
+            _, table, f = self.choose_terms(effects, idx, fit)
+        finally:
+            self._disc, self.equivalent_terms = disc, equivalent
+        f.extra["cv_table"] = table
+        return f
 
     def refine(self, effects, fit: Fit, idx: np.ndarray) -> Fit:
         """``fit`` with the shape term's complexity chosen again now that ``effects`` are
@@ -614,15 +735,31 @@ class PhysicsFamily:
         hi = np.array([p.upper for p in specs])
         theta0 = np.clip(self._start(effects, names, idx, start), lo, hi)
         y = self.data_y(idx)
-        k_extra = self.disc.k if self.disc is not None else 0
+        k_extra = self.disc.ncols if self.disc is not None else 0
 
         def fun(th):
             return self.evaluate(th, names, idx, target=y) - y
 
-        try:
-            res = least_squares(fun, theta0, method="lm", x_scale="jac",
-                                max_nfev=40 * (len(names) + 1), xtol=1e-9, ftol=1e-9)
-        except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+        starts = [theta0]
+        imb = "secondary_imbalance.imbalance_fraction"
+        if imb in names and (start is None or imb not in start.names):
+            # the imbalance's fit has a second minimum at zero imbalance with the sum's bend
+            # at its limit (no gradient there): start on both sides of zero as well
+            ie, ic = names.index(imb), names.index(f"secondary_imbalance.{SUM_CURVATURE}")
+            for e in (0.01, -0.01):
+                t = theta0.copy()
+                t[ie], t[ic] = e, 0.0
+                starts.append(t)
+        res = None
+        for t0 in starts:
+            try:
+                r = least_squares(fun, t0, method="lm", x_scale="jac",
+                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL)
+            except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+                continue
+            if res is None or r.cost < res.cost:
+                res = r
+        if res is None:
             return Fit(effects, names, theta0, np.full(len(names), np.nan), -fun(theta0), idx,
                        ok=False, k_extra=k_extra)
         theta = self._canonical(self._physical(res.x, names), names)
