@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..physics.effects import EFFECTS, Context, Signal
+from ..physics.effects import EFFECTS
 from ..physics.simulate import simulate_output_v
 from .select import Fit, make_folds
 

@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import FlannError
 from ..recordings import Recordings
 from .effects import EFFECTS, Context, Signal
-from .lvdt import demodulate_v, inductances_h, primary_current_a
+from .lvdt import demodulate_v, inductances_h
 from .sensor import Sensor
 
 _ORDER = {name: i for i, name in enumerate(EFFECTS)}
