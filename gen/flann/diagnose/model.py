@@ -224,8 +224,10 @@ class PhysicsFamily:
             elif e == "leadscrew_periodic":
                 step = self._typical_step()
                 out += [ParamSpec("leadscrew_periodic.amplitude_mm", -span / 20, span / 20, "mm"),
-                        ParamSpec("leadscrew_periodic.period_mm", 2.05 * step,
-                                  max(self.max_period(), 2.1 * step), "mm"),
+                        # at least 3 readings per period: nearer the sampling limit a period
+                        # is an alias of point-to-point scatter (rounding of the readings)
+                        ParamSpec("leadscrew_periodic.period_mm", 3 * step,
+                                  max(self.max_period(), 3.05 * step), "mm"),
                         ParamSpec("leadscrew_periodic.phase_rad", -4 * math.pi, 4 * math.pi, "rad")]
             else:
                 raise ValueError(f"unknown candidate {e}")

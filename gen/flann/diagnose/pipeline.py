@@ -186,7 +186,10 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
 
     # -- name the missing physics --------------------------------------------------------
     candidates = tuple(c for c in family.candidates if not (rails and c == "adc_clipping"))
-    sel = forward_select(family, candidates, fit_idx, progress=progress)
+    # readings on a converter's grid with less noise than one step are not dithered
+    step_v = D.reading_step(y[off])
+    sel = forward_select(family, candidates, fit_idx, progress=progress,
+                         resolution_v=step_v if step_v > gsj else 0.0)
     all_idx = np.arange(x.size)
     before = y - family.predict(sel.baseline, all_idx)
     after = y - family.predict(sel.final, all_idx)

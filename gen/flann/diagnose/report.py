@@ -120,6 +120,7 @@ def format_text(dg) -> str:
                          "cross-validation t > 2): " + ", ".join(
                              f"{t.name} {t.delta_bic:+.1f}" + (f" (CV t {t.cv_t:.1f})"
                                                                if t.cv_t is not None else "")
+                             + (f" ({t.note})" if t.note else "")
                              for t in last[:3]))
     if dg.untestable:
         lines.append("not testable on these recordings: " + "; ".join(

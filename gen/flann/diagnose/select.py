@@ -161,7 +161,10 @@ def oof_errors(family: Family, effects: Sequence[str], idx: np.ndarray,
 
 def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                    bic_margin: float = BIC_MARGIN, cv_t: float = CV_T,
-                   max_effects: int = 4, progress=None) -> Selection:
+                   max_effects: int = 4, progress=None, resolution_v: float = 0.0) -> Selection:
+    """``resolution_v``: the converter's step when the readings are not dithered by noise; an
+    effect that moves no reading by a whole step is then not named (undithered rounding
+    draws patterns of up to half a step that look like structure, e.g. a short period)."""
     current: list[str] = []
     fit0 = family.fit([], idx)
     best = fit0
@@ -219,6 +222,12 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
         for j, (db, c, f) in enumerate(fits):
             if not db < -bic_margin:
                 break
+            if resolution_v > 0:
+                moved = float(np.max(np.abs(family.predict(f, idx) - family.predict(best, idx))))
+                if moved < resolution_v:
+                    trials[j].note = (f"moves no reading by a whole converter step ({moved * 1e3:.3g} mV "
+                                      f"< {resolution_v * 1e3:.3g} mV, readings not dithered by noise)")
+                    continue
             e0 = oof(current, best)
             e1 = oof(current + [c], f)
             d = e0 ** 2 - e1 ** 2
