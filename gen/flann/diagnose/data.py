@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RecordingsError
+from ..recordings.checks import row_directions, run_lengths
 
 MIN_POINTS = 6
 # |pseudo-residual| / sigma above which a lone point is a glitch (false alarm ~1e-6/point)
@@ -78,8 +79,8 @@ def check_inputs(x: np.ndarray, y: np.ndarray, direction: np.ndarray | None, sou
 def find_passes(x: np.ndarray, direction: np.ndarray | None) -> Passes:
     """Split the recording (in row order) into monotonic sweeps.
 
-    With a direction column the runs follow it.  Without one, the sign of each step
-    from the previous row gives the direction; if that flips so often that runs are
+    With a direction column the runs follow it.  Without one, the file order gives it
+    (:func:`flann.recordings.checks.row_directions`); if that flips so often that runs are
     shorter than 4 points, the rows are taken as unordered (no direction information).
     """
     n = x.size
@@ -88,20 +89,12 @@ def find_passes(x: np.ndarray, direction: np.ndarray | None) -> Passes:
         cuts = np.flatnonzero(np.diff(d) != 0) + 1
         runs = tuple(np.split(np.arange(n), cuts))
         return Passes(direction=d, runs=runs, inferred=False, ordered=True)
-    step = np.sign(np.diff(x))
-    # zero steps (repeated readings) carry the previous direction
-    for i in range(step.size):
-        if step[i] == 0:
-            step[i] = step[i - 1] if i else 0
-    if np.all(step == 0):
+    d = row_directions(x)
+    if d is None:
         return Passes(None, (np.argsort(x, kind="stable"),), inferred=True, ordered=False)
-    first = step[np.flatnonzero(step)[0]]
-    step[step == 0] = first
-    d = np.concatenate([[step[0]], step])
     cuts = np.flatnonzero(np.diff(d) != 0) + 1
     runs = tuple(np.split(np.arange(n), cuts))
-    lengths = np.array([r.size for r in runs])
-    if len(runs) > 1 and np.median(lengths) < 4:
+    if len(runs) > 1 and np.median(run_lengths(d)) < 4:
         return Passes(None, (np.argsort(x, kind="stable"),), inferred=True, ordered=False)
     return Passes(direction=d, runs=runs, inferred=True, ordered=True)
 

@@ -182,9 +182,8 @@ def check_units(rec: Recordings) -> None:
             "or 'Voltage (mV)'")
 
 
-def sweep_direction(displacement_mm) -> np.ndarray | None:
-    """+1/-1 per row from the file order (a forward then a reverse sweep, ...), or None when
-    the rows are not in sweeps: a single sweep, no motion, or runs shorter than 4 points.
+def row_directions(displacement_mm) -> np.ndarray | None:
+    """+1/-1 per row from the file order, or None when nothing moves.
 
     A row that repeats the previous displacement keeps the previous direction, except at a
     turn, where the repeat (the same position read again on the way back) starts the new sweep.
@@ -200,8 +199,21 @@ def sweep_direction(displacement_mm) -> np.ndarray | None:
     zero = step == 0
     before = np.arange(step.size) < moving[0]
     step[zero] = np.where(before[zero] | (prev_dir[zero] != next_dir[zero]), next_dir[zero], prev_dir[zero])
-    d = np.concatenate([[step[0]], step])
-    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0.0], d, [0.0]]))))
+    return np.concatenate([[step[0]], step])
+
+
+def run_lengths(direction: np.ndarray) -> np.ndarray:
+    """Lengths of the runs of equal direction, in row order."""
+    return np.diff(np.flatnonzero(np.diff(np.concatenate([[0.0], direction, [0.0]]))))
+
+
+def sweep_direction(displacement_mm) -> np.ndarray | None:
+    """+1/-1 per row from the file order (a forward then a reverse sweep, ...), or None when
+    the rows are not in sweeps: a single sweep, no motion, or runs shorter than 4 points."""
+    d = row_directions(displacement_mm)
+    if d is None:
+        return None
+    runs = run_lengths(d)
     if runs.size < 2 or np.median(runs) < 4:
         return None
     return d
