@@ -194,10 +194,7 @@ class CaseResult:
 
     @property
     def right(self) -> bool:
-        """Exactly the hidden effects named; a control must also locate no mismatch."""
-        if not self.truth:
-            return not self.named and self.regions == 0
-        return sorted(self.named) == self.truth
+        return IND.judged_right(self.truth, self.named, self.regions)
 
     def to_json(self) -> dict:
         return {"case": self.case.name, "hidden": self.case.hidden,

@@ -131,6 +131,14 @@ def recording(case: IndependentCase, seed: int | None = None, scale: float = 1.0
     return rec, d, eff
 
 
+def judged_right(truth: list[str], named: list[str], regions: int) -> bool:
+    """A demo case is right when exactly the hidden effects are named; a control (nothing
+    hidden) must also locate no mismatch.  Both forward models' demos judge by this."""
+    if not truth:
+        return not named and regions == 0
+    return sorted(named) == truth
+
+
 @dataclass
 class IndependentResult:
     case: IndependentCase
@@ -150,9 +158,7 @@ class IndependentResult:
 
     @property
     def right(self) -> bool:
-        if not self.truth:
-            return not self.named and self.regions == 0
-        return sorted(self.named) == self.truth
+        return judged_right(self.truth, self.named, self.regions)
 
     def to_json(self) -> dict:
         return {"model": "independent (filament)", "case": self.case.name,

@@ -219,11 +219,14 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                      and abs(db - fits[0][0]) < TIE_BIC]
         trials = [Trial(c, db, None, False) for db, c, _ in fits]
         accepted = None
+        base_pred = None  # the current model's prediction, once per round
         for j, (db, c, f) in enumerate(fits):
             if not db < -bic_margin:
                 break
             if resolution_v > 0:
-                moved = float(np.max(np.abs(family.predict(f, idx) - family.predict(best, idx))))
+                if base_pred is None:
+                    base_pred = family.predict(best, idx)
+                moved = float(np.max(np.abs(family.predict(f, idx) - base_pred)))
                 if moved < resolution_v:
                     trials[j].note = (f"moves no reading by a whole converter step ({moved * 1e3:.3g} mV "
                                       f"< {resolution_v * 1e3:.3g} mV, readings not dithered by noise)")
