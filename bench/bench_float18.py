@@ -21,7 +21,7 @@ from flann.implement import synth
 from flann.hardware.float18.render import generate as generate_f18
 from flann.hardware.fixed.render import generate as generate_fixed
 from flann.golden.model import load_model
-from flann.hardware.fixed.spec import CLOCK_HZ
+from flann.hardware.target import CLOCK_HZ
 from flann.analysis.trace import run_trace
 
 

@@ -8,16 +8,13 @@ the rebuilt spec must equal the manifest's), and the simulation compiles DIR's o
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import FlannError
 from ..golden.model import model_sha256
-from ..hardware.fixed.render import MANIFEST, generate, load, read_manifest
+from ..hardware.fixed.render import MANIFEST, generate, load, manifest_options, read_manifest, rebuild_spec
 from ..hardware.fixed.spec import Spec
-
-_FMT_RE = re.compile(r"^[us]fix<(\d+),(-?\d+),")
 
 
 @dataclass(frozen=True)
@@ -45,38 +42,6 @@ def from_model(model, build_dir, options: dict | None = None) -> Design:
     return Design(hdl, man, Path(model).resolve(), options, load(model, **options))
 
 
-def _frac(fmt: str, field: str) -> int:
-    m = _FMT_RE.match(str(fmt))
-    if not m:
-        raise FlannError(f"manifest spec field {field!r}: cannot read the format {fmt!r}")
-    return int(m.group(1)) - int(m.group(2))
-
-
-def manifest_options(man: dict, clamp: bool = True) -> dict:
-    """derive_spec options that regenerate the design recorded in a manifest."""
-    s = man.get("spec")
-    if not isinstance(s, dict):
-        raise FlannError("manifest.json has no 'spec' object: regenerate the design with flann gen")
-    try:
-        return dict(
-            device=s["device"], input_bits=s["input_bits"], input_lsb_v=s["input_lsb_v"], clamp=clamp,
-            output_bits=_width(s["output"]), output_lsb_mm=s["output_lsb_mm"], lanes=s["lanes"],
-            mult_style=s["mult_style"], mult_digit_bits=s["mult_digit_bits"], interp=s["interp"],
-            phase_bits=s["phase_bits"], table_addr_bits=s["table_addr_bits"],
-            term_frac_bits=_frac(s["term"], "term"), weight_frac_bits=_frac(s["weight"], "weight"),
-            product_frac_bits=_frac(s["product"], "product"),
-        )
-    except KeyError as exc:
-        raise FlannError(f"manifest.json spec has no field {exc.args[0]!r}: regenerate the design") from None
-
-
-def _width(fmt: str) -> int:
-    m = _FMT_RE.match(str(fmt))
-    if not m:
-        raise FlannError(f"manifest spec field 'output': cannot read the format {fmt!r}")
-    return int(m.group(1))
-
-
 def from_directory(directory, model=None) -> Design:
     """The design in ``directory`` with the twin of ``model`` (default: the manifest's 'model')."""
     directory = Path(directory).resolve()
@@ -100,19 +65,8 @@ def from_directory(directory, model=None) -> Design:
     for f in man.get("files", []):
         if not (directory / f).is_file():
             raise FlannError(f"{directory / MANIFEST}: listed file {f!r} does not exist")
-    last = None
-    for clamp in (True, False):
-        options = manifest_options(man, clamp)
-        try:
-            spec = load(model, **options)
-        except FlannError as exc:
-            last = str(exc)
-            continue
-        if spec.to_dict() == man["spec"]:
-            return Design(directory, man, model, options, spec)
-        diff = sorted(k for k, v in spec.to_dict().items() if man["spec"].get(k) != v)
-        last = f"field(s) {', '.join(diff)} differ"
-    raise FlannError(f"cannot rebuild the twin of {directory} from its manifest: {last}")
+    spec, options = rebuild_spec(model, man, f"cannot rebuild the twin of {directory}")
+    return Design(directory, man, model, options, spec)
 
 
 def open_design(target, build_dir, options: dict | None = None, model=None) -> Design:

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
-from ..hardware.fixed.spec import CLOCK_HZ
+from ..hardware.target import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CONFIG_ENV
