@@ -72,3 +72,42 @@ def test_permission_refused_on_the_temporary_file(tmp_path, monkeypatch):
     monkeypatch.setattr(tempfile, "mkstemp", refuse)
     with pytest.raises(FlannError, match="cannot write .permission denied"):
         atomic_write_text(tmp_path / "x.txt", "x\n")
+
+
+def test_directory_is_replaced_as_a_whole(tmp_path):
+    from flann.fileio import atomic_directory
+    d = tmp_path / "out"
+    with atomic_directory(d, lambda p: True) as tmp:
+        (tmp / "a.txt").write_text("1")
+        (tmp / "b.txt").write_text("1")
+    with atomic_directory(d, lambda p: (p / "a.txt").exists()) as tmp:
+        (tmp / "a.txt").write_text("2")
+    assert sorted(p.name for p in d.iterdir()) == ["a.txt"]
+    assert (d / "a.txt").read_text() == "2"
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+def test_foreign_directory_is_refused_and_untouched(tmp_path):
+    from flann.errors import FlannError
+    from flann.fileio import atomic_directory
+    d = tmp_path / "mine"
+    d.mkdir()
+    (d / "thesis.tex").write_text("keep")
+    with pytest.raises(FlannError, match="not empty"):
+        with atomic_directory(d) as tmp:
+            (tmp / "x").write_text("x")
+    assert [p.name for p in d.iterdir()] == ["thesis.tex"]
+    assert [p.name for p in tmp_path.iterdir()] == ["mine"]
+
+
+def test_failure_inside_leaves_old_directory(tmp_path):
+    from flann.fileio import atomic_directory
+    d = tmp_path / "out"
+    d.mkdir()
+    (d / "old").write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_directory(d, lambda p: True) as tmp:
+            (tmp / "new").write_text("new")
+            raise RuntimeError("boom")
+    assert [p.name for p in d.iterdir()] == ["old"]
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]

@@ -80,34 +80,55 @@ def atomic_save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
-@contextlib.contextmanager
-def atomic_directory(path: str | os.PathLike):
-    """Yield a temporary directory that replaces/merges into ``path`` only on success.
+def _nobody_else_s(path: Path) -> bool:
+    return False
 
-    Files written into the yielded directory are moved into ``path`` (created if needed)
-    when the block exits cleanly; on error nothing in ``path`` is touched.
+
+@contextlib.contextmanager
+def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: str = "directory"):
+    """Yield a fresh temporary directory that replaces ``path`` as a whole on success.
+
+    ``path`` may be absent, an empty directory, or a directory ``replaceable(path)`` accepts
+    (an earlier output of the same kind); any other existing directory is refused before
+    anything is written, so a user's files are never mixed with ours or deleted.  On success
+    the old directory is renamed aside, the new one renamed in and the old one removed:
+    nothing stale survives and no reader sees a mixture.  On any error ``path`` is untouched.
+    A symlink to a directory is followed (its target is replaced).
     """
     path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
     _parent_dir(path)
-    if path.exists() and not path.is_dir():
-        raise FlannError(f"{path}: exists and is not a directory")
+    if path.exists():
+        if not path.is_dir():
+            raise FlannError(f"{path}: exists and is not a directory")
+        if any(path.iterdir()) and not replaceable(path):
+            raise FlannError(f"{path}: directory is not empty and is not a {what}; "
+                             f"choose a new or empty directory")
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.new.", dir=path.parent))
     except OSError as exc:
         raise _cannot_write(path, exc) from None
+    aside = None
     try:
         yield tmp
         try:
-            path.mkdir(parents=True, exist_ok=True)
-            for item in sorted(tmp.rglob("*")):
-                if item.is_file():
-                    dest = path / item.relative_to(tmp)
-                    dest.parent.mkdir(parents=True, exist_ok=True)
-                    os.replace(item, dest)
+            os.chmod(tmp, 0o777 & ~_umask())
+            if path.exists():
+                aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.old.", dir=path.parent))
+                os.replace(path, aside / "d")
+            try:
+                os.replace(tmp, path)
+            except OSError:
+                if aside is not None:
+                    os.replace(aside / "d", path)
+                raise
         except OSError as exc:
             raise _cannot_write(path, exc) from None
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+        if aside is not None:
+            shutil.rmtree(aside, ignore_errors=True)
 
 
 __all__ = ["atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",

@@ -17,6 +17,11 @@ from ..hardware.accuracy import fixed_point_cost
 HELP = "reproduce the seed paper's tables and figures"
 
 
+
+def _only_pngs(directory) -> bool:
+    return all(p.suffix == ".png" and p.is_file() for p in directory.iterdir())
+
+
 def add_arguments(p) -> None:
     p.add_argument("--json", action="store_true",
                    help="print {raw_linearity_pct, tolerance_pct_fs, rows: [...]} as JSON")
@@ -52,7 +57,7 @@ def run(args) -> int:
     offset_scale = normalisation(rec.voltage_v, args.normalise)
     out, details = paper.reproduce(rec, args.eta, args.epochs, args.tol, offset_scale)
     if args.plot:
-        with atomic_directory(args.plot) as tmp:
+        with atomic_directory(args.plot, _only_pngs, "directory of flann paper plots") as tmp:
             paper.plot_fig5(tmp, rec, details)
     if args.json:
         print(json.dumps(out, indent=2))

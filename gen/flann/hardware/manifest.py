@@ -31,12 +31,17 @@ class Manifest(dict):
         return dict(self)
 
 
+def is_design(directory: Path) -> bool:
+    """A directory flann wrote a design into (so it may be replaced as a whole)."""
+    return (Path(directory) / MANIFEST).is_file()
+
+
 def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
     """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir) as tmp:
+    with atomic_directory(out_dir, is_design, "flann design") as tmp:
         for name, text in texts.items():
             (tmp / name).write_text(text, newline="")
         (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")
@@ -68,4 +73,4 @@ def read_manifest(directory) -> Manifest:
     return Manifest(directory, top, tuple(paths), data)
 
 
-__all__ = ["MANIFEST", "Manifest", "read_manifest", "write_design"]
+__all__ = ["MANIFEST", "Manifest", "is_design", "read_manifest", "write_design"]

@@ -159,7 +159,7 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
         "README.txt": template("implement/templates/ise_readme.txt.j2").render(**ctx),
     }
     out = Path(out_dir)
-    with atomic_directory(out) as tmp:
+    with atomic_directory(out, _is_ise_project, "flann ISE project") as tmp:
         tmp = Path(tmp)
         (tmp / "src").mkdir()
         for f in man.files:
@@ -168,6 +168,10 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
         for name, text in texts.items():
             (tmp / name).write_text(text, newline="")
     return [*texts, *sources, "src/manifest.json"]
+
+
+def _is_ise_project(directory: Path) -> bool:
+    return (directory / "README.txt").is_file() and (directory / "src" / "manifest.json").is_file()
 
 
 def summary(files: list[str], out_dir, part: Part | str) -> str:

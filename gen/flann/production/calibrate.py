@@ -221,6 +221,10 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
     return res
 
 
+def _is_sensor_output(directory: Path) -> bool:
+    return (directory / "certificate.html").is_file()
+
+
 def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings, basis: str) -> None:
     model, words = chk["model"], chk["words"]
     model_json = model.to_json()
@@ -228,7 +232,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis)
-    with atomic_directory(dest) as tmp:
+    with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "model.json").write_text(model_json, newline="")
         (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
         (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
