@@ -17,13 +17,14 @@ from ..errors import FlannError
 from ..fileio import atomic_write_json
 from ..hardware import options as gen_options
 from ..verify.design import open_design
-from ..verify.runner import ENGINES, plot, simulate
+from ..verify.datapaths import simulate
+from ..verify.runner import ENGINES, plot
 from ..verify.shards import terminal_progress
 
 HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
 
 FIELDS = ("codes_tested", "mismatches", "max_err_lsb", "max_err_mm", "cycles_per_sample",
-          "samples_per_s_at_50mhz")
+          "samples_per_s", "clock_hz", "samples_per_s_at_50mhz")
 
 
 def add_arguments(parser) -> None:
@@ -45,6 +46,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--build", metavar="DIR", default=None,
                         help="keep generated HDL, logs and results here (default: a temporary directory)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the random stimuli (default %(default)s)")
+    parser.add_argument("--image", action="append", metavar="HEX", default=None,
+                        help="a family design: a sensor's weight image (flann calibrate) to load through the "
+                             "cfg port; give two or more (default: the images flann gen kept in DIR)")
     parser.add_argument("--summary-json", metavar="FILE", default=None, help="also write the summary here")
     gen_options.add_arguments(parser)
 
@@ -56,11 +60,12 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
+        images = [{"name": Path(h).stem, "hex": str(Path(h).resolve())} for h in args.image or []]
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
-                       progress=terminal_progress)
+                       progress=terminal_progress, images=images or None)
         s = res["summary"]
         if args.plot and res["curve"] is not None:
-            plot(res["curve"], res["spec"], args.plot)
+            plot(res["curve"], design.manifest, args.plot)
     if args.summary_json:
         atomic_write_json(args.summary_json, s)
     if args.json:
@@ -70,18 +75,24 @@ def run(args) -> int:
         sw = s.get("sweep") or {}
         how = sw.get("backend") or "Verilator on GHDL's synthesised netlist"
         print(f"input codes tested      {s['codes_tested']}"
-              + (f" ({sw['codes_per_s']} codes/s, {how}, {sw['shards']} shard(s))" if sw else ""))
+              + (f" ({sw['codes_per_s']} codes/s, {how}, {sw['shards']} shard(s))" if sw.get("codes_per_s") else
+                 f" ({how})" if sw else ""))
         if sw.get("vhdl_sample"):
             print(f"  VHDL under GHDL       {sw['vhdl_sample']['codes']} codes (sample)")
         print(f"bit mismatches vs twin  {s['mismatches']}")
         if s["max_err_lsb"] is not None:
             print(f"max |HDL - float model| {s['max_err_lsb']:.4f} LSB = {s['max_err_mm']:.6f} mm "
                   f"(1 LSB = {s['output_lsb_mm']} mm)")
+        elif s["max_err_mm"] is not None:
+            print(f"max |HDL - float model| {s['max_err_mm']:.6f} mm")
+        if s.get("images"):
+            print(f"weight images           {', '.join(s['images'])} (through the cfg port)")
         print(f"cycles per sample       {s['cycles_per_sample']} (latency {s['latency_cycles']})")
-        print(f"samples/s at 50 MHz     {s['samples_per_s_at_50mhz']:.0f}")
+        print(f"{'samples/s at ' + format(s['clock_hz'] / 1e6, 'g') + ' MHz':<24}{s['samples_per_s']:.0f}")
         for name, b in s["benches"].items():
             state = "ok" if b["failures"] == 0 and b["tests"] > 0 else f"FAILED {b['failed']}"
-            print(f"  bench {name:<11} {b['tests']} test(s) {b['seconds']:>6.1f} s  {state}")
+            secs = f"{b['seconds']:>6.1f} s" if b["seconds"] is not None else ""
+            print(f"  bench {name:<11} {b['tests']} test(s) {secs}  {state}")
         if "netlist" in s:
             n = s["netlist"]
             print(f"netlist (Yosys xcv)     {n['codes_tested']} codes, {n['mismatches']} mismatches "

@@ -1,9 +1,10 @@
-"""The design under verification: a generated directory (manifest + VHDL) and its bit-true twin.
+"""The design under verification: a generated directory (manifest + VHDL + model) and its bit-true twin.
 
-``flann sim DIR`` / ``flann trace DIR`` verify exactly the files in DIR: the twin is rebuilt from
-the model and the options recorded in ``DIR/manifest.json`` (the model's sha256 must match, and
-the rebuilt spec must equal the manifest's), and the simulation compiles DIR's own VHDL.
-``flann sim MODEL`` generates into the build directory first, as before.
+``flann sim DIR`` / ``flann trace DIR`` / ``flann eval --design DIR`` verify exactly the files in
+DIR, whatever its datapath: the manifest names the datapath (:mod:`flann.hardware.registry`),
+whose ``rebuild`` derives the spec again from the model kept in DIR (or ``--model``; its sha256
+must match) and the options the manifest records, field for field.  ``flann sim MODEL``
+generates into the build directory first, as before.
 """
 
 from __future__ import annotations
@@ -13,8 +14,10 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..golden.model import model_sha256
-from ..hardware.fixed.render import MANIFEST, generate, load, manifest_options, read_manifest, rebuild_spec
-from ..hardware.fixed.spec import Spec
+from ..hardware.datapath import Datapath
+from ..hardware.fixed.render import generate, load, manifest_options
+from ..hardware.manifest import MANIFEST
+from ..hardware.registry import FIXED, read_design
 
 
 @dataclass(frozen=True)
@@ -22,12 +25,16 @@ class Design:
     directory: Path
     manifest: dict
     model: Path
-    options: dict  # derive_spec keyword arguments that rebuild the spec (and the twin)
-    spec: Spec
+    options: dict  # keyword arguments that rebuild the spec (and the twin)
+    spec: object   # the datapath's spec (fixed Spec, F18Spec, FamilySpec)
+    datapath: Datapath = FIXED
 
     @property
     def files(self) -> list[Path]:
         return [self.directory / f for f in self.manifest["files"]]
+
+    def twin(self):
+        return self.datapath.twin(self.spec)
 
 
 def is_design_dir(path) -> bool:
@@ -35,26 +42,21 @@ def is_design_dir(path) -> bool:
 
 
 def from_model(model, build_dir, options: dict | None = None) -> Design:
-    """Generate the design of ``model`` with ``options`` into ``build_dir/hdl``."""
+    """Generate the fixed-point design of ``model`` with ``options`` into ``build_dir/hdl``."""
     options = dict(options or {})
     hdl = Path(build_dir).resolve() / "hdl"
     man = generate(model, hdl, **options)
     return Design(hdl, man, Path(model).resolve(), options, load(model, **options))
 
 
-def from_directory(directory, model=None) -> Design:
-    """The design in ``directory`` with the twin of ``model`` (default: the manifest's 'model')."""
-    directory = Path(directory).resolve()
-    if not (directory / MANIFEST).is_file():
-        raise FlannError(f"{directory}: no {MANIFEST} (a design directory is written by flann gen -o DIR)")
-    man = read_manifest(directory)
-    if man.get("spec", {}).get("number_format", "fixed") != "fixed" or man.get("top") != "flann_top":
-        raise FlannError(f"{directory}: only fixed-point flann_top designs can be simulated from a directory")
+def design_model(directory, man: dict, dp: Datapath, model=None) -> Path:
+    """The model a design was generated from: ``model``, else the one kept in the directory."""
+    directory = Path(directory)
     if model is None:
-        model = man.get("model")
-        if not model:
-            raise FlannError(f"{directory / MANIFEST} does not name its model: pass --model MODEL.json")
-        model = (directory / model) if not Path(model).is_absolute() else Path(model)
+        model = dp.model_path(directory, man)
+        if model is None:
+            raise FlannError(f"{directory / MANIFEST} does not name its model: pass --model MODEL.json "
+                             "(or regenerate the design: flann gen keeps the model in the directory)")
     model = Path(model).resolve()
     if not model.is_file():
         raise FlannError(f"{model}: model file not found")
@@ -62,11 +64,21 @@ def from_directory(directory, model=None) -> Design:
     if man.get("model_sha256") and sha != man["model_sha256"]:
         raise FlannError(f"{model} is not the model {directory.name} was generated from "
                          f"(sha256 {sha[:12]}... vs manifest {str(man['model_sha256'])[:12]}...)")
-    for f in man.get("files", []):
-        if not (directory / f).is_file():
-            raise FlannError(f"{directory / MANIFEST}: listed file {f!r} does not exist")
-    spec, options = rebuild_spec(model, man, f"cannot rebuild the twin of {directory}")
-    return Design(directory, man, model, options, spec)
+    return model
+
+
+def from_directory(directory, model=None) -> Design:
+    """The design in ``directory`` with its twin, rebuilt through the manifest's datapath."""
+    directory = Path(directory).resolve()
+    if not (directory / MANIFEST).is_file():
+        raise FlannError(f"{directory}: no {MANIFEST} (a design directory is written by flann gen -o DIR)")
+    man, dp = read_design(directory)
+    where = f"cannot rebuild the twin of {directory}"
+    if not dp.model_field:
+        dp.rebuild(None, man, where)  # says why this datapath has no twin rebuilt from a directory
+    model = design_model(directory, man, dp, model)
+    spec, options = dp.rebuild(model, man, where)
+    return Design(directory, man, model, options, spec, dp)
 
 
 def open_design(target, build_dir, options: dict | None = None, model=None) -> Design:
@@ -78,4 +90,5 @@ def open_design(target, build_dir, options: dict | None = None, model=None) -> D
     return from_model(target, build_dir, options)
 
 
-__all__ = ["Design", "from_model", "from_directory", "open_design", "manifest_options", "is_design_dir"]
+__all__ = ["Design", "from_model", "from_directory", "open_design", "manifest_options", "is_design_dir",
+           "design_model"]

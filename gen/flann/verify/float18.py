@@ -30,6 +30,15 @@ def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **optio
         fmodel, sha = load_model(model), model_sha256(model)
     fspec = derive_f18_spec(fmodel, model_sha256=sha, **options)
     man = generate(model, build_dir / "hdl", **options)
+    return run_files(fspec, man, [build_dir / "hdl" / f for f in man["files"]], build_dir, codes, seed, stage_codes)
+
+
+def run_design(design, build_dir, codes=None, seed: int = 1, stage_codes=()) -> dict:
+    """The float18 design of a directory (:class:`flann.verify.design.Design`), as written."""
+    return run_files(design.spec, design.manifest, design.files, Path(build_dir), codes, seed, stage_codes)
+
+
+def run_files(fspec, man: dict, files, build_dir: Path, codes=None, seed: int = 1, stage_codes=()) -> dict:
     top = F18Top(fspec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     out, sat = top.process(codes)
@@ -39,7 +48,7 @@ def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **optio
     cfg = {"codes": codes.tolist(), "out": out.tolist(), "sat": sat.tolist(),
            "latency": man["latency_cycles"], "in_bits": man["input_bits"],
            "records": str(rec.resolve()), "stage_codes": [int(c) for c in stage_codes]}
-    res = run_cocotb([build_dir / "hdl" / f for f in man["files"]], man["top"], "test_f18_top",
+    res = run_cocotb(list(files), man["top"], "test_f18_top",
                      build_dir / "sim_build", cfg, name="float18_top", seed=seed)
     failed = not res.ok
     if not rec.is_file():
@@ -71,4 +80,4 @@ def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **optio
             "manifest": man, "spec": fspec, "stages": stages}
 
 
-__all__ = ["run_top"]
+__all__ = ["run_top", "run_design", "run_files"]

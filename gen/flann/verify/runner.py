@@ -35,7 +35,7 @@ from ..fileio import atomic_save_figure
 from ..hardware.target import CLOCK_HZ
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.manifest import read_manifest
-from .benches import BENCH_DIR, CONFIG_ENV
+from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from .design import Design
 from .netlist import check_netlist, check_rtl_netlist
 from .shards import count_lines, cores, merge, read_results, split
@@ -52,7 +52,6 @@ BENCHES = {
 FAMILY_BENCH = "test_flann_family_top"  # flann gen --family designs (weights in memory)
 HARNESSES = {"flann_sweep": "flann_sweep.vhd", "flann_harness": "flann_harness.vhd"}
 BENCH_PACKAGE = "flann.verify.benches"
-CLK_NS = 10
 
 
 def sim_dir() -> Path:
@@ -200,7 +199,7 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
     man = design.manifest
     params, plus = {}, []
     if toplevel == "flann_harness":
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"]}
+        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2}
         # the harness's clock never stops: bound the run (a test still running is reported failed)
         n = 3 * int((extra or {}).get("handshake_samples", 60)) + 80
         plus.append(f"--stop-time={(n * man['cycles_per_sample'] * 3 + 10000) * CLK_NS}ns")
@@ -263,7 +262,7 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
 
     def one(k: int) -> None:
         s = shard_cfg[k]
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"],
+        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2,
                   "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
         if "codes_file" in s:
             params["codes_file_g"] = s["codes_file"]
@@ -338,6 +337,19 @@ def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple
     return sw, {**{k: nl[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
 
 
+def throughput(cycles_per_sample: int, clock_hz: float = CLOCK_HZ) -> dict:
+    """Samples per second at the design's clock; ``samples_per_s_at_50mhz`` is the older
+    name of the same figure (scripts read it), kept as an alias."""
+    sps = round(clock_hz / cycles_per_sample, 1)
+    return {"clock_hz": clock_hz, "samples_per_s": sps, "samples_per_s_at_50mhz": sps}
+
+
+def simulator_name(about: dict) -> str:
+    """Which simulator produced every code's output, for a plot's legend."""
+    return "Verilator, GHDL's synthesised netlist" if about.get("engine") == "verilator" else \
+        f"GHDL {about.get('backend', '')}".strip()
+
+
 def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
              engine: str = "auto", progress=None) -> dict:
     """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
@@ -348,8 +360,7 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     spec, man = design.spec, design.manifest
     results, summary = [], {
         "codes_tested": 0, "mismatches": None, "max_err_lsb": None, "max_err_mm": None,
-        "cycles_per_sample": man["cycles_per_sample"],
-        "samples_per_s_at_50mhz": round(CLOCK_HZ / man["cycles_per_sample"], 1),
+        "cycles_per_sample": man["cycles_per_sample"], **throughput(man["cycles_per_sample"]),
     }
     curve = None
     for b in benches:
@@ -358,14 +369,14 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
             results.append(sw["bench"])
             codes, data, sat = every["codes"], every["data"], every["sat"]
             if codes.size:
-                twin_out, twin_sat = FlannTop(spec).process(codes)
+                twin_out, twin_sat = design.twin().process(codes)
                 ref = spec.float_reference(codes) / spec.output_lsb_mm
                 err = np.abs(data - ref)
                 bad = (data != twin_out) | (sat != twin_sat) | (every["latency"] != man["latency_cycles"])
                 summary.update(codes_tested=int(codes.size), mismatches=int(np.count_nonzero(bad)),
                                max_err_lsb=round(float(err.max()), 4),
                                max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6))
-                curve = {"codes": codes, "hdl": data, "ref": ref}
+                curve = {"codes": codes, "hdl": data, "ref": ref, "simulator": simulator_name(every["about"])}
             summary["sweep"] = every["about"]
         else:
             if progress and sys.stderr.isatty():
@@ -387,19 +398,22 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
-def plot(curve: dict, spec, path) -> None:
-    """HDL output and golden model across the input range, and their difference (paper Fig. 6)."""
+def plot(curve: dict, man: dict, path) -> None:
+    """HDL output and golden model across the input range, and their difference (paper Fig. 6);
+    ``man``: the design's manifest (input LSB, clamp codes, output LSB)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    v = curve["codes"] * spec.input_lsb_v
-    q = spec.output_lsb_mm
+    lsb_v = man["input_lsb_v"]
+    v = curve["codes"] * lsb_v
+    q = 1.0 if curve.get("unit_mm") else man["output_lsb_mm"]
+    clamp_lo, clamp_hi = man["clamp_codes"]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     a1.plot(v, curve["ref"] * q, label="golden model (float64)", lw=2, color="0.7")
-    a1.plot(v, curve["hdl"] * q, label="HDL (GHDL)", lw=0.8, color="C0")
-    a1.axvspan(spec.clamp_lo * spec.input_lsb_v, spec.clamp_hi * spec.input_lsb_v, color="C2", alpha=0.06,
+    a1.plot(v, curve["hdl"] * q, label=f"HDL ({curve.get('simulator', 'GHDL')})", lw=0.8, color="C0")
+    a1.axvspan(clamp_lo * lsb_v, clamp_hi * lsb_v, color="C2", alpha=0.06,
                label="trained range")
     a1.set_ylabel("displacement (mm)")
     a1.legend(loc="best", fontsize=8)
@@ -407,9 +421,9 @@ def plot(curve: dict, spec, path) -> None:
     a2.plot(v, curve["hdl"] - curve["ref"], lw=0.6, color="C3")
     a2.axhline(1, ls=":", color="k")
     a2.axhline(-1, ls=":", color="k")
-    a2.set_ylabel("HDL - golden (output LSB)")
+    a2.set_ylabel("HDL - golden (mm)" if curve.get("unit_mm") else "HDL - golden (output LSB)")
     a2.set_xlabel("input (V)")
-    a2.set_title(f"(b) difference (1 LSB = {q} mm)")
+    a2.set_title("(b) difference" if curve.get("unit_mm") else f"(b) difference (1 LSB = {q} mm)")
     fig.tight_layout()
     try:
         atomic_save_figure(fig, path, dpi=120)
@@ -417,5 +431,5 @@ def plot(curve: dict, spec, path) -> None:
         plt.close(fig)
 
 
-__all__ = ["run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]

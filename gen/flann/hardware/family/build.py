@@ -55,7 +55,10 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
                          "(nothing written): " + "; ".join(bad))
     names = [Path(p).stem for p in sources]
     fam = derive_family(models, names=names, margin=margin, **options)
-    return write(fam, out_dir, fam.spec.model, init_name=names[0])
+    unique = dict(zip(names, models))
+    if len(unique) < len(names):  # members with one file name: told apart by their place
+        unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
+    return write(fam, out_dir, fam.spec.model, init_name=names[0], members=unique)
 
 
 __all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "NORMALISATION"]

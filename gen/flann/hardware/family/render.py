@@ -20,10 +20,11 @@ from ...textgen import template
 from ..header import header
 from ..manifest import write_design
 from ..fixed import render as fixed
-from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict
+from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict, member_spec
 from .twin import FlannFamilyMem
 
 TOP = "flann_family_top"
+DATAPATH = "family"
 INIT_MODEL = "init_model.json"
 # compile order: (entity, title, template path)
 ENTITIES = (
@@ -101,8 +102,8 @@ def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
 def manifest(fam: FamilySpec, files: list[str]) -> dict:
     s = fam.spec
     man = fixed.manifest(s, files)
-    man.update(top=TOP, latency_cycles=fam.latency_cycles, cycles_per_sample=fam.cycles_per_sample,
-               family=fam.to_dict(), init_model=INIT_MODEL)
+    man.update(top=TOP, datapath=DATAPATH, model=INIT_MODEL, latency_cycles=fam.latency_cycles,
+               cycles_per_sample=fam.cycles_per_sample, family=fam.to_dict(), init_model=INIT_MODEL)
     man["cfg_port"] = {
         "ports": {"cfg_we": "in std_logic", "cfg_addr": f"in std_logic_vector({fam.addr_bits - 1} downto 0)",
                   "cfg_data": f"in std_logic_vector({DATA_BITS - 1} downto 0)"},
@@ -125,10 +126,21 @@ def design_hash(out_dir) -> str:
     return h.hexdigest()
 
 
-def write(fam: FamilySpec, out_dir, init_model: FlannModel, init_name: str = "") -> dict:
+def image_text(words) -> str:
+    """A weight image as ``flann calibrate`` writes it: one hex word per line."""
+    return "".join(format(int(w), f"0{DATA_BITS // 4}x") + "\n" for w in words)
+
+
+def write(fam: FamilySpec, out_dir, init_model: FlannModel, init_name: str = "",
+          members: dict | None = None) -> dict:
+    """The VHDL, manifest.json, the initial model and each member's weight image (``members``:
+    {name: FlannModel}), so `flann sim DIR` can load two sensors through the cfg port."""
     texts = render(fam, init_name)
     man = manifest(fam, list(texts))
-    return write_design({**texts, INIT_MODEL: init_model.to_json()}, man, out_dir)
+    images = {f"image_{name}.hex": image_text(FlannFamilyMem.encode(fam, member_spec(fam, m)))
+              for name, m in (members or {}).items()}
+    man["images"] = [{"name": n[len("image_"):-len(".hex")], "hex": n} for n in images]
+    return write_design({**texts, INIT_MODEL: init_model.to_json(), **images}, man, out_dir)
 
 
 def read_manifest(out_dir) -> dict:

@@ -24,6 +24,9 @@ from ..options import NAMES as OPTION_NAMES, GenOptions
 from .spec import Spec, derive_spec
 
 TOP = "flann_top"
+DATAPATH = "fixed"
+# the model a design was generated from, kept in its directory: verification needs nothing else
+MODEL_FILE = "model.json"
 # the entities' templates; a variant the spec chooses is a fragment in a sub-folder
 TEMPLATES = "hardware/fixed/templates"
 # compile order
@@ -138,7 +141,9 @@ def manifest(spec: Spec, files: list[str], adc_plan: AdcPlan | None = None) -> d
     are dropped); without it the design's input is the converter."""
     return {
         "top": TOP,
+        "datapath": DATAPATH,
         "files": list(files),
+        "model": MODEL_FILE,
         "input_bits": spec.input_bits,
         "input_lsb_v": spec.input_lsb_v,
         "adc_bits": adc_plan.adc_bits if adc_plan else spec.input_bits,
@@ -171,12 +176,22 @@ def generate(model_path_or_model, out_dir, options: GenOptions | None = None, **
     """
     spec = load(model_path_or_model, options, **overrides)
     o = GenOptions.of(options, **{k: v for k, v in overrides.items() if k in OPTION_NAMES})
-    return write(spec, out_dir, plan_adc(spec.model, o.input_bits, o.input_lsb_v, o.clamp))
+    return write(spec, out_dir, plan_adc(spec.model, o.input_bits, o.input_lsb_v, o.clamp),
+                 model_text(model_path_or_model))
 
 
-def write(spec: Spec, out_dir, adc_plan: AdcPlan | None = None) -> dict:
+def model_text(model_path_or_model) -> str:
+    """The model as its file holds it (so its sha256 is the one stamped into the VHDL)."""
+    if isinstance(model_path_or_model, FlannModel):
+        return model_path_or_model.to_json()
+    return Path(model_path_or_model).read_bytes().decode("utf-8")
+
+
+def write(spec: Spec, out_dir, adc_plan: AdcPlan | None = None, model: str | None = None) -> dict:
+    """The VHDL, manifest.json and the model (``model``: its file's text) as one directory."""
     texts = render(spec)
-    return write_design(texts, manifest(spec, list(texts), adc_plan), out_dir)
+    man = manifest(spec, list(texts), adc_plan)
+    return write_design({**texts, MODEL_FILE: model if model is not None else spec.model.to_json()}, man, out_dir)
 
 
 # -- a generated design, rebuilt from its manifest ----------------------------------------
@@ -230,7 +245,7 @@ def rebuild_spec(model_path, man: dict, where, check_device: bool = True) -> tup
                      "version of flann; regenerate the design")
 
 
-__all__ = ["generate", "write", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
+__all__ = ["generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
            "rebuild_spec", "TOP",
            "ENTITIES", "MANIFEST", "write_design"]
 

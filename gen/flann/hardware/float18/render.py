@@ -16,9 +16,10 @@ from ...textgen import template
 from ..header import header
 from ..manifest import write_design
 from ...golden.model import FlannModel, load_model, model_sha256
-from ..fixed.render import render as render_fixed
+from ..fixed.render import MODEL_FILE, model_text, render as render_fixed
 from .spec import CVT, TOP, derive_f18_spec
 
+DATAPATH = "float18"
 BLOCKS = {"mul": F18Mul, "add": F18Add}
 BLOCK_TITLES = {"mul": "multiplier", "add": "adder"}
 TEMPLATES = "hardware/float18/templates"
@@ -134,7 +135,9 @@ def manifest(fspec, files: list[str]) -> dict:
     b = fspec.base
     return {
         "top": TOP,
+        "datapath": DATAPATH,
         "files": list(files),
+        "model": MODEL_FILE,
         "number_format": "float18",
         "input_bits": b.input_bits,
         "input_lsb_v": b.input_lsb_v,
@@ -156,13 +159,14 @@ def generate(model_path_or_model, out_dir, **options) -> dict:
     else:
         path = Path(model_path_or_model)
         fspec = derive_f18_spec(load_model(path), model_sha256=model_sha256(path), **options)
-    return write(fspec, out_dir)
+    return write(fspec, out_dir, model_text(model_path_or_model))
 
 
-def write(fspec, out_dir) -> dict:
+def write(fspec, out_dir, model: str | None = None) -> dict:
     texts = render_design(fspec)
-    return write_design(texts, manifest(fspec, list(texts)), out_dir)
+    man = manifest(fspec, list(texts))
+    return write_design({**texts, MODEL_FILE: model if model is not None else fspec.model.to_json()}, man, out_dir)
 
 
 __all__ = ["BLOCKS", "block_context", "render_block", "render_blocks", "render_design", "generate",
-           "write", "manifest", "TOP", "CVT"]
+           "write", "manifest", "TOP", "CVT", "DATAPATH"]

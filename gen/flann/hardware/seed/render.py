@@ -42,9 +42,13 @@ def render(s: SeedSpec) -> dict[str, str]:
     return {SEED_FILE: text}
 
 
+DATAPATH = "seed"
+
+
 def manifest(s: SeedSpec) -> dict:
     return {
         "top": ENTITY,
+        "datapath": DATAPATH,
         "files": [SEED_FILE],
         "input_bits": s.input_bits,
         "input_lsb_v": s.input_lsb_v,

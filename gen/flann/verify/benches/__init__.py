@@ -10,6 +10,8 @@ from pathlib import Path
 
 BENCH_DIR = Path(__file__).resolve().parent
 CONFIG_ENV = "FLANN_BENCH_CONFIG"
+# the simulation clock of every bench and harness (100 MHz; timing is checked by synthesis, not here)
+CLK_NS = 10
 
 
 def config() -> dict:

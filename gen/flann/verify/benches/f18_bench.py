@@ -16,7 +16,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.numeric.float18 import F18Add, F18Mul, FloatFormat
-from flann.verify.benches import config
+from flann.verify.benches import CLK_NS, config
 
 TWINS = {"mul": F18Mul, "add": F18Add}
 
@@ -126,7 +126,7 @@ class Bench:
         self.scoreboard = Scoreboard(dut._log)
 
     async def start(self):
-        cocotb.start_soon(Clock(self.dut.clk, 10, unit="ns", impl="gpi").start())
+        cocotb.start_soon(Clock(self.dut.clk, CLK_NS, unit="ns", impl="gpi").start())
         self.driver.idle()
         self.dut.rst.value = 1
         for _ in range(3):

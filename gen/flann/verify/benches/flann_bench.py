@@ -23,10 +23,9 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Event, FallingEdge, RisingEdge
 
 from flann.hardware.fixed.render import load
-from flann.verify.benches import config
+from flann.verify.benches import CLK_NS, config
 from flann.hardware.fixed.twin import FlannTop
 
-CLK_NS = 10
 
 
 def load_spec(cfg: dict):

@@ -18,7 +18,7 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from flann.verify.benches import config
+from flann.verify.benches import CLK_NS, config
 
 
 class TopBench:
@@ -35,7 +35,7 @@ class TopBench:
         self.stages = {}                     # code -> {"terms": [...], "products": [...], "sums": [...]}
 
     async def reset(self):
-        cocotb.start_soon(Clock(self.dut.clk, 10, unit="ns", impl="gpi").start())
+        cocotb.start_soon(Clock(self.dut.clk, CLK_NS, unit="ns", impl="gpi").start())
         self.dut.in_valid.value = 0
         self.dut.in_data.value = 0
         self.dut.rst.value = 1

@@ -1,0 +1,125 @@
+"""What every datapath offers, whatever its number format or architecture.
+
+A datapath (``fixed``, ``float18``, ``family``, ``seed``: one folder each under ``hardware/``)
+is one :class:`Datapath` object, registered in :mod:`flann.hardware.registry`.  Commands never
+ask a datapath's name: they read a design's ``manifest.json`` (whose ``datapath`` field names
+it), look the datapath up there, and call it:
+
+* ``generate(model, out_dir, options)``: derive the spec, render the VHDL, write the design
+  directory as a whole (VHDL, ``manifest.json`` and the model it came from);
+* ``rebuild(model, manifest)``: the spec of a written design, derived again from its model and
+  the options the manifest records, checked field for field (``from_manifest``);
+* ``twin(spec)``: the bit-true top-level twin (``entity``, ``latency``, ``process``,
+  ``all_codes``, ``error_vs_float``);
+* ``fields``: the manifest fields this datapath's readers rely on, with their types, so
+  one reader refuses a tampered manifest in one line naming the field;
+* ``bench`` / ``stages``: which verification bench and which stage model of ``flann trace``
+  apply (``None``: the command refuses in one line saying why);
+* ``estimate(manifest)``: resources before synthesis (LUT4, flip-flops, block RAMs), so
+  ``flann ise`` can refuse a part the design cannot fit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from ..errors import FlannError
+
+NUMBER = (int, float)
+
+
+@dataclass(frozen=True)
+class Field:
+    """One manifest field: dotted path, allowed types, and the smallest value of a number."""
+
+    path: str
+    types: tuple
+    minimum: float | None = None
+    optional: bool = False  # older designs lack it
+
+    def what(self) -> str:
+        names = {int: "an integer", float: "a number", str: "a string", list: "a list", dict: "an object",
+                 bool: "true or false"}
+        return " or ".join(dict.fromkeys(names[t] for t in self.types))
+
+
+def _int(path: str, minimum: int | None = 1) -> Field:
+    return Field(path, (int,), minimum)
+
+
+def _num(path: str, minimum: float | None = None) -> Field:
+    return Field(path, NUMBER, minimum)
+
+
+# the fields every design's readers use (simulation, synthesis, the ISE pin map)
+COMMON_FIELDS = (
+    Field("top", (str,)), Field("files", (list,)), Field("datapath", (str,)), Field("model", (str,), optional=True),
+    _int("input_bits", 2), _num("input_lsb_v", 0), _int("output_bits", 2),
+    _int("latency_cycles", 0), _int("cycles_per_sample"), Field("generator_version", (str,)),
+    Field("spec", (dict,)),
+)
+
+
+def _lookup(man: dict, f: Field, where):
+    """(found, value) of a dotted field; a missing required one (or a parent that is not an
+    object) is one FlannError naming it."""
+    value, here = man, ""
+    for part in f.path.split("."):
+        here = f"{here}.{part}" if here else part
+        if not isinstance(value, dict):
+            raise FlannError(f"{where}: field {here.rsplit('.', 1)[0]!r} must be an object, got {value!r}")
+        if part not in value:
+            if f.optional:
+                return False, None
+            raise FlannError(f"{where}: field {here!r} is missing (regenerate the design with flann gen)")
+        value = value[part]
+    return True, value
+
+
+def check_fields(man: dict, fields, where) -> None:
+    """One FlannError naming the first field of ``fields`` that is missing or of the wrong type."""
+    for f in fields:
+        found, value = _lookup(man, f, where)
+        if not found:
+            continue
+        if not isinstance(value, f.types) or (isinstance(value, bool) and bool not in f.types):
+            raise FlannError(f"{where}: field {f.path!r} must be {f.what()}, got {value!r}")
+        if f.minimum is not None and value < f.minimum:
+            raise FlannError(f"{where}: field {f.path!r} must be >= {f.minimum:g}, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Datapath:
+    """One datapath: its name (the manifest's ``datapath``), its top entity and its hooks."""
+
+    name: str
+    top: str
+    about: str
+    generate: Callable                 # (model path, out_dir, GenOptions, **extra) -> manifest dict
+    rebuild: Callable                  # (model path, manifest) -> (spec, options dict)
+    twin: Callable                     # spec -> top-level twin
+    estimate: Callable                 # manifest -> {"luts", "ffs", "brams"}
+    fields: tuple = ()                 # manifest fields beyond COMMON_FIELDS
+    model_field: str = "model"         # manifest field naming the model file in the directory
+    bench: str | None = None           # verification bench (flann.verify.design.BENCHES)
+    stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
+    why_no_bench: str = ""
+    why_no_stages: str = ""
+    lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
+    summary: Callable | None = None    # manifest -> lines flann gen prints
+    options: tuple = field(default=())  # GenOptions fields that apply to it
+
+    def check(self, man: dict, where) -> None:
+        check_fields(man, COMMON_FIELDS + tuple(self.fields), where)
+        if man["top"] != self.top:
+            raise FlannError(f"{where}: field 'top' is {man['top']!r}, the {self.name} datapath's top is "
+                             f"{self.top!r}")
+
+    def model_path(self, directory: Path, man: dict) -> Path | None:
+        name = man.get(self.model_field)
+        return (Path(directory) / name) if isinstance(name, str) and name else None
+
+
+__all__ = ["Datapath", "Field", "COMMON_FIELDS", "check_fields", "NUMBER"]

@@ -1,0 +1,62 @@
+"""The family datapath (``flann gen --family``: weights in a memory) behind the :class:`Datapath` interface."""
+
+from __future__ import annotations
+
+import warnings
+
+from ...errors import FlannError, SpecError
+from ...golden.model import load_model
+from ..datapath import Datapath, Field, _int, _num
+from ..options import GenOptions
+from . import render
+from .build import DEFAULT_TERMS, generate_family
+from .spec import DEFAULT_MARGIN, family_from_dict
+from .twin import FlannFamilyTop
+
+
+def generate(sources, out_dir, options: GenOptions | None = None, *, terms: int = DEFAULT_TERMS,
+             margin: float = DEFAULT_MARGIN) -> dict:
+    return generate_family(sources, out_dir, terms=terms, margin=margin, **(options or GenOptions()).to_kwargs())
+
+
+def rebuild(model, man: dict, where="design"):
+    """The FamilySpec of the manifest's ``family`` entry with the memory's initial model."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return family_from_dict(man["family"], load_model(model)), {}
+    except SpecError as exc:
+        raise FlannError(f"{where}: {exc}") from None
+
+
+def estimate(man: dict) -> dict:
+    return dict(man["analysis"]["estimate"])
+
+
+def summary(man: dict) -> list[str]:
+    fam = man["family"]
+    mem = fam["memory"]
+    return [f"  family of {len(fam['members'])} sensor(s), margin {fam['margin']:g}, {fam['terms']} terms",
+            f"  {man['input_bits']}-bit input x {man['input_lsb_v']} V -> {man['output_bits']}-bit output x "
+            f"{man['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample",
+            f"  weight memory {mem['used_words']} of {mem['depth']} x {mem['data_bits']}-bit words "
+            f"(cfg_addr {mem['addr_bits']} bits); estimate {man['analysis']['estimate']}"]
+
+
+FIELDS = (
+    _num("output_lsb_mm", 0), Field("family", (dict,)), _num("family.margin", 0),
+    Field("family.members", (list,)), Field("family.options", (dict,)), _int("family.terms", 2),
+    Field("family.widths", (dict,)),
+    *(_int(f"family.widths.{k}") for k in ("weight_bits", "lin_width", "lin_bits", "product_bits", "acc_bits")),
+    Field("images", (list,), optional=True), Field("family.memory", (dict,)), _int("family.memory.depth"), _int("family.memory.addr_bits"),
+    _int("family.memory.data_bits"), _int("family.memory.used_words"),
+    _int("analysis.estimate.luts", 0), _int("analysis.estimate.ffs", 0), _int("analysis.estimate.brams", 0),
+)
+
+DATAPATH = Datapath(
+    name=render.DATAPATH, top=render.TOP, about="one design for a family of sensors, weights in a memory",
+    generate=generate, rebuild=rebuild, twin=FlannFamilyTop, estimate=estimate, fields=FIELDS,
+    bench="family", stages="family", summary=summary,
+)
+
+__all__ = ["DATAPATH"]
