@@ -37,7 +37,9 @@ from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import F18Top, derive_f18_spec
 from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
-from ..verify.design import open_design
+from ..hardware.family.twin import FlannFamilyTop
+from ..verify.datapaths import simulate as simulate_design
+from ..verify.design import Design, open_design
 from ..verify.runner import sweep
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
@@ -281,8 +283,10 @@ class TraceResult:
                   f"why: {d['reason']}"]
         if self.hdl is not None:
             h = self.hdl
+            err = (f"; max |HDL - golden| {h['max_err_mm']:.3g} mm over the trained range"
+                   if h.get("max_err_mm") is not None else "")
             lines.append(f"HDL (GHDL, {h['top']}): {h['codes']} codes simulated, {h['mismatches']} mismatches "
-                         f"vs the twin; max |HDL - golden| {h['max_err_mm']:.3g} mm over the trained range")
+                         f"vs the twin{err}")
             st = h.get("stages")
             if st:
                 lines.append(f"HDL stages captured by cocotb at {st['codes']} codes: "
@@ -489,15 +493,41 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_s
     return result.hdl
 
 
+def stages_family(fam, codes=None) -> Stages:
+    """The family design with its memory as initialised: the fixed datapath's stages of those values."""
+    return stages_fixed(FlannFamilyTop(fam).top().spec, codes)
+
+
+# the stage model a datapath names (Datapath.stages)
+STAGE_MODELS = {"fixed": stages_fixed, "float18": stages_float18, "family": stages_family}
+# the spec each --format derives (a model traced without a design directory)
+DERIVE = {"fixed": derive_spec, "float18": derive_f18_spec}
+
+
 def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options) -> TraceResult:
-    if fmt == "fixed":
-        st = stages_fixed(derive_spec(model, **spec_options), codes)
-    elif fmt == "float18":
-        st = stages_float18(derive_f18_spec(model, **spec_options), codes)
-    else:
-        raise FlannError(f"--format {fmt!r}: allowed fixed, float18")
-    return trace(st)
+    if fmt not in DERIVE:
+        raise FlannError(f"--format {fmt!r}: allowed {', '.join(DERIVE)}")
+    return trace(STAGE_MODELS[fmt](DERIVE[fmt](model, **spec_options), codes))
+
+
+def trace_design(design: Design, codes=None) -> TraceResult:
+    """The stages of a written design (any datapath with a stage model), from its own spec."""
+    dp = design.datapath
+    if dp.stages is None:
+        raise FlannError(f"{design.directory}: {dp.why_no_stages}")
+    return trace(STAGE_MODELS[dp.stages](design.spec, codes))
+
+
+def check_design_hdl(result: TraceResult, design: Design, build_dir) -> dict:
+    """A design directory's VHDL over every input code with its datapath's bench (flann sim's)."""
+    res = simulate_design(design, build_dir)
+    s = res["summary"]
+    result.hdl = {"top": design.manifest["top"], "codes": s["codes_tested"], "mismatches": s["mismatches"],
+                  "max_err_mm": s["max_err_mm"], "equals_twin": bool(s["mismatches"] == 0 and s["all_passed"]),
+                  "stages": None}
+    return result.hdl
 
 
 __all__ = ["Stages", "Source", "TraceResult", "STAGES", "attribute", "trace", "stages_fixed",
-           "stages_float18", "plot_trace", "plot_compare", "run_trace", "check_hdl", "term_label"]
+           "stages_float18", "stages_family", "plot_trace", "plot_compare", "run_trace", "check_hdl", "term_label",
+           "trace_design", "check_design_hdl", "STAGE_MODELS"]

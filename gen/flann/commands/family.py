@@ -1,11 +1,9 @@
-"""The ``--family`` option of ``flann gen``: its arguments and what it runs (not a subcommand of its own)."""
+"""The ``--family`` option of ``flann gen``: its arguments and their checks (not a subcommand of its own)."""
 
 from __future__ import annotations
 
-import json
-
 from ..errors import FlannError
-from ..hardware.family.build import DEFAULT_TERMS, generate_family
+from ..hardware.family.build import DEFAULT_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN
 
 
@@ -21,23 +19,10 @@ def add_family_arguments(parser) -> None:
                         "ranges (default %(default)s)")
 
 
-def run_family(args, options: dict) -> int:
+def check_family_args(args) -> None:
     if args.family is None:
         raise FlannError("give a model.json, or --family REC_OR_MODEL...")
     if args.model is not None:
         raise FlannError(f"{args.model}: give either a model or --family, not both")
     if args.format != "fixed":
         raise FlannError("--family generates the fixed-point datapath only (--format fixed)")
-    man = generate_family(args.family, args.out, terms=args.terms, margin=args.margin, **options)
-    if args.json:
-        print(json.dumps(man, indent=2))
-        return 0
-    fam = man["family"]
-    mem = fam["memory"]
-    print(f"wrote {len(man['files'])} VHDL files + manifest.json + {man['init_model']} to {args.out}")
-    print(f"  family of {len(fam['members'])} sensor(s), margin {fam['margin']:g}, {fam['terms']} terms")
-    print(f"  {man['input_bits']}-bit input x {man['input_lsb_v']} V -> {man['output_bits']}-bit output x "
-          f"{man['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample")
-    print(f"  weight memory {mem['used_words']} of {mem['depth']} x {mem['data_bits']}-bit words "
-          f"(cfg_addr {mem['addr_bits']} bits); estimate {man['analysis']['estimate']}")
-    return 0

@@ -17,19 +17,20 @@ from pathlib import Path
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
-from ..analysis.trace import check_hdl, plot_compare, plot_trace, run_trace
+from ..analysis.trace import check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace, trace_design
 from ..hardware import options as gen_options
 from ..hardware.float18.spec import float18_options
+from ..hardware.registry import FORMATS as REGISTRY_FORMATS
 from ..verify.design import from_directory
 
 HELP = "stage-by-stage error of hardware against the golden model"
-FORMATS = ("fixed", "float18")
+FORMATS = REGISTRY_FORMATS
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("model", metavar="MODEL|DIR",
-                        help="model.json (flann-model/1), or a fixed-point design directory written by "
-                             "flann gen -o DIR (traced with the options in its manifest)")
+                        help="model.json (flann-model/1), or a design directory written by flann gen -o DIR "
+                             "(traced as it is, with the model it keeps)")
     parser.add_argument("--model", dest="design_model", metavar="MODEL.json", default=None,
                         help="with DIR: the model DIR was generated from (checked against the manifest's sha256)")
     parser.add_argument("--format", choices=FORMATS, default="fixed",
@@ -47,7 +48,7 @@ def add_arguments(parser) -> None:
 
 def _options(args, fmt: str) -> dict:
     opts = gen_options.from_args(args)
-    if fmt == "float18":
+    if fmt != FORMATS[0]:  # a datapath of its own number format takes the front end's options only
         return float18_options(opts, fixed_too=args.compare)
     return opts.to_kwargs()
 
@@ -56,8 +57,8 @@ def _design_dir(args):
     """A design directory: trace exactly that design (its manifest's options and model)."""
     if not Path(args.model).is_dir():
         return None
-    if args.format != "fixed" or args.compare:
-        raise FlannError(f"{args.model}: a design directory is traced as it is (fixed point, no --compare)")
+    if args.format != FORMATS[0] or args.compare:
+        raise FlannError(f"{args.model}: a design directory is traced as it is (no --format, no --compare)")
     return from_directory(args.model, args.design_model)
 
 
@@ -66,7 +67,8 @@ def run(args) -> int:
     model = load_model(design.model if design else args.model)
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:
-        results = {"fixed": run_trace(model, "fixed", **design.options)}
+        args.format = design.datapath.name
+        results = {args.format: trace_design(design)}
     else:
         results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
     if args.hdl:
@@ -74,7 +76,7 @@ def run(args) -> int:
             print(f"simulating the {f} design over every input code ...", file=sys.stderr)
             with tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:
                 if design:
-                    check_hdl(r, design.directory, design.options, tmp, design_model=design.model)
+                    check_design_hdl(r, design, tmp)
                 else:
                     check_hdl(r, args.model, _options(args, f), tmp)
     points = None

@@ -22,7 +22,7 @@ from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
 from ..golden.model import FlannModel, load_model, model_sha256
 from .adc import MAX_DESIGN_INPUT_BITS
-from .fixed.render import read_manifest, rebuild_spec
+from .registry import read_design
 from .fixed.spec import Spec, derive_spec
 from .fixed.twin import FlannTop
 
@@ -63,26 +63,14 @@ def fixed_point_cost(model: FlannModel) -> dict:
 
 # -- a generated design, rebuilt ---------------------------------------------------------
 def design_spec(model_path, design_dir) -> Spec:
-    """The Spec of the design in ``design_dir`` for the model file ``model_path``.
-
-    The generator options are read back from the design's manifest.json and the spec is
-    derived again; it must reproduce the manifest's spec field for field (else the design
-    came from another model or generator version and must be regenerated).
-    """
-    man = read_manifest(design_dir)
-    load_model(model_path)  # a file that is not a model says so before the hash is compared
-    sha = model_sha256(model_path)
-    if man.get("model_sha256") != sha:
-        raise FlannError(f"{design_dir}: generated from another model (sha256 {str(man.get('model_sha256'))[:12]}, "
-                         f"{Path(model_path).name} is {sha[:12]}): run flann gen {model_path} -o {design_dir}")
-    want = man.get("spec") or {}
-    if want.get("number_format") != "fixed":
-        raise FlannError(f"{design_dir}: number format {want.get('number_format')!r}: "
-                         "--design reads fixed-point designs (flann gen --format fixed)")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        spec, _ = rebuild_spec(model_path, man, design_dir, check_device=False)
-    return spec
+    """The fixed-point Spec that computes what the design in ``design_dir`` outputs for the
+    model file ``model_path``, through the manifest's datapath (its ``eval_spec``): the model
+    the design was generated from, or for a family design any sensor whose image it can load.
+    A datapath without one is refused in one line saying why."""
+    man, dp = read_design(design_dir)
+    if dp.eval_spec is None:
+        raise FlannError(f"{design_dir}: a {dp.name} design: {dp.why_no_eval}")
+    return dp.eval_spec(model_path, man, design_dir)
 
 
 def design_adc(design_dir) -> tuple[int, float]:
@@ -91,7 +79,7 @@ def design_adc(design_dir) -> tuple[int, float]:
     Wider than the design's input when ``flann gen`` dropped low bits (manifest ``adc_bits``);
     a manifest without it (older flann) had the design's input as the converter.
     """
-    man = read_manifest(design_dir)
+    man, _ = read_design(design_dir)
     bits, lsb = man.get("adc_bits", man.get("input_bits")), man.get("adc_lsb_v", man.get("input_lsb_v"))
     if not (isinstance(bits, int) and isinstance(lsb, (int, float)) and lsb > 0):
         raise FlannError(f"{design_dir}/manifest.json: adc_bits/adc_lsb_v malformed "

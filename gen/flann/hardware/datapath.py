@@ -105,6 +105,8 @@ class Datapath:
     model_field: str = "model"         # manifest field naming the model file in the directory
     bench: str | None = None           # verification bench (flann.verify.design.BENCHES)
     stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
+    eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design
+    why_no_eval: str = ""
     why_no_bench: str = ""
     why_no_stages: str = ""
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml

@@ -34,7 +34,8 @@ from ..hardware.target import CLOCK_HZ, DEFAULT_PART, Part, parse_part
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
-from ..hardware.manifest import read_manifest
+from ..hardware.registry import read_design
+from .synth import Resources, shortfall, smallest_fit
 
 CLOCK_PIN = "P77"  # GCK1
 RESET_PIN = "P57"
@@ -74,7 +75,23 @@ def top_ports(manifest: dict) -> list[Port]:
         Port("clk", "in", 0), Port("rst", "in", 0),
         Port("in_valid", "in", 0), Port("in_ready", "out", 0), Port("in_data", "in", ib),
         Port("out_valid", "out", 0), Port("out_data", "out", ob), Port("out_sat", "out", 0),
-    ]
+    ] + _extra_ports(manifest)
+
+
+_DECL_RE = re.compile(r"^(in|out)\s+std_logic(?:_vector\s*\(\s*(\d+)\s+downto\s+0\s*\))?$", re.I)
+
+
+def _extra_ports(manifest: dict) -> list[Port]:
+    """Ports a datapath adds to the common interface (a family design's cfg_* write port),
+    as its manifest declares them under ``cfg_port.ports``."""
+    decl = (manifest.get("cfg_port") or {}).get("ports") or {}
+    out = []
+    for name, text in decl.items():
+        m = _DECL_RE.match(str(text).strip())
+        if not m:
+            raise FlannError(f"manifest.json: cfg_port.ports.{name} = {text!r} is not a flat std_logic port")
+        out.append(Port(name, m.group(1).lower(), int(m.group(2)) + 1 if m.group(2) else 0))
+    return out
 
 
 _PORT_RE = re.compile(
@@ -128,10 +145,29 @@ def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
     return rows
 
 
-def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6) -> list[str]:
+def check_fits(man, dp, part, force: bool = False) -> None:
+    """Refuse (one line naming the smallest part that fits) a part the design's resource
+    estimate exceeds, unless ``force``; a datapath without an estimate is not checked."""
+    est = dp.estimate(man)
+    if est is None or force:
+        return
+    res = Resources(luts=est["luts"], ffs=est["ffs"], brams=est["brams"], carry=0, xorcy=0, mult_and=0,
+                    muxf5=0, muxf6=0, io=sum(len(p.bits()) for p in top_ports(man) if p.name != "clk"))
+    short = shortfall(res, part)
+    if not short:
+        return
+    best = smallest_fit(res, part)
+    where = f"smallest Spartan-II that fits: {best.name}" if best else "no Spartan-II holds it"
+    raise FlannError(f"{man.top} does not fit {part.name} (estimate: {'; '.join(short)}); {where} "
+                     "(--force writes the project anyway)")
+
+
+def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
+              force: bool = False) -> list[str]:
     """Write the ISE 10.1 handoff for a generated design; returns the files written."""
     part = parse_part(device)
-    man = read_manifest(directory)
+    man, dp = read_design(directory)
+    check_fits(man, dp, part, force)
     if not (0 < clock_mhz <= 200):
         raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
     if part.device.name not in PIN_MAP_DEVICES:

@@ -10,7 +10,7 @@ from ..datapath import Datapath, Field, _int, _num
 from ..options import GenOptions
 from . import render
 from .build import DEFAULT_TERMS, generate_family
-from .spec import DEFAULT_MARGIN, family_from_dict
+from .spec import DEFAULT_MARGIN, family_from_dict, member_spec
 from .twin import FlannFamilyTop
 
 
@@ -27,6 +27,18 @@ def rebuild(model, man: dict, where="design"):
             return family_from_dict(man["family"], load_model(model)), {}
     except SpecError as exc:
         raise FlannError(f"{where}: {exc}") from None
+
+
+def eval_spec(model, man: dict, directory):
+    """``model`` (any sensor of the family) as the design computes it with that sensor's
+    weight image loaded; FitError (one line) when it is outside the family."""
+    fam, _ = rebuild(DATAPATH.model_path(directory, man), man, directory)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return member_spec(fam, load_model(model))
+    except SpecError as exc:
+        raise FlannError(f"{model}: does not fit the family design {directory}: {exc}") from None
 
 
 def estimate(man: dict) -> dict:
@@ -56,7 +68,7 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="one design for a family of sensors, weights in a memory",
     generate=generate, rebuild=rebuild, twin=FlannFamilyTop, estimate=estimate, fields=FIELDS,
-    bench="family", stages="family", summary=summary,
+    bench="family", stages="family", summary=summary, eval_spec=eval_spec,
 )
 
 __all__ = ["DATAPATH"]

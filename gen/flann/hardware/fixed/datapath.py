@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
+
+from ...errors import FlannError
+from ...golden.model import load_model, model_sha256
 
 from ..datapath import Datapath, Field, _int, _num
 from ..options import GenOptions
@@ -18,6 +22,17 @@ def rebuild(model, man: dict, where="design"):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return render.rebuild_spec(model, man, where, check_device=False)
+
+
+def eval_spec(model, man: dict, directory):
+    """The design's Spec for ``model``, which must be the model it was generated from."""
+    load_model(model)  # a file that is not a model says so before the hash is compared
+    sha = model_sha256(model)
+    if man.get("model_sha256") != sha:
+        raise FlannError(f"{directory}: generated from another model (sha256 {str(man.get('model_sha256'))[:12]}, "
+                         f"{Path(model).name} is {sha[:12]}): evaluate the model the design keeps "
+                         f"({Path(directory) / man.get('model', 'model.json')})")
+    return rebuild(model, man, directory)[0]
 
 
 def estimate(man: dict) -> dict:
@@ -43,7 +58,7 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="fixed point, widths from the error budget",
     generate=generate, rebuild=rebuild, twin=FlannTop, estimate=estimate, fields=FIELDS,
-    bench="sweep", stages="fixed", summary=summary,
+    bench="sweep", stages="fixed", summary=summary, eval_spec=eval_spec,
 )
 
 __all__ = ["DATAPATH"]
