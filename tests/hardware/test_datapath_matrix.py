@@ -1,0 +1,137 @@
+"""Every command on every datapath's design directory: it works, or refuses in one line naming why;
+and a tampered manifest is refused in one line naming the field (exit 2), whatever the command."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from flann.golden.train import fit_lstsq
+from flann.production.demo import write_batch
+from flann.recordings import prepare_for_fit, read_recordings
+
+FLANN = [sys.executable, "-m", "flann.cli"]
+BITS = "8"
+
+
+def flann(*args, cwd=None):
+    return subprocess.run([*FLANN, *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+@pytest.fixture(scope="module")
+def designs(tmp_path_factory):
+    """Small designs (5 terms, 8-bit input) of every datapath flann gen writes."""
+    d = tmp_path_factory.mktemp("designs")
+    recs = write_batch(d / "rec", 2, seed=11, points=400)
+    rec = prepare_for_fit(read_recordings(recs[0]))
+    model = d / "m5.json"
+    model.write_text(fit_lstsq(rec.voltage_v, rec.displacement_mm, 5, norm="half").to_json())
+    for args in ((model, "-o", d / "fixed"), (model, "-o", d / "float18", "--format", "float18"),
+                 ("--family", *recs, "--terms", 5, "-o", d / "family")):
+        r = flann("gen", *args, "--input-bits", BITS)
+        assert r.returncode == 0, r.stderr
+    return {"dir": d, "model": model, "rec": recs[0]}
+
+
+def one_line_refusal(r) -> None:
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.returncode == 2 and len(lines) == 1 and lines[0].startswith("error: "), r.stderr
+    assert "Traceback" not in r.stderr
+
+
+# command -> argument list for a design directory (the designs keep their model)
+COMMANDS = {
+    "sim": lambda d, fx: ("sim", d),
+    "trace": lambda d, fx: ("trace", d),
+    "eval": lambda d, fx: ("eval", fx["model"], fx["rec"], "--design", d),
+    "ise": lambda d, fx: ("ise", d, "-o", fx["dir"] / f"ise_{d.name}"),
+}
+# (datapath, command) that refuse, with a word the one line must hold
+REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map"}
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family"])
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_command_on_datapath(designs, datapath, command):
+    r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))
+    why = REFUSED.get((datapath, command))
+    if why:
+        one_line_refusal(r)
+        assert why in r.stderr
+    else:
+        assert r.returncode == 0, r.stderr
+
+
+def test_ise_refuses_a_part_too_small(designs):
+    r = flann("ise", designs["dir"] / "fixed", "--device", "xc2s15-vq100-5", "-o", designs["dir"] / "ise_small")
+    one_line_refusal(r)
+    assert "smallest Spartan-II that fits: xc2s" in r.stderr
+    assert not (designs["dir"] / "ise_small").exists()
+    r = flann("ise", designs["dir"] / "fixed", "--device", "xc2s15-vq100-5", "--force", "-o",
+              designs["dir"] / "ise_small")
+    assert "does not fit" not in r.stderr
+
+
+def test_gen_says_it_replaces_a_design(designs, tmp_path):
+    out = tmp_path / "d"
+    assert flann("gen", designs["model"], "-o", out, "--input-bits", BITS).returncode == 0
+    r = flann("gen", designs["model"], "-o", out, "--input-bits", BITS, "--format", "float18")
+    assert r.returncode == 0 and "replaced the flann design" in r.stderr
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        json.loads((out / "manifest.json").read_text())["files"] + ["manifest.json", "model.json"])
+
+
+def _drop(path):
+    def edit(m):
+        *parents, last = path.split(".")
+        for p in parents:
+            m = m[p]
+        del m[last]
+    return edit
+
+
+def _set(path, value):
+    def edit(m):
+        *parents, last = path.split(".")
+        for p in parents:
+            m = m[p]
+        m[last] = value
+    return edit
+
+
+# (datapath, edit, the field the one line must name)
+TAMPERED = [
+    ("family", _drop("family.widths.weight_bits"), "family.widths.weight_bits"),
+    ("family", _set("family.widths.weight_bits", "22"), "family.widths.weight_bits"),
+    ("family", _set("family.members", 5), "family.members"),
+    ("fixed", _set("spec", "x"), "'spec'"),
+    ("fixed", _set("input_bits", True), "input_bits"),
+    ("float18", _drop("output.frac_bits"), "output.frac_bits"),
+    ("fixed", _set("datapath", "quantum"), "datapath"),
+]
+TAMPER_COMMANDS = {
+    "sim": lambda d, fx: ("sim", d),
+    "trace": lambda d, fx: ("trace", d),
+    "eval": lambda d, fx: ("eval", fx["model"], fx["rec"], "--design", d),
+    "synth": lambda d, fx: ("synth", d, "--no-netlist-check"),
+    "ise": lambda d, fx: ("ise", d, "-o", d.parent / f"ise_{d.name}"),
+}
+
+
+@pytest.mark.parametrize("command", sorted(TAMPER_COMMANDS))
+@pytest.mark.parametrize("datapath,edit,field", TAMPERED, ids=[f"{t[0]}-{t[2]}-{k}" for k, t in enumerate(TAMPERED)])
+def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field):
+    d = tmp_path / datapath
+    shutil.copytree(designs["dir"] / datapath, d)
+    man = json.loads((d / "manifest.json").read_text())
+    edit(man)
+    (d / "manifest.json").write_text(json.dumps(man))
+    r = flann(*TAMPER_COMMANDS[command](d, designs))
+    one_line_refusal(r)
+    assert field in r.stderr
