@@ -21,7 +21,7 @@ it), look the datapath up there, and call it:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -111,11 +111,11 @@ class Datapath:
     why_no_stages: str = ""
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
     summary: Callable | None = None    # manifest -> lines flann gen prints
-    options: tuple = field(default=())  # GenOptions fields that apply to it
+    common: tuple = COMMON_FIELDS      # the shared key set (a design flann did not write: fewer)
 
     def check(self, man: dict, where) -> None:
-        check_fields(man, COMMON_FIELDS + tuple(self.fields), where)
-        if man["top"] != self.top:
+        check_fields(man, tuple(self.common) + tuple(self.fields), where)
+        if self.top and man["top"] != self.top:
             raise FlannError(f"{where}: field 'top' is {man['top']!r}, the {self.name} datapath's top is "
                              f"{self.top!r}")
 

@@ -9,14 +9,31 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import FlannError
-from .datapath import Datapath
+from .datapath import Datapath, Field, _int
 from .family.datapath import DATAPATH as FAMILY
 from .fixed.datapath import DATAPATH as FIXED
 from .float18.datapath import DATAPATH as FLOAT18
 from .manifest import MANIFEST, Manifest, read_manifest
 from .seed.datapath import DATAPATH as SEED
 
-DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED)}
+def _no(what: str):
+    def refuse(*_args, **_kw):
+        raise FlannError(f"{WHY_PLAIN} {what}")
+    return refuse
+
+
+WHY_PLAIN = ("a design flann did not write (its manifest names no datapath and no flann spec): "
+             "synthesis and the ISE handoff take it; it has no")
+# VHDL with a hand-written manifest: `top`, `files` and the port widths the ISE pin map needs
+PLAIN = Datapath(
+    name="plain", top="", about="VHDL with a hand-written manifest (synth and ise only)",
+    generate=_no("generator"), rebuild=_no("twin"), twin=_no("twin"), estimate=lambda man: None,
+    common=(Field("top", (str,)), Field("files", (list,)), _int("input_bits", 2), _int("output_bits", 2),
+            Field("spec", (dict,), optional=True)),
+    model_field="", why_no_bench=f"{WHY_PLAIN} bench", why_no_stages=f"{WHY_PLAIN} stage model",
+    why_no_eval=f"{WHY_PLAIN} twin",
+)
+DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)
 FORMATS = (FIXED.name, FLOAT18.name)
 
@@ -27,9 +44,19 @@ def datapath(name: str) -> Datapath:
     return DATAPATHS[name]
 
 
-def _legacy_name(data: dict) -> str | None:
-    """The datapath of a manifest written before the field existed (by its top entity)."""
-    return next((dp.name for dp in DATAPATHS.values() if dp.top == data.get("top")), None)
+def _legacy_name(data: dict) -> str:
+    """The datapath of a manifest written before the field existed: what its spec says it is
+    (a family has its ``family`` entry), else a design flann did not write."""
+    spec = data.get("spec") if isinstance(data.get("spec"), dict) else {}
+    if "family" in data:
+        return FAMILY.name
+    if data.get("number_format") == FLOAT18.name:
+        return FLOAT18.name
+    if spec.get("number_format") == FIXED.name:
+        return FIXED.name
+    if spec.get("architecture") == "seed_parallel":
+        return SEED.name
+    return PLAIN.name
 
 
 def read_design(directory) -> tuple[Manifest, Datapath]:
@@ -46,4 +73,4 @@ def read_design(directory) -> tuple[Manifest, Datapath]:
     return man, dp
 
 
-__all__ = ["DATAPATHS", "FORMATS", "FIXED", "FLOAT18", "FAMILY", "SEED", "datapath", "read_design"]
+__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "SEED", "datapath", "read_design"]

@@ -116,6 +116,8 @@ class FlannFamilyMultiplier(FlannMultiplier):
 class FlannFamilyTop:
     """flann_family_top: out_data / out_sat for every sample, given the memory content."""
 
+    entity = "flann_family_top"
+
     def __init__(self, fam: FamilySpec, words=None):
         self.fam = fam
         self.mem = FlannFamilyMem(fam, words if words is not None else FlannFamilyMem.encode(fam, fam.spec))
@@ -137,6 +139,13 @@ class FlannFamilyTop:
     def all_codes(self) -> np.ndarray:
         s = self.fam.spec
         return np.arange(s.code_min, s.code_max + 1, dtype=np.int64)
+
+    def error_vs_float(self, codes=None) -> dict:
+        """max |twin - float model of the loaded sensor| (the fixed datapath's measure)."""
+        return self.top().error_vs_float(codes)
+
+    def trace(self, codes):
+        return self.top().trace(codes)
 
 
 __all__ = ["FlannFamilyMem", "FlannFamilyNorm", "FlannFamilyMultiplier", "FlannFamilyTop"]

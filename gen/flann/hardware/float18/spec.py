@@ -255,5 +255,11 @@ class F18Top:
     def all_codes(self) -> np.ndarray:
         return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
 
+    def error_vs_float(self, codes=None) -> dict:
+        """max |twin - float model| in mm over ``codes`` (default every code); no output LSB in float18."""
+        codes = self.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
+        e = float(np.max(np.abs(self.out_mm(codes) - self.spec.float_reference(codes))))
+        return {"max_err_lsb": None, "max_err_mm": e, "codes": int(codes.size)}
+
 
 __all__ = ["float18_options", "FRONT_END_OPTIONS", "F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]

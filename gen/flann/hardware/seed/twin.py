@@ -40,9 +40,12 @@ class SeedTop:
             raise SpecError("seed architecture: the adder tree overflows")
         return TopOut(out_data=acc, out_sat=c != c_in)
 
-    def error_vs_float(self) -> dict:
+    def all_codes(self) -> np.ndarray:
+        return np.arange(-(1 << (self.spec.input_bits - 1)), 1 << (self.spec.input_bits - 1), dtype=np.int64)
+
+    def error_vs_float(self, codes=None) -> dict:
         s = self.spec
-        codes = np.arange(s.clamp_lo, s.clamp_hi + 1, dtype=np.int64)
+        codes = np.arange(s.clamp_lo, s.clamp_hi + 1, dtype=np.int64) if codes is None else np.asarray(codes)
         out = self.process(codes).out_data
         ref = s.model.predict(codes * s.input_lsb_v)
         e = float(np.max(np.abs(out * s.output_lsb_mm - ref)))
