@@ -87,7 +87,9 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
 def header_spec(fam: FamilySpec) -> dict:
     """The fixed datapath's spec plus the family's sizing, for the shared header."""
     d = fam.to_dict()
-    return dict(fam.spec.to_dict(), family={k: d[k] for k in ("margin", "members", "terms", "widths")})
+    # one short line per value (a line of VHDL stays under VSG's 120 characters)
+    return dict(fam.spec.to_dict(), **{f"family_{k}": d[k] for k in ("margin", "members", "terms")},
+                **{f"family_{k}": v for k, v in d["widths"].items()})
 
 
 def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
