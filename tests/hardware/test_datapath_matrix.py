@@ -11,6 +11,8 @@ import sys
 import pytest
 
 from flann.golden.train import fit_lstsq
+from flann.hardware.seed import render as seed_render
+from flann.hardware.seed.spec import derive_seed_spec
 from flann.production.demo import write_batch
 from flann.recordings import prepare_for_fit, read_recordings
 
@@ -34,6 +36,8 @@ def designs(tmp_path_factory):
                  ("--family", *recs, "--terms", 5, "-o", d / "family")):
         r = flann("gen", *args, "--input-bits", BITS)
         assert r.returncode == 0, r.stderr
+    # the seed architecture is written by flann explore only (for comparison)
+    seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
     return {"dir": d, "model": model, "rec": recs[0]}
 
 
@@ -49,14 +53,20 @@ COMMANDS = {
     "trace": lambda d, fx: ("trace", d),
     "eval": lambda d, fx: ("eval", fx["model"], fx["rec"], "--design", d),
     "ise": lambda d, fx: ("ise", d, "-o", fx["dir"] / f"ise_{d.name}"),
+    # lint on; the mapped netlist checked where a bench drives it; abc -fast: the seed is parallel
+    "synth": lambda d, fx: ("synth", d, "--abc", "fast"),
+    "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--mult", "shiftadd", "--widths", "budget", "--no-seed"),
 }
 # (datapath, command) that refuse, with a word the one line must hold
-REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map"}
+REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map", ("family", "explore"): "members",
+           **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore")},
+           # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
+           ("seed", "synth"): "does not fit"}
 
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-@pytest.mark.parametrize("datapath", ["fixed", "float18", "family"])
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed"])
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_command_on_datapath(designs, datapath, command):
     r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))

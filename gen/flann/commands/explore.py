@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 
 from ..implement import explore
 from ..errors import FlannError
+from ..hardware.registry import read_design
 from ..hardware.target import DEFAULT_PART
+from ..verify.design import design_model
 
 HELP = "design-space table (lanes x multiplier x widths)"
 
@@ -21,7 +24,8 @@ def _ints(text: str) -> tuple[int, ...]:
 
 
 def add_arguments(p):
-    p.add_argument("model", help="model.json")
+    p.add_argument("model", metavar="MODEL|DIR",
+                   help="model.json, or a design directory written by flann gen (its model and its ADC)")
     p.add_argument("--device", default=DEFAULT_PART, metavar="PART", help="target part (default %(default)s)")
     p.add_argument("--lanes", default="1,2,4", help="lane counts to try (default 1,2,4)")
     p.add_argument("--mult", default="lut,shiftadd", help="multiplier styles (default lut,shiftadd)")
@@ -40,7 +44,21 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
+def _design_model(args) -> None:
+    """DIR: explore the model the design keeps, at the design's ADC unless given."""
+    if not Path(args.model).is_dir():
+        return
+    man, dp = read_design(args.model)
+    if dp.why_no_explore:
+        raise FlannError(f"{args.model}: {dp.why_no_explore}")
+    model = design_model(args.model, man, dp)
+    args.model = str(model)
+    args.input_bits = man["input_bits"] if args.input_bits is None else args.input_bits
+    args.input_lsb_v = man["input_lsb_v"] if args.input_lsb_v is None else args.input_lsb_v
+
+
 def run(args) -> int:
+    _design_model(args)
     progress = sys.stderr.isatty()   # progress lines on a terminal only, never into a log
     if args.seed_only:
         rows = explore.seed_rows(args.model, args.device, abc=args.abc, progress=progress)

@@ -107,6 +107,7 @@ class Datapath:
     stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
     eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design
     why_no_eval: str = ""
+    why_no_explore: str = ""           # empty: flann explore DIR explores the model the design keeps
     why_no_bench: str = ""
     why_no_stages: str = ""
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml

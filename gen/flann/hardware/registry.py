@@ -31,7 +31,7 @@ PLAIN = Datapath(
     common=(Field("top", (str,)), Field("files", (list,)), _int("input_bits", 2), _int("output_bits", 2),
             Field("spec", (dict,), optional=True)),
     model_field="", why_no_bench=f"{WHY_PLAIN} bench", why_no_stages=f"{WHY_PLAIN} stage model",
-    why_no_eval=f"{WHY_PLAIN} twin",
+    why_no_eval=f"{WHY_PLAIN} twin", why_no_explore=f"{WHY_PLAIN} model",
 )
 DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)

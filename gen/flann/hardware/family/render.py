@@ -35,6 +35,7 @@ ENTITIES = (
      "hardware/fixed/templates"),
     ("flann_family_multiplier", "terms x weights read from the memory", "hardware/family/templates"),
     ("flann_adder", "accumulation, rounding, saturation", "hardware/fixed/templates"),
+    ("flann_seq", "sequencer of one sample (shared by every top level)", "hardware/fixed/templates"),
     ("flann_family_top", "FLANN LVDT compensator for a sensor family, top level", "hardware/family/templates"),
 )
 
@@ -81,7 +82,8 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
     top = dict(t, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
                param_base=fam.param_base, step_bits=step_bits, pidx_bits=max(1, fam.param_words.bit_length()))
     return {"flann_family_mem": mem, "flann_family_norm": norm, "flann_expansion": base["flann_expansion"],
-            "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_family_top": top}
+            "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_seq": base["flann_seq"],
+            "flann_family_top": top}
 
 
 def header_spec(fam: FamilySpec) -> dict:

@@ -35,6 +35,7 @@ ENTITIES = (
     ("flann_expansion", "trigonometric expansion (phase accumulation, quarter-wave table)"),
     ("flann_multiplier", "terms x trained weights"),
     ("flann_adder", "accumulation, rounding, saturation"),
+    ("flann_seq", "sequencer of one sample (shared by every top level)"),
     ("flann_top", "FLANN LVDT compensator, top level"),
 )
 
@@ -122,8 +123,10 @@ def contexts(spec: Spec) -> dict[str, dict]:
         output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, steps=s.steps, n_advs=n_advs,
         adv_period=s.adv_period, timer_bits=_ubits(max(1, s.adv_period - 1)), adv_cnt_bits=_ubits(n_advs),
     )
+    seq = dict(steps=s.steps, n_advs=n_advs, adv_period=s.adv_period, timer_bits=top["timer_bits"],
+               adv_cnt_bits=top["adv_cnt_bits"])
     return {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
-            "flann_adder": adder, "flann_top": top}
+            "flann_adder": adder, "flann_seq": seq, "flann_top": top}
 
 
 def render(spec: Spec) -> dict[str, str]:

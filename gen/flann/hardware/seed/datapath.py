@@ -27,7 +27,8 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=ENTITY, about="the seed paper's parallel architecture (comparison only)",
     generate=generate, rebuild=rebuild, twin=SeedTop, estimate=estimate,
     fields=(_num("output_lsb_mm", 0), _int("spec.terms")), model_field="",
-    why_no_bench=WHY.format("simulation bench"), why_no_eval=WHY.format("twin rebuilt from a directory"), why_no_stages=WHY.format("stage model for flann trace"),
+    why_no_bench=WHY.format("simulation bench"), why_no_eval=WHY.format("twin rebuilt from a directory"),
+    why_no_explore=WHY.format("model kept in its directory"), why_no_stages=WHY.format("stage model for flann trace"),
 )
 
 __all__ = ["DATAPATH"]
