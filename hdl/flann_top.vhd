@@ -40,8 +40,8 @@ use ieee.numeric_std.all;
 --   out_sat  : input outside the trained range (clamped) or output saturated
 -- One sample at a time: accepted when in_valid and in_ready; out_valid pulses once per sample,
 -- 610 clock edges after the accepting edge; in_ready returns one cycle later.
--- Sequencer: norm (12 + 1 cycles) -> 55 pipeline advances, one every 11 cycle(s)
--- (50 steps of 1 term(s) + pipeline drain) -> finish.
+-- Sequencer (flann_seq): norm (12 + 1 cycles) -> 55 pipeline advances, one every
+-- 11 cycle(s) (50 steps of 1 term(s) + pipeline drain) -> finish.
 entity flann_top is
   port (
     clk       : in  std_logic;
@@ -56,14 +56,6 @@ entity flann_top is
 end entity flann_top;
 
 architecture rtl of flann_top is
-  type state_t is (st_idle, st_norm, st_run, st_fin);
-  constant steps_c  : natural := 50;
-  constant n_advs_c : natural := 55;
-  constant period_c : natural := 11;
-
-  signal state      : state_t;
-  signal timer      : unsigned(3 downto 0);
-  signal adv_cnt    : unsigned(5 downto 0);
   signal ready      : std_logic;
   signal accept     : std_logic;
   signal adv        : std_logic;
@@ -79,44 +71,19 @@ architecture rtl of flann_top is
   signal mul_prods  : std_logic_vector(20 downto 0);
 begin
 
-  ready  <= '1' when state = st_idle else '0';
   accept <= in_valid and ready;
-  adv    <= '1' when state = st_run and timer = 0 else '0';
-  issue  <= '1' when adv_cnt < steps_c else '0';
-  finish <= '1' when state = st_fin else '0';
 
-  p_seq : process (clk)
-  begin
-    if rising_edge(clk) then
-      case state is
-        when st_idle =>
-          if in_valid = '1' then
-            state <= st_norm;
-          end if;
-        when st_norm =>
-          if norm_valid = '1' then
-            state   <= st_run;
-            timer   <= (others => '0');
-            adv_cnt <= (others => '0');
-          end if;
-        when st_run =>
-          if timer = 0 then
-            timer   <= to_unsigned(period_c - 1, 4);
-            adv_cnt <= adv_cnt + 1;
-            if adv_cnt = n_advs_c - 1 then
-              state <= st_fin;
-            end if;
-          else
-            timer <= timer - 1;
-          end if;
-        when st_fin =>
-          state <= st_idle;
-      end case;
-      if rst = '1' then
-        state <= st_idle;
-      end if;
-    end if;
-  end process p_seq;
+  i_seq : entity work.flann_seq
+    port map (
+      clk        => clk,
+      rst        => rst,
+      in_start   => accept,
+      in_norm    => norm_valid,
+      out_idle   => ready,
+      out_adv    => adv,
+      out_issue  => issue,
+      out_finish => finish
+    );
 
   i_norm : entity work.flann_norm
     port map (
