@@ -36,13 +36,14 @@ use ieee.numeric_std.all;
 
 -- Sequencer of one sample, shared by every top level: idle -> normalise (until in_norm) ->
 -- 55 pipeline advances, one every 11 cycle(s) (50 issuing a step, then the
--- pipeline drains) -> finish (one cycle) -> idle.
+-- pipeline drains) -> finish (until in_done: a top whose arithmetic drains later holds it) -> idle.
 entity flann_seq is
   port (
     clk        : in  std_logic;
     rst        : in  std_logic;
     in_start   : in  std_logic;
     in_norm    : in  std_logic;
+    in_done    : in  std_logic;
     out_idle   : out std_logic;
     out_adv    : out std_logic;
     out_issue  : out std_logic;
@@ -91,7 +92,9 @@ begin
             timer <= timer - 1;
           end if;
         when st_fin =>
-          state <= st_idle;
+          if in_done = '1' then
+            state <= st_idle;
+          end if;
       end case;
       if rst = '1' then
         state <= st_idle;

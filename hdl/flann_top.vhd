@@ -79,6 +79,7 @@ begin
       rst        => rst,
       in_start   => accept,
       in_norm    => norm_valid,
+      in_done    => '1',
       out_idle   => ready,
       out_adv    => adv,
       out_issue  => issue,

@@ -35,7 +35,7 @@ def test_manifest_fields_and_files(model_file, tmp_path):
     man = generate(model_file, tmp_path / "hdl")
     assert MANIFEST_KEYS <= set(man)
     assert man["top"] == "flann_top"
-    assert man["files"][-1] == "flann_top.vhd" and len(man["files"]) == 5
+    assert man["files"][-1] == "flann_top.vhd" and len(man["files"]) == 6  # + the shared flann_seq
     assert man["model_sha256"] == model_sha256(model_file)
     on_disk = json.loads((tmp_path / "hdl" / "manifest.json").read_text())
     assert on_disk == man

@@ -46,6 +46,12 @@ def _ubits(n: int) -> int:
     return max(1, int(n).bit_length())
 
 
+def seq_context(steps: int, n_advs: int, adv_period: int) -> dict:
+    """flann_seq, the sequencer every top level instantiates."""
+    return dict(steps=steps, n_advs=n_advs, adv_period=adv_period, timer_bits=_ubits(max(1, adv_period - 1)),
+                adv_cnt_bits=_ubits(n_advs))
+
+
 def contexts(spec: Spec) -> dict[str, dict]:
     """Template context of every entity."""
     s = spec
@@ -123,8 +129,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
         output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, steps=s.steps, n_advs=n_advs,
         adv_period=s.adv_period, timer_bits=_ubits(max(1, s.adv_period - 1)), adv_cnt_bits=_ubits(n_advs),
     )
-    seq = dict(steps=s.steps, n_advs=n_advs, adv_period=s.adv_period, timer_bits=top["timer_bits"],
-               adv_cnt_bits=top["adv_cnt_bits"])
+    seq = seq_context(s.steps, n_advs, s.adv_period)
     return {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
             "flann_adder": adder, "flann_seq": seq, "flann_top": top}
 
@@ -248,7 +253,7 @@ def rebuild_spec(model_path, man: dict, where, check_device: bool = True) -> tup
                      "version of flann; regenerate the design")
 
 
-__all__ = ["generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
+__all__ = ["seq_context", "generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
            "rebuild_spec", "TOP",
            "ENTITIES", "MANIFEST", "write_design"]
 

@@ -16,10 +16,11 @@ from ...textgen import template
 from ..header import header
 from ..manifest import write_design
 from ...golden.model import FlannModel, load_model, model_sha256
-from ..fixed.render import MODEL_FILE, model_text, render as render_fixed
+from ..fixed.render import MODEL_FILE, TEMPLATES as FIXED_TEMPLATES, model_text, render as render_fixed, seq_context
 from .spec import CVT, TOP, derive_f18_spec
 
 DATAPATH = "float18"
+SEQ = "flann_seq"
 BLOCKS = {"mul": F18Mul, "add": F18Add}
 BLOCK_TITLES = {"mul": "multiplier", "add": "adder"}
 TEMPLATES = "hardware/float18/templates"
@@ -118,8 +119,14 @@ def render_design(fspec) -> dict[str, str]:
     """{file: text} in compile order: shared front end, float18 blocks, top."""
     fmt = fspec.fmt
     fixed = render_fixed(fspec.base)
-    out = {"flann_norm.vhd": fixed["flann_norm.vhd"], "flann_expansion.vhd": fixed["flann_expansion.vhd"]}
+    # the shared front end, as the fixed datapath renders it, and the shared sequencer with this
+    # datapath's advances (one term per adder latency)
+    out = {f: fixed[f] for f in ("flann_norm.vhd", "flann_expansion.vhd")}
     b = fspec.base
+    h = header(f"{SEQ}.vhd", "sequencer of one sample (shared by every top level)", COMMAND, fspec.to_dict(),
+               b.model_sha256)
+    out[f"{SEQ}.vhd"] = template(f"{FIXED_TEMPLATES}/{SEQ}.vhd.j2").render(
+        h=h, **seq_context(b.steps, fspec.n_advs, fspec.adv_period))
     ctx = cvt_context(fmt, b.term_fmt.width, b.term_fmt.frac_bits)
     cvt_spec = dict(_format_spec(fmt), in_bits=ctx["in_bits"], in_frac_bits=ctx["in_frac"])
     h = header(f"{CVT}.vhd", "signed fixed point terms to float18", COMMAND, cvt_spec, BLOCK_MODEL)
