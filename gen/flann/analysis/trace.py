@@ -82,7 +82,8 @@ class Stages:
     step_cols: list[list[int]]   # columns added at each running-sum step
     h_out: np.ndarray            # (n,) mm
     start_stage: str             # "linear" (fixed) or "weights" (float18: bias constant)
-    info: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict)  # sig_bits: float rounding; output_lsb_mm: a fixed output
+    converts: bool = False       # a fixed -> float conversion stage sits between expansion and products
 
     @property
     def g_out(self) -> np.ndarray:
@@ -154,7 +155,7 @@ def stages_float18(fspec, codes=None) -> Stages:
         h_fixed_terms=t.fixed_terms.astype(float) * 2.0 ** -Tf, h_terms=dec(t.terms),
         h_weights=dec(np.asarray(fspec.weight_codes)), h_products=dec(t.products),
         h_start=np.full(codes.size, float(fmt.decode(fspec.start_code))), h_running=dec(t.running),
-        step_cols=[[i] for i in range(N)], h_out=dec(t.out), start_stage="weights",
+        step_cols=[[i] for i in range(N)], h_out=dec(t.out), start_stage="weights", converts=True,
         info=dict(table_addr_bits=base.table_addr_bits, interp=base.interp, phase_bits=base.phase_bits,
                   term_frac_bits=Tf, sig_bits=fmt.sig_bits, format=fmt.describe(),
                   input_lsb_v=base.input_lsb_v),
@@ -173,7 +174,7 @@ def attribute(st: Stages) -> list[Source]:
         "products": st.h_products - hw * st.h_terms,
     }
     for stage, arr in pieces.items():
-        if stage == "convert" and st.fmt != "float18":
+        if stage == "convert" and not st.converts:
             continue
         for col, i in enumerate(st.term_index):
             out.append(Source(stage, i, term_label(i), arr[:, col]))
@@ -364,7 +365,7 @@ def _reason(st: Stages, src: Source, ok: np.ndarray) -> str:
                 f"(relative {abs(hw - gw) / max(abs(gw), 1e-300):.2g}) times a term up to {t:.3g}.")
     if src.stage == "products" and col is not None:
         p = float(np.abs(st.h_products[ok, col]).max())
-        if st.fmt == "float18":
+        if "sig_bits" in info:  # float products round to half an ulp of their own size
             return (f"rounding of large-argument products: |w·t| for {src.label} reaches {p:.3g} mm, "
                     f"where float18's half-ulp is {0.5 * _ulp(p, info['sig_bits']):.2g} mm.")
         return (f"each product is rounded to 2^-{info['product_frac_bits']} output LSB "
@@ -386,7 +387,7 @@ def _reason(st: Stages, src: Source, ok: np.ndarray) -> str:
         return ("rounding of the serial linear term w0·v_n + bias to the accumulator's "
                 f"2^-{info['product_frac_bits']} output LSB.")
     if src.stage == "output":
-        if st.fmt == "fixed":
+        if "output_lsb_mm" in info:
             return (f"final rounding to the {info['output_lsb_mm']} mm output LSB (at most "
                     f"{info['output_lsb_mm'] / 2:.3g} mm), larger than every upstream error.")
         return "saturation of the output at float18's max finite value."
