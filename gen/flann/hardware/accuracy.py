@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import FlannError, SpecError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
-from ..golden.model import FlannModel, load_model, model_sha256
+from ..golden.model import FlannModel
 from .adc import MAX_DESIGN_INPUT_BITS
 from .registry import read_design
 from .fixed.spec import Spec, derive_spec

@@ -42,7 +42,8 @@ from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text
 from ..golden.metrics import raw_output_mm
 from ..hardware.family.build import train_model
-from ..hardware.family.render import design_hash, load_design
+from ..hardware.family.render import design_hash
+from ..hardware.registry import FAMILY, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
@@ -258,7 +259,11 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
                     max_error_mm: float | None = None, progress: bool | None = None,
                     diagnosis_points: int | None = DIAGNOSIS_POINTS) -> list[Result]:
     """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording."""
-    fam = load_design(design_dir)
+    man, dp = read_design(design_dir)  # the manifest's own datapath, its fields checked
+    if dp is not FAMILY:
+        raise FlannError(f"{design_dir}: a {dp.name} design; flann calibrate writes weight images for a family "
+                         "design (flann gen --family)")
+    fam, _ = dp.rebuild(dp.model_path(design_dir, man), man, design_dir)
     if diagnosis_points is not None and diagnosis_points < 0:
         raise FlannError(f"--diagnosis-points {diagnosis_points}: must be >= 0 (0 = every point)")
     if sensor_toml is not None:  # a bad sensor file stops the batch before it starts

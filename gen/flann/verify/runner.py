@@ -33,7 +33,6 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..hardware.target import CLOCK_HZ
-from ..hardware.fixed.twin import FlannTop
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from .design import Design
