@@ -8,15 +8,20 @@ import shutil
 import subprocess
 import sys
 
+from pathlib import Path
+
 import pytest
 
 from flann.golden.train import fit_lstsq
 from flann.hardware.seed import render as seed_render
 from flann.hardware.seed.spec import derive_seed_spec
 from flann.production.demo import write_batch
+from flann.implement.synth import lint_vhdl
 from flann.recordings import prepare_for_fit, read_recordings
+from flann.verify.runner import simulator_name, throughput
 
 FLANN = [sys.executable, "-m", "flann.cli"]
+REPO = Path(__file__).resolve().parents[2]
 BITS = "8"
 
 
@@ -145,3 +150,18 @@ def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field):
     r = flann(*TAMPER_COMMANDS[command](d, designs))
     one_line_refusal(r)
     assert field in r.stderr
+
+
+@pytest.mark.skipif(shutil.which("vsg") is None and not (Path(sys.executable).parent / "vsg").exists(),
+                    reason="vsg not installed")
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family"])
+def test_generated_vhdl_passes_vsg(designs, datapath):
+    files = sorted((designs["dir"] / datapath).glob("*.vhd"))
+    assert files and lint_vhdl(files, start=REPO) == []
+
+
+def test_plot_legend_and_throughput_name_what_ran():
+    assert simulator_name({"engine": "verilator"}).startswith("Verilator")
+    assert simulator_name({"engine": "ghdl", "backend": "ghdl-llvm"}) == "GHDL ghdl-llvm"
+    t = throughput(100, clock_hz=25e6)
+    assert t == {"clock_hz": 25e6, "samples_per_s": 250000.0, "samples_per_s_at_50mhz": 250000.0}
