@@ -11,6 +11,7 @@ from flann.hardware.registry import DATAPATHS
 from flann.hardware.family.spec import derive_family
 from flann.hardware.fixed.spec import derive_spec
 from flann.hardware.float18.spec import derive_f18_spec
+from flann.numeric.float18 import FLOAT18
 
 
 @pytest.fixture(scope="module")
@@ -37,3 +38,30 @@ def test_top_twin_protocol(model, name):
     assert out.shape == sat.shape == codes.shape
     e = twin.error_vs_float(codes)
     assert e["codes"] == codes.size and 0 <= e["max_err_mm"] < 1.0
+
+
+def _block_twins(model):
+    """(twin, inputs of process) of every block: the fixed datapath's, float18's converter and arithmetic."""
+    from flann.hardware.fixed.twin import FlannAdder, FlannExpansion, FlannMultiplier, FlannNorm
+    from flann.hardware.float18.spec import F18Cvt
+    from flann.numeric.float18 import F18Add, F18Mul
+
+    s = derive_spec(model, input_bits=8)
+    codes = np.arange(-128, 128)
+    n = FlannNorm(s).process(codes)
+    e = FlannExpansion(s).process(n.out_theta)
+    p = FlannMultiplier(s).process(e.out_terms)
+    one = FLOAT18.encode_array([1.5] * 4)
+    return [(FlannNorm(s), (codes,), "out_theta"), (FlannExpansion(s), (n.out_theta,), "out_terms"),
+            (FlannMultiplier(s), (e.out_terms,), "out_products"),
+            (FlannAdder(s), (n.out_lin, p.out_products, n.out_sat), "out_data"),
+            (F18Cvt(s.term_fmt.frac_bits), (np.arange(-8, 8),), "out_y"),
+            (F18Mul(), (one, one), "out_y"), (F18Add(), (one, one), "out_y")]
+
+
+def test_block_twin_protocol(model):
+    for twin, inputs, port in _block_twins(model):
+        assert twin.entity.startswith("flann_"), twin
+        assert isinstance(twin.latency, int) and twin.latency > 0, twin.entity
+        rec = twin.process(*inputs)
+        assert getattr(rec, port) is not None, (twin.entity, port)

@@ -282,6 +282,13 @@ FLOAT18 = FloatFormat()
 
 
 # -- twins of the VHDL blocks ----------------------------------------------------------
+@dataclass(frozen=True)
+class FloatOut:
+    """Output port of a float block twin (``out_y``), the result its ``process`` returns."""
+
+    out_y: np.ndarray
+
+
 class _PipelinedTwin:
     """Cycle model of a fixed-latency pipeline with a valid flag (data is not reset)."""
 
@@ -301,6 +308,10 @@ class _PipelinedTwin:
 
     def compute(self, a: int, b: int) -> int:
         raise NotImplementedError
+
+    def process(self, in_a, in_b) -> FloatOut:
+        """Every (in_a, in_b) pair, vectorised; ``out_y`` as the entity gives it ``latency`` cycles later."""
+        return FloatOut(out_y=self.compute_array(in_a, in_b))
 
     def step(self, in_valid: bool, a: int = 0, b: int = 0) -> tuple[bool, int | None]:
         """One rising edge: returns (out_valid, out_y) after the edge."""
@@ -335,4 +346,4 @@ class F18Add(_PipelinedTwin):
         return self.fmt.add_array(a, b)
 
 
-__all__ = ["FLOAT18", "F18Add", "F18Mul", "FloatFormat"]
+__all__ = ["FloatOut", "FLOAT18", "F18Add", "F18Mul", "FloatFormat"]

@@ -151,6 +151,7 @@ class FlannAdder:
     """Start at the linear part, add every product, round to the output LSB, saturate."""
 
     entity = "flann_adder"
+    latency = 1  # clock edges from in_finish to out_valid (the rounded, saturated sum registered)
 
     def __init__(self, spec: Spec):
         self.spec = spec

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import SpecError
-from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
+from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
 from ..fixed.spec import Spec, derive_spec
 from ..options import GenOptions
@@ -194,6 +194,9 @@ class F18Cvt:
         if a.size and np.abs(a).max() >= 2 ** 53:
             raise ValueError("fixed value too wide for the float64 path")
         return self.fmt.encode_array(np.ldexp(a.astype(float), -self.frac_bits))
+
+    def process(self, in_data) -> FloatOut:
+        return FloatOut(out_y=self.compute_array(in_data))
 
 
 @dataclass
