@@ -162,6 +162,6 @@ def test_generated_vhdl_passes_vsg(designs, datapath):
 
 def test_plot_legend_and_throughput_name_what_ran():
     assert simulator_name({"engine": "verilator"}).startswith("Verilator")
-    assert simulator_name({"engine": "ghdl", "backend": "ghdl-llvm"}) == "GHDL ghdl-llvm"
+    assert simulator_name({"engine": "ghdl", "backend": "ghdl-llvm"}) == "GHDL, llvm"
     t = throughput(100, clock_hz=25e6)
     assert t == {"clock_hz": 25e6, "samples_per_s": 250000.0, "samples_per_s_at_50mhz": 250000.0}

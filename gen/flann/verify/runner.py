@@ -345,8 +345,10 @@ def throughput(cycles_per_sample: int, clock_hz: float = CLOCK_HZ) -> dict:
 
 def simulator_name(about: dict) -> str:
     """Which simulator produced every code's output, for a plot's legend."""
-    return "Verilator, GHDL's synthesised netlist" if about.get("engine") == "verilator" else \
-        f"GHDL {about.get('backend', '')}".strip()
+    if about.get("engine") == "verilator":
+        return "Verilator, GHDL's synthesised netlist"
+    backend = str(about.get("backend", "")).removeprefix("ghdl-")
+    return f"GHDL, {backend}" if backend else "GHDL"
 
 
 def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
