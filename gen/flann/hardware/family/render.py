@@ -26,17 +26,19 @@ from .twin import FlannFamilyMem
 TOP = "flann_family_top"
 DATAPATH = "family"
 INIT_MODEL = "init_model.json"
-# compile order: (entity, title, template path)
+# compile order: (entity, title, template); the multiplier is the fixed datapath's, its weights
+# read from the memory (the "memory" weight fragment) instead of a ROM
+FIXED_T, FAMILY_T = "hardware/fixed/templates", "hardware/family/templates"
 ENTITIES = (
-    ("flann_family_mem", "weight memory (per-sensor values, cfg write port)", "hardware/family/templates"),
+    ("flann_family_mem", "weight memory (per-sensor values, cfg write port)", f"{FAMILY_T}/flann_family_mem"),
     ("flann_family_norm", "input clamp and normalisation, constants fetched from the memory",
-     "hardware/family/templates"),
+     f"{FAMILY_T}/flann_family_norm"),
     ("flann_expansion", "trigonometric expansion (phase accumulation, quarter-wave table)",
-     "hardware/fixed/templates"),
-    ("flann_family_multiplier", "terms x weights read from the memory", "hardware/family/templates"),
-    ("flann_adder", "accumulation, rounding, saturation", "hardware/fixed/templates"),
-    ("flann_seq", "sequencer of one sample (shared by every top level)", "hardware/fixed/templates"),
-    ("flann_family_top", "FLANN LVDT compensator for a sensor family, top level", "hardware/family/templates"),
+     f"{FIXED_T}/flann_expansion"),
+    ("flann_family_multiplier", "terms x weights read from the memory", f"{FIXED_T}/flann_multiplier"),
+    ("flann_adder", "accumulation, rounding, saturation", f"{FIXED_T}/flann_adder"),
+    ("flann_seq", "sequencer of one sample (shared by every top level)", f"{FIXED_T}/flann_seq"),
+    ("flann_family_top", "FLANN LVDT compensator for a sensor family, top level", f"{FAMILY_T}/flann_family_top"),
 )
 
 
@@ -73,11 +75,10 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
     step_bits = mu["step_bits"]
     if step_bits > fam.addr_bits:
         raise FlannError(f"internal: step counter ({step_bits} bits) wider than the memory address")
-    mult = dict(term_bits=mu["term_bits"], product_bits=mu["product_bits"], weight_bits=mu["weight_bits"],
-                weight_frac=mu["weight_frac"], full_bits=mu["full_bits"], shift=mu["shift"], half=mu["half"],
-                step_bits=step_bits, cnt_bits=mu["cnt_bits"], cnt_init=mu["cnt_init"],
-                cnt_init_n=int(mu["cnt_init"].strip('"'), 2), digit_bits=mu["digit_bits"],
-                shift_bits=mu["shift_bits"], data_bits=DATA_BITS)
+    if mu["lanes"] != 1 or mu["style"] != "shiftadd":
+        raise FlannError("internal: the family multiplier is one serial shift-add lane")
+    mult = dict(mu, entity="flann_family_multiplier", weight=f"{FIXED_T}/multiplier/weight/memory",
+                data_bits=DATA_BITS)
     t = base["flann_top"]
     top = dict(t, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
                param_base=fam.param_base, step_bits=step_bits, pidx_bits=max(1, fam.param_words.bit_length()))
@@ -97,9 +98,9 @@ def header_spec(fam: FamilySpec) -> dict:
 def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
     ctx = contexts(fam, init_name or "(first member)")
     out = {}
-    for name, title, folder in ENTITIES:
+    for name, title, tpl in ENTITIES:
         h = header(f"{name}.vhd", title, "flann gen --family", header_spec(fam), fam.spec.model_sha256)
-        out[f"{name}.vhd"] = template(f"{folder}/{name}.vhd.j2").render(h=h, **ctx[name])
+        out[f"{name}.vhd"] = template(f"{tpl}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 

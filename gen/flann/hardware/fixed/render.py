@@ -102,7 +102,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, entity="flann_multiplier", weight=f"{TEMPLATES}/multiplier/weight/rom", style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
         weight_type=s.weight_fmt.vhdl_type, product_type=s.product_fmt.vhdl_type,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
