@@ -38,7 +38,7 @@ def test_writes_design_and_manifest_deterministically(tmp_path, capsys):
     assert run_gen(_args(DEFAULT, "-o", tmp_path / "b")) == 0
     man = json.loads((tmp_path / "a" / "manifest.json").read_text())
     assert man["top"] == "flann_f18_top" and man["number_format"] == "float18"
-    assert man["files"] == ["flann_norm.vhd", "flann_expansion.vhd", "flann_f18_cvt.vhd",
+    assert man["files"] == ["flann_norm.vhd", "flann_expansion.vhd", "flann_seq.vhd", "flann_f18_cvt.vhd",
                             "flann_f18_mul.vhd", "flann_f18_add.vhd", "flann_f18_top.vhd"]
     assert man["model_sha256"] == model_sha256(DEFAULT)
     assert man["output"]["exp_bits"] == 6 and man["output"]["frac_bits"] == 11 and man["output"]["bias"] == 31
