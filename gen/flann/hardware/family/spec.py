@@ -31,7 +31,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
-from ..fixed.spec import BRAM_BITS, Spec, _round_sig, check_fits, derive_spec, estimate_resources, nice_125
+from ..fixed.spec import BRAM_BITS, Spec, round_sig, check_fits, derive_spec, estimate_resources, nice_125
 from ..target import DEFAULT_PART
 
 DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
@@ -231,7 +231,7 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
     # common input code: every member's voltage range + margin
     vmax = max(max(abs(v) for v in m.voltage_range_v) for m in models)
     if input_lsb_v is None:
-        input_lsb_v = _round_sig(max(vmax, 1e-12) * (1 + mu) / (1 << (input_bits - 1)))
+        input_lsb_v = round_sig(max(vmax, 1e-12) * (1 + mu) / (1 << (input_bits - 1)))
     # common output code: the finest LSB a member needs, range of all + margin
     ys = []
     for m in models:

@@ -60,7 +60,7 @@ def nice_125(x: float, up: bool) -> float:
     return min(c for c in cands if c >= x * (1 - 1e-12)) if up else max(c for c in cands if c <= x * (1 + 1e-12))
 
 
-def _round_sig(x: float, sig: int = 3, up: bool = True) -> float:
+def round_sig(x: float, sig: int = 3, up: bool = True) -> float:
     e = math.floor(math.log10(abs(x))) - sig + 1
     f = math.ceil if up else math.floor
     return float(f"{f(x / 10.0 ** e) * 10.0 ** e:.12g}")
@@ -342,7 +342,7 @@ def derive_spec(
     cmin, cmax = -(1 << (B - 1)), (1 << (B - 1)) - 1
     if input_lsb_v is None:
         # cover the trained range with 10 % margin, 3 significant digits (rounded up)
-        input_lsb_v = _round_sig(max(abs(vlo), abs(vhi), 1e-12) * 1.10 / (1 << (B - 1)))
+        input_lsb_v = round_sig(max(abs(vlo), abs(vhi), 1e-12) * 1.10 / (1 << (B - 1)))
     if not (isinstance(input_lsb_v, (int, float)) and math.isfinite(input_lsb_v) and input_lsb_v > 0):
         raise SpecError(f"input_lsb_v = {input_lsb_v!r}: must be a positive number of volts")
     lsb = float(input_lsb_v)
@@ -597,5 +597,5 @@ def check_fits(spec: Spec, part: str) -> None:
     )
 
 
-__all__ = ["Spec", "derive_spec", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["Spec", "derive_spec", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ"]
