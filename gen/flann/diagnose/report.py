@@ -136,12 +136,13 @@ def plot(dg, path) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
-    x, d = dg.x, dg.direction
-    keep = ~dg.outlier_mask
+    arr = dg.plot
+    x, d = arr.x, arr.direction
+    keep = ~arr.outlier_mask
     title_after = ("after " + " + ".join(e.name for e in dg.effects)) if dg.effects \
         else "no effect added (nothing missing)"
-    for ax, r, title in ((axes[0], dg.resid_before, "ideal simulation, calibrated"),
-                         (axes[1], dg.resid_after, title_after)):
+    for ax, r, title in ((axes[0], arr.resid_before, "ideal simulation, calibrated"),
+                         (axes[1], arr.resid_after, title_after)):
         for reg in dg.regions:
             color = {"+": "tab:red", "-": "tab:blue", "both": "tab:purple"}[reg["direction"]]
             ax.axvspan(reg["from_mm"], reg["to_mm"], color=color, alpha=0.12, lw=0)
@@ -164,7 +165,7 @@ def plot(dg, path) -> None:
         inl = r[keep] * 1e3
         lim = max(float(np.max(np.abs(inl))) if inl.size else 1.0, 3 * dg.noise_v * 1e3) * 1.25
         ax.set_ylim(-lim, lim)
-        if dg.outlier_mask.any():
+        if arr.outlier_mask.any():
             # outliers drawn at the edge of the axis, their value written next to them
             ro = np.clip(r[~keep] * 1e3, -0.95 * lim, 0.95 * lim)
             ax.plot(x[~keep], ro, "x", color="tab:orange", ms=8, label="outlier (value noted)")
