@@ -38,7 +38,10 @@ def test_batch_reports_bad_rows_and_goes_on(batch):
     for p in batch["bad"]:
         r = rows[p.stem]
         assert r["status"] == "failed" and r["reason"], r
-        assert not (batch["out"] / p.stem).exists(), "a failed sensor left files"
+        assert r["verdict"] == "FAIL" and r["reasons"].startswith("rejected: "), r
+        # a rejected sensor gets a certificate saying why, and no weights a loader could use
+        assert sorted(q.name for q in (batch["out"] / p.stem).iterdir()) == ["certificate.html"]
+        assert "FAIL" in (batch["out"] / p.stem / "certificate.html").read_text()
     assert "voltage_v" in rows["bad_no_voltage"]["reason"]
     assert "exceeds the design's input" in rows["bad_out_of_family"]["reason"]
     for p in batch["good"]:
