@@ -23,6 +23,7 @@ from ..recordings import Recordings, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
+from .confound import Confounding, equivalent_sets
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
 from .select import Fit, Selection, Trial, forward_select
@@ -75,6 +76,11 @@ class Diagnosis:
     noise_method: str = ""
     noise_regions: list = field(default_factory=list)
     ideal_rms: float = math.nan
+    # sets of effects that explain the recordings equally well (empty: one explanation);
+    # ``effects`` then holds only the effects every set shares
+    alternatives: list[list[str]] = field(default_factory=list)
+    alternatives_delta_bic: list[float] = field(default_factory=list)
+    alternatives_margin: float = math.nan
     # the candidates tried in each round of the selection (the report names the closest)
     trials: list[list[Trial]] = field(repr=False, default_factory=list)
     plot: PlotArrays | None = field(repr=False, default=None)
@@ -140,6 +146,7 @@ class SelectionResult:
     deltas: tuple[float, ...]
     cvts: tuple[float, ...]
     alternatives: dict
+    confounding: Confounding
 
 
 def _param(value, stderr, unit) -> dict:
@@ -288,9 +295,13 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
             deltas.append(f.bic - prev.bic)
             prev = f
         cumulative[-1] = sel.final
+    if progress:
+        progress("testing for equally good explanations")
+    conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
     return SelectionResult(selection=sel, order=tuple(order), cumulative=tuple(cumulative),
                            deltas=tuple(deltas), cvts=tuple(cvts),
-                           alternatives={s.name: s.alternatives for s in sel.steps})
+                           alternatives={s.name: s.alternatives for s in sel.steps},
+                           confounding=conf)
 
 
 def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult,
@@ -323,7 +334,10 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
                                     explain("adc_clipping", params, contrib, x, direction,
                                             temp, y, slope, null_at),
                                     params, final.rms, math.nan, math.nan))
+    conf = chosen.confounding
     for k, name in enumerate(chosen.order):
+        if name not in conf.shared:   # confounded: named only as one of the alternatives
+            continue
         params = {}
         for n, v, se in zip(final.names, final.theta, final.stderr):
             if n.startswith(name + "."):
@@ -404,6 +418,9 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
         shape_description=shape_desc, noise_method=D.NOISE_METHOD,
         noise_regions=noise_regions,
         ideal_rms=float(np.sqrt(np.mean((before + shape_v)[fit_idx] ** 2))),
+        alternatives=[list(s) for s in conf.sets] if conf.confounded else [],
+        alternatives_delta_bic=[float(d) for d in conf.delta_bic] if conf.confounded else [],
+        alternatives_margin=float(conf.margin) if conf.confounded else math.nan,
         trials=sel.trials,
         plot=PlotArrays(x=x, direction=direction, resid_before=before, resid_after=after,
                         outlier_mask=skip))

@@ -32,6 +32,9 @@ def to_json(dg) -> dict:
         "effects": [{"name": e.name, "explanation": e.explanation, "params": e.params,
                      "rms_v_after": _num(e.rms_v_after), "delta_bic": _num(e.delta_bic)}
                     for e in dg.effects],
+        # equally good explanations (each a list of effect names); "effects" then holds only
+        # what they all share
+        "alternatives": [list(a) for a in dg.alternatives],
         "final": {"rms_v": _num(dg.final_rms)},
         "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
     }
@@ -93,10 +96,17 @@ def format_text(dg) -> str:
             unit = "s" if dg.time_unit == "s" else "rows"
             spans = ", ".join(f"{a:g}..{b:g} {unit}" for a, b, _ in dg.time_spans)
             lines.append(f"  in recording time: {spans}")
-    if not dg.effects and not dg.regions:
+    if dg.alternatives:
+        sets = " | ".join("{" + " + ".join(a) + "}" + f" ({d:+.1f})"
+                          for a, d in zip(dg.alternatives, dg.alternatives_delta_bic))
+        shared = ", ".join(e.name for e in dg.effects) or "none"
+        lines.append(f"confounded: these explanations fit the recordings equally well (delta BIC "
+                     f"within {dg.alternatives_margin:.3g} of the best): {sets}; the recordings cannot tell "
+                     f"them apart, so only what they share is named: {shared}")
+    if not dg.effects and not dg.alternatives and not dg.regions:
         lines.append(f"nothing missing: the residual ({_mv(dg.final_rms)} RMS) is noise; "
                      "no effect of the catalogue earns its keep")
-    elif not dg.effects:
+    elif not dg.effects and not dg.alternatives:
         lines.append("no effect of the catalogue explains the mismatch located above: it is "
                      "physics the catalogue lacks, or a shape the simulated geometry cannot take")
     if dg.effects:

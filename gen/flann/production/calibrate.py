@@ -212,8 +212,7 @@ def _diagnosis(rec, sensor, points: int | None):
         found.append(f"{len(dg.outliers)} outlier point(s)")
     found += [f"warning: {w.message}" for w in caught]
     named = tuple(e.name for e in dg.effects)
-    groups = tuple(tuple(g) for g in getattr(dg, "alternatives", ()) or ()) or tuple(
-        (e.name, *e.alternatives) for e in dg.effects if e.alternatives)
+    groups = tuple(tuple(g) for g in dg.alternatives)
     return found, basis, named, groups
 
 
