@@ -218,8 +218,8 @@ def _diagnosis(rec, sensor, points: int | None):
 
 def diagnosis_cell(named, groups) -> str:
     """The summary's diagnosis column: the named effects, or the sets that fit equally."""
-    if groups:
-        return "confounded: " + " | ".join("+".join(g) or "nothing" for g in groups)
+    if groups:  # sorted: the same sets read the same in every row (best first is in the JSON)
+        return "confounded: " + " | ".join(sorted("+".join(sorted(g)) or "nothing" for g in groups))
     return "; ".join(named) or "none"
 
 
