@@ -291,7 +291,11 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
         res.trace = traceability(path, None, Station(station.station, station.operator,
                                                      station.fixture, station.temperature_c))
     try:
-        html = render_rejection(res, fam, dhash, spec)
+        sha = rec.sha256 if rec is not None else hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        sha = ""
+    try:
+        html = render_rejection(res, fam, dhash, spec, sha)
         with atomic_directory(Path(out_dir) / res.sensor, _is_sensor_output, "sensor calibration") as tmp:
             (tmp / "certificate.html").write_text(html, newline="")
     except (FlannError, OSError) as exc:

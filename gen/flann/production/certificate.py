@@ -47,7 +47,7 @@ def _specification(spec, verdict) -> tuple:
     if verdict.range_text:
         rows.append(("judged over", verdict.range_text))
     if verdict.full_scale_mm is not None:
-        rows.append(("full scale (FS)", f"{verdict.full_scale_mm:g} mm (span judged over)"))
+        rows.append(("full scale (FS)", f"{verdict.full_scale_mm:.4g} mm (span judged over)"))
     rows.append(("decision rule", DECISION_RULE))
     rows.append(("verdict", verdict.verdict))
     return ("Specification and verdict", rows)
@@ -102,9 +102,9 @@ def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings, ba
                    after=[hardware])
 
 
-def render_rejection(res, fam, dhash: str, spec) -> str:
+def render_rejection(res, fam, dhash: str, spec, rec_sha: str = "") -> str:
     """The certificate of a sensor that could not be calibrated: FAIL and why."""
-    tables = [_identification(res, dhash, "", ""), _traceability(res),
+    tables = [_identification(res, dhash, "", rec_sha), _traceability(res),
               _specification(spec, res.verdict)]
     return _render(res, res.trace, res.verdict, tables, "", "", [], "", shipped=False)
 

@@ -6,7 +6,7 @@ max error is within the tolerance; the expanded uncertainty U (k = 2) is stated 
 a result within U of the tolerance is flagged as marginal in the reasons.
 
 Uncertainty of the max error (method stated on the certificate): one reading's noise sigma_v
-(from the recording, :func:`flann.recordings.checks.estimate_noise_v` per pass) becomes
+(from the recording, :func:`flann.recordings.checks.estimate_noise_v` per direction) becomes
 sigma_x = sigma_v |dx/dv| in mm (median over the stroke); the fitted curve adds its own
 uncertainty sigma_x sqrt(p / N) (p model terms, N positions); the output code adds
 q / sqrt(12).  u = sqrt(sigma_x^2 (1 + p / N) + q^2 / 12), U = 2 u.
@@ -28,8 +28,9 @@ COVERAGE = 2.0
 RANGE_SLACK_MM = 1e-6
 UNCERTAINTY_METHOD = (
     "U = 2 u (k = 2, about 95 %); u^2 = sigma_x^2 (1 + p/N) + q^2/12 with sigma_x the "
-    "recording's noise (median absolute successive difference per pass, in V) times |dx/dv|, "
-    "p the model terms, N the positions recorded, q the output LSB")
+    "recording's noise per reading (median absolute second difference along each direction "
+    "of travel / (0.6745 sqrt 6), in V) times the median |dx/dv|, p the model terms, N the "
+    "positions recorded, q the output LSB")
 
 
 @dataclass(frozen=True)
@@ -90,14 +91,14 @@ def judge(spec: ProductionSpec, x_mm, err_mm, ratio_to_limit: float | None,
     lo_x, hi_x = float(np.min(x)), float(np.max(x))
     if spec.working_range_mm is not None:
         lo, hi = spec.working_range_mm
-        rng = f"{lo:g}..{hi:g} mm"
+        rng = f"{lo:.4g}..{hi:.4g} mm"
         if lo < lo_x - RANGE_SLACK_MM or hi > hi_x + RANGE_SLACK_MM:
-            reasons.append(f"the recording covers {lo_x:g}..{hi_x:g} mm, not the whole working "
+            reasons.append(f"the recording covers {lo_x:.4g}..{hi_x:.4g} mm, not the whole working "
                            f"range {rng}")
         inside = (x >= lo) & (x <= hi)
     else:
         lo, hi = lo_x, hi_x
-        rng = f"the recorded stroke {lo_x:g}..{hi_x:g} mm"
+        rng = f"the recorded stroke {lo_x:.4g}..{hi_x:.4g} mm"
         inside = np.ones(x.size, bool)
     fs = hi - lo
     max_err = float(np.max(e[inside])) if inside.any() else None
@@ -116,7 +117,7 @@ def judge(spec: ProductionSpec, x_mm, err_mm, ratio_to_limit: float | None,
         u_pct = 100.0 * u / fs if fs > 0 else 0.0
         if pct > spec.max_error_pct_fs:
             reasons.append(f"max error {pct:.4g} % FS > tolerance {spec.max_error_pct_fs:g} % FS "
-                           f"(FS {fs:g} mm, {rng})")
+                           f"(FS {fs:.4g} mm, {rng})")
         elif pct + u_pct > spec.max_error_pct_fs:
             reasons.append(f"marginal: max error {pct:.4g} % FS is within U = {u_pct:.2g} % FS "
                            f"of the tolerance (passed by simple acceptance)")
