@@ -249,8 +249,14 @@ class PhysicsFamily:
         return float(np.ptp(self.data.x)) * self.scale / 8
 
     def _typical_step(self) -> float:
-        u = np.unique(self.data.x)
-        return float(np.median(np.diff(u))) * self.scale if u.size > 1 else 1.0
+        """The median step between the positions of one direction of travel: where the two
+        directions sample different positions (bin means of each pass), a period shorter
+        than three of a pass's steps would alias the direction split into a ripple."""
+        d = self.data
+        groups = ([d.x[d.direction == s] for s in np.unique(d.direction)]
+                  if d.direction is not None else [d.x])
+        steps = [float(np.median(np.diff(u))) for u in map(np.unique, groups) if u.size > 1]
+        return max(steps) * self.scale if steps else 1.0
 
     # -- the model -------------------------------------------------------------------
     def _unpack(self, theta: np.ndarray, names: list[str]):
