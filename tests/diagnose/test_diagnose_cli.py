@@ -32,8 +32,8 @@ def test_table1_json_plot(tmp_path, capsys):
                  "--quiet"]) == 0
     text = capsys.readouterr().out
     d = json.loads(out.read_text())
-    assert list(d) == ["baseline", "noise_v", "regions", "outliers", "effects", "final",
-                       "improvement"]
+    assert list(d) == ["baseline", "noise_v", "regions", "outliers", "effects", "alternatives",
+                       "final", "improvement"]
     assert {"rms_v", "params", "shape_term"} <= set(d["baseline"])
     assert "odd" in d["baseline"]["shape_term"]["description"] or \
         d["baseline"]["shape_term"]["terms"] == 0

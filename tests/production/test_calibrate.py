@@ -38,7 +38,10 @@ def test_batch_reports_bad_rows_and_goes_on(batch):
     for p in batch["bad"]:
         r = rows[p.stem]
         assert r["status"] == "failed" and r["reason"], r
-        assert not (batch["out"] / p.stem).exists(), "a failed sensor left files"
+        assert r["verdict"] == "FAIL" and r["reasons"].startswith("rejected: "), r
+        # a rejected sensor gets a certificate saying why, and no weights a loader could use
+        assert sorted(q.name for q in (batch["out"] / p.stem).iterdir()) == ["certificate.html"]
+        assert "FAIL" in (batch["out"] / p.stem / "certificate.html").read_text()
     assert "voltage_v" in rows["bad_no_voltage"]["reason"]
     assert "exceeds the design's input" in rows["bad_out_of_family"]["reason"]
     for p in batch["good"]:
@@ -99,3 +102,39 @@ def test_bad_options_stop_before_any_work(batch, tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("error: ") == 3 and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_spec_verdicts_certificates_and_summary(batch, tmp_path):
+    """A tolerance between the good sensors' errors: those above FAIL (certificate, no
+    weights), those below PASS; the summary has the verdict and traceability columns; the
+    exit code says a sensor failed (1: no bad input among them)."""
+    good = batch["good"]
+    errs = sorted(float(batch["rows"][p.stem]["max_error_mm"]) for p in good)
+    tol = (errs[0] + errs[1]) / 2
+    spec = tmp_path / "spec.toml"
+    spec.write_text(f'name = "line A"\n[tolerance]\nmax_error_mm = {tol}\n')
+    out = tmp_path / "o"
+    rc = main(["calibrate", *map(str, good), "-o", str(out), "--design", str(batch["design"]), "-j", "1",
+               "--spec", str(spec), "--station", "S1", "--operator", "Ann", "--fixture", "F9",
+               "--temperature-c", "23.5"])
+    assert rc == 1
+    with open(out / "summary.csv", newline="") as fh:
+        reader = csv.DictReader(fh)
+        rows = {r["sensor"]: r for r in reader}
+        cols = reader.fieldnames
+    for c in ("verdict", "reasons", "tolerance", "max_error_pct_fs", "diagnosis", "design_sha256",
+              "model_sha256", "calibrated_at", "station", "operator", "temperature_c"):
+        assert c in cols
+    for p in good:
+        r = rows[p.stem]
+        passed = float(r["max_error_mm"]) <= tol
+        assert r["verdict"] == ("PASS" if passed else "FAIL"), r
+        assert (r["station"], r["operator"], r["temperature_c"]) == ("S1", "Ann", "23.5")
+        assert len(r["design_sha256"]) == 64 and len(r["model_sha256"]) == 64 and r["diagnosis"]
+        html = (out / p.stem / "certificate.html").read_text()
+        assert ("PASS: " if passed else "FAIL: ") in html and "k = 2" in html and "F9" in html
+        assert html.count("<polyline") == 6 and "tolerance +-" in html    # the tolerance band
+        assert "@page { size: A4" in html and "<script" not in html
+        files = sorted(q.name for q in (out / p.stem).iterdir())
+        assert (files == ["certificate.html"]) != passed, files          # no weights for a FAIL
+    assert sum(r["verdict"] == "FAIL" for r in rows.values()) == 2

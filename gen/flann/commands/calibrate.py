@@ -1,10 +1,13 @@
-"""``flann calibrate REC.csv... -o OUTDIR --design DIR [-j N]``: per-sensor weights and certificates."""
+"""``flann calibrate REC.csv... -o OUTDIR --design DIR [-j N] [--spec SPEC.toml]``: per-sensor
+weights, certificates with a PASS/FAIL verdict, and a summary."""
 
 from __future__ import annotations
 
 import sys
 
 from ..production.calibrate import DIAGNOSIS_POINTS, SUMMARY, calibrate_batch
+from ..production.spec import build_spec
+from ..production.traceability import Station
 
 HELP = "calibrate sensors for a family design: weight images and certificates"
 
@@ -19,15 +22,44 @@ def add_arguments(p) -> None:
     p.add_argument("--diagnosis-points", type=int, default=DIAGNOSIS_POINTS, metavar="N",
                    help="the diagnosis sees at most N bin means of the recording (0 = every point; "
                         f"default {DIAGNOSIS_POINTS})")
-    p.add_argument("--max-error-mm", type=float, default=None,
-                   help="fail a sensor whose hardware max error on its recording exceeds this")
+    g = p.add_argument_group("specification (PASS/FAIL; flags override --spec)")
+    g.add_argument("--spec", metavar="SPEC.toml", default=None,
+                   help="tolerance and limits every sensor is judged against (docs/production.md)")
+    g.add_argument("--tolerance-mm", "--max-error-mm", dest="tolerance_mm", type=float, default=None,
+                   metavar="MM", help="FAIL a sensor whose hardware max error exceeds this (mm)")
+    g.add_argument("--tolerance-pct-fs", type=float, default=None, metavar="PCT",
+                   help="the same in %% of full scale (the working range's span, else the recorded one)")
+    g.add_argument("--working-range", default=None, metavar="LO:HI",
+                   help="judge the error over this displacement range (mm; default the whole stroke)")
+    g.add_argument("--max-ratio-to-limit", type=float, default=None, metavar="R",
+                   help="FAIL when the max error exceeds R x the physical limit")
+    g.add_argument("--fail-on-effect", action="append", default=[], metavar="EFFECT",
+                   help="FAIL when the diagnosis names this effect (repeatable)")
+    t = p.add_argument_group("traceability (a recording's own '# key: value' lines take precedence)")
+    t.add_argument("--station", default="", help="calibration station")
+    t.add_argument("--operator", default="", help="operator")
+    t.add_argument("--fixture", default="", help="fixture")
+    t.add_argument("--temperature-c", type=float, default=None, metavar="DEGC",
+                   help="calibration temperature (default: the recording's, if it says)")
+    t.add_argument("--serial-column", default="", metavar="NAME",
+                   help="read each sensor's serial from this CSV column (default: the file name)")
 
 
 def run(args) -> int:
+    spec = build_spec(args.spec, max_error_mm=args.tolerance_mm, max_error_pct_fs=args.tolerance_pct_fs,
+                      working_range=args.working_range, max_ratio_to_limit=args.max_ratio_to_limit,
+                      fail_on_effects=args.fail_on_effect)
+    station = Station(station=args.station, operator=args.operator, fixture=args.fixture,
+                      temperature_c=args.temperature_c, serial_column=args.serial_column)
     results = calibrate_batch(args.recordings, args.out, args.design, jobs=args.jobs, sensor_toml=args.sensor,
-                              max_error_mm=args.max_error_mm, diagnosis_points=args.diagnosis_points)
-    bad = [r for r in results if r.status != "ok"]
-    for r in bad:
+                              diagnosis_points=args.diagnosis_points, spec=spec, station=station)
+    rejected = [r for r in results if r.verdict is None or r.verdict.rejected]
+    failed = [r for r in results if r.status != "ok" and r not in rejected]
+    for r in rejected:
         print(f"error: {r.sensor}: {r.reason}", file=sys.stderr)
-    print(f"{len(results) - len(bad)} of {len(results)} sensor(s) calibrated; summary {args.out}/{SUMMARY}")
-    return 2 if bad else 0
+    for r in failed:
+        print(f"FAIL: {r.sensor}: {r.reason}", file=sys.stderr)
+    passed = len(results) - len(rejected) - len(failed)
+    print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
+          f"{len(rejected)} rejected; summary {args.out}/{SUMMARY}")
+    return 2 if rejected else 1 if failed else 0

@@ -23,6 +23,7 @@ repeat inside every candidate fit.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -153,10 +154,14 @@ class PhysicsFamily:
 
     def __init__(self, sensor, data: Data, origin_known: bool, shape: ShapeModes | None,
                  gain0: float, origin0: float, scale: float = 1.0,
-                 disc: OddBasis | None = None, origin_from_travel: bool = False):
+                 shape_ref: OddBasis | None = None, origin_from_travel: bool = False,
+                 terms: int = 0, equivalent_terms: tuple[int, ...] = ()):
         self.sensor = sensor.replace(effects={})
-        self._disc_ref = disc      # half-range and rectification of the shape term
-        self.disc = disc
+        self.shape_ref = shape_ref  # half-range, rectification and warp of the shape term
+        # shape terms of a fit that starts from nothing, and the numbers of terms that
+        # cross-validate as well (see choose_terms); a fit carries its own in ``extra``
+        self.terms = int(terms) if shape_ref is not None else 0
+        self.equivalent_terms = tuple(equivalent_terms)
         self.origin_from_travel = origin_from_travel
         self.data = data
         self.origin_known = origin_known
@@ -234,8 +239,8 @@ class PhysicsFamily:
         return out
 
     def _half_range(self) -> float:
-        if self._disc_ref is not None:
-            return self._disc_ref.half
+        if self.shape_ref is not None:
+            return self.shape_ref.half
         return max(float(np.max(np.abs((self.data.x - self.origin0) * self.scale))), 1e-9)
 
     def max_period(self) -> float:
@@ -244,8 +249,14 @@ class PhysicsFamily:
         return float(np.ptp(self.data.x)) * self.scale / 8
 
     def _typical_step(self) -> float:
-        u = np.unique(self.data.x)
-        return float(np.median(np.diff(u))) * self.scale if u.size > 1 else 1.0
+        """The median step between the positions of one direction of travel: where the two
+        directions sample different positions (bin means of each pass), a period shorter
+        than three of a pass's steps would alias the direction split into a ripple."""
+        d = self.data
+        groups = ([d.x[d.direction == s] for s in np.unique(d.direction)]
+                  if d.direction is not None else [d.x])
+        steps = [float(np.median(np.diff(u))) for u in map(np.unique, groups) if u.size > 1]
+        return max(steps) * self.scale if steps else 1.0
 
     # -- the model -------------------------------------------------------------------
     def _unpack(self, theta: np.ndarray, names: list[str]):
@@ -304,10 +315,10 @@ class PhysicsFamily:
 
     def evaluate(self, theta: np.ndarray, names: list[str], idx: np.ndarray,
                  coef: np.ndarray | None = None, target: np.ndarray | None = None,
-                 want_coef: bool = False):
-        """Model output at the points ``idx``.  With a shape term, its coefficients are
-        ``coef`` or, given ``target``, solved by least squares against it (on the points
-        the rails leave free); ``want_coef`` returns (output, coef)."""
+                 want_coef: bool = False, basis: OddBasis | None = None):
+        """Model output at the points ``idx``.  With a shape term (``basis``), its
+        coefficients are ``coef`` or, given ``target``, solved by least squares against it
+        (on the points the rails leave free); ``want_coef`` returns (output, coef)."""
         self.nfev += 1
         gain, origin, shape, eff = self._unpack(self._physical(theta, names), names)
         d = self.data
@@ -342,39 +353,39 @@ class PhysicsFamily:
             y = y + eff["null_offset"]["offset_v"]
         hi = eff.get("adc_clipping", {}).get("rail_high_v", math.inf)
         lo = eff.get("adc_clipping", {}).get("rail_low_v", -math.inf)
-        if self.disc is not None:
+        if basis is not None:
             # the shape follows a zero shift (it may be large); the origin's own change
             # inside a fit (~1e-3 mm) would only move it by a negligible amount, and keeping
             # it fixed lets every evaluation reuse one factorisation of the basis
             shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
-            B, pinv = self._disc_at(idx, core - shift)
+            B, pinv = self._basis_at(basis, idx, core - shift)
             if coef is None:
                 if target is None:
-                    coef = np.zeros(self.disc.ncols)
+                    coef = np.zeros(basis.ncols)
                 else:
                     free = (y < hi) & (y > lo)
                     if free.all():
                         coef = pinv() @ (target - y)
-                    elif free.sum() > self.disc.ncols:
+                    elif free.sum() > basis.ncols:
                         coef = np.linalg.lstsq(B[free], (target - y)[free], rcond=RCOND)[0]
                     else:
-                        coef = np.zeros(self.disc.ncols)
+                        coef = np.zeros(basis.ncols)
             y = y + B @ coef
         if "adc_clipping" in eff:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
-    def _disc_at(self, idx: np.ndarray, core: np.ndarray):
+    def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
         inside a fit the basis moves only with a zero shift, so the finite-difference
         steps of every other parameter reuse one factorisation (a least-squares solve per
         evaluation was most of the diagnosis' time on 2,000 points)."""
-        key = ("disc", self.disc.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        key = ("disc", basis.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         hit = self._shape_cache.get(key)
         if hit is None:
             if len(self._shape_cache) > 400:
                 self._shape_cache.clear()
-            B = self.disc.evaluate(core)
+            B = basis.evaluate(core)
             store: list = []
 
             def pinv():
@@ -411,7 +422,7 @@ class PhysicsFamily:
         return self.data.y[idx]
 
     # -- starting values ---------------------------------------------------------------
-    def _start(self, effects, names, idx, start: Fit | None) -> np.ndarray:
+    def _start(self, effects, names, idx, start: Fit | None, basis) -> np.ndarray:
         theta = np.empty(len(names))
         known = dict(zip(start.names, start.theta)) if start is not None else {}
         base = {"baseline.gain_ratio": self.gain0, "baseline.origin_mm": self.origin0}
@@ -429,17 +440,18 @@ class PhysicsFamily:
         if missing:
             if start is not None:
                 resid = self.data_y(idx) - self.evaluate(start.theta, start.names, idx,
-                                                          target=self.data_y(idx))
+                                                          target=self.data_y(idx), basis=basis)
                 base_theta, base_names = start.theta, start.names
             else:
                 base_names = [n for n in names if n.startswith("baseline.")]
                 base_theta = theta[:len(base_names)]
                 resid = self.data_y(idx) - self.evaluate(base_theta, base_names, idx,
-                                                          target=self.data_y(idx))
+                                                          target=self.data_y(idx), basis=basis)
             want = {names[i].split(".", 1)[0] for i in missing}
             guesses = self._guess(resid, idx, dict(zip(base_names, base_theta)), want)
             if "secondary_imbalance" in want:
-                guesses.update(self._guess_imbalance(resid, idx, base_theta, base_names))
+                guesses.update(self._guess_imbalance(resid, idx, base_theta, base_names,
+                                                     basis))
             for i in missing:
                 theta[i] = guesses.get(names[i], 0.0)
         return theta
@@ -470,7 +482,8 @@ class PhysicsFamily:
             g.update(self._guess_leadscrew(x, resid, slope))
         return g
 
-    def _guess_imbalance(self, resid, idx, base_theta, base_names) -> dict[str, float]:
+    def _guess_imbalance(self, resid, idx, base_theta, base_names,
+                         basis) -> dict[str, float]:
         """The imbalance and the sum's bend by linear regression of the residual on the
         imbalance's contribution D and on u^2 D (the model is e D (1 + c u^2)), less what
         the shape term and the null position can take.  Starting from zero, the fit can
@@ -478,19 +491,18 @@ class PhysicsFamily:
         trial = 0.01
         names = list(base_names) + ["secondary_imbalance.imbalance_fraction"]
         base = np.asarray(base_theta, float)
-        with self._with_k(0):
-            on = self.evaluate(np.r_[base, trial], names, idx)
-            off = self.evaluate(np.r_[base, 0.0], names, idx)
-            h = 1e-3
-            k_o = names.index("baseline.origin_mm") if "baseline.origin_mm" in names else None
-            cols = [off / max(float(np.max(np.abs(off))), 1e-12)]
-            if k_o is not None:
-                moved = base.copy()
-                moved[k_o] += h
-                cols.append(self.evaluate(np.r_[moved, 0.0], names, idx) - off)
+        on = self.evaluate(np.r_[base, trial], names, idx)
+        off = self.evaluate(np.r_[base, 0.0], names, idx)
+        h = 1e-3
+        k_o = names.index("baseline.origin_mm") if "baseline.origin_mm" in names else None
+        cols = [off / max(float(np.max(np.abs(off))), 1e-12)]
+        if k_o is not None:
+            moved = base.copy()
+            moved[k_o] += h
+            cols.append(self.evaluate(np.r_[moved, 0.0], names, idx) - off)
         core = (self.data.x[idx] - self.origin0) * self.scale
-        if self.disc is not None:
-            cols.append(self.disc.evaluate(core))
+        if basis is not None:
+            cols.append(basis.evaluate(core))
         A = np.column_stack(cols)
         unit = on - off
         u2 = (core / self._half_range()) ** 2
@@ -542,7 +554,7 @@ class PhysicsFamily:
         term as chosen and with fewer terms (a rail and a smooth shape both flatten the
         ends: BIC decides which needs fewer parameters), unless ``start`` already says."""
         effects = tuple(effects)
-        k0 = self.disc.k if self.disc is not None else 0
+        k0 = self.terms
         if start is not None and "k_shape" in start.extra:
             k0 = start.extra["k_shape"]
         if "adc_clipping" not in effects:
@@ -566,18 +578,39 @@ class PhysicsFamily:
 
     fewer_terms = (0, 2)
 
-    def set_shape_range(self, half_range_mm: float, rectified: bool) -> None:
-        """Where the smooth shape term lives (the recorded half-range of core positions)."""
+    def with_shape_range(self, half_range_mm: float, rectified: bool) -> "PhysicsFamily":
+        """This family with a smooth shape term over the recorded half-range of core
+        positions (no terms chosen yet: see :meth:`with_terms`)."""
         grid = np.linspace(-1.5 * half_range_mm, 1.5 * half_range_mm, 601)
         s1 = self.sensor.replace(demodulator_gain_ratio=1.0)
         h = 1e-3 * max(half_range_mm, 1e-6)
         slope = (simulate_output_v(s1, grid + h) - simulate_output_v(s1, grid - h)) / (2 * h)
         top = float(np.max(np.abs(slope)))
         warp = (grid, slope / top) if top > 0 and np.all(np.isfinite(slope)) else None
-        self._disc_ref = OddBasis(half_range_mm, 1, rectified, warp)
+        return self._copy(shape_ref=OddBasis(half_range_mm, 1, rectified, warp), terms=0,
+                          equivalent_terms=(), fresh_cache=True)
 
-    def _basis(self, k: int):
-        ref = self._disc_ref
+    def with_terms(self, k: int, equivalent_terms: tuple[int, ...] = ()) -> "PhysicsFamily":
+        """This family with ``k`` shape terms for fits that start from nothing."""
+        return self._copy(terms=k, equivalent_terms=equivalent_terms)
+
+    def with_data(self, data: Data) -> "PhysicsFamily":
+        """This family (its calibration, ranges and candidates) evaluated on ``data``."""
+        return self._copy(data=data, fresh_cache=True)
+
+    def _copy(self, fresh_cache: bool = False, **changes) -> "PhysicsFamily":
+        new = copy.copy(self)
+        for k, v in changes.items():
+            setattr(new, k, v)
+        if new.shape_ref is None:
+            new.terms = 0
+        if fresh_cache:
+            new._shape_cache = {}
+        return new
+
+    def basis(self, k: int):
+        """The shape term with ``k`` terms (None for none)."""
+        ref = self.shape_ref
         return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified, ref.warp)
 
     @staticmethod
@@ -602,13 +635,13 @@ class PhysicsFamily:
         squares.  The smallest number within 1 % of the best out-of-fold error is taken."""
         effects = tuple(effects)
         sides = self._sides(start)
-        if self._disc_ref is None:
-            return 0, {}, self._fit(effects, idx, start, sides, 0)
+        if self.shape_ref is None:
+            return 0, {}, self._fit(effects, idx, start, sides, 0), ()
         folds = make_folds(np.arange(idx.size))
         table, fits = {}, {}
         stale = 0
         for k in SHAPE_TERMS:
-            basis = self._basis(k)
+            basis = self.basis(k)
             if idx.size - len(self.specs(effects, sides)) - (basis.ncols if basis else 0) < 10:
                 continue
             if stale >= STOP_AFTER:
@@ -616,7 +649,7 @@ class PhysicsFamily:
             # each number of terms starts where the previous one ended (more terms can
             # always do what fewer did; a cold start may fall into another minimum)
             f = self._fit(effects, idx, fits[max(fits)] if fits else start, sides, k)
-            if (start is not None and start.ok and self._k_of(start) == k
+            if (start is not None and start.ok and self.terms_of(start) == k
                     and tuple(start.effects) == effects and start.rss < f.rss):
                 f = start      # the chain found a worse minimum than the fit it came from
             if not f.ok:
@@ -633,15 +666,10 @@ class PhysicsFamily:
                 v for j, v in table.items() if j != k) else 0
             fits[k] = f
         if not table:
-            return 0, {}, self._fit(effects, idx, start, sides, 0)
+            return 0, {}, self._fit(effects, idx, start, sides, 0), ()
         best = min(table.values())
         tied = sorted(k for k, v in table.items() if v <= best * 1.01)
-        self.equivalent_terms = tuple(tied)
-        return tied[0], table, fits[tied[0]]
-
-    # numbers of shape terms that cross-validate as well as the chosen one (set by
-    # choose_terms for the model last chosen)
-    equivalent_terms: tuple[int, ...] = ()
+        return tied[0], table, fits[tied[0]], tuple(tied)
 
     def least_evidence(self, effects, candidate: str, idx: np.ndarray, without: Fit,
                        with_: Fit) -> float:
@@ -651,8 +679,8 @@ class PhysicsFamily:
         let the shift trade against an offset (0.6 mm became 0.33 mm + -117 mV), while three
         to six terms, as good by cross-validation, need no offset."""
         worst = with_.bic - without.bic
-        k_now = self._k_of(without)
-        for k in self.equivalent_terms:
+        k_now = self.terms_of(without)
+        for k in without.extra.get("equivalent_terms", self.equivalent_terms):
             if k == k_now:
                 continue
             f0 = self._fit(tuple(effects), idx, without, self._sides(without), k)
@@ -663,84 +691,57 @@ class PhysicsFamily:
 
     def _jacobian(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
         """d(model)/d(parameters, shape coefficients) at ``fit`` (finite differences)."""
-        k = self._k_of(fit)
+        k = self.terms_of(fit)
         coef = fit.extra.get("coef")
-        basis = self._basis(k)
+        basis = self.basis(k)
         if coef is None:
             coef = np.zeros(0 if basis is None else basis.ncols)
         coef = np.asarray(coef, float)
-        with self._with_k(k):
-            y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef)
-            cols = []
-            for j, th in enumerate(fit.theta):
-                h = 1e-6 * max(abs(th), 1e-3)
-                t1 = fit.theta.copy()
-                t1[j] += h
-                cols.append((self.evaluate(t1, fit.names, idx, coef=coef) - y0) / h)
-            for j in range(coef.size):
-                c1 = coef.copy()
-                c1[j] += 1.0
-                cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1) - y0)
+        y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef, basis=basis)
+        cols = []
+        for j, th in enumerate(fit.theta):
+            h = 1e-6 * max(abs(th), 1e-3)
+            t1 = fit.theta.copy()
+            t1[j] += h
+            cols.append((self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) - y0) / h)
+        for j in range(coef.size):
+            c1 = coef.copy()
+            c1[j] += 1.0
+            cols.append(self.evaluate(fit.theta, fit.names, idx, coef=c1, basis=basis) - y0)
         return np.stack(cols, 1)
-
-    def rechoose(self, effects, idx: np.ndarray, fit: Fit) -> Fit:
-        """``fit`` with the number of shape terms chosen for ``effects`` (by
-        :meth:`choose_terms`), the family's current choice left as it was."""
-        disc, equivalent = self._disc, self.equivalent_terms
-        try:
-            _, table, f = self.choose_terms(effects, idx, fit)
-        finally:
-            self._disc, self.equivalent_terms = disc, equivalent
-        f.extra["cv_table"] = table
-        return f
 
     def refine(self, effects, fit: Fit, idx: np.ndarray) -> Fit:
         """``fit`` with the shape term's complexity chosen again now that ``effects`` are
-        in the model (see :meth:`choose_terms`)."""
-        k, table, f = self.choose_terms(effects, idx, fit)
-        self.disc = self._basis(k)
+        in the model (see :meth:`choose_terms`); the fit carries its number of terms, the
+        cross-validation table and the equally good numbers of terms."""
+        _, table, f, tied = self.choose_terms(effects, idx, fit)
+        f.extra["cv_table"] = table
+        if tied:
+            f.extra["equivalent_terms"] = tied
+        return f
+
+    def rechoose(self, effects, idx: np.ndarray, fit: Fit) -> Fit:
+        """``fit`` with the number of shape terms chosen for ``effects``."""
+        _, table, f, _ = self.choose_terms(effects, idx, fit)
         f.extra["cv_table"] = table
         return f
 
-    @property
-    def disc(self):
-        return self._disc
-
-    @disc.setter
-    def disc(self, value):
-        self._disc = value if value is not None and value.k > 0 else None
-
-    def _with_k(self, k: int):
-        """Context: the shape term with ``k`` terms while a fit or prediction runs."""
-        family = self
-
-        class _Swap:
-            def __enter__(self):
-                self.old = family._disc
-                family._disc = family._basis(k)
-
-            def __exit__(self, *exc):
-                family._disc = self.old
-
-        return _Swap()
-
     def _fit(self, effects, idx, start, clip_sides, k_shape) -> Fit:
-        with self._with_k(k_shape):
-            f = self._fit_now(effects, idx, start, clip_sides)
+        f = self._fit_now(effects, idx, start, clip_sides, self.basis(k_shape))
         f.extra["k_shape"] = k_shape
         return f
 
-    def _fit_now(self, effects, idx, start, clip_sides) -> Fit:
+    def _fit_now(self, effects, idx, start, clip_sides, basis) -> Fit:
         specs = self.specs(effects, clip_sides)
         names = [p.name for p in specs]
         lo = np.array([p.lower for p in specs])
         hi = np.array([p.upper for p in specs])
-        theta0 = np.clip(self._start(effects, names, idx, start), lo, hi)
+        theta0 = np.clip(self._start(effects, names, idx, start, basis), lo, hi)
         y = self.data_y(idx)
-        k_extra = self.disc.ncols if self.disc is not None else 0
+        k_extra = basis.ncols if basis is not None else 0
 
         def fun(th):
-            return self.evaluate(th, names, idx, target=y) - y
+            return self.evaluate(th, names, idx, target=y, basis=basis) - y
 
         starts = [theta0]
         imb = "secondary_imbalance.imbalance_fraction"
@@ -765,27 +766,28 @@ class PhysicsFamily:
             return Fit(effects, names, theta0, np.full(len(names), np.nan), -fun(theta0), idx,
                        ok=False, k_extra=k_extra)
         theta = self._canonical(self._physical(res.x, names), names)
-        pred, coef = self.evaluate(theta, names, idx, target=y, want_coef=True)
+        pred, coef = self.evaluate(theta, names, idx, target=y, want_coef=True, basis=basis)
         resid = y - pred
         stderr = _stderr(res.jac, resid, len(names) + k_extra)[:len(names)]
         return Fit(effects, names, theta, stderr, resid, idx,
                    ok=bool(np.all(np.isfinite(resid))), extra={"coef": coef}, k_extra=k_extra)
 
     def predict(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
-        with self._with_k(self._k_of(fit)):
-            return self.evaluate(fit.theta, fit.names, idx, coef=fit.extra.get("coef"))
+        return self.evaluate(fit.theta, fit.names, idx, coef=fit.extra.get("coef"),
+                             basis=self.basis(self.terms_of(fit)))
 
-    def _k_of(self, fit: Fit) -> int:
-        return fit.extra.get("k_shape", self.disc.k if self.disc is not None else 0)
+    def terms_of(self, fit: Fit) -> int:
+        """Number of shape terms of ``fit``."""
+        return fit.extra.get("k_shape", self.terms)
 
     def evaluate_like(self, fit: Fit, theta: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """``theta`` in ``fit``'s parameterisation, with its shape term."""
-        with self._with_k(self._k_of(fit)):
-            return self.evaluate(theta, fit.names, idx, coef=fit.extra.get("coef"))
+        return self.evaluate(theta, fit.names, idx, coef=fit.extra.get("coef"),
+                             basis=self.basis(self.terms_of(fit)))
 
     def shape_term(self, fit: Fit, idx: np.ndarray) -> np.ndarray:
         """The smooth shape term's contribution (V) at ``idx`` (zeros without one)."""
-        basis = self._basis(self._k_of(fit))
+        basis = self.basis(self.terms_of(fit))
         if basis is None or fit.extra.get("coef") is None:
             return np.zeros(idx.size)
         core = (self.data.x[idx] - self.origin0) * self.scale

@@ -1,5 +1,12 @@
-"""The diagnosis, step by step: shape checks, rails, calibration, shape term, noise,
-outliers, effect selection, located mismatch (see docs/diagnose.md)."""
+"""The diagnosis as passes, each returning a new frozen result (see docs/diagnose.md):
+
+shape (rectified output, fold-back, passes) -> rails -> calibration (ideal simulation,
+outliers, the least-squares family) -> shape term (its complexity) -> selection (named
+effects) -> report (findings, kept apart from the arrays the plot draws).
+
+No pass changes what an earlier one returned: a family with another shape term or other
+data is a new family (:meth:`PhysicsFamily.with_terms`, :meth:`PhysicsFamily.with_data`).
+"""
 
 from __future__ import annotations
 
@@ -14,16 +21,18 @@ from ..physics.effects import EFFECTS
 from ..physics.sensor import default_sensor
 from ..recordings import Recordings, monotonic_span
 from . import data as D
+from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
+from .confound import Confounding, equivalent_sets
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
-from .select import Fit, forward_select
+from .select import Fit, Selection, Trial, forward_select
 
 # the travel is "centred on 0 mm" when |min + max| <= this fraction of the span
 CENTRED = 0.1
 
 
-@dataclass
+@dataclass(frozen=True)
 class EffectReport:
     name: str
     explanation: str
@@ -34,7 +43,18 @@ class EffectReport:
     alternatives: list[str] = field(default_factory=list)
 
 
-@dataclass
+@dataclass(frozen=True)
+class PlotArrays:
+    """What the residual plot draws (kept points only): not findings."""
+
+    x: np.ndarray = field(repr=False)
+    direction: np.ndarray | None = field(repr=False)
+    resid_before: np.ndarray = field(repr=False)
+    resid_after: np.ndarray = field(repr=False)
+    outlier_mask: np.ndarray = field(repr=False)
+
+
+@dataclass(frozen=True)
 class Diagnosis:
     source: str
     n: int
@@ -56,16 +76,14 @@ class Diagnosis:
     noise_method: str = ""
     noise_regions: list = field(default_factory=list)
     ideal_rms: float = math.nan
-    # for the plot (kept points only)
-    x: np.ndarray = field(repr=False, default=None)
-    direction: np.ndarray | None = field(repr=False, default=None)
-    resid_before: np.ndarray = field(repr=False, default=None)
-    resid_after: np.ndarray = field(repr=False, default=None)
-    outlier_mask: np.ndarray = field(repr=False, default=None)
-    trials: list = field(repr=False, default_factory=list)
-    final_fit: Fit | None = field(repr=False, default=None)
-    family: PhysicsFamily | None = field(repr=False, default=None)
-    fit_idx: np.ndarray | None = field(repr=False, default=None)
+    # sets of effects that explain the recordings equally well (empty: one explanation);
+    # ``effects`` then holds only the effects every set shares
+    alternatives: list[list[str]] = field(default_factory=list)
+    alternatives_delta_bic: list[float] = field(default_factory=list)
+    alternatives_margin: float = math.nan
+    # the candidates tried in each round of the selection (the report names the closest)
+    trials: list[list[Trial]] = field(repr=False, default_factory=list)
+    plot: PlotArrays | None = field(repr=False, default=None)
 
     @property
     def named(self) -> list[str]:
@@ -76,18 +94,70 @@ class Diagnosis:
         return self.baseline_rms / self.final_rms if self.final_rms > 0 else math.inf
 
 
+# -- pass results ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ShapeResult:
+    """The recordings as diagnosed: detector kind, fold-back trimmed, passes found."""
+
+    source: str
+    n_all: int
+    sensor: object                # the simulated sensor (no effects), detector kind set
+    known: bool                   # geometry and origin from a sensor file
+    notes: tuple[str, ...]
+    tip: float | None             # null of a rectified (V-shaped) output
+    rows: np.ndarray              # rows of the recordings kept
+    data: Data
+    passes: D.Passes
+
+
+@dataclass(frozen=True)
+class RailsResult:
+    rails: tuple[dict, ...]
+    on_rail: np.ndarray
+    off: np.ndarray               # indices of the points off the rails
+    passes_off: D.Passes
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    ideal: IdealCalibration
+    centred: bool
+    family: PhysicsFamily         # no shape term chosen yet
+    noise_v: float                # noise of the calibration's residual (off the rails)
+    out_mask: np.ndarray          # isolated outliers
+    skip: np.ndarray              # outliers and rail points: left out of the fits
+    fit_idx: np.ndarray
+    notes: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ShapeTermResult:
+    family: PhysicsFamily         # with the chosen number of shape terms
+    terms: int
+    cv_table: dict
+
+
+@dataclass(frozen=True)
+class SelectionResult:
+    selection: Selection
+    order: tuple[str, ...]
+    cumulative: tuple[Fit, ...]
+    deltas: tuple[float, ...]
+    cvts: tuple[float, ...]
+    alternatives: dict
+    confounding: Confounding
+
+
 def _param(value, stderr, unit) -> dict:
     se = float(stderr)
     return {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
 
 
-def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
-    """Calibrate the ideal simulation to ``rec``, locate the mismatch, name missing physics.
+# -- the passes ----------------------------------------------------------------------------
 
-    ``sensor`` (a :class:`flann.physics.sensor.Sensor`) makes geometry and origin known;
-    without it the paper's LVDT is the starting point and geometry, gain and origin are
-    calibrated.
-    """
+def shape_pass(rec: Recordings, sensor=None) -> ShapeResult:
+    """Rectified output (V shape through the null), fold-back beyond the stroke, passes."""
     x_all = np.asarray(rec.displacement_mm, dtype=float)
     y_all = np.asarray(rec.voltage_v, dtype=float)
     d_given = None if rec.direction is None else np.asarray(rec.direction, dtype=float)
@@ -96,7 +166,6 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     known = sensor is not None
     sensor = (sensor or default_sensor()).replace(effects={})
 
-    # -- shape: rectified output, fold-back beyond the stroke ---------------------------
     passes_all = D.find_passes(x_all, d_given)
     raw_noise = D.estimate_noise(x_all, y_all, passes_all)
     tip = D.detect_v_shape(x_all, y_all, raw_noise)
@@ -107,7 +176,7 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
                "diagnosing against an amplitude-demodulated simulation")
         notes.append(msg)
         if sensor.demodulator_kind != "amplitude":
-            warnings.warn(f"{rec.source}: {msg}", stacklevel=2)
+            warnings.warn(f"{rec.source}: {msg}", stacklevel=3)
             sensor = sensor.replace(demodulator_kind="amplitude")
     elif sensor.demodulator_kind == "amplitude":
         notes.append("the sensor file says amplitude demodulator but the output changes sign; "
@@ -126,48 +195,56 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
             msg = (f"{span.message}; trimmed to the monotonic span "
                    f"{x_all[keep].min():g}..{x_all[keep].max():g} mm "
                    f"({int((~keep).sum())} points dropped)")
-            warnings.warn(msg, stacklevel=2)
+            warnings.warn(msg, stacklevel=3)
             notes.append(msg.split(": ", 1)[-1])
-    rows = np.flatnonzero(keep)
-    x = x_all[keep]
-    y = y_all[keep]
-    passes = D.find_passes(x, None if d_given is None else d_given[keep])
-    direction = passes.direction
-    temp = None if rec.temperature_c is None else np.asarray(rec.temperature_c, float)[keep]
-    time = None if rec.time_s is None else np.asarray(rec.time_s, float)[keep]
+    passes = D.find_passes(x_all[keep], None if d_given is None else d_given[keep])
+    data = Data(x=x_all[keep], y=y_all[keep], direction=passes.direction,
+                temperature_c=None if rec.temperature_c is None
+                else np.asarray(rec.temperature_c, float)[keep],
+                time_s=None if rec.time_s is None else np.asarray(rec.time_s, float)[keep])
+    return ShapeResult(source=rec.source, n_all=int(x_all.size), sensor=sensor, known=known,
+                       notes=tuple(notes), tip=tip, rows=np.flatnonzero(keep), data=data,
+                       passes=passes)
 
-    # -- rails read off the data: flat runs at the extremes --------------------------------
-    rails = D.find_rails(x, y, passes) if tip is None else []
+
+def rails_pass(shape: ShapeResult) -> RailsResult:
+    """Rails read off the data: flat runs at the extremes (none on a rectified output)."""
+    x, y, direction = shape.data.x, shape.data.y, shape.data.direction
+    rails = D.find_rails(x, y, shape.passes) if shape.tip is None else []
     on_rail = np.zeros(x.size, bool)
     for r in rails:
         on_rail |= r["mask"]
     off = np.flatnonzero(~on_rail)
     passes_off = D.find_passes(x[off], None if direction is None else direction[off])
+    return RailsResult(tuple(rails), on_rail, off, passes_off)
 
-    # -- calibrate the ideal simulation (off the rails) ----------------------------------
+
+def calibration_pass(shape: ShapeResult, rails: RailsResult, progress=None) -> CalibrationResult:
+    """The ideal simulation calibrated off the rails; isolated outliers; the fit family."""
     if progress:
         progress("calibrating the ideal simulation")
+    x, y, off = shape.data.x, shape.data.y, rails.off
+    known = shape.known
     # A travel centred on 0 mm says where the null should be: a null elsewhere is a
     # zero_shift.  A travel starting at 0 (or anywhere else) leaves the null to calibration.
     lo_x, hi_x = float(np.min(x)), float(np.max(x))
     centred = (not known) and abs(lo_x + hi_x) <= CENTRED * (hi_x - lo_x)
-    origin0 = initial_origin(x[off], y[off], tip)
-    cal = calibrate(sensor, x[off], y[off], origin_known=known or centred, geometry_known=known,
-                    origin0=origin0, progress=progress)
-    gsj = D.estimate_noise(x[off], cal.resid, passes_off)
-    out_off = D.find_outliers(x[off], cal.resid, passes_off, gsj)
+    origin0 = initial_origin(x[off], y[off], shape.tip)
+    cal = calibrate(shape.sensor, x[off], y[off], origin_known=known or centred,
+                    geometry_known=known, origin0=origin0, progress=progress)
+    gsj = D.estimate_noise(x[off], cal.resid, rails.passes_off)
+    out_off = D.find_outliers(x[off], cal.resid, rails.passes_off, gsj)
     if out_off.sum() > max(1, 0.02 * off.size):
         # many "glitches" are not glitches: keep them (they are structure or noise)
-        out_off[:] = False
+        out_off = np.zeros_like(out_off)
     out_mask = np.zeros(x.size, bool)
     out_mask[off[out_off]] = True
-    skip = out_mask | on_rail
-    fit_idx = np.flatnonzero(~skip)
-
-    data = Data(x=x, y=y, direction=direction, temperature_c=temp, time_s=time)
-    family = PhysicsFamily(cal.sensor, data, origin_known=known or centred, shape=cal.shape,
-                           gain0=cal.gain, origin0=0.0 if centred else cal.origin_mm,
-                           scale=cal.scale, origin_from_travel=centred)
+    skip = out_mask | rails.on_rail
+    family = PhysicsFamily(cal.sensor, shape.data, origin_known=known or centred,
+                           shape=cal.shape, gain0=cal.gain,
+                           origin0=0.0 if centred else cal.origin_mm, scale=cal.scale,
+                           origin_from_travel=centred)
+    notes = []
     if cal.scale != 1.0:
         notes.append(f"the recorded displacement is scaled by {cal.scale:.4g} to match the "
                      "simulated sensor (recorded in other units than mm, or a sensor of "
@@ -175,56 +252,92 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     if centred:
         notes.append(f"the travel ({lo_x:g}..{hi_x:g} mm) is centred on 0 mm, so the null is "
                      "expected at 0 mm: a null elsewhere is tested as zero_shift")
+    return CalibrationResult(ideal=cal, centred=centred, family=family, noise_v=gsj,
+                             out_mask=out_mask, skip=skip, fit_idx=np.flatnonzero(~skip),
+                             notes=tuple(notes))
 
-    # -- the smooth shape term: model-form error of the physics model ----------------------
+
+def shape_term_pass(shape: ShapeResult, calib: CalibrationResult,
+                    progress=None) -> ShapeTermResult:
+    """The smooth shape term (model-form error of the physics model): its range and its
+    number of terms, by cross-validation without effects."""
     if progress:
         progress("choosing the smooth shape term")
-    core_half = float(np.max(np.abs((x[fit_idx] - family.origin0) * family.scale)))
-    family.set_shape_range(core_half, rectified=sensor.demodulator_kind == "amplitude")
-    k_shape, cv_table, _ = family.choose_terms([], fit_idx)
-    family.disc = family._basis(k_shape)
+    fam = calib.family
+    core = (shape.data.x[calib.fit_idx] - fam.origin0) * fam.scale
+    fam = fam.with_shape_range(float(np.max(np.abs(core))),
+                               rectified=shape.sensor.demodulator_kind == "amplitude")
+    k_shape, cv_table, _, tied = fam.choose_terms([], calib.fit_idx)
+    return ShapeTermResult(family=fam.with_terms(k_shape, tied), terms=k_shape,
+                           cv_table=cv_table)
 
-    # -- name the missing physics --------------------------------------------------------
-    candidates = tuple(c for c in family.candidates if not (rails and c == "adc_clipping"))
+
+def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult,
+                   term: ShapeTermResult, progress=None) -> SelectionResult:
+    """Name the missing physics: forward selection by BIC and cross-validation."""
+    family = term.family
+    candidates = tuple(c for c in family.candidates
+                       if not (rails.rails and c == "adc_clipping"))
     # readings on a converter's grid with less noise than one step are not dithered
-    step_v = D.reading_step(y[off])
-    sel = forward_select(family, candidates, fit_idx, progress=progress,
-                         resolution_v=step_v if step_v > gsj else 0.0)
-    all_idx = np.arange(x.size)
-    before = y - family.predict(sel.baseline, all_idx)
-    after = y - family.predict(sel.final, all_idx)
-    shape_v = family.shape_term(sel.baseline, all_idx)
-
+    step_v = D.reading_step(shape.data.y[rails.off])
+    sel = forward_select(family, candidates, calib.fit_idx, progress=progress,
+                         resolution_v=step_v if step_v > calib.noise_v else 0.0)
     order = [s.name for s in sel.steps]
-    cumulative: list[Fit] = [s.fit for s in sel.steps]
+    cumulative = [s.fit for s in sel.steps]
     deltas = [s.delta_bic for s in sel.steps]
     cvts = [s.cv_t for s in sel.steps]
-    alts = {s.name: s.alternatives for s in sel.steps}
     if sel.dropped:  # recompute the cumulative chain in the surviving order
         cumulative, deltas = [], []
         prev = sel.baseline
         for k in range(len(order)):
-            f = family.fit(order[:k + 1], fit_idx, start=prev)
+            f = family.fit(order[:k + 1], calib.fit_idx, start=prev)
             cumulative.append(f)
             deltas.append(f.bic - prev.bic)
             prev = f
         cumulative[-1] = sel.final
+    if progress:
+        progress("testing for equally good explanations")
+    conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
+    return SelectionResult(selection=sel, order=tuple(order), cumulative=tuple(cumulative),
+                           deltas=tuple(deltas), cvts=tuple(cvts),
+                           alternatives={s.name: s.alternatives for s in sel.steps},
+                           confounding=conf)
+
+
+def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult,
+                term: ShapeTermResult, chosen: SelectionResult) -> Diagnosis:
+    """Findings (effects with their sentences, baseline, shape, noise, located mismatch)
+    and, apart from them, the arrays the plot draws."""
+    family = term.family
+    data = shape.data
+    x, y, direction = data.x, data.y, data.direction
+    temp, time = data.temperature_c, data.time_s
+    fit_idx, skip = calib.fit_idx, calib.skip
+    sel = chosen.selection
     final = sel.final
+    all_idx = np.arange(x.size)
+    before = y - family.predict(sel.baseline, all_idx)
+    after = y - family.predict(final, all_idx)
+    shape_v = family.shape_term(sel.baseline, all_idx)
+
     effects = []
     slope = _slope(family, final, all_idx)
     units = family.units()
     null_at = final.value("baseline.origin_mm") if not family.origin_known else 0.0
-    if rails:
+    if rails.rails:
         params = {}
-        for r in rails:
+        for r in rails.rails:
             params[f"rail_{r['side']}_v"] = _param(r["level_v"], r["stderr_v"], "V")
-        params["readings_on_rail"] = _param(sum(r["n"] for r in rails), math.nan, "")
+        params["readings_on_rail"] = _param(sum(r["n"] for r in rails.rails), math.nan, "")
         contrib = np.zeros(x.size)
         effects.append(EffectReport("adc_clipping",
                                     explain("adc_clipping", params, contrib, x, direction,
                                             temp, y, slope, null_at),
                                     params, final.rms, math.nan, math.nan))
-    for k, name in enumerate(order):
+    conf = chosen.confounding
+    for k, name in enumerate(chosen.order):
+        if name not in conf.shared:   # confounded: named only as one of the alternatives
+            continue
         params = {}
         for n, v, se in zip(final.names, final.theta, final.stderr):
             if n.startswith(name + "."):
@@ -235,18 +348,22 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
             params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
         contrib = family.predict(final, all_idx) - _without(family, final, name, all_idx)
         sentence = explain(name, params, contrib, x, direction, temp, y, slope, null_at)
-        effects.append(EffectReport(name, sentence, params, cumulative[k].rms, deltas[k],
-                                    cvts[k] if k < len(cvts) else math.nan,
-                                    alternatives=alts.get(name, [])))
+        effects.append(EffectReport(name, sentence, params, chosen.cumulative[k].rms,
+                                    chosen.deltas[k],
+                                    chosen.cvts[k] if k < len(chosen.cvts) else math.nan,
+                                    alternatives=chosen.alternatives.get(name, [])))
 
     # -- noise and located mismatch (residual of the baseline: simulation + shape) --------
+    passes = shape.passes
     noise, noise_regions = D.estimate_noise_local(x, before, passes, exclude=skip)
     regions = D.locate_regions(x, before, passes, noise, exclude=skip)
+    rows = shape.rows
     t_axis, t_unit = (time, "s") if time is not None else (rows.astype(float), "rows")
     time_spans = D.locate_time_spans(t_axis, before, noise, exclude=skip) if regions else []
     outliers = [{"row": int(rows[i]), "displacement_mm": float(x[i]),
-                 "residual_v": float(after[i])} for i in np.flatnonzero(out_mask)]
+                 "residual_v": float(after[i])} for i in np.flatnonzero(calib.out_mask)]
 
+    known, centred, cal = shape.known, calib.centred, calib.ideal
     base = sel.baseline
     base_params = {"gain_ratio": _param(base.value("baseline.gain_ratio"),
                                         _se(base, "baseline.gain_ratio"), "")}
@@ -263,18 +380,18 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
                                                        "sensor mm per recorded unit")
     # the shape of this sensor as fitted together with the named effects (its complexity
     # re-chosen once they are in: see PhysicsFamily.choose_terms)
-    k_final = family._k_of(final)
-    basis_final = family._basis(k_final)
+    k_final = family.terms_of(final)
+    basis_final = family.basis(k_final)
     shape_f = family.shape_term(final, all_idx)[fit_idx]
     shape_desc = {
         "terms": int(k_final),
-        "terms_without_effects": int(k_shape),
+        "terms_without_effects": int(term.terms),
         "description": (basis_final.describe() if basis_final is not None else
                         "none: cross-validation prefers the calibrated simulation alone"),
         "rms_v": float(np.sqrt(np.mean(shape_f ** 2))) if fit_idx.size else 0.0,
         "peak_v": float(np.max(np.abs(shape_f))) if fit_idx.size else 0.0,
         "cv_rms_v_by_terms": {str(k): v for k, v in
-                              final.extra.get("cv_table", cv_table).items()},
+                              final.extra.get("cv_table", term.cv_table).items()},
         "meaning": ("a smooth, odd, direction- and time-independent difference between this "
                     "sensor's curve and the simulated one: the shape of this sensor, not an "
                     "effect"),
@@ -286,13 +403,14 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
     cal_text = ("sensor file: geometry and origin known; gain fitted" if known else
                 "paper LVDT as start; geometry, gain and "
                 + ("origin fitted" if not centred else "shape fitted, null expected at 0 mm")) + \
-        f", {sensor.demodulator_kind.replace('_', '-')} detector"
+        f", {shape.sensor.demodulator_kind.replace('_', '-')} detector"
     untestable = dict(family.untestable)
-    if rails:
+    if rails.rails:
         untestable.pop("adc_clipping", None)
     return Diagnosis(
-        source=rec.source, n=int(x_all.size), n_used=int(fit_idx.size), passes_text=passes_text,
-        calibration_text=cal_text, notes=notes,
+        source=shape.source, n=shape.n_all, n_used=int(fit_idx.size),
+        passes_text=passes_text, calibration_text=cal_text,
+        notes=list(shape.notes) + list(calib.notes),
         baseline_rms=float(np.sqrt(np.mean(before[fit_idx] ** 2))),
         baseline_params=base_params, noise_v=float(noise), regions=regions,
         time_spans=time_spans, time_unit=t_unit, outliers=outliers, effects=effects,
@@ -300,9 +418,27 @@ def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
         shape_description=shape_desc, noise_method=D.NOISE_METHOD,
         noise_regions=noise_regions,
         ideal_rms=float(np.sqrt(np.mean((before + shape_v)[fit_idx] ** 2))),
-        x=x, direction=direction, resid_before=before, resid_after=after,
-        outlier_mask=skip, trials=sel.trials, final_fit=final, family=family,
-        fit_idx=fit_idx)
+        alternatives=[list(s) for s in conf.sets] if conf.confounded else [],
+        alternatives_delta_bic=[float(d) for d in conf.delta_bic] if conf.confounded else [],
+        alternatives_margin=float(conf.margin) if conf.confounded else math.nan,
+        trials=sel.trials,
+        plot=PlotArrays(x=x, direction=direction, resid_before=before, resid_after=after,
+                        outlier_mask=skip))
+
+
+def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
+    """Calibrate the ideal simulation to ``rec``, locate the mismatch, name missing physics.
+
+    ``sensor`` (a :class:`flann.physics.sensor.Sensor`) makes geometry and origin known;
+    without it the paper's LVDT is the starting point and geometry, gain and origin are
+    calibrated.
+    """
+    shape = shape_pass(rec, sensor)
+    rails = rails_pass(shape)
+    calib = calibration_pass(shape, rails, progress)
+    term = shape_term_pass(shape, calib, progress)
+    chosen = selection_pass(shape, rails, calib, term, progress)
+    return report_pass(shape, rails, calib, term, chosen)
 
 
 def _se(fit: Fit, name: str) -> float:
@@ -321,14 +457,9 @@ def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
 
 
 def _slope(family: PhysicsFamily, fit: Fit, idx) -> np.ndarray:
+    """d(fitted model)/dx, by moving the recorded displacements (a family on moved data)."""
     h = 0.01
-    x = family.data.x
-    orig = family.data
-    try:
-        family.data = Data(x + h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
-        up = family.predict(fit, idx)
-        family.data = Data(x - h, orig.y, orig.direction, orig.temperature_c, orig.time_s)
-        dn = family.predict(fit, idx)
-    finally:
-        family.data = orig
-    return (up - dn) / (2 * h)
+    d = family.data
+    up = family.with_data(Data(d.x + h, d.y, d.direction, d.temperature_c, d.time_s))
+    dn = family.with_data(Data(d.x - h, d.y, d.direction, d.temperature_c, d.time_s))
+    return (up.predict(fit, idx) - dn.predict(fit, idx)) / (2 * h)

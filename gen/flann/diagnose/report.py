@@ -32,6 +32,9 @@ def to_json(dg) -> dict:
         "effects": [{"name": e.name, "explanation": e.explanation, "params": e.params,
                      "rms_v_after": _num(e.rms_v_after), "delta_bic": _num(e.delta_bic)}
                     for e in dg.effects],
+        # equally good explanations (each a list of effect names); "effects" then holds only
+        # what they all share
+        "alternatives": [list(a) for a in dg.alternatives],
         "final": {"rms_v": _num(dg.final_rms)},
         "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
     }
@@ -93,10 +96,17 @@ def format_text(dg) -> str:
             unit = "s" if dg.time_unit == "s" else "rows"
             spans = ", ".join(f"{a:g}..{b:g} {unit}" for a, b, _ in dg.time_spans)
             lines.append(f"  in recording time: {spans}")
-    if not dg.effects and not dg.regions:
+    if dg.alternatives:
+        sets = " | ".join("{" + " + ".join(a) + "}" + f" ({d:+.1f})"
+                          for a, d in zip(dg.alternatives, dg.alternatives_delta_bic))
+        shared = ", ".join(e.name for e in dg.effects) or "none"
+        lines.append(f"confounded: these explanations fit the recordings equally well (delta BIC "
+                     f"within {dg.alternatives_margin:.3g} of the best): {sets}; the recordings cannot tell "
+                     f"them apart, so only what they share is named: {shared}")
+    if not dg.effects and not dg.alternatives and not dg.regions:
         lines.append(f"nothing missing: the residual ({_mv(dg.final_rms)} RMS) is noise; "
                      "no effect of the catalogue earns its keep")
-    elif not dg.effects:
+    elif not dg.effects and not dg.alternatives:
         lines.append("no effect of the catalogue explains the mismatch located above: it is "
                      "physics the catalogue lacks, or a shape the simulated geometry cannot take")
     if dg.effects:
@@ -136,12 +146,13 @@ def plot(dg, path) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
-    x, d = dg.x, dg.direction
-    keep = ~dg.outlier_mask
+    arr = dg.plot
+    x, d = arr.x, arr.direction
+    keep = ~arr.outlier_mask
     title_after = ("after " + " + ".join(e.name for e in dg.effects)) if dg.effects \
         else "no effect added (nothing missing)"
-    for ax, r, title in ((axes[0], dg.resid_before, "ideal simulation, calibrated"),
-                         (axes[1], dg.resid_after, title_after)):
+    for ax, r, title in ((axes[0], arr.resid_before, "ideal simulation, calibrated"),
+                         (axes[1], arr.resid_after, title_after)):
         for reg in dg.regions:
             color = {"+": "tab:red", "-": "tab:blue", "both": "tab:purple"}[reg["direction"]]
             ax.axvspan(reg["from_mm"], reg["to_mm"], color=color, alpha=0.12, lw=0)
@@ -164,7 +175,7 @@ def plot(dg, path) -> None:
         inl = r[keep] * 1e3
         lim = max(float(np.max(np.abs(inl))) if inl.size else 1.0, 3 * dg.noise_v * 1e3) * 1.25
         ax.set_ylim(-lim, lim)
-        if dg.outlier_mask.any():
+        if arr.outlier_mask.any():
             # outliers drawn at the edge of the axis, their value written next to them
             ro = np.clip(r[~keep] * 1e3, -0.95 * lim, 0.95 * lim)
             ax.plot(x[~keep], ro, "x", color="tab:orange", ms=8, label="outlier (value noted)")

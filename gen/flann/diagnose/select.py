@@ -95,13 +95,12 @@ class Family(Protocol):
     def data_y(self, idx: np.ndarray) -> np.ndarray: ...
 
     def refine(self, effects: Sequence[str], fit: Fit, idx: np.ndarray) -> Fit:
-        """Re-choose the family's own complexity (a discrepancy term) once ``effects`` are
-        accepted; returns the refitted model."""
+        """The fit with the family's own complexity (a discrepancy term) chosen again once
+        ``effects`` are accepted; the fit carries it (the family is not changed)."""
         ...
 
     def rechoose(self, effects: Sequence[str], idx: np.ndarray, fit: Fit) -> Fit:
-        """(Optional) ``fit`` with the family's own complexity chosen for ``effects``, leaving
-        the family as it was."""
+        """(Optional) ``fit`` with the family's own complexity chosen for ``effects``."""
         ...
 
     def least_evidence(self, effects: Sequence[str], candidate: str, idx: np.ndarray,

@@ -48,7 +48,10 @@ from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
 from . import images
-from .certificate import render_certificate
+from .certificate import render_certificate, render_rejection
+from .spec import ProductionSpec
+from .traceability import Station, Traceability, traceability
+from .verdict import FAIL, PASS, Verdict, judge, rejected, uncertainty
 
 RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the design
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
@@ -57,7 +60,12 @@ RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the de
 DIAGNOSIS_POINTS = 250
 SUMMARY = "summary.csv"
 SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit", "limit_mm",
-                  "raw_max_error_mm", "twin_vs_float_lsb", "recording")
+                  "raw_max_error_mm", "twin_vs_float_lsb", "recording",
+                  # the verdict against the spec and the traceability (production/verdict.py,
+                  # production/traceability.py)
+                  "verdict", "reasons", "tolerance", "max_error_pct_fs", "diagnosis",
+                  "design_sha256", "model_sha256", "calibrated_at", "station", "operator",
+                  "temperature_c")
 
 
 @dataclass
@@ -72,6 +80,11 @@ class Result:
     raw_max_error_mm: float | None = None
     twin_vs_float_lsb: float | None = None
     warnings: list = field(default_factory=list)
+    verdict: Verdict | None = None
+    trace: Traceability | None = None
+    diagnosis: str = ""
+    design_sha256: str = ""
+    model_sha256: str = ""
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -84,7 +97,27 @@ class Result:
         return {"sensor": self.sensor, "status": self.status, "reason": self.reason,
                 "max_error_mm": f(self.max_error_mm), "ratio_to_limit": f(self.ratio_to_limit, 4),
                 "limit_mm": f(self.limit_mm), "raw_max_error_mm": f(self.raw_max_error_mm),
-                "twin_vs_float_lsb": f(self.twin_vs_float_lsb, 4), "recording": self.recording}
+                "twin_vs_float_lsb": f(self.twin_vs_float_lsb, 4), "recording": self.recording,
+                **self.verdict_cells()}
+
+    def verdict_cells(self) -> dict:
+        """The verdict and traceability columns (a row without a verdict was rejected before
+        it was judged: a duplicate name)."""
+        v = self.verdict
+        t = self.trace
+        reasons = v.reasons if v is not None else (f"rejected: {self.reason}",)
+        return {"verdict": v.verdict if v is not None else FAIL,
+                "reasons": "; ".join(reasons),
+                "tolerance": v.tolerance if v is not None else "",
+                "max_error_pct_fs": "" if v is None or v.max_error_pct_fs is None
+                else f"{v.max_error_pct_fs:.4g}",
+                "diagnosis": self.diagnosis, "design_sha256": self.design_sha256,
+                "model_sha256": self.model_sha256,
+                "calibrated_at": t.calibrated_at if t is not None else "",
+                "station": t.station if t is not None else "",
+                "operator": t.operator if t is not None else "",
+                "temperature_c": "" if t is None or t.temperature_c is None
+                else f"{t.temperature_c:.4g}"}
 
 
 def train_for_design(rec, fam: FamilySpec):
@@ -162,9 +195,9 @@ def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
                    "noise figures are those of a mean")
 
 
-def _diagnosis(rec, sensor, points: int | None) -> tuple[list[str], str]:
-    """The diagnosis' findings as sentences (warnings for the certificate, never a failure)
-    and what it was run on."""
+def _diagnosis(rec, sensor, points: int | None):
+    """The diagnosis' findings as sentences (for the certificate), what it was run on, the
+    effects it named and the sets of effects it could not tell apart."""
     from ..diagnose import diagnose  # heavy (scipy): only when calibrating
 
     small, basis = diagnosis_sample(rec, points)
@@ -173,13 +206,22 @@ def _diagnosis(rec, sensor, points: int | None) -> tuple[list[str], str]:
         try:
             dg = diagnose(small, sensor=sensor)
         except FlannError as exc:
-            return [f"diagnosis not possible: {exc}"], basis
+            return [f"diagnosis not possible: {exc}"], basis, (), ()
     found = [f"{e.name}: {e.explanation}" for e in dg.effects]
     found += list(dg.notes)
     if dg.outliers:
         found.append(f"{len(dg.outliers)} outlier point(s)")
     found += [f"warning: {w.message}" for w in caught]
-    return found, basis
+    named = tuple(e.name for e in dg.effects)
+    groups = tuple(tuple(g) for g in dg.alternatives)
+    return found, basis, named, groups
+
+
+def diagnosis_cell(named, groups) -> str:
+    """The summary's diagnosis column: the named effects, or the sets that fit equally."""
+    if groups:  # sorted: the same sets read the same in every row (best first is in the JSON)
+        return "confounded: " + " | ".join(sorted("+".join(sorted(g)) or "nothing" for g in groups))
+    return "; ".join(named) or "none"
 
 
 @lru_cache(maxsize=4)
@@ -191,10 +233,16 @@ def _sensor(toml: str):
 
 
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
-                  max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS) -> Result:
-    """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row."""
+                  max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
+                  spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
+    """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
+    that fails its spec or is rejected gets a certificate saying why and no weights."""
     path = Path(path)
-    res = Result(sensor=path.stem, recording=str(path))
+    res = Result(sensor=path.stem, recording=str(path), design_sha256=dhash)
+    if spec is None:
+        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
+    station = station or Station()
+    rec = None
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -209,31 +257,70 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
-        if max_error_mm is not None and res.max_error_mm > max_error_mm:
-            raise FlannError(f"hardware max error {res.max_error_mm:.4g} mm > --max-error-mm {max_error_mm:g}")
+        res.trace = traceability(path, rec, station)
+        res.model_sha256 = hashlib.sha256(chk["model"].to_json().encode()).hexdigest()
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
-        findings, basis = _diagnosis(rec, sensor, diagnosis_points)
-        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings, basis)
-        res.status, res.reason = "ok", ""
+        findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
+        res.diagnosis = diagnosis_cell(named, groups)
+        dxdv = chk["limit_mm"] / (0.5 * fam.spec.input_lsb_v)
+        unc = uncertainty(rec, dxdv, fam.terms, fam.spec.output_lsb_mm)
+        res.verdict = judge(spec, rec.displacement_mm, chk["hw_err_mm"], res.ratio_to_limit,
+                            named, groups, unc.expanded_mm)
+        extra = {"spec": spec, "verdict": res.verdict, "trace": res.trace, "uncertainty": unc,
+                 "confounded": groups}
+        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings, basis, extra)
+        if res.verdict.verdict == PASS:
+            res.status, res.reason = "ok", ""
+        else:
+            res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
     except FlannError as exc:
-        res.fail(str(exc))
+        _reject(res, str(exc), path, rec, out_dir, fam, dhash, spec, station)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
-        res.fail(f"{exc.__class__.__name__}: {exc}")
+        _reject(res, f"{exc.__class__.__name__}: {exc}", path, rec, out_dir, fam, dhash, spec, station)
     return res
+
+
+def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec, station) -> None:
+    """A sensor that could not be calibrated: FAIL with the reason, and a certificate that
+    says so (when even that cannot be written, the summary row still does)."""
+    res.fail(reason)
+    res.verdict = rejected(spec, res.reason)
+    res.model_sha256 = ""
+    try:
+        res.trace = traceability(path, rec, station)
+    except FlannError:
+        res.trace = traceability(path, None, Station(station.station, station.operator,
+                                                     station.fixture, station.temperature_c))
+    try:
+        sha = rec.sha256 if rec is not None else hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        sha = ""
+    try:
+        html = render_rejection(res, fam, dhash, spec, sha)
+        with atomic_directory(Path(out_dir) / res.sensor, _is_sensor_output, "sensor calibration") as tmp:
+            (tmp / "certificate.html").write_text(html, newline="")
+    except (FlannError, OSError) as exc:
+        res.warnings.append(f"no certificate written: {exc}")
 
 
 def _is_sensor_output(directory: Path) -> bool:
     return (directory / "certificate.html").is_file()
 
 
-def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings, basis: str) -> None:
+def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: str, findings, basis: str,
+                  extra: dict) -> None:
+    """A passed sensor: its model, weight images and certificate; a failed one: only the
+    certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
     model_json = model.to_json()
     mhash = hashlib.sha256(model_json.encode()).hexdigest()
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
-    html = render_certificate(res, chk, fam, dhash, mhash, findings, basis)
+    html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
+        if not res.verdict.passed:
+            (tmp / "certificate.html").write_text(html, newline="")
+            return
         (tmp / "model.json").write_text(model_json, newline="")
         (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
         (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
@@ -257,7 +344,8 @@ def _worker_init() -> None:
 
 def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
                     max_error_mm: float | None = None, progress: bool | None = None,
-                    diagnosis_points: int | None = DIAGNOSIS_POINTS) -> list[Result]:
+                    diagnosis_points: int | None = DIAGNOSIS_POINTS,
+                    spec: ProductionSpec | None = None, station: Station | None = None) -> list[Result]:
     """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording."""
     man, dp = read_design(design_dir)  # the manifest's own datapath, its fields checked
     if dp is not FAMILY:
@@ -283,14 +371,16 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     todo = []
     for i, p in enumerate(paths):
         if p.stem in seen:  # two files would write the same folder
-            results[i] = Result(sensor=p.stem, recording=str(p))
+            results[i] = Result(sensor=p.stem, recording=str(p), design_sha256=dhash)
             results[i].fail(f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
         else:
             seen[p.stem] = i
             todo.append(i)
     t0 = time.monotonic()
     failed = sum(1 for r in results.values() if r.status != "ok")
-    args = (out_dir, fam, dhash, sensor_toml, max_error_mm, diagnosis_points)
+    if spec is None:
+        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
+    args = (out_dir, fam, dhash, sensor_toml, max_error_mm, diagnosis_points, spec, station)
     if jobs == 1 or len(todo) == 1:
         for i in todo:
             results[i] = calibrate_one(paths[i], *args)

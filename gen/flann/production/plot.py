@@ -18,7 +18,7 @@ from ..textgen import template
 TEMPLATE = "production/templates/error_plot.svg.j2"
 WIDTH, PANEL_H = 720, 250          # px
 LEFT, RIGHT, TOP, GAP, BOTTOM = 78, 16, 30, 48, 46
-COLOURS = {"raw": "#c0392b", "hw": "#1f5fa8", "limit": "#222222"}
+COLOURS = {"raw": "#c0392b", "hw": "#1f5fa8", "limit": "#222222", "tolerance": "#2e8b57"}
 
 
 @dataclass(frozen=True)
@@ -44,6 +44,16 @@ class Panel:
     series: tuple
     yticks: tuple
     zero: float | None  # px of y = 0 when inside the panel
+    bands: tuple = ()   # shaded rectangles (x, y, width, height) in px: the tolerance band
+
+
+@dataclass(frozen=True)
+class Band:
+    x: float
+    y: float
+    width: float
+    height: float
+    colour: str
 
 
 def nice_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
@@ -78,39 +88,54 @@ def _points(px: np.ndarray, py: np.ndarray) -> str:
     return " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px, py))
 
 
-def _panel(top: float, title: str, ylabel: str, x, lines, sx) -> Panel:
-    """lines: (values, colour, dash, width); the y range covers them all (and 0)."""
-    ys = np.concatenate([np.asarray(v, float) for v, *_ in lines] + [np.zeros(1)])
+def _panel(top: float, title: str, ylabel: str, lines, sx, bands=()) -> Panel:
+    """lines: (x, values, colour, dash, width); the y range covers them all (and 0); bands:
+    (x_lo, x_hi, y_lo, y_hi, colour) in data units, shaded."""
+    ys = np.concatenate([np.asarray(v, float) for _, v, *_ in lines] + [np.zeros(1)])
     yt = nice_ticks(float(np.min(ys)), float(np.max(ys)))
     sy = _scale(yt[0], yt[-1], top + PANEL_H, top)
     step = yt[1] - yt[0] if len(yt) > 1 else 1.0
-    series = tuple(Series(_points(sx(x), sy(v)), c, d, w) for v, c, d, w in lines)
+    series = tuple(Series(_points(sx(x), sy(v)), c, d, w) for x, v, c, d, w in lines)
     z = float(sy(0.0))
+    shaded = tuple(Band(float(sx(x0)), float(sy(y1)), float(sx(x1) - sx(x0)), float(sy(y0) - sy(y1)), c)
+                   for x0, x1, y0, y1, c in bands)
     return Panel(top, PANEL_H, title, ylabel, series,
                  tuple(Tick(float(sy(t)), _label(t, step)) for t in yt),
-                 z if yt[0] < 0 < yt[-1] else None)
+                 z if yt[0] < 0 < yt[-1] else None, shaded)
 
 
-def error_plot_svg(chk: dict, sensor: str) -> str:
-    """Raw and compensated error vs displacement (mm), with the physical limit, as an <svg>."""
+def error_plot_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
+                   working_range_mm: tuple[float, float] | None = None) -> str:
+    """Raw and compensated error vs displacement (mm), with the physical limit and, given a
+    tolerance, the tolerance band (over the working range), as an <svg>."""
     x = np.asarray(chk["rec"].displacement_mm, dtype=float)
     o = np.argsort(x, kind="stable")
     x = x[o]
     xt = nice_ticks(float(x[0]), float(x[-1]), 8)
     sx = _scale(xt[0], xt[-1], LEFT, WIDTH - RIGHT)
     lim = np.asarray(chk["limit_mm"], float)[o]
-    raw = _panel(TOP, f"{sensor}: raw sensor (error from its least-squares line)", "raw error (mm)", x,
-                 [(chk["raw_err_mm"][o], COLOURS["raw"], "", 1.0)], sx)
-    hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design (bit-true twin)", "compensated error (mm)", x,
-                [(chk["hw_err_mm"][o], COLOURS["hw"], "", 1.0), (lim, COLOURS["limit"], "3,3", 1.2),
-                 (-lim, COLOURS["limit"], "3,3", 1.2)], sx)
+    raw = _panel(TOP, f"{sensor}: raw sensor (error from its least-squares line)", "raw error (mm)",
+                 [(x, chk["raw_err_mm"][o], COLOURS["raw"], "", 1.0)], sx)
+    lines = [(x, chk["hw_err_mm"][o], COLOURS["hw"], "", 1.0), (x, lim, COLOURS["limit"], "3,3", 1.2),
+             (x, -lim, COLOURS["limit"], "3,3", 1.2)]
+    legend = [("compensated (hardware twin)", COLOURS["hw"], ""),
+              ("physical limit (half an input LSB / slope)", COLOURS["limit"], "3,3")]
+    bands = ()
+    if tolerance_mm is not None:
+        lo, hi = working_range_mm or (float(x[0]), float(x[-1]))
+        bands = ((max(lo, xt[0]), min(hi, xt[-1]), -tolerance_mm, tolerance_mm, COLOURS["tolerance"]),)
+        ends = np.array([max(lo, xt[0]), min(hi, xt[-1])])
+        tol = np.full(2, float(tolerance_mm))
+        lines += [(ends, tol, COLOURS["tolerance"], "8,3", 1.4), (ends, -tol, COLOURS["tolerance"], "8,3", 1.4)]
+        legend.append((f"tolerance +-{tolerance_mm:.3g} mm ({lo:g}..{hi:g} mm)", COLOURS["tolerance"], "8,3"))
+    hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design (bit-true twin)", "compensated error (mm)",
+                lines, sx, bands)
     xstep = xt[1] - xt[0] if len(xt) > 1 else 1.0
     height = TOP + 2 * PANEL_H + GAP + BOTTOM
     return template(TEMPLATE).render(
         width=WIDTH, height=height, left=LEFT, right=WIDTH - RIGHT, panels=(raw, hw),
         xticks=[Tick(float(sx(t)), _label(t, xstep)) for t in xt], xlabel="displacement (mm)",
-        legend=[("compensated (hardware twin)", COLOURS["hw"], ""),
-                ("physical limit (half an input LSB / slope)", COLOURS["limit"], "3,3")],
+        legend=legend,
         legend_y=TOP + PANEL_H + GAP + 14,
     )
 

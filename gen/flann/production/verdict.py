@@ -1,0 +1,151 @@
+"""PASS or FAIL against a :class:`~flann.production.spec.ProductionSpec`, with the reasons,
+and the expanded uncertainty of the figures the verdict rests on.
+
+Decision rule: simple acceptance (ILAC-G8 "shared risk"): a sensor passes when its measured
+max error is within the tolerance; the expanded uncertainty U (k = 2) is stated beside it and
+a result within U of the tolerance is flagged as marginal in the reasons.
+
+Uncertainty of the max error (method stated on the certificate): one reading's noise sigma_v
+(from the recording, :func:`flann.recordings.checks.estimate_noise_v` per direction) becomes
+sigma_x = sigma_v |dx/dv| in mm (median over the stroke); the fitted curve adds its own
+uncertainty sigma_x sqrt(p / N) (p model terms, N positions); the output code adds
+q / sqrt(12).  u = sqrt(sigma_x^2 (1 + p / N) + q^2 / 12), U = 2 u.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..recordings.checks import estimate_noise_v
+from .spec import ProductionSpec
+
+PASS, FAIL = "PASS", "FAIL"
+COVERAGE = 2.0
+# the working range must lie inside the recorded displacements to within this (mm)
+RANGE_SLACK_MM = 1e-6
+UNCERTAINTY_METHOD = (
+    "U = 2 u (k = 2, about 95 %); u^2 = sigma_x^2 (1 + p/N) + q^2/12 with sigma_x the "
+    "recording's noise per reading (median absolute second difference along each direction "
+    "of travel / (0.6745 sqrt 6), in V) times the median |dx/dv|, p the model terms, N the "
+    "positions recorded, q the output LSB")
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    noise_v: float
+    sigma_x_mm: float
+    positions: int
+    terms: int
+    expanded_mm: float          # U, k = 2
+    method: str = UNCERTAINTY_METHOD
+
+
+@dataclass(frozen=True)
+class Verdict:
+    verdict: str                         # PASS | FAIL
+    reasons: tuple[str, ...]
+    tolerance: str                       # the spec as one cell
+    max_error_mm: float | None           # over the working range
+    max_error_pct_fs: float | None
+    full_scale_mm: float | None
+    range_text: str                      # "-8..8 mm" or "the recorded stroke -10..10 mm"
+    rejected: bool = False               # not calibrated at all (bad input, outside the family)
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == PASS
+
+
+def noise_v(rec) -> float:
+    """One reading's noise (V): the median of the per-direction estimates (both passes of a
+    sweep share the noise; a turn of direction is not a step of the curve)."""
+    v = np.asarray(rec.voltage_v, dtype=float)
+    x = np.asarray(rec.displacement_mm, dtype=float)
+    groups = ([np.flatnonzero(rec.direction == d) for d in (1.0, -1.0)]
+              if rec.direction is not None else [np.arange(v.size)])
+    est = [estimate_noise_v(v[g][np.argsort(x[g], kind="stable")]) for g in groups if g.size >= 3]
+    return float(np.median(est)) if est else 0.0
+
+
+def uncertainty(rec, dxdv: np.ndarray, terms: int, output_lsb_mm: float) -> Uncertainty:
+    nv = noise_v(rec)
+    sx = nv * float(np.median(np.abs(dxdv)))
+    n = int(np.unique(np.asarray(rec.displacement_mm, dtype=float)).size)
+    u2 = sx ** 2 * (1.0 + terms / max(n, 1)) + output_lsb_mm ** 2 / 12.0
+    return Uncertainty(noise_v=nv, sigma_x_mm=sx, positions=n, terms=int(terms),
+                       expanded_mm=COVERAGE * math.sqrt(u2))
+
+
+def judge(spec: ProductionSpec, x_mm, err_mm, ratio_to_limit: float | None,
+          named: tuple[str, ...], alternatives: tuple[tuple[str, ...], ...] = (),
+          expanded_mm: float | None = None) -> Verdict:
+    """The verdict of a calibrated sensor: its hardware error ``err_mm`` at the recorded
+    displacements ``x_mm``, its ratio to the physical limit, and the effects its diagnosis
+    named (and the sets it could not tell apart)."""
+    x = np.asarray(x_mm, dtype=float)
+    e = np.abs(np.asarray(err_mm, dtype=float))
+    reasons: list[str] = []
+    lo_x, hi_x = float(np.min(x)), float(np.max(x))
+    if spec.working_range_mm is not None:
+        lo, hi = spec.working_range_mm
+        rng = f"{lo:.4g}..{hi:.4g} mm"
+        if lo < lo_x - RANGE_SLACK_MM or hi > hi_x + RANGE_SLACK_MM:
+            reasons.append(f"the recording covers {lo_x:.4g}..{hi_x:.4g} mm, not the whole working "
+                           f"range {rng}")
+        inside = (x >= lo) & (x <= hi)
+    else:
+        lo, hi = lo_x, hi_x
+        rng = f"the recorded stroke {lo_x:.4g}..{hi_x:.4g} mm"
+        inside = np.ones(x.size, bool)
+    fs = hi - lo
+    max_err = float(np.max(e[inside])) if inside.any() else None
+    pct = 100.0 * max_err / fs if max_err is not None and fs > 0 else None
+    if max_err is None:
+        reasons.append(f"no recorded point inside the working range {rng}")
+    u = expanded_mm or 0.0
+    if spec.max_error_mm is not None and max_err is not None:
+        if max_err > spec.max_error_mm:
+            reasons.append(f"max error {max_err:.4g} mm > tolerance {spec.max_error_mm:g} mm "
+                           f"over {rng}")
+        elif max_err + u > spec.max_error_mm:
+            reasons.append(f"marginal: max error {max_err:.4g} mm is within U = {u:.2g} mm of "
+                           f"the tolerance {spec.max_error_mm:g} mm (passed by simple acceptance)")
+    if spec.max_error_pct_fs is not None and pct is not None:
+        u_pct = 100.0 * u / fs if fs > 0 else 0.0
+        if pct > spec.max_error_pct_fs:
+            reasons.append(f"max error {pct:.4g} % FS > tolerance {spec.max_error_pct_fs:g} % FS "
+                           f"(FS {fs:.4g} mm, {rng})")
+        elif pct + u_pct > spec.max_error_pct_fs:
+            reasons.append(f"marginal: max error {pct:.4g} % FS is within U = {u_pct:.2g} % FS "
+                           f"of the tolerance (passed by simple acceptance)")
+    if spec.max_ratio_to_limit is not None and ratio_to_limit is not None \
+            and ratio_to_limit > spec.max_ratio_to_limit:
+        reasons.append(f"max error is {ratio_to_limit:.3g} x the physical limit > "
+                       f"{spec.max_ratio_to_limit:g}")
+    bad = [n for n in named if n in spec.fail_on_effects]
+    if bad:
+        reasons.append(f"the diagnosis names {', '.join(bad)}, which the spec does not allow")
+    for group in alternatives:
+        maybe = [n for n in group if n in spec.fail_on_effects and n not in named]
+        if maybe:
+            reasons.append(f"the diagnosis cannot rule out {', '.join(maybe)} (confounded with "
+                           f"{', '.join(n for n in group if n not in maybe)}), which the spec "
+                           "does not allow")
+    failed = [r for r in reasons if not r.startswith("marginal")]
+    return Verdict(verdict=FAIL if failed else PASS, reasons=tuple(reasons),
+                   tolerance=spec.tolerance_text(), max_error_mm=max_err, max_error_pct_fs=pct,
+                   full_scale_mm=fs, range_text=rng)
+
+
+def rejected(spec: ProductionSpec, reason: str) -> Verdict:
+    """The verdict of a sensor that could not be calibrated (bad input, outside the family)."""
+    return Verdict(verdict=FAIL, reasons=(f"rejected: {reason}",), tolerance=spec.tolerance_text(),
+                   max_error_mm=None, max_error_pct_fs=None, full_scale_mm=None, range_text="",
+                   rejected=True)
+
+
+__all__ = ["PASS", "FAIL", "Verdict", "Uncertainty", "judge", "rejected", "uncertainty",
+           "noise_v", "UNCERTAINTY_METHOD"]

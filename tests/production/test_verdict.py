@@ -1,0 +1,120 @@
+"""Verdicts against a production spec, the spec file, traceability and the uncertainty."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from flann.errors import FlannError
+from flann.production.spec import ProductionSpec, build_spec, load_spec
+from flann.production.traceability import Station, comment_fields, traceability
+from flann.production.verdict import FAIL, PASS, judge, rejected, uncertainty
+
+X = np.linspace(-10, 10, 201)
+
+
+def _err(peak_at: float, peak: float) -> np.ndarray:
+    """An error of 0.01 mm everywhere except ``peak`` at ``peak_at`` mm."""
+    e = np.full(X.size, 0.01)
+    e[np.argmin(np.abs(X - peak_at))] = peak
+    return e
+
+
+def test_tolerance_in_mm_over_the_whole_stroke_and_a_working_range():
+    err = _err(9.5, 0.08)   # the worst point is outside -8..8
+    v = judge(ProductionSpec(max_error_mm=0.05), X, err, 2.0, ())
+    assert v.verdict == FAIL and v.max_error_mm == pytest.approx(0.08)
+    assert "0.08 mm > tolerance 0.05 mm" in v.reasons[0]
+    v = judge(ProductionSpec(max_error_mm=0.05, working_range_mm=(-8, 8)), X, err, 2.0, ())
+    assert v.verdict == PASS and v.max_error_mm == pytest.approx(0.01) and v.reasons == ()
+    assert v.full_scale_mm == 16 and v.max_error_pct_fs == pytest.approx(100 * 0.01 / 16)
+
+
+def test_tolerance_in_percent_of_full_scale():
+    err = _err(0.0, 0.05)   # 0.05 mm of a 20 mm span = 0.25 % FS
+    assert judge(ProductionSpec(max_error_pct_fs=0.3), X, err, None, ()).verdict == PASS
+    v = judge(ProductionSpec(max_error_pct_fs=0.2), X, err, None, ())
+    assert v.verdict == FAIL and "0.25 % FS > tolerance 0.2 % FS" in v.reasons[0]
+
+
+def test_a_working_range_the_recording_does_not_cover_fails():
+    v = judge(ProductionSpec(max_error_mm=1.0, working_range_mm=(-12, 8)), X, _err(0, 0.01), None, ())
+    assert v.verdict == FAIL and "not the whole working range" in v.reasons[0]
+
+
+def test_marginal_within_the_uncertainty_passes_and_says_so():
+    v = judge(ProductionSpec(max_error_mm=0.05), X, _err(0, 0.049), None, (), expanded_mm=0.003)
+    assert v.verdict == PASS and v.reasons[0].startswith("marginal")
+
+
+def test_ratio_and_named_effects_and_confounded_alternatives():
+    spec = ProductionSpec(max_ratio_to_limit=10, fail_on_effects=("backlash",))
+    assert judge(spec, X, _err(0, 0.01), 12.0, ()).verdict == FAIL
+    v = judge(spec, X, _err(0, 0.01), 5.0, ("null_offset", "backlash"))
+    assert v.verdict == FAIL and "names backlash" in v.reasons[0]
+    # an alternative explanation that includes a forbidden effect cannot be ruled out
+    v = judge(spec, X, _err(0, 0.01), 5.0, (), (("null_offset",), ("backlash",)))
+    assert v.verdict == FAIL and "cannot rule out backlash" in v.reasons[0]
+    assert judge(spec, X, _err(0, 0.01), 5.0, ("null_offset",)).verdict == PASS
+
+
+def test_no_spec_passes_a_calibrated_sensor_and_rejected_is_a_fail():
+    assert judge(ProductionSpec(), X, _err(0, 5.0), 100.0, ("backlash",)).verdict == PASS
+    r = rejected(ProductionSpec(max_error_mm=0.1), "no voltage column")
+    assert r.verdict == FAIL and r.rejected and r.reasons == ("rejected: no voltage column",)
+
+
+def test_spec_file_and_flags(tmp_path):
+    p = tmp_path / "line.toml"
+    p.write_text('name = "A"\n[tolerance]\nmax_error_pct_fs = 0.5\nworking_range_mm = [-5, 5]\n'
+                 '[limits]\nmax_ratio_to_limit = 50\nfail_on_effects = ["backlash"]\n')
+    s = load_spec(p)
+    assert (s.name, s.max_error_pct_fs, s.working_range_mm, s.max_ratio_to_limit, s.fail_on_effects) == \
+        ("A", 0.5, (-5.0, 5.0), 50.0, ("backlash",))
+    # a flag replaces the file's tolerance (mm instead of % FS)
+    s2 = build_spec(p, max_error_mm=0.02, working_range="-4:4")
+    assert s2.max_error_mm == 0.02 and s2.max_error_pct_fs is None and s2.working_range_mm == (-4, 4)
+    assert s2.source.endswith("+ flags")
+
+
+@pytest.mark.parametrize("text, words", [
+    ("[tolerance]\nmax_error_mm = -1\n", "must be > 0"),
+    ("[tolerance]\nmax_error_mm = 0.1\nmax_error_pct_fs = 1\n", "not both"),
+    ("[tolerance]\nworking_range_mm = [5, -5]\n", "below high"),
+    ("[limits]\nfail_on_effects = [\"gremlins\"]\n", "unknown effect"),
+    ("[tolerance]\nmax_eror_mm = 0.1\n", "unknown key"),
+    ("[tolerance\n", "not TOML"),
+])
+def test_bad_spec_files_are_one_line_errors(tmp_path, text, words):
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(FlannError, match=words):
+        load_spec(p)
+
+
+def test_traceability_from_comments_flags_and_columns(tmp_path):
+    assert comment_fields(["serial: SN-1", "Operator = Ann", "simulated by x", "station:  B2"]) == \
+        {"serial": "SN-1", "operator": "Ann", "station": "B2"}
+    rec = SimpleNamespace(comments=("serial: SN-7", "operator: Ann"), temperature_c=np.array([22.0, 24.0]))
+    t = traceability(tmp_path / "f.csv", rec, Station(station="L1", operator="Bob", fixture="F2"))
+    assert (t.serial, t.operator, t.station, t.fixture) == ("SN-7", "Ann", "L1", "F2")
+    assert t.temperature_c == 23.0 and "mean" in t.temperature_from
+    assert t.calibrated_at[10] == "T" and t.calibrated_at[-6] in "+-"   # ISO 8601 with offset
+    t = traceability(tmp_path / "g.csv", None, Station(temperature_c=20.5))
+    assert (t.serial, t.serial_from, t.temperature_c) == ("g", "file name", 20.5)
+    csvp = tmp_path / "h.csv"
+    csvp.write_text("# a comment\ndisplacement_mm;voltage_v;sn\n0;1;ABC-9\n1;2;ABC-9\n")
+    assert traceability(csvp, None, Station(serial_column="sn")).serial == "ABC-9"
+    with pytest.raises(FlannError, match="no column 'serial'"):
+        traceability(csvp, None, Station(serial_column="serial"))
+
+
+def test_expanded_uncertainty_follows_noise_and_positions():
+    rng = np.random.default_rng(1)
+    x = np.linspace(-10, 10, 400)
+    rec = SimpleNamespace(voltage_v=0.5 * x + rng.normal(0, 0.002, x.size), displacement_mm=x, direction=None)
+    u = uncertainty(rec, np.full(x.size, 2.0), terms=15, output_lsb_mm=0.0)
+    assert u.noise_v == pytest.approx(0.002, rel=0.15)
+    # sigma_x = 2 mm/V x 2 mV = 4 um; U = 2 sigma_x sqrt(1 + 15/400)
+    assert u.expanded_mm == pytest.approx(2 * 0.004 * math.sqrt(1 + 15 / 400), rel=0.15)
