@@ -14,7 +14,8 @@ import sys
 import warnings
 
 from . import __version__
-from .errors import FlannError
+from .errors import FlannError, one_line
+from .fileio import forget_inputs
 
 # name -> one-line help; the module is flann.commands.<name>
 COMMANDS: dict[str, str] = {
@@ -61,12 +62,21 @@ def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
 
 def _one_line_warnings() -> None:
     def show(message, category, filename, lineno, file=None, line=None):
-        print(f"warning: {message}", file=sys.stderr)
+        print(f"warning: {one_line(message)}", file=sys.stderr)
 
     warnings.showwarning = show
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        # anywhere, even while a command's modules are still importing (the first ~0.2 s)
+        print("error: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     selected = next((a for a in argv if a in COMMANDS), None)
     parser = build_parser(selected)
@@ -75,6 +85,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     _one_line_warnings()
+    forget_inputs()
     try:
         code = int(_load(args.command).run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
@@ -85,11 +96,8 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
     except FlannError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(exc)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
 
 
 if __name__ == "__main__":
