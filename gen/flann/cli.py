@@ -14,6 +14,7 @@ import sys
 import warnings
 
 from . import __version__
+from .argtypes import finite_float
 from .errors import FlannError, one_line
 from .fileio import forget_inputs
 
@@ -43,8 +44,12 @@ class _Parser(argparse.ArgumentParser):
     """Wrong flags and values are bad input like any other: one line, exit code 2 (the
     usage block argparse prints would bury the message; it is one ``--help`` away)."""
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("type", float, finite_float)   # no flag takes NaN or infinity
+
     def error(self, message: str):
-        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+        self.exit(2, f"error: {self.prog}: {one_line(message)} (see {self.prog} --help)\n")
 
 
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+from ..argtypes import bounded
 from ..production.calibrate import DIAGNOSIS_POINTS, SUMMARY, calibrate_batch
 
 HELP = "calibrate sensors for a family design: weight images and certificates"
@@ -19,7 +20,7 @@ def add_arguments(p) -> None:
     p.add_argument("--diagnosis-points", type=int, default=DIAGNOSIS_POINTS, metavar="N",
                    help="the diagnosis sees at most N bin means of the recording (0 = every point; "
                         f"default {DIAGNOSIS_POINTS})")
-    p.add_argument("--max-error-mm", type=float, default=None,
+    p.add_argument("--max-error-mm", type=bounded(float, 0, lo_open=True), default=None,
                    help="fail a sensor whose hardware max error on its recording exceeds this")
 
 
