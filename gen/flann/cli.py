@@ -7,16 +7,21 @@ subcommand is used, so one command's heavy imports never slow down or break anot
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import os
 import sys
-import warnings
 
-from . import __version__
-from .argtypes import finite_float
-from .errors import FlannError, one_line
-from .fileio import forget_inputs
+try:   # Ctrl-C while the interpreter imports this module: one line too, not a traceback
+    import argparse
+    import importlib
+    import os
+    import warnings
+
+    from . import __version__
+    from .argtypes import finite_float
+    from .errors import FlannError, one_line
+    from .fileio import forget_inputs
+except KeyboardInterrupt:
+    sys.stderr.write("error: interrupted\n")
+    sys.exit(130)
 
 # name -> one-line help; the module is flann.commands.<name>
 COMMANDS: dict[str, str] = {
