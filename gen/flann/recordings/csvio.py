@@ -75,7 +75,7 @@ _WS_HEADER = re.compile(r"[^\s(\[]+(?:\s*[(\[][^)\]]*[)\]])?")
 # Resource bounds.  Rows are parsed into Python lists before they become arrays: ~120 bytes
 # a row at the peak, so MAX_ROWS keeps reading (and training) well under 1 GB
 # (bench/recordings_memory.py); longer sweeps are averaged or decimated first.
-MAX_ROWS = 2_000_000
+MAX_ROWS = 1_000_000
 MAX_LINE_CHARS = 65_536
 # |value| in canonical units (mm, V, s, degC, Hz): 0 or within these
 VALUE_RANGE = (1e-30, 1e12)
