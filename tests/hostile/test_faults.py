@@ -157,5 +157,9 @@ def test_ctrl_c_in_imports_is_caught_by_the_entry_point(monkeypatch, capsys):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli, "_load", interrupted)
-    assert cli.main(["train", "x.csv", "-o", "m.json"]) == 130
+    try:
+        rc = cli.main(["train", "x.csv", "-o", "m.json"])
+    except KeyboardInterrupt:
+        pytest.fail("KeyboardInterrupt escaped flann.cli.main")
+    assert rc == 130
     assert capsys.readouterr().err == "error: interrupted\n"

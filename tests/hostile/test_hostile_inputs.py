@@ -33,6 +33,7 @@ class Case:
     expect: str = ""    # a substring of the error line (rc != 0) or of stdout+stderr (rc 0)
     changes: tuple = ()  # glob patterns (relative to the world) that may be created/changed
     prep: str = ""      # name of a function below that makes the hostile file(s)
+    absent: tuple = ()  # paths that must not exist afterwards (a stale result)
 
 
 # ---------------------------------------------------------------------------- hostile files
@@ -215,11 +216,16 @@ def p_stale(w):
 
 # ------------------------------------------------------------------------------------- table
 FAM = ("--design", "fam", "--diagnosis-points", "40", "-j", "1")
+
+
+def SANE(name: str) -> tuple:
+    """What a calibrate of one sensor named ``name`` may write: its folder and the summary."""
+    return ("out", "out/summary.csv", f"out/{name}", f"out/{name}/[!/]*")
 CASES = [
     # 1 path traversal and names from files
-    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", ("out", "out/**"), "p_traversal"),
-    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", ("out", "out/**"), "p_dotname"),
-    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", ("out", "out/**"), "p_newline_name"),
+    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_traversal"),
+    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_dotname"),
+    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", SANE("a_b"), "p_newline_name"),
     # 2 special files and symlinks as outputs
     Case("train-o-fifo", "2", ("train", "rec.csv", "-o", "pipe", "--terms", "5"), 2, "FIFO", (), "p_fifo"),
     Case("predict-o-fifo", "2", ("predict", "m.json", "rec.csv", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
@@ -317,7 +323,7 @@ CASES = [
     Case("gen-o-user-directory", "own", ("gen", "m.json", "-o", "mine"), 2, "not empty", (), "p_userdir"),
     Case("calibrate-o-is-file", "own", ("calibrate", "s1.csv", "-o", "out", *FAM), 2, "not a directory", (), "p_outdir_file"),
     Case("calibrate-stale-removed", "5", ("calibrate", "bad.csv", "-o", "out", *FAM), 2, "missing column",
-         ("out/**",), "p_stale"),
+         ("out/**",), "p_stale", absent=("out/bad",)),
     Case("simulate-sensor-missing", "own", ("simulate", "nosuch.toml", "-o", "o.csv"), 2, "no such file"),
     Case("ise-o-fifo", "2", ("ise", "design", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
 ]
@@ -374,6 +380,7 @@ def test_hostile(case, world, capsys, monkeypatch):
     changed = {k for k in before.keys() | after.keys() if before.get(k) != after.get(k)}
     stray = sorted(k for k in changed if not any(fnmatch.fnmatch(k, pat) for pat in allowed))
     assert not stray, f"changed outside the expected place: {stray}"
+    assert not [p for p in case.absent if (world / p).exists()], "a stale result survived"
 
 
 def test_the_table_covers_every_subcommand_and_class():
