@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import RecordingsError
+from ..errors import RecordingsError, one_line
 from ..fileio import atomic_write_text, note_input
 
 REQUIRED = ("displacement_mm", "voltage_v")
@@ -406,7 +406,7 @@ def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
         text, note = raw.decode("latin-1"), "Latin-1 text"   # spreadsheets on Windows
     rec = parse_recordings(text, source=str(path), required=required, encoding_note=note)
     if announce and rec.recognised:
-        print(f"{path}: read {rec.recognised}", file=sys.stderr)
+        print(one_line(f"{path}: read {rec.recognised}"), file=sys.stderr)
     return rec
 
 
