@@ -264,7 +264,8 @@ def _agree(source: str, header, col: str, used, other, a, b, lines) -> str:
         raise RecordingsError(
             f"{source}: line {lines[k]}: '{header[used]}' and '{header[other]}' give the same quantity "
             f"but disagree ({a[k]:.6g} vs {b[k]:.6g} in {col}'s unit, more than {tol:.3g})")
-    return f"'{header[other]}' agrees with '{header[used]}' (within {max(float(diff[k]), 0):.2g}), " \
+    unit = col.rsplit("_", 1)[-1]
+    return f"'{header[other]}' agrees with '{header[used]}' (within {float(diff[k]):.2g} {unit}), " \
            f"{col} from '{header[used]}'"
 
 
@@ -309,10 +310,16 @@ def parse_recordings(text: str, source: str = "<memory>",
         if not body:
             raise RecordingsError(f"{source}: no header line after '{excel_sep.group(0).strip()}'")
     sep = excel_sep.group("sep") if excel_sep else _sniff_separator(body[0][1])
-    header = [h.strip() for h in _cells(body[0][1], sep)]
+    for n, line in body[:2]:   # the header and a possible unit line, before they are split
+        _check_line(source, n, line)
+    try:
+        header = [h.strip() for h in _cells(body[0][1], sep)]
+        units = _unit_row(body, sep, len(header))
+    except RecordingsError as exc:
+        raise RecordingsError(f"{source}: line {body[0][0]}: {exc}") from None
     if sep == " ":   # "Displacement (mm) Voltage (V)": a unit in brackets belongs to the name before
         header = _WS_HEADER.findall(body[0][1])
-    units = _unit_row(body, sep, len(header))
+        units = _unit_row(body, sep, len(header))
     if units is not None:   # loggers: names on one line, units on the next
         header = [f"{h} ({u})" if u and recognise_header(h) is None else h
                   for h, u in zip(header, units)]
