@@ -71,6 +71,7 @@ class Result:
     raw_max_error_mm: float | None = None
     twin_vs_float_lsb: float | None = None
     warnings: list = field(default_factory=list)
+    written: bool = False   # OUTDIR/<sensor>/ was written by this run (_write_sensor)
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -244,6 +245,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
         (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
         (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")
         (tmp / "certificate.html").write_text(html, newline="")
+    res.written = True
 
 
 # ------------------------------------------------------------------------------------------
@@ -305,8 +307,9 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     def record(item, res: Result) -> None:
         nonlocal failed
         results[item[0]] = res
-        if res.status != "ok":   # an earlier run's passing files must not outlive this verdict
+        if not res.written:   # an earlier run's files must not outlive this run's verdict
             remove_output_directory(child(out_dir, res.sensor), _is_sensor_output)
+        if res.status != "ok":
             failed += 1
         if progress:
             _progress(len(results), len(paths), failed, t0)
