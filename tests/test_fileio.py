@@ -127,20 +127,19 @@ def test_safe_name_never_leaves_its_directory(name, safe, tmp_path):
 
 def test_output_that_is_an_input_is_refused_and_left_alone(tmp_path):
     from flann.errors import FlannError
-    from flann.fileio import forget_inputs, note_input
+    from flann.fileio import guarding_inputs, note_input
 
     src = tmp_path / "rec.csv"
     src.write_text("keep me\n")
     hard = tmp_path / "hard.csv"
     os.link(src, hard)           # the same file under another name is the same input
-    note_input(src)
-    try:
+    with guarding_inputs():
+        note_input(src)
         for out in (src, hard):
             with pytest.raises(FlannError, match="also an input"):
                 atomic_write_text(out, "x\n")
-        assert src.read_text() == "keep me\n"
-    finally:
-        forget_inputs()
+    assert src.read_text() == "keep me\n"
+    atomic_write_text(src, "library use, outside a command: not guarded\n")
 
 
 def test_a_symlinked_output_writes_its_target(tmp_path):

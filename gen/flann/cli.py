@@ -18,7 +18,7 @@ try:   # Ctrl-C while the interpreter imports this module: one line too, not a t
     from . import __version__
     from .argtypes import finite_float
     from .errors import FlannError, one_line
-    from .fileio import forget_inputs
+    from .fileio import guarding_inputs
 except KeyboardInterrupt:
     sys.stderr.write("error: interrupted\n")
     sys.exit(130)
@@ -95,9 +95,9 @@ def _main(argv: list[str] | None) -> int:
         parser.print_help()
         return 2
     _one_line_warnings()
-    forget_inputs()
     try:
-        code = int(_load(args.command).run(args) or 0)
+        with guarding_inputs():   # no output of this command overwrites one of its inputs
+            code = int(_load(args.command).run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return code
     except BrokenPipeError:

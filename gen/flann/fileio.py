@@ -8,8 +8,8 @@ Every output goes through :func:`_target`, which decides what may be written whe
 
 * a symlink is followed (its target is written, the link stays a link);
 * a FIFO, device, socket or (for a file) directory is refused, never replaced;
-* a file this process has read as input (:func:`note_input`, called by every reader) is
-  refused as an output, and so is a directory holding one, so no command overwrites what
+* a file the running command has read as input (:func:`note_input`, called by every
+  reader, inside :func:`guarding_inputs`) is refused as an output, and so is a directory holding one, so no command overwrites what
   it reads;
 * names derived from input files (:func:`safe_name`) are sanitised and confined under their
   output directory (:func:`child`).
@@ -50,22 +50,32 @@ def _cannot_write(path, exc: OSError) -> FlannError:
     return FlannError(f"{path}: cannot write ({why})")
 
 
-# (st_dev, st_ino) and resolved path of every file read as input by this process
-_INPUTS: dict[tuple[int, int], Path] = {}
+# (st_dev, st_ino) -> resolved path of every file read as input by the running command;
+# None outside a command (library use: nothing is guarded)
+_INPUTS: dict[tuple[int, int], Path] | None = None
+
+
+@contextlib.contextmanager
+def guarding_inputs():
+    """While a command runs (the CLI wraps each in this), the files it reads may not be
+    written over by its outputs.  Forked workers inherit the guard."""
+    global _INPUTS
+    outer, _INPUTS = _INPUTS, {}
+    try:
+        yield
+    finally:
+        _INPUTS = outer
 
 
 def note_input(path: str | os.PathLike) -> None:
-    """Remember that ``path`` is an input of this command: it may not be written over."""
+    """Remember that ``path`` is an input of the running command: it may not be written over."""
+    if _INPUTS is None:
+        return
     try:
         st = os.stat(path)
     except OSError:
         return
     _INPUTS[(st.st_dev, st.st_ino)] = Path(os.path.realpath(path))
-
-
-def forget_inputs() -> None:
-    """Start a new command (the CLI calls this; tests calling ``main`` twice need it)."""
-    _INPUTS.clear()
 
 
 _KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
@@ -92,14 +102,14 @@ def _target(path: str | os.PathLike, directory: bool = False) -> Path:
         if not directory:
             raise FlannError(f"{shown}: is a directory, expected a file name")
         real = Path(os.path.realpath(path))
-        for src in _INPUTS.values():
+        for src in (_INPUTS or {}).values():
             if real == src or real in src.parents:
                 raise FlannError(f"{shown}: holds {src.name}, an input of this command; "
                                  "it would be replaced: choose another output directory")
         return path
     if directory:
         raise FlannError(f"{shown}: exists and is not a directory")
-    if (st.st_dev, st.st_ino) in _INPUTS:
+    if (st.st_dev, st.st_ino) in (_INPUTS or {}):
         raise FlannError(f"{shown}: is also an input of this command; writing it would destroy "
                          "the input: choose another output name")
     return path
@@ -236,5 +246,5 @@ def remove_output_directory(path: str | os.PathLike, replaceable) -> None:
 
 
 __all__ = ["atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",
-           "atomic_directory", "note_input", "forget_inputs", "safe_name", "child",
+           "atomic_directory", "note_input", "guarding_inputs", "safe_name", "child",
            "remove_output_directory"]
