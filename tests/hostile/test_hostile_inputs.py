@@ -368,7 +368,8 @@ def test_hostile(case, world, capsys, monkeypatch):
     rc, out, err = run_case(case, capsys)
     after = snapshot(root)
     errors = [ln for ln in err.splitlines() if ln.startswith("error:")]
-    OBSERVED[case.id] = (rc, errors[0] if errors else (out.strip().splitlines() or [""])[-1])
+    said = [ln for ln in (out + err).splitlines() if case.expect and case.expect in ln] or (out + err).splitlines()
+    OBSERVED[case.id] = (rc, errors[0] if errors else (said or [""])[0])
     assert "Traceback" not in err, err
     assert rc == case.rc, err
     assert len(errors) == (1 if case.rc else 0), err
