@@ -1,5 +1,6 @@
 """The atomic writers leave no temporary file behind and respect the umask (not mkstemp's 0600)."""
 
+import json
 import os
 import stat
 
@@ -111,3 +112,80 @@ def test_failure_inside_leaves_old_directory(tmp_path):
             raise RuntimeError("boom")
     assert [p.name for p in d.iterdir()] == ["old"]
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+# -- the output policy --------------------------------------------------------------------
+@pytest.mark.parametrize("name, safe", [("..", "_"), (".", "_"), ("...", "_"), ("", "_"), (".hidden", "hidden"),
+                                        ("a/../b", "a_.._b"), ("a\nb", "a_b"), ("x\x00y", "x_y"),
+                                        ("sensor-01.v2+A", "sensor-01.v2+A")])
+def test_safe_name_never_leaves_its_directory(name, safe, tmp_path):
+    from flann.fileio import child, safe_name
+
+    assert safe_name(name) == safe
+    assert child(tmp_path, safe_name(name)).parent == tmp_path
+
+
+def test_output_that_is_an_input_is_refused_and_left_alone(tmp_path):
+    from flann.errors import FlannError
+    from flann.fileio import guarding_inputs, note_input
+
+    src = tmp_path / "rec.csv"
+    src.write_text("keep me\n")
+    hard = tmp_path / "hard.csv"
+    os.link(src, hard)           # the same file under another name is the same input
+    with guarding_inputs():
+        note_input(src)
+        for out in (src, hard):
+            with pytest.raises(FlannError, match="also an input"):
+                atomic_write_text(out, "x\n")
+    assert src.read_text() == "keep me\n"
+    atomic_write_text(src, "library use, outside a command: not guarded\n")
+
+
+def test_a_symlinked_output_writes_its_target(tmp_path):
+    (tmp_path / "t.json").write_text("old\n")
+    os.symlink("t.json", tmp_path / "l.json")
+    atomic_write_json(tmp_path / "l.json", {"a": 1})
+    assert (tmp_path / "l.json").is_symlink() and json.loads((tmp_path / "t.json").read_text()) == {"a": 1}
+
+
+def test_remove_output_directory_only_removes_our_own(tmp_path):
+    from flann.fileio import remove_output_directory
+
+    ours, theirs = tmp_path / "ours", tmp_path / "theirs"
+    for d in (ours, theirs):
+        d.mkdir()
+    (ours / "certificate.html").write_text("x")
+    (theirs / "notes.txt").write_text("x")
+    mine = lambda d: (d / "certificate.html").is_file()   # noqa: E731
+    remove_output_directory(ours, mine)
+    remove_output_directory(theirs, mine)
+    assert not ours.exists() and (theirs / "notes.txt").is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["theirs"]
+
+
+# -- the input layer ------------------------------------------------------------------------
+@pytest.mark.parametrize("text, why", [
+    ("[" * 40 + "]" * 40, "nested deeper"), ("[" * 100000 + "]" * 100000, "nested deeper"),
+    ('{"a": ' + "1" * 20 + "}", "digits"), ('{"a": 1e999}', "not finite"), ('{"a": NaN}', "not a number"),
+    ('{"a": -Infinity}', "not a number"),
+])
+def test_json_bounds(text, why):
+    from flann.errors import ModelFileError
+    from flann.inputs import parse_json
+
+    with pytest.raises(ModelFileError, match=why):
+        parse_json(text, "f.json", ModelFileError)
+    assert parse_json('{"a": [1, 2.5, -9223372036854775808]}', "f.json", ModelFileError)["a"][2] == -2 ** 63
+
+
+@pytest.mark.parametrize("text, why", [
+    ("a = " + "[" * 40 + "]" * 40, "nested deeper"), ("a = " + "[" * 3000 + "]" * 3000, "nested deeper"),
+    ("a = " + "7" * 5000, "too large"), ("a = 99999999999999999999", "beyond 64 bits"), ("a = inf", "not finite"),
+])
+def test_toml_bounds(text, why):
+    from flann.errors import SensorError
+    from flann.inputs import parse_toml
+
+    with pytest.raises(SensorError, match=why):
+        parse_toml(text, "f.toml", SensorError)

@@ -7,14 +7,21 @@ subcommand is used, so one command's heavy imports never slow down or break anot
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import os
 import sys
-import warnings
 
-from . import __version__
-from .errors import FlannError
+try:   # Ctrl-C while the interpreter imports this module: one line too, not a traceback
+    import argparse
+    import importlib
+    import os
+    import warnings
+
+    from . import __version__
+    from .argtypes import finite_float
+    from .errors import FlannError, one_line
+    from .fileio import guarding_inputs
+except KeyboardInterrupt:
+    sys.stderr.write("error: interrupted\n")
+    sys.exit(130)
 
 # name -> one-line help; the module is flann.commands.<name>
 COMMANDS: dict[str, str] = {
@@ -42,8 +49,12 @@ class _Parser(argparse.ArgumentParser):
     """Wrong flags and values are bad input like any other: one line, exit code 2 (the
     usage block argparse prints would bury the message; it is one ``--help`` away)."""
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("type", float, finite_float)   # no flag takes NaN or infinity
+
     def error(self, message: str):
-        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+        self.exit(2, f"error: {self.prog}: {one_line(message)} (see {self.prog} --help)\n")
 
 
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
@@ -61,12 +72,21 @@ def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
 
 def _one_line_warnings() -> None:
     def show(message, category, filename, lineno, file=None, line=None):
-        print(f"warning: {message}", file=sys.stderr)
+        print(f"warning: {one_line(message)}", file=sys.stderr)
 
     warnings.showwarning = show
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        # anywhere, even while a command's modules are still importing (the first ~0.2 s)
+        print("error: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     selected = next((a for a in argv if a in COMMANDS), None)
     parser = build_parser(selected)
@@ -76,7 +96,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     _one_line_warnings()
     try:
-        code = int(_load(args.command).run(args) or 0)
+        with guarding_inputs():   # no output of this command overwrites one of its inputs
+            code = int(_load(args.command).run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return code
     except BrokenPipeError:
@@ -85,11 +106,8 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
     except FlannError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(exc)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
 
 
 if __name__ == "__main__":

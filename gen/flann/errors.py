@@ -5,6 +5,12 @@ into one line on stderr and exit code 2.  Messages name the file/field and what 
 """
 
 
+def one_line(text) -> str:
+    """``text`` as one printable line: a newline, NUL or other control character (from a
+    hostile file name or cell) is shown escaped (``\\n``, ``\\x00``), never printed raw."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+
+
 class FlannError(Exception):
     """Bad input from the user: reported as one line, exit code 2."""
 

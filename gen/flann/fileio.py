@@ -3,6 +3,19 @@
 One writer for every file kind (text, JSON, bytes, a matplotlib figure as PNG, a directory
 of files).  Files come out with the permissions the umask gives any new file (usually
 0644), not the 0600 of the temporary file they are written through.
+
+Every output goes through :func:`_target`, which decides what may be written where:
+
+* a symlink is followed (its target is written, the link stays a link);
+* a FIFO, device, socket or (for a file) directory is refused, never replaced;
+* a file the running command has read as input (:func:`note_input`, called by every
+  reader, inside :func:`guarding_inputs`) is refused as an output, and so is a directory holding one, so no command overwrites what
+  it reads;
+* names derived from input files (:func:`safe_name`) are sanitised and confined under their
+  output directory (:func:`child`).
+
+Errors of the file system (disk full, permission, a file where a directory is needed) come
+out as one :class:`FlannError` line naming the output.
 """
 
 from __future__ import annotations
@@ -11,7 +24,9 @@ import contextlib
 import io
 import json
 import os
+import re
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 
@@ -35,6 +50,92 @@ def _cannot_write(path, exc: OSError) -> FlannError:
     return FlannError(f"{path}: cannot write ({why})")
 
 
+# (st_dev, st_ino) -> resolved path of every file read as input by the running command;
+# None outside a command (library use: nothing is guarded)
+_INPUTS: dict[tuple[int, int], Path] | None = None
+
+
+@contextlib.contextmanager
+def guarding_inputs():
+    """While a command runs (the CLI wraps each in this), the files it reads may not be
+    written over by its outputs.  Forked workers inherit the guard."""
+    global _INPUTS
+    outer, _INPUTS = _INPUTS, {}
+    try:
+        yield
+    finally:
+        _INPUTS = outer
+
+
+def note_input(path: str | os.PathLike) -> None:
+    """Remember that ``path`` is an input of the running command: it may not be written over."""
+    if _INPUTS is None:
+        return
+    try:
+        st = os.stat(path)
+    except OSError:
+        return
+    _INPUTS[(st.st_dev, st.st_ino)] = Path(os.path.realpath(path))
+
+
+_KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def _target(path: str | os.PathLike, directory: bool = False) -> Path:
+    """The path to write for output ``path``: a symlink resolved; special files, inputs and
+    (for a file) directories refused with one line."""
+    shown = Path(path)
+    # a symlink is followed: what it points to is judged and written (a dangling one
+    # creates its target)
+    path = Path(os.path.realpath(shown)) if shown.is_symlink() else shown
+    try:
+        st = os.stat(shown)
+    except FileNotFoundError:
+        return path
+    except OSError as exc:
+        raise _cannot_write(shown, exc) from None
+    for test, kind in _KINDS:
+        if test(st.st_mode):
+            raise FlannError(f"{shown}: is {kind}; flann writes only regular files (give a file name)")
+    if stat.S_ISDIR(st.st_mode):
+        if not directory:
+            raise FlannError(f"{shown}: is a directory, expected a file name")
+        real = Path(os.path.realpath(path))
+        for src in (_INPUTS or {}).values():
+            if real == src or real in src.parents:
+                raise FlannError(f"{shown}: holds {src.name}, an input of this command; "
+                                 "it would be replaced: choose another output directory")
+        return path
+    if directory:
+        raise FlannError(f"{shown}: exists and is not a directory")
+    if (st.st_dev, st.st_ino) in (_INPUTS or {}):
+        raise FlannError(f"{shown}: is also an input of this command; writing it would destroy "
+                         "the input: choose another output name")
+    return path
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._+\-]")
+
+
+def safe_name(name: str) -> str:
+    """A file/directory name derived from input (a recording's stem), safe to join to an
+    output directory: only letters, digits and ``._+-`` (others become ``_``), no leading
+    dot (so never ``.``/``..`` or hidden), never empty."""
+    out = _UNSAFE.sub("_", name).lstrip(".")
+    return out or "_"
+
+
+def child(directory: str | os.PathLike, name: str) -> Path:
+    """``directory/name`` for a name from :func:`safe_name`, refused if it would leave
+    ``directory`` (one last guard: a safe name never does)."""
+    base = Path(os.path.realpath(directory))
+    dest = Path(os.path.realpath(base / name))
+    if dest.parent != base:
+        raise FlannError(f"{name!r}: not a plain name inside {directory}")
+    return Path(directory) / name
+
+
 def _parent_dir(path: Path) -> None:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -43,10 +144,8 @@ def _parent_dir(path: Path) -> None:
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
-    path = Path(path)
+    path = _target(path)
     _parent_dir(path)
-    if path.is_dir():
-        raise FlannError(f"{path}: is a directory, expected a file name")
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     except OSError as exc:
@@ -92,16 +191,15 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
     (an earlier output of the same kind); any other existing directory is refused before
     anything is written, so a user's files are never mixed with ours or deleted.  On success
     the old directory is renamed aside, the new one renamed in and the old one removed:
-    nothing stale survives and no reader sees a mixture.  On any error ``path`` is untouched.
-    A symlink to a directory is followed (its target is replaced).
+    nothing stale survives and no reader sees a mixture.  On any error ``path`` is untouched
+    (a file-system error while the body writes into the temporary directory -- disk full --
+    becomes one line naming ``path``).  A symlink to a directory is followed (its target is
+    replaced); a directory holding one of the command's inputs is refused.
     """
-    path = Path(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))
+    shown = Path(path)
+    path = _target(path, directory=True)
     _parent_dir(path)
     if path.exists():
-        if not path.is_dir():
-            raise FlannError(f"{path}: exists and is not a directory")
         if any(path.iterdir()) and not replaceable(path):
             raise FlannError(f"{path}: directory is not empty and is not a {what}; "
                              f"choose a new or empty directory")
@@ -111,7 +209,10 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
         raise _cannot_write(path, exc) from None
     aside = None
     try:
-        yield tmp
+        try:
+            yield tmp
+        except OSError as exc:
+            raise _cannot_write(shown, exc) from None
         try:
             os.chmod(tmp, 0o777 & ~_umask())
             if path.exists():
@@ -131,5 +232,19 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
             shutil.rmtree(aside, ignore_errors=True)
 
 
+def remove_output_directory(path: str | os.PathLike, replaceable) -> None:
+    """Remove ``path`` if it is an earlier output ``replaceable`` accepts (a result that is no
+    longer true must not survive beside a report that says so); anything else is left."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink() and replaceable(path):
+        try:
+            aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.old.", dir=path.parent))
+            os.replace(path, aside / "d")
+        except OSError as exc:
+            raise _cannot_write(path, exc) from None
+        shutil.rmtree(aside, ignore_errors=True)
+
+
 __all__ = ["atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",
-           "atomic_directory"]
+           "atomic_directory", "note_input", "guarding_inputs", "safe_name", "child",
+           "remove_output_directory"]

@@ -182,11 +182,14 @@ def test_gen_rejects_model_of_another_format_and_too_many_terms(tmp_path, capsys
     code, err = _cli(["gen", str(bad), "-o", str(tmp_path / "o1")], capsys)
     assert code == 2 and len(err) == 1 and "format" in err[0]
     big = tmp_path / "big.json"
-    table1_model(801).save(big)
+    table1_model(61).save(big)   # the most terms a model.json may hold, too many for this part
     code, err = _cli(["gen", str(big), "-o", str(tmp_path / "o2"), "--device", "xc2s30-pq208-5",
                       "--lanes", "16", "--mult-style", "lut"], capsys)
     assert code == 2 and len(err) == 1 and "xc2s30" in err[0]
     assert not (tmp_path / "o2").exists()
+    table1_model(801).save(big)  # beyond MAX_TERMS: refused as it is read
+    code, err = _cli(["gen", str(big), "-o", str(tmp_path / "o2")], capsys)
+    assert code == 2 and len(err) == 1 and "'terms' = 801 out of range [1, 61]" in err[0]
 
 
 def test_gen_cli_writes_manifest(model_file, tmp_path, capsys):

@@ -39,9 +39,16 @@ def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
 def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):
     model = small_model(11)
     flann = Path(sys.executable).with_name("flann")
-    p = subprocess.Popen([str(flann), "sim", str(model), "--input-bits", "10"], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, start_new_session=True, cwd=tmp_path)
-    time.sleep(6)  # inside the build or the sweep
+    build = tmp_path / "build"
+    p = subprocess.Popen([str(flann), "sim", str(model), "--input-bits", "10", "--build", str(build)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                         cwd=tmp_path)
+    # the state we interrupt: the build has started (its first files are in place); the whole
+    # run takes seconds more, so the interrupt lands inside the build or the sweep
+    deadline = time.monotonic() + 120
+    while not (build.is_dir() and any(build.rglob("*"))):
+        assert p.poll() is None and time.monotonic() < deadline, p.communicate()
+        time.sleep(0.01)
     os.killpg(p.pid, signal.SIGINT)  # what Ctrl-C on a terminal does: the whole process group
     out, err = p.communicate(timeout=60)
     assert p.returncode == 130, err

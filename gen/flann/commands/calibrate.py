@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 
+from ..argtypes import bounded
 from ..production.calibrate import DIAGNOSIS_POINTS, SUMMARY, calibrate_batch
 from ..production.spec import build_spec
 from ..production.traceability import Station
@@ -25,13 +26,14 @@ def add_arguments(p) -> None:
     g = p.add_argument_group("specification (PASS/FAIL; flags override --spec)")
     g.add_argument("--spec", metavar="SPEC.toml", default=None,
                    help="tolerance and limits every sensor is judged against (docs/production.md)")
-    g.add_argument("--tolerance-mm", "--max-error-mm", dest="tolerance_mm", type=float, default=None,
+    g.add_argument("--tolerance-mm", "--max-error-mm", dest="tolerance_mm", type=bounded(float, 0, lo_open=True),
+                   default=None,
                    metavar="MM", help="FAIL a sensor whose hardware max error exceeds this (mm)")
-    g.add_argument("--tolerance-pct-fs", type=float, default=None, metavar="PCT",
+    g.add_argument("--tolerance-pct-fs", type=bounded(float, 0, lo_open=True), default=None, metavar="PCT",
                    help="the same in %% of full scale (the working range's span, else the recorded one)")
     g.add_argument("--working-range", default=None, metavar="LO:HI",
                    help="judge the error over this displacement range (mm; default the whole stroke)")
-    g.add_argument("--max-ratio-to-limit", type=float, default=None, metavar="R",
+    g.add_argument("--max-ratio-to-limit", type=bounded(float, 0, lo_open=True), default=None, metavar="R",
                    help="FAIL when the max error exceeds R x the physical limit")
     g.add_argument("--fail-on-effect", action="append", default=[], metavar="EFFECT",
                    help="FAIL when the diagnosis names this effect (repeatable)")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import sys
 import warnings
 
+from ..argtypes import bounded
 from ..errors import FlannError
 from ..fileio import atomic_write_json, atomic_write_text
 from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
@@ -32,15 +33,15 @@ def add_arguments(p) -> None:
     p.add_argument("--sweeps", type=int, default=1,
                    help="forward+reverse passes (default 1)")
     p.add_argument("--step-mm", type=float, default=1.0, help="actuator step (default 1 mm)")
-    p.add_argument("--from-mm", type=float, default=None,
+    p.add_argument("--from-mm", type=bounded(float, -1e6, 1e6), default=None,
                    help="start of travel (default -stroke_mm of the sensor)")
-    p.add_argument("--to-mm", type=float, default=None,
+    p.add_argument("--to-mm", type=bounded(float, -1e6, 1e6), default=None,
                    help="end of travel (default +stroke_mm of the sensor)")
     p.add_argument("--step-time-s", type=float, default=1.0,
                    help="time per step (default 1 s)")
     p.add_argument("--noise-v", type=float, default=0.0,
                    help="white Gaussian noise, V rms, before the ADC (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--seed", type=bounded(int, 0, 2**32 - 1), default=0, help="noise seed (default 0)")
     p.add_argument("--temperature-profile", default="const:20",
                    help="const:T | ramp:T0:T1 (over the run) | sine:MEAN:AMP:PERIOD_S "
                         "(degC; default const:20)")

@@ -57,6 +57,8 @@ def _check_netlist(args, netlist: Path) -> None:
 def run(args) -> int:
     if args.device is not None:
         parse_part(args.device)  # refuse a bad part before any slow step
+    if args.work and Path(args.work).exists() and not Path(args.work).is_dir():
+        raise FlannError(f"--work {args.work}: exists and is not a directory")
     read_design(args.directory)  # a tampered manifest is refused before any slow step
     if not args.no_lint:
         man = synth.read_manifest(args.directory)

@@ -9,11 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..argtypes import bounded
 from ..errors import FlannError
 from ..recordings import prepare_for_fit, read_recordings
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
+from ..golden.model import MAX_TERMS
 from ..hardware.accuracy import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 
@@ -27,8 +29,8 @@ def _terms(text: str):
         n = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"must be a positive integer or 'auto', got {text!r}")
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {n}")
+    if not 1 <= n <= MAX_TERMS:
+        raise argparse.ArgumentTypeError(f"must be 1..{MAX_TERMS} (the most terms flann fits and builds), got {n}")
     return n
 
 
@@ -43,15 +45,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="closed-form least squares (default) or the paper's LMS")
     p.add_argument("--eta", type=float, default=0.01, help="LMS learning rate (default 0.01)")
     p.add_argument("--epochs", type=int, default=1000, help="LMS epochs (default 1000)")
-    p.add_argument("--ridge", type=float, default=0.0,
+    p.add_argument("--ridge", type=bounded(float, 0, 1e6), default=0.0,
                    help="lstsq ridge penalty on mean squared error (default 0)")
     p.add_argument("--normalise", choices=NORMALISATIONS, default=None,
                    help="input normalisation for explicit --terms: 'range' (default: the "
                         "data's voltage range -> [-1, 1]), 'half' (-> [-0.5, 0.5]) or 'none' "
                         "(raw volts, as the paper)")
-    p.add_argument("--input-offset-v", type=float, default=None,
+    p.add_argument("--input-offset-v", type=bounded(float, -1e6, 1e6), default=None,
                    help="explicit normalisation offset (V); needs --input-scale-v")
-    p.add_argument("--input-scale-v", type=float, default=None,
+    p.add_argument("--input-scale-v", type=bounded(float, -1e6, 1e6, nonzero_abs=1e-9), default=None,
                    help="explicit normalisation scale (V); needs --input-offset-v")
     p.add_argument("--trim", action="store_true",
                    help="keep only the monotonic span when the voltage folds back")

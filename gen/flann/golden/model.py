@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -23,8 +22,14 @@ import numpy as np
 
 from ..errors import ModelFileError
 from ..fileio import atomic_write_text
+from ..inputs import number, parse_json, read_text
 
 FORMAT = "flann-model/1"
+# The most expansion terms flann fits, stores and builds: the paper's largest (61); more
+# adds harmonics no 13..2,000-point sweep resolves and hardware no Spartan-II holds.
+MAX_TERMS = 61
+# |input_scale_v| bounds: a scale of 1e-320 (subnormal) turns every prediction into NaN
+SCALE_V = (1e-9, 1e9)
 
 
 def term_kind(i: int) -> tuple[str, int]:
@@ -149,47 +154,40 @@ class FlannModel:
                 f"{source}: format is {d.get('format')!r}, expected {FORMAT!r}"
             )
         try:
-            weights = tuple(float(w) for w in d["weights"])
-            terms = int(d["terms"])
+            terms = number(d["terms"], "'terms'", source, ModelFileError, integer=True, lo=1, hi=MAX_TERMS)
+            weights = d["weights"]
+            if not isinstance(weights, list):
+                raise ModelFileError(f"{source}: 'weights' must be a list of numbers, got {type(weights).__name__}")
+            weights = tuple(number(w, f"weights[{i}]", source, ModelFileError) for i, w in enumerate(weights))
+            ranges = {}
+            for key in ("voltage_range_v", "displacement_range_mm"):
+                r = d[key]
+                if not isinstance(r, list) or len(r) != 2:
+                    raise ModelFileError(f"{source}: {key} must be [lo, hi]")
+                ranges[key] = tuple(number(x, key, source, ModelFileError) for x in r)
+            training = d.get("training", {})
+            if not isinstance(training, dict):
+                raise ModelFileError(f"{source}: 'training' must be an object")
             model = cls(
                 weights=weights,
-                bias=float(d["bias"]),
-                input_offset_v=float(d["input_offset_v"]),
-                input_scale_v=float(d["input_scale_v"]),
-                voltage_range_v=tuple(float(x) for x in d["voltage_range_v"]),
-                displacement_range_mm=tuple(float(x) for x in d["displacement_range_mm"]),
-                training=dict(d.get("training", {})),
+                bias=number(d["bias"], "bias", source, ModelFileError),
+                input_offset_v=number(d["input_offset_v"], "input_offset_v", source, ModelFileError),
+                input_scale_v=number(d["input_scale_v"], "input_scale_v", source, ModelFileError,
+                                     lo=-SCALE_V[1], hi=SCALE_V[1], tiny=SCALE_V[0]),
+                training=dict(training), **ranges,
             )
         except KeyError as exc:
             raise ModelFileError(f"{source}: missing field {exc.args[0]!r}") from None
-        except (TypeError, ValueError) as exc:
-            raise ModelFileError(f"{source}: malformed field ({exc})") from None
-        if terms != len(weights) or terms < 1:
+        if terms != len(weights):
             raise ModelFileError(f"{source}: 'terms' is {terms} but there are {len(weights)} weights")
-        values = (*weights, model.bias, model.input_offset_v, model.input_scale_v,
-                  *model.voltage_range_v, *model.displacement_range_mm)
-        if not all(math.isfinite(x) for x in values):
-            raise ModelFileError(f"{source}: non-finite number in model")
         if model.input_scale_v == 0:
             raise ModelFileError(f"{source}: input_scale_v must not be 0")
-        if len(model.voltage_range_v) != 2 or len(model.displacement_range_mm) != 2:
-            raise ModelFileError(f"{source}: ranges must be [lo, hi]")
         return model
 
 
 def load_model(path: str | Path) -> FlannModel:
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ModelFileError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelFileError(f"{path}: cannot read ({exc.__class__.__name__})") from None
-    try:
-        d = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{path}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
-    return FlannModel.from_dict(d, source=str(path))
+    text = read_text(path, ModelFileError, "a model.json")
+    return FlannModel.from_dict(parse_json(text, str(path), ModelFileError), source=str(path))
 
 
 def model_sha256(path: str | Path) -> str:
@@ -197,5 +195,5 @@ def model_sha256(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-__all__ = ["FORMAT", "FlannModel", "evaluate", "expand", "harmonics", "load_model", "model_sha256",
+__all__ = ["FORMAT", "MAX_TERMS", "FlannModel", "evaluate", "expand", "harmonics", "load_model", "model_sha256",
            "term_kind", "asdict"]

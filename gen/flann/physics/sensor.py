@@ -68,13 +68,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
 from ..errors import SensorError
+from ..inputs import parse_toml, read_text
 from .effect_params import SPECS, validate_effects
 
 FORMAT = "flann-sensor/1"
@@ -347,25 +347,12 @@ def _unknown_key_msg(section: str, key: str) -> str:
 
 
 def parse_sensor(text: str, source: str = "<memory>") -> Sensor:
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise _bad(source, f"not valid TOML ({exc})") from None
-    return sensor_from_dict(doc, source)
+    return sensor_from_dict(parse_toml(text, source, SensorError), source)
 
 
 def load_sensor(path: str | Path) -> Sensor:
     """Read and validate a sensor TOML file (raises SensorError with one clear line)."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise SensorError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise SensorError(f"{path}: is a directory, expected a sensor TOML file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SensorError(f"{path}: cannot read ({exc.__class__.__name__})") from None
-    return parse_sensor(text, str(path))
+    return parse_sensor(read_text(path, SensorError, "a sensor TOML file"), str(path))
 
 
 # The seed paper's LVDT.  Core, turns and excitation are the paper's; winding lengths, gap,

@@ -30,22 +30,22 @@ import os
 import sys
 import time
 import warnings
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
 from ..errors import FlannError
-from ..fileio import atomic_directory, atomic_write_text
+from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.metrics import raw_output_mm
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
+from ..pool import run_batch
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
 from . import images
 from .certificate import render_certificate, render_rejection
@@ -85,6 +85,7 @@ class Result:
     diagnosis: str = ""
     design_sha256: str = ""
     model_sha256: str = ""
+    written: bool = False   # OUTDIR/<sensor>/ was written by this run (_write_sensor)
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -232,13 +233,19 @@ def _sensor(toml: str):
     return load_sensor(toml)
 
 
+def sensor_name(path) -> str:
+    """The sensor's name and folder under OUTDIR: the recording's stem, sanitised (never
+    ``..``, a hidden name or a path; see :func:`flann.fileio.safe_name`)."""
+    return safe_name(Path(path).stem)
+
+
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
                   spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
     that fails its spec or is rejected gets a certificate saying why and no weights."""
     path = Path(path)
-    res = Result(sensor=path.stem, recording=str(path), design_sha256=dhash)
+    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
     if spec is None:
         spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
     station = station or Station()
@@ -268,7 +275,7 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                             named, groups, unc.expanded_mm)
         extra = {"spec": spec, "verdict": res.verdict, "trace": res.trace, "uncertainty": unc,
                  "confounded": groups}
-        _write_sensor(Path(out_dir) / res.sensor, res, chk, fam, dhash, findings, basis, extra)
+        _write_sensor(child(out_dir, res.sensor), res, chk, fam, dhash, findings, basis, extra)
         if res.verdict.verdict == PASS:
             res.status, res.reason = "ok", ""
         else:
@@ -297,8 +304,9 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
         sha = ""
     try:
         html = render_rejection(res, fam, dhash, spec, sha)
-        with atomic_directory(Path(out_dir) / res.sensor, _is_sensor_output, "sensor calibration") as tmp:
+        with atomic_directory(child(out_dir, res.sensor), _is_sensor_output, "sensor calibration") as tmp:
             (tmp / "certificate.html").write_text(html, newline="")
+        res.written = True
     except (FlannError, OSError) as exc:
         res.warnings.append(f"no certificate written: {exc}")
 
@@ -326,6 +334,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
         (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
         (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")
         (tmp / "certificate.html").write_text(html, newline="")
+    res.written = True
 
 
 # ------------------------------------------------------------------------------------------
@@ -338,15 +347,19 @@ def _progress(done: int, total: int, failed: int, t0: float) -> None:
     sys.stderr.flush()
 
 
-def _worker_init() -> None:
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+def _calibrate_item(item, **kw) -> Result:
+    return calibrate_one(item[1], **kw)
 
 
 def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
                     max_error_mm: float | None = None, progress: bool | None = None,
                     diagnosis_points: int | None = DIAGNOSIS_POINTS,
                     spec: ProductionSpec | None = None, station: Station | None = None) -> list[Result]:
-    """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording."""
+    """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording.
+
+    Ctrl-C stops the batch promptly (:func:`flann.pool.run_batch`): the sensors already
+    running finish, the rest are ``interrupted`` rows, summary.csv is written, and then
+    KeyboardInterrupt goes on up (exit 130)."""
     man, dp = read_design(design_dir)  # the manifest's own datapath, its fields checked
     if dp is not FAMILY:
         raise FlannError(f"{design_dir}: a {dp.name} design; flann calibrate writes weight images for a family "
@@ -358,6 +371,8 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         _sensor(str(sensor_toml))
     dhash = design_hash(design_dir)
     out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise FlannError(f"{out_dir}: exists and is not a directory (OUTDIR)")
     paths = [Path(p) for p in paths]
     if not paths:
         raise FlannError("no recordings given")
@@ -370,38 +385,46 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     seen: dict[str, int] = {}
     todo = []
     for i, p in enumerate(paths):
-        if p.stem in seen:  # two files would write the same folder
-            results[i] = Result(sensor=p.stem, recording=str(p), design_sha256=dhash)
-            results[i].fail(f"sensor name {p.stem!r} already used by {paths[seen[p.stem]]}")
+        name = sensor_name(p)
+        if name == SUMMARY:
+            results[i] = Result(sensor=name, recording=str(p), design_sha256=dhash)
+            results[i].fail(f"sensor name {name!r} is the batch summary's file name; rename the recording")
+        elif name in seen:  # two files would write the same folder
+            results[i] = Result(sensor=name, recording=str(p), design_sha256=dhash)
+            results[i].fail(f"sensor name {name!r} already used by {paths[seen[name]]}")
         else:
-            seen[p.stem] = i
+            seen[name] = i
             todo.append(i)
     t0 = time.monotonic()
     failed = sum(1 for r in results.values() if r.status != "ok")
     if spec is None:
         spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
-    args = (out_dir, fam, dhash, sensor_toml, max_error_mm, diagnosis_points, spec, station)
-    if jobs == 1 or len(todo) == 1:
-        for i in todo:
-            results[i] = calibrate_one(paths[i], *args)
-            failed += results[i].status != "ok"
-            if progress:
-                _progress(len(results), len(paths), failed, t0)
-    else:
-        from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
 
-        with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), initializer=_worker_init) as pool:
-            futs = {pool.submit(calibrate_one, paths[i], *args): i for i in todo}
-            for fut in as_completed(futs):
-                i = futs[fut]
-                results[i] = fut.result()
-                failed += results[i].status != "ok"
-                if progress:
-                    _progress(len(results), len(paths), failed, t0)
+    def record(item, res: Result) -> None:
+        nonlocal failed
+        results[item[0]] = res
+        if not res.written:   # an earlier run's files must not outlive this run's verdict
+            remove_output_directory(child(out_dir, res.sensor), _is_sensor_output)
+        if res.status != "ok":
+            failed += 1
+        if progress:
+            _progress(len(results), len(paths), failed, t0)
+
+    if jobs > 1 and len(todo) > 1:
+        from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
+    fn = partial(_calibrate_item, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
+                 max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
+    interrupted = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record)
     if progress:
         sys.stderr.write("\n")
+    for i in todo:
+        if i not in results:
+            results[i] = Result(sensor=sensor_name(paths[i]), recording=str(paths[i]), status="interrupted",
+                                reason="not calibrated: the batch was interrupted (Ctrl-C)")
     ordered = [results[i] for i in range(len(paths))]
     write_summary(out_dir / SUMMARY, ordered)
+    if interrupted:
+        raise KeyboardInterrupt
     return ordered
 
 

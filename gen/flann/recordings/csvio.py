@@ -11,6 +11,15 @@ line ends, a semicolon, tab or whitespace separator (sniffed from the header; Ex
 and headers that carry their unit (``Displacement (mm)``, ``x_mm``, ``U / mV``,
 ``Voltage (mV)``, ``displacement_in``...): values are converted to the canonical unit and
 what was recognised is said in one line on stderr.  Error messages give the *file* line.
+Two columns of one quantity in different units (``displacement_mm`` and ``displacement_in``)
+are read as one: the canonical unit is used, the other must agree with it.
+
+Bounds (one ``error:`` line when exceeded, before anything is computed): at most
+:data:`MAX_ROWS` data rows and :data:`MAX_LINE_CHARS` characters per line; every value,
+after conversion to its canonical unit, finite and within :data:`VALUE_RANGE` (a number
+that overflows when converted, or a subnormal one, would turn a fit into NaN); a last line
+without a line end that is shorter than every other line's cells looks cut off (a file
+copied while being written) and is refused as such.
 """
 
 from __future__ import annotations
@@ -27,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import RecordingsError
-from ..fileio import atomic_write_text
+from ..errors import RecordingsError, one_line
+from ..fileio import atomic_write_text, note_input
 
 REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
@@ -63,6 +72,13 @@ DIRECTION_WORDS = {"+": "1", "-": "-1", "up": "1", "down": "-1", "fwd": "1", "re
 _WORDLIKE_UNITS = {"in", "in.", "m", "mil"}
 SEPARATORS = {";": "semicolon", "\t": "tab", ",": "comma", " ": "whitespace"}
 _WS_HEADER = re.compile(r"[^\s(\[]+(?:\s*[(\[][^)\]]*[)\]])?")
+# Resource bounds.  Rows are parsed into Python lists before they become arrays: ~120 bytes
+# a row at the peak, so MAX_ROWS keeps reading (and training) well under 1 GB
+# (bench/recordings_memory.py); longer sweeps are averaged or decimated first.
+MAX_ROWS = 1_000_000
+MAX_LINE_CHARS = 65_536
+# |value| in canonical units (mm, V, s, degC, Hz): 0 or within these
+VALUE_RANGE = (1e-30, 1e12)
 _EXCEL_SEP = re.compile(r'^\s*"?sep=(?P<sep>[;\t,])"?\s*$', re.IGNORECASE)
 
 
@@ -139,15 +155,23 @@ class Recordings:
                           lines=lines, recognised=self.recognised)
 
 
-def _parse_float(text: str, column: str, where: str, source: str) -> float:
+def _parse_float(text: str, column: str, where: str, source: str, factor: float = 1.0) -> float:
+    """A cell as a number in the canonical unit (x ``factor``), finite and in VALUE_RANGE."""
     try:
         value = float(text)
     except ValueError:
         raise RecordingsError(
-            f"{source}: {where}, column '{column}': '{text}' is not a number"
+            f"{source}: {where}, column '{column}': '{text[:40]}' is not a number"
         ) from None
     if not math.isfinite(value):
         raise RecordingsError(f"{source}: {where}, column '{column}': value {text} is not finite")
+    value *= factor
+    lo, hi = VALUE_RANGE
+    if value != 0 and not lo <= abs(value) <= hi:
+        unit = f" (x {factor:g} to the canonical unit)" if factor != 1.0 else ""
+        raise RecordingsError(
+            f"{source}: {where}, column '{column}': value {text[:40]}{unit} is outside what flann "
+            f"computes with (0 or {lo:g} <= |value| <= {hi:g})")
     return value
 
 
@@ -162,7 +186,18 @@ def _sniff_separator(header_line: str) -> str:
 
 
 def _cells(line: str, sep: str) -> list[str]:
-    return line.split() if sep == " " else next(csv.reader([line], delimiter=sep))
+    if sep == " ":
+        return line.split()
+    try:
+        return next(csv.reader([line], delimiter=sep))
+    except csv.Error as exc:   # a NUL byte, a quote left open over the field-size limit...
+        raise RecordingsError(f"not CSV ({exc})") from None
+
+
+def _check_line(source: str, line_no: int, line: str) -> None:
+    if len(line) > MAX_LINE_CHARS:
+        raise RecordingsError(f"{source}: line {line_no} is {len(line):,} characters long "
+                              f"(at most {MAX_LINE_CHARS:,}): not a recordings line")
 
 
 def _unit_row(body, sep: str, width: int) -> list[str] | None:
@@ -181,6 +216,7 @@ def _unit_row(body, sep: str, width: int) -> list[str] | None:
 def _header_map(header: list[str], required, source: str):
     """{canonical column: (index, factor)}, notes on conversions, unknown headers."""
     found: dict[str, tuple[int, float]] = {}
+    also: dict[str, tuple[int, float]] = {}   # a second column of the same quantity
     notes, unknown = [], []
     for i, h in enumerate(header):
         hit = recognise_header(h)
@@ -190,9 +226,22 @@ def _header_map(header: list[str], required, source: str):
             continue
         col, factor = hit
         if col in found:
-            raise RecordingsError(
-                f"{source}: duplicate column(s) {col} ('{header[found[col][0]]}' and '{h}')")
+            j, other = found[col]
+            if factor == other:   # the same quantity twice in the same unit: which one?
+                raise RecordingsError(
+                    f"{source}: duplicate column(s) {col} ('{header[j]}' and '{h}')")
+            if col in also:
+                raise RecordingsError(f"{source}: {col} given three times ('{header[j]}', "
+                                      f"'{header[also[col][0]]}', '{h}')")
+            if factor == 1.0:   # the canonical unit is the one used; the other is checked
+                also[col] = (j, other)
+                found[col] = (i, factor)
+            else:
+                also[col] = (i, factor)
+            continue
         found[col] = (i, factor)
+    for col, (i, factor) in found.items():
+        h = header[i]
         if h != col:
             notes.append(f"'{h}' as {col}" + (f" (x {factor:g})" if factor != 1.0 else ""))
     missing = [c for c in required if c not in found]
@@ -202,13 +251,43 @@ def _header_map(header: list[str], required, source: str):
             f"{source}: missing column(s) {', '.join(missing)} (header has: {', '.join(header)}"
             f"{what}); accepted: {accepted_names()}"
         )
-    return found, notes, unknown
+    return found, also, notes, unknown
+
+
+def _agree(source: str, header, col: str, used, other, a, b, lines) -> str:
+    """The note for a quantity given twice: ``b`` (other unit) must agree with ``a`` within
+    the rounding of the coarser of the two (1e-3 of the span, at least 1e-9)."""
+    tol = max(1e-3 * float(np.ptp(a)), 1e-6 * float(np.max(np.abs(a))), 1e-9)
+    diff = np.abs(a - b)
+    k = int(np.argmax(diff))
+    if diff[k] > tol:
+        raise RecordingsError(
+            f"{source}: line {lines[k]}: '{header[used]}' and '{header[other]}' give the same quantity "
+            f"but disagree ({a[k]:.6g} vs {b[k]:.6g} in {col}'s unit, more than {tol:.3g})")
+    unit = col.rsplit("_", 1)[-1]
+    return f"'{header[other]}' agrees with '{header[used]}' (within {float(diff[k]):.2g} {unit}), " \
+           f"{col} from '{header[used]}'"
+
+
+def _looks_cut(source: str, line_no: int, last: list[str], width: int, shortest: int | None) -> None:
+    """The last line, without a line end: fewer cells than the header, or a last cell shorter
+    than that column's on every other line, means it was cut off mid-line (a copy of a file
+    still being written): said as such, not as whatever its numbers imply."""
+    if len(last) == width and (shortest is None or len(last[-1].strip()) >= shortest):
+        return
+    raise RecordingsError(
+        f"{source}: line {line_no}: the last line looks cut off (no line end, and it is shorter than "
+        "every other line): copied while being written? complete it or delete that line")
 
 
 def parse_recordings(text: str, source: str = "<memory>",
                      required: tuple[str, ...] = REQUIRED, encoding_note: str = "") -> Recordings:
     """Parse CSV text.  ``required=("voltage_v",)`` lets ``displacement_mm`` be absent
     (then ``None``): only for commands that do not need it (``flann predict``)."""
+    # the bound first, on the text: the lists below cost ~100 bytes a row
+    if text.count("\n") - text.count("\n#") > MAX_ROWS + 2:
+        raise RecordingsError(f"{source}: more than {MAX_ROWS:,} data rows, more than flann reads: "
+                              "average or decimate the recording first")
     sha = hashlib.sha256(text.encode()).hexdigest()
     notes = [encoding_note] if encoding_note else []
     if text.startswith("\ufeff"):
@@ -231,31 +310,50 @@ def parse_recordings(text: str, source: str = "<memory>",
         if not body:
             raise RecordingsError(f"{source}: no header line after '{excel_sep.group(0).strip()}'")
     sep = excel_sep.group("sep") if excel_sep else _sniff_separator(body[0][1])
-    header = [h.strip() for h in _cells(body[0][1], sep)]
+    for n, line in body[:2]:   # the header and a possible unit line, before they are split
+        _check_line(source, n, line)
+    try:
+        header = [h.strip() for h in _cells(body[0][1], sep)]
+        units = _unit_row(body, sep, len(header))
+    except RecordingsError as exc:
+        raise RecordingsError(f"{source}: line {body[0][0]}: {exc}") from None
     if sep == " ":   # "Displacement (mm) Voltage (V)": a unit in brackets belongs to the name before
         header = _WS_HEADER.findall(body[0][1])
-    units = _unit_row(body, sep, len(header))
+        units = _unit_row(body, sep, len(header))
     if units is not None:   # loggers: names on one line, units on the next
         header = [f"{h} ({u})" if u and recognise_header(h) is None else h
                   for h, u in zip(header, units)]
         body = body[:1] + body[2:]
-    found, col_notes, unknown = _header_map(header, required, source)
+    found, also, col_notes, unknown = _header_map(header, required, source)
     if unknown:
         warnings.warn(f"{source}: ignoring unknown column(s) {', '.join(unknown)}", stacklevel=2)
     wanted = [c for c in REQUIRED + OPTIONAL if c in found]
-    data: dict[str, list[float]] = {c: [] for c in wanted}
+    columns = {c: found[c] for c in wanted} | {"+" + c: also[c] for c in also}
+    data: dict[str, list[float]] = {c: [] for c in columns}
     line_numbers: list[int] = []
     decimal_comma = False
-    for line_no, row in ((n, _cells(line, sep)) for n, line in body[1:]):
+    # one pass, row by row (no list of split rows: ~100 bytes a row less at the peak)
+    cut_candidate = not text.endswith(("\n", "\r")) and len(body) > 3
+    shortest_last = None   # the shortest last cell of a full row so far (for a cut-off last line)
+    width = len(header)
+    for k, (line_no, line) in enumerate(body[1:], start=2):
+        _check_line(source, line_no, line)
+        try:
+            row = _cells(line, sep)
+        except RecordingsError as exc:
+            raise RecordingsError(f"{source}: line {line_no}: {exc}") from None
         if not any(cell.strip() for cell in row):
             continue
+        if cut_candidate and k == len(body):
+            _looks_cut(source, line_no, row, width, shortest_last)
         where = f"line {line_no}"
-        if len(row) != len(header):
+        if len(row) != width:
             raise RecordingsError(
-                f"{source}: {where} has {len(row)} cells, header (line {body[0][0]}) has {len(header)}"
+                f"{source}: {where} has {len(row)} cells, header (line {body[0][0]}) has {width}"
             )
-        for c in wanted:
-            i, factor = found[c]
+        n_last = len(row[-1].strip())
+        shortest_last = n_last if shortest_last is None else min(shortest_last, n_last)
+        for c, (i, factor) in columns.items():
             cell = row[i].strip()
             if c == "direction":
                 cell = DIRECTION_WORDS.get(cell.lower(), cell)
@@ -263,12 +361,18 @@ def parse_recordings(text: str, source: str = "<memory>",
             # when quoted, "1,5"); with a point as well it is a thousands separator: refused
             if "," in cell and "." not in cell and cell.count(",") == 1:
                 cell, decimal_comma = cell.replace(",", "."), True
-            data[c].append(_parse_float(cell, header[i], where, source) * factor)
+            data[c].append(_parse_float(cell, header[i], where, source, factor))
         line_numbers.append(line_no)
+    if len(line_numbers) > MAX_ROWS:
+        raise RecordingsError(f"{source}: {len(line_numbers):,} data rows, more than flann reads ({MAX_ROWS:,}): "
+                              "average or decimate the recording first")
     if not data["voltage_v"]:
         raise RecordingsError(f"{source}: no data rows")
     arrays = {c: np.asarray(v, dtype=float) for c, v in data.items()}
+    del data
     lines = np.asarray(line_numbers, dtype=np.int64)
+    for c in also:
+        col_notes.append(_agree(source, header, c, found[c][0], also[c][0], arrays[c], arrays.pop("+" + c), lines))
     if "direction" in arrays:
         bad = ~np.isin(arrays["direction"], (-1.0, 1.0))
         if bad.any():
@@ -293,6 +397,7 @@ def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
     note = ""
     try:
         raw = path.read_bytes()
+        note_input(path)
     except FileNotFoundError:
         raise RecordingsError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -308,7 +413,7 @@ def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
         text, note = raw.decode("latin-1"), "Latin-1 text"   # spreadsheets on Windows
     rec = parse_recordings(text, source=str(path), required=required, encoding_note=note)
     if announce and rec.recognised:
-        print(f"{path}: read {rec.recognised}", file=sys.stderr)
+        print(one_line(f"{path}: read {rec.recognised}"), file=sys.stderr)
     return rec
 
 

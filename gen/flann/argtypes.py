@@ -1,0 +1,49 @@
+"""Flag values checked where they are parsed: one ``error:`` line naming the flag, never a
+crash or a silently ignored check further on.
+
+:class:`flann.cli._Parser` makes every ``type=float`` flag refuse NaN and infinity
+(``--max-error-mm nan`` would turn a check off, ``--from-mm nan`` crash a sweep); flags
+with a physical range use :func:`bounded`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number")
+    return value
+
+
+def bounded(kind: type = float, lo: float | None = None, hi: float | None = None, *,
+            lo_open: bool = False, nonzero_abs: float | None = None):
+    """An argparse ``type`` for a number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``);
+    ``nonzero_abs``: the value's magnitude at least this (and not 0)."""
+    def parse(text: str):
+        if kind is int:
+            try:
+                value = int(text)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        else:
+            value = finite_float(text)
+        if lo is not None and (value <= lo if lo_open else value < lo):
+            raise argparse.ArgumentTypeError(f"{text}: must be {'>' if lo_open else '>='} {lo:g}")
+        if hi is not None and value > hi:
+            raise argparse.ArgumentTypeError(f"{text}: must be <= {hi:g}")
+        if nonzero_abs is not None and abs(value) < nonzero_abs:
+            raise argparse.ArgumentTypeError(f"{text}: |value| must be >= {nonzero_abs:g}")
+        return value
+
+    parse.__name__ = kind.__name__
+    return parse
+
+
+__all__ = ["finite_float", "bounded"]
