@@ -326,14 +326,12 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
-        if not res.verdict.passed:
-            (tmp / "certificate.html").write_text(html, newline="")
-            return
-        (tmp / "model.json").write_text(model_json, newline="")
-        (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
-        (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
-        (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")
         (tmp / "certificate.html").write_text(html, newline="")
+        if res.verdict.passed:
+            (tmp / "model.json").write_text(model_json, newline="")
+            (tmp / "weights.hex").write_text(images.hex_text(words, head), newline="")
+            (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
+            (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")
     res.written = True
 
 
