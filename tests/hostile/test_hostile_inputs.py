@@ -33,7 +33,7 @@ class Case:
     expect: str = ""    # a substring of the error line (rc != 0) or of stdout+stderr (rc 0)
     changes: tuple = ()  # glob patterns (relative to the world) that may be created/changed
     prep: str = ""      # name of a function below that makes the hostile file(s)
-    absent: tuple = ()  # paths that must not exist afterwards (a stale result)
+    absent: tuple = ()  # paths that must not exist afterwards (a stale result: weights of an earlier run)
 
 
 # ---------------------------------------------------------------------------- hostile files
@@ -323,7 +323,7 @@ CASES = [
     Case("gen-o-user-directory", "own", ("gen", "m.json", "-o", "mine"), 2, "not empty", (), "p_userdir"),
     Case("calibrate-o-is-file", "own", ("calibrate", "s1.csv", "-o", "out", *FAM), 2, "not a directory", (), "p_outdir_file"),
     Case("calibrate-stale-removed", "5", ("calibrate", "bad.csv", "-o", "out", *FAM), 2, "missing column",
-         ("out/**",), "p_stale", absent=("out/bad",)),
+         ("out/**",), "p_stale", absent=("out/bad/model.json", "out/bad/weights.hex", "out/bad/weights.mem")),
     Case("simulate-sensor-missing", "own", ("simulate", "nosuch.toml", "-o", "o.csv"), 2, "no such file"),
     Case("ise-o-fifo", "2", ("ise", "design", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
 ]
