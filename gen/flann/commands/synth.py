@@ -8,8 +8,8 @@ import tempfile
 from pathlib import Path
 
 from ..errors import FlannError
-from ..implement import synth
-from ..hardware.target import DEFAULT_PART, DEVICES, parse_part
+from ..implement import synth, timing
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART, DEVICES, parse_part
 from ..verify.design import from_directory
 from ..verify.netlist import check_synthesized
 
@@ -71,6 +71,10 @@ def run(args) -> int:
         print(report.table())
         for w in report.warnings:
             print(f"warning: yosys: {w}", file=sys.stderr)
+    if report.timing and not report.timing.meets(CLOCK_HZ):
+        print(f"warning: {report.top} is estimated at {report.timing.fmax_mhz:.1f} MHz on {report.part.name}, "
+              f"below the design's clock {CLOCK_HZ / 1e6:g} MHz: run it at most at "
+              f"{timing.safe_clock_mhz(report.timing):g} MHz (flann ise writes that PERIOD)", file=sys.stderr)
     if not report.fits:
         print(f"error: {synth.not_fit_message(report)}", file=sys.stderr)
         return 2
