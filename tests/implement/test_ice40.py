@@ -105,3 +105,16 @@ def test_non_ansi_header():
     text = "\nmodule chip (output a, input [3:0] \\b , input c);\nwire c;\nendmodule\n"
     got = non_ansi_header(text)
     assert got.startswith("\nmodule chip (a, \\b , c);\noutput a;\ninput [3:0] \\b ;\ninput c;\nwire c;")
+
+
+@pytest.mark.sim
+@pytest.mark.pnr
+@needs_tools
+def test_flann_sim_post_route(small, tmp_path, capsys):
+    model, hdl = small
+    assert main(["sim", str(hdl), "--model", str(model), "--post-route", "--post-route-device", "ice40-hx1k-tq144",
+                 "--json", "--engine", "verilator"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    pr = s["post_route"]
+    assert pr["device"] == "ice40-hx1k-tq144" and pr["codes_tested"] == 256 and pr["mismatches"] == 0
+    assert pr["fmax_mhz"] > 0

@@ -13,7 +13,7 @@ from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVIC
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
 from ..verify.netlist import check_synthesized
-from ..verify.post_route import check_post_route
+from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
@@ -74,17 +74,7 @@ def post_route_check(directory, model):
         raise FlannError("--post-route: the twin and the sweep driver are those of a generated fixed-point flann_top")
     if model is None and not man.data.get("model"):
         raise FlannError("--post-route: pass --model MODEL.json (the twin is built from the model)")
-    design = from_directory(directory, model)
-
-    def check(asc, pcf, part, work):
-        res = check_post_route(design, asc, pcf, part, Path(work) / "post_route")
-        if res["mismatches"]:
-            raise FlannError(f"the routed design of {directory} on {part.name} disagrees with its twin on "
-                             f"{res['mismatches']} of {res['codes_tested']} input codes (first: "
-                             f"{res['first_mismatches']}); no bitstream written")
-        return {k: res[k] for k in ("codes_tested", "mismatches", "first_mismatches", "simulator", "seconds")}
-
-    return check
+    return checker(from_directory(directory, model), refuse=True)
 
 
 def run_ice40(args) -> int:

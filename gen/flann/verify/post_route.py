@@ -82,4 +82,23 @@ def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, buil
     return res
 
 
-__all__ = ["check_post_route", "non_ansi_header", "routed_verilog"]
+SUMMARY_KEYS = ("codes_tested", "mismatches", "first_mismatches", "simulator", "seconds")
+
+
+def checker(design: Design, refuse: bool = False):
+    """The post-route check as :func:`flann.implement.ice40.implement` calls it: (asc, pcf, part,
+    work) → summary.  ``refuse``: a routed design that disagrees with its twin raises (nothing
+    is written then) instead of being reported."""
+
+    def check(asc, pcf, part, work) -> dict:
+        res = check_post_route(design, asc, pcf, part, Path(work) / "post_route")
+        if refuse and res["mismatches"]:
+            raise FlannError(f"the routed design of {design.directory} on {part.name} disagrees with its twin on "
+                             f"{res['mismatches']} of {res['codes_tested']} input codes (first: "
+                             f"{res['first_mismatches']}); no bitstream written")
+        return {k: res[k] for k in SUMMARY_KEYS}
+
+    return check
+
+
+__all__ = ["check_post_route", "checker", "non_ansi_header", "routed_verilog"]
