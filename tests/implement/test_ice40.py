@@ -11,7 +11,7 @@ import pytest
 
 from flann.cli import main
 from flann.hardware.target import ICE40_PARTS, parse_ice40
-from flann.implement.ice40 import package_pins
+from flann.implement.ice40 import global_clock_pins, package_pins
 from flann.verify.design import from_model
 from flann.verify.post_route import check_post_route, non_ansi_header
 
@@ -61,6 +61,7 @@ def test_hx8k_place_route_bitstream_and_post_route(small, tmp_path, capsys):
     assert set(pcf) == want
     assert len(set(pcf.values())) == len(pcf)
     assert set(pcf.values()) <= set(package_pins(part).values())
+    assert pcf["clk"] in global_clock_pins(part)  # a global clock input, not a fabric-routed pin
     # every input code through the routed design
     assert rep["post_route"]["codes_tested"] == 256 and rep["post_route"]["mismatches"] == 0
 
@@ -99,6 +100,16 @@ def test_every_table_part_has_its_package_in_the_chip_database():
     for part in ICE40_PARTS:
         pins = package_pins(part)
         assert len(pins) >= 30, part.name  # the smallest package here (SG48) bonds 39 I/O
+
+
+def test_global_clock_pins_agree_with_boards():
+    if not shutil.which("nextpnr-ice40"):
+        pytest.skip("needs fpga-icestorm's chip database")
+    # the oscillators of public boards sit on global clock inputs: iCEstick (HX1K-TQ144) pin 21,
+    # iCE40-HX8K breakout board (CT256) J3, iCEBreaker (UP5K-SG48) pin 35
+    assert "21" in global_clock_pins(parse_ice40("ice40-hx1k-tq144"))
+    assert "J3" in global_clock_pins(parse_ice40("ice40-hx8k-ct256"))
+    assert "35" in global_clock_pins(parse_ice40("ice40-up5k-sg48"))
 
 
 def test_non_ansi_header():

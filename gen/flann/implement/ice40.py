@@ -55,20 +55,31 @@ def chipdb(part: Ice40Part) -> Path:
                      f"(searched {', '.join(map(str, CHIPDB_DIRS))}; Debian package fpga-icestorm-chipdb)")
 
 
-def package_pins(part: Ice40Part) -> dict[tuple[int, int, int], str]:
-    """(x, y, z) of every I/O site → package pin name, from the chip database's ``.pins`` section."""
-    pins: dict[tuple[int, int, int], str] = {}
-    inside = False
+def _section(part: Ice40Part, header: list[str]) -> list[list[str]]:
+    """The rows of one section of the chip database (``.pins ct256``, ``.gbufpin``)."""
+    rows, inside = [], False
     for line in chipdb(part).read_text().splitlines():
         if line.startswith("."):
-            inside = line.split()[:2] == [".pins", part.pins]
+            inside = line.split() == header
             continue
         if inside and line.strip():
-            name, x, y, z = line.split()
-            pins[(int(x), int(y), int(z))] = name
+            rows.append(line.split())
+    return rows
+
+
+def package_pins(part: Ice40Part) -> dict[tuple[int, int, int], str]:
+    """(x, y, z) of every I/O site → package pin name, from the chip database's ``.pins`` section."""
+    pins = {(int(x), int(y), int(z)): name for name, x, y, z in _section(part, [".pins", part.pins])}
     if not pins:
         raise FlannError(f"chipdb-{part.chipdb}.txt has no pins for package {part.pins}")
     return pins
+
+
+def global_clock_pins(part: Ice40Part) -> list[str]:
+    """Bonded package pins that drive a global network directly (``.gbufpin``), in network order."""
+    pins = package_pins(part)
+    sites = [(int(x), int(y), int(z)) for x, y, z, _glb in _section(part, [".gbufpin"])]
+    return [pins[s] for s in sites if s in pins]
 
 
 _BEL_RE = re.compile(r"^X(\d+)/Y(\d+)/io(\d)$")
@@ -90,7 +101,8 @@ def example_pcf(routed: dict, part: Ice40Part, top: str) -> str:
             raise FlannError(f"I/O site {site} of {name} is not bonded in {part.package}")
         lines.append((name.split("$")[0], pins[site]))
     lines.sort()
-    head = [f"# {top} on {part.name}: EXAMPLE ASSIGNMENT (the pins nextpnr chose); edit it for your board.",
+    head = [f"# {top} on {part.name}: EXAMPLE ASSIGNMENT (clk on a global clock input pin, the other pins "
+            "nextpnr chose); edit it for your board.",
             "# Written by flann synth --device " + part.name + "."]
     return "\n".join(head + [f"set_io {net} {pin}" for net, pin in lines]) + "\n"
 
@@ -194,9 +206,18 @@ def yosys_ice40(verilog: Path, top: str, work: Path) -> dict[str, int]:
     return {str(k): int(v) for k, v in data["design"]["num_cells_by_type"].items()}
 
 
+CLOCK_PORT = "clk"
+
+
 def place_and_route(part: Ice40Part, top: str, work: Path, clock_mhz: float, seed: int = 1) -> dict:
-    """nextpnr-ice40: placement, routing and timing; returns its ``--report`` JSON."""
+    """nextpnr-ice40: placement, routing and timing; returns its ``--report`` JSON.  The clock is
+    put on a global clock input pin; nextpnr places the other ports."""
+    gbin = global_clock_pins(part)
+    if not gbin:
+        raise FlannError(f"{part.name}: no global clock input pin bonded in {part.package}")
+    (work / "clock.pcf").write_text(f"set_io {CLOCK_PORT} {gbin[0]}\n")
     cmd = [_tool("nextpnr-ice40"), f"--{part.nextpnr}", "--package", part.package, "--json", SYNTH_JSON,
+           "--pcf", "clock.pcf", "--pcf-allow-unconstrained",
            "--write", ROUTED_JSON, "--asc", f"{top}.asc", "--report", NEXTPNR_REPORT, "--freq", f"{clock_mhz:g}",
            "--seed", str(seed), "--timing-allow-fail", "-q", "-l", "nextpnr.log"]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
@@ -265,4 +286,4 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
     return report
 
 
-__all__ = ["Ice40Report", "implement", "example_pcf", "package_pins", "fmax_of", "REPORT"]
+__all__ = ["Ice40Report", "implement", "example_pcf", "package_pins", "global_clock_pins", "fmax_of", "REPORT"]
