@@ -110,3 +110,22 @@ def test_default_design_meets_the_default_clock_with_margin(capsys):
     assert main(["synth", str(hdl), "--device", "xc2s30-pq208-5", "--json", "--no-lint", "--no-netlist-check"]) == 0
     t = json.loads(capsys.readouterr().out)["timing"]
     assert t["meets_clock"] and t["fmax_mhz_estimate"] >= MARGIN * CLOCK_HZ / 1e6
+
+
+@pytest.mark.synth
+def test_a_missed_clock_is_said(monkeypatch, capsys):
+    import flann.commands.synth as synth_cmd
+
+    monkeypatch.setattr(synth_cmd, "CLOCK_HZ", 400e6)  # no Spartan-II path with a LUT reaches 400 MHz
+    assert main(["synth", str(FIX), "--device", "xc2s30-pq208-5", "--no-lint", "--no-netlist-check"]) == 0
+    err = capsys.readouterr().err
+    assert "below the design's clock 400 MHz" in err and "flann ise writes that PERIOD" in err
+
+
+def test_lut_ram_is_read_through_a_lut_level(tmp_path):
+    # FF -> routed address -> RAM16X1S read (a LUT) -> FF; its write port is an end point
+    cells = [_ff(2, 10), ("RAM16X1S", {"WCLK": [1], "A0": [10], "A1": ["0"], "A2": ["0"], "A3": ["0"],
+                                       "D": [10], "WE": ["1"], "O": [11]}), ("LUT1", {"I0": [11], "O": [99]}),
+             _ff(99, 3), ("GND", {"G": [40]})]
+    t = analyse(_netlist(tmp_path, cells), PART5)
+    assert t.logic_levels == 2 and t.delay_ns == pytest.approx(1.3 + 1.0 + 0.7 + 1.0 + 1.4)

@@ -68,9 +68,13 @@ ROUTE_NS = 1.0
 MARGIN = 1.2
 
 _LUTS = {"LUT1", "LUT2", "LUT3", "LUT4", "INV"}
-_OUTPUT_PINS = {"O", "Q", "DO", "DOA", "DOB", "LO"}
+_OUTPUT_PINS = {"O", "Q", "DO", "DOA", "DOB", "LO", "SPO", "DPO", "Q15"}
 _FF_PREFIX = "FD"
-_IGNORED = {"BUFG", "IBUF", "IBUFG", "OBUF", "OBUFT"}  # clock tree and pads: I/O paths not counted
+_IGNORED = {"BUFG", "IBUF", "IBUFG", "OBUF", "OBUFT", "GND", "VCC"}  # clock tree, pads, constants
+# LUT RAM and shift registers: written on the clock (a start point, TCKO), read through the LUT
+# from the address pins (TILO, as a LUT level); data and enables are end points
+_LUT_MEMORY = ("RAM16X1", "RAM32X1", "SRL16")
+_ADDRESS_PINS = {"A0", "A1", "A2", "A3", "A4", "DPRA0", "DPRA1", "DPRA2", "DPRA3"}
 
 
 @dataclass(frozen=True)
@@ -172,6 +176,21 @@ def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Tim
                         setup = {"CE": g.tceck, "R": g.trck, "S": g.trck}.get(
                             pin, g.tick_extra if loc and driver.get(b, ("",))[0] != "XORCY" else g.tdick)
                         sinks.append((b, setup, not loc, name))
+            continue
+        if t.startswith(_LUT_MEMORY):
+            outs = [b for p, conn in conns.items() if p in _OUTPUT_PINS for b in _bits(conn)]
+            for pin, conn in conns.items():
+                if pin in ("WCLK", "CLK"):
+                    continue
+                for b in _bits(conn):
+                    if pin in _OUTPUT_PINS:
+                        sources[b] = g.tcko
+                    elif pin in _ADDRESS_PINS:
+                        for o in outs:
+                            edges[b].append((o, g.tilo + ROUTE_NS, True, False, True))
+                            indeg[o] += 1
+                    else:
+                        sinks.append((b, g.tick_extra + g.tilo, True, name))
             continue
         if t in _LUTS or t == "MULT_AND":
             arcs = {p: g.tilo for p in conns if p not in _OUTPUT_PINS}
