@@ -16,7 +16,7 @@ DEVICE   ?= xc2s200-pq208-5
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: all venv tools test sim gen synth paper bench clean
+.PHONY: all venv tools test sim gen synth pnr paper bench clean
 
 all: test
 
@@ -55,6 +55,11 @@ gen: venv
 
 synth: venv tools
 	$(BIN)/flann synth hdl --device $(DEVICE) --model $(DEFAULT_MODEL)
+
+# Real place and route of hdl/ on an iCE40: nextpnr Fmax, bitstream, routed design over every code.
+ICE40 ?= ice40-hx8k-ct256
+pnr: venv tools
+	$(BIN)/flann synth hdl --device $(ICE40) --post-route --model $(DEFAULT_MODEL) -o $(BUILD)/ice40
 
 paper: venv
 	$(BIN)/flann paper --plot $(BUILD)/paper

@@ -3,6 +3,8 @@
 #   ghdl, ghdl-llvm  VHDL simulation (LLVM backend: the exhaustive sweep runs ~2.6x faster than mcode)
 #   yosys            synthesis (synth_xilinx -family xcv) and its Xilinx cell models
 #   verilator        post-synthesis netlist simulation; iverilog: the netlist regression test
+#   nextpnr-ice40    iCE40 place and route + static timing (flann synth --device ice40-...)
+#   fpga-icestorm    icepack (bitstream), icebox_vlog (post-route simulation); chip databases
 set -euo pipefail
 missing=()
 command -v ghdl      >/dev/null 2>&1 || missing+=(ghdl)
@@ -10,6 +12,8 @@ command -v ghdl-llvm >/dev/null 2>&1 || missing+=(ghdl-llvm)
 command -v yosys     >/dev/null 2>&1 || missing+=(yosys)
 command -v verilator >/dev/null 2>&1 || missing+=(verilator)
 command -v iverilog  >/dev/null 2>&1 || missing+=(iverilog)
+command -v nextpnr-ice40 >/dev/null 2>&1 || missing+=(nextpnr-ice40)
+{ command -v icepack >/dev/null 2>&1 && command -v icebox_vlog >/dev/null 2>&1; } || missing+=(fpga-icestorm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 if [ "$(id -u)" -ne 0 ]; then
     echo "error: ${missing[*]} not found; install them as root: apt-get update && apt-get install -y ${missing[*]}" >&2

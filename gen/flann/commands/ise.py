@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from ..hardware.target import CLOCK_HZ, DEFAULT_PART
+import sys
+
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
 from ..implement import ise
 
 HELP = "write an ISE 10.1 project for the generated VHDL"
@@ -11,15 +13,26 @@ HELP = "write an ISE 10.1 project for the generated VHDL"
 def add_arguments(p):
     p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
     p.add_argument("--device", default=DEFAULT_PART, metavar="PART",
-                   help="Spartan-II part DEVICE-PQ208-SPEED (default %(default)s)")
+                   help="Spartan-II part DEVICE-PACKAGE-SPEED, e.g. xc2s15-tq144-5 (default %(default)s; "
+                        "the example pin map is for PQ208, on other packages ISE chooses the pins)")
     p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
     p.add_argument("--force", action="store_true",
                    help="write the project even when the design's resource estimate does not fit the part")
     p.add_argument("--clock-mhz", type=float, default=CLOCK_HZ / 1e6,
-                   help="clock frequency for the PERIOD constraint (default %(default)g)")
+                   help="clock frequency for the PERIOD constraint (default %(default)g); lowered to what the "
+                        "Spartan-II timing estimate meets, with a warning")
+    p.add_argument("--no-timing-check", action="store_true",
+                   help="write the PERIOD as given, without synthesising for the timing estimate")
 
 
 def run(args) -> int:
-    files = ise.write_ise(args.directory, args.device, args.output, args.clock_mhz, force=args.force)
+    parse_part(args.device)  # refuse a bad part before synthesis
+    ise.check_directory_fits(args.directory, args.device, force=args.force)
+    clock = args.clock_mhz
+    if not args.no_timing_check:
+        clock, why = ise.checked_clock(args.directory, args.device, args.clock_mhz)
+        if why:
+            print(f"warning: {why}", file=sys.stderr)
+    files = ise.write_ise(args.directory, args.device, args.output, clock, force=args.force)
     print(ise.summary(files, args.output, args.device))
     return 0

@@ -16,8 +16,11 @@ from pathlib import Path
 from ..errors import FlannError
 from ..fileio import atomic_write_json
 from ..hardware import options as gen_options
+from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
+from ..implement import ice40
 from ..verify.design import open_design
 from ..verify.datapaths import simulate
+from ..verify.post_route import checker
 from ..verify.runner import ENGINES, plot
 from ..verify.shards import terminal_progress
 
@@ -36,6 +39,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--netlist", action="store_true",
                         help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
                              "netlist over every input code (Verilator, Yosys's Xilinx cell models)")
+    parser.add_argument("--post-route", action="store_true",
+                        help="also place and route on an iCE40 (--post-route-device) and simulate the routed design "
+                             "over every input code (icebox_vlog + Verilator, Yosys's iCE40 cell models)")
+    parser.add_argument("--post-route-device", metavar="PART", default=DEFAULT_ICE40_PART,
+                        help="iCE40 part for --post-route (default %(default)s)")
     parser.add_argument("--engine", choices=ENGINES, default="auto",
                         help="every input code through: ghdl = the VHDL under GHDL; verilator = GHDL's "
                              "synthesised netlist compiled by Verilator (~25x faster), the VHDL on a sample; "
@@ -57,6 +65,8 @@ def run(args) -> int:
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
     opts = gen_options.from_args(args).to_kwargs()
+    if args.post_route:
+        parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
@@ -64,6 +74,11 @@ def run(args) -> int:
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=terminal_progress, images=images or None)
         s = res["summary"]
+        if args.post_route:
+            rep = ice40.implement(design.directory, args.post_route_device, build / "ice40", work=build / "ice40_work",
+                                  seed=args.seed, progress=not args.json, post_route=checker(design))
+            s["post_route"] = {**rep.post_route, "device": rep.part.name, "fmax_mhz": rep.fmax_mhz,
+                               "timing_met": rep.timing_met}
         if args.plot and res["curve"] is not None:
             plot(res["curve"], design.manifest, args.plot)
     if args.summary_json:
@@ -97,8 +112,16 @@ def run(args) -> int:
             n = s["netlist"]
             print(f"netlist (Yosys xcv)     {n['codes_tested']} codes, {n['mismatches']} mismatches "
                   f"({n['simulator']}, {n['seconds']:.0f} s)")
+        if "post_route" in s:
+            n = s["post_route"]
+            print(f"post-route ({n['device']})  {n['codes_tested']} codes, {n['mismatches']} mismatches "
+                  f"(Fmax {n['fmax_mhz']:.1f} MHz, {n['seconds']:.0f} s)")
         if args.plot:
             print(f"plot: {args.plot}")
+    if s.get("post_route", {}).get("mismatches"):
+        if not args.json:
+            print("error: the placed-and-routed design disagrees with its twin", file=sys.stderr)
+        return 1
     if not s["all_passed"] or s["mismatches"]:
         if not args.json:
             print("error: co-simulation failed (see the bench lines above)", file=sys.stderr)

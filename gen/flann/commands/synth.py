@@ -8,11 +8,13 @@ import tempfile
 from pathlib import Path
 
 from ..errors import FlannError
-from ..implement import synth
-from ..hardware.target import DEFAULT_PART, DEVICES, parse_part
+from ..implement import ice40, synth, timing
 from ..hardware.registry import FIXED, read_design
+from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
+                               parse_ice40, parse_part)
 from ..verify.design import from_directory
 from ..verify.netlist import check_synthesized
+from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
@@ -22,8 +24,17 @@ def add_arguments(p):
     p.add_argument(
         "--device", default=None, metavar="PART",
         help="target part DEVICE-PACKAGE-SPEED, e.g. xc2s30-pq208-5 (default: the part in DIR/manifest.json, "
-        f"else {DEFAULT_PART}; devices " + ", ".join(d.name for d in DEVICES) + ")",
+        f"else {DEFAULT_PART}; devices " + ", ".join(d.name for d in DEVICES) + "); or an iCE40 part for real "
+        "place and route, timing and a bitstream (" + ", ".join(p.name for p in ICE40_PARTS) + ")",
     )
+    p.add_argument("-o", "--output", metavar="OUT", default="ice40",
+                   help="iCE40 only: directory for the bitstream (.bin), example pins (.pcf), .asc and reports "
+                        "(default %(default)s/)")
+    p.add_argument("--post-route", action="store_true",
+                   help="iCE40 only: simulate the placed-and-routed design (icebox_vlog + Verilator, Yosys's iCE40 "
+                        "cell models) over every input code against the twin (needs the model: --model or the "
+                        "manifest's)")
+    p.add_argument("--seed", type=int, default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
@@ -54,7 +65,42 @@ def _check_netlist(args, netlist: Path) -> None:
                          f"{res['codes_tested']} input codes (first: {res['first_mismatches']}); not handing it on")
 
 
+def post_route_check(directory, model):
+    """The post-route simulation as :func:`flann.implement.ice40.implement` calls it; refuses a
+    routed design that disagrees with its twin (nothing is written then)."""
+    man, dp = read_design(directory)
+    if dp.bench != FIXED.bench:
+        raise FlannError(f"--post-route: the sweep driver drives {FIXED.top}'s ports; {directory} holds a "
+                         f"{dp.name} design")
+    if model is None and not man.get("model"):
+        raise FlannError("--post-route: pass --model MODEL.json (the twin is built from the model)")
+    return checker(from_directory(directory, model), refuse=True)
+
+
+def run_ice40(args) -> int:
+    parse_ice40(args.device)  # refuse a bad part before any slow step
+    if not args.no_lint:
+        synth.check_lint(synth.read_manifest(args.directory).files, args.vsg_config, start=args.directory)
+    check = post_route_check(args.directory, args.model) if args.post_route else None
+    with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
+        report = ice40.implement(args.directory, args.device, args.output, work=Path(args.work or tmp),
+                                 seed=args.seed, progress=not args.json, post_route=check)
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    else:
+        print(report.table())
+    if not report.timing_met:
+        print(f"warning: {report.top} on {report.part.name}: nextpnr's Fmax {report.fmax_mhz or 0:.1f} MHz is below "
+              f"the design's clock {report.clock_mhz:g} MHz", file=sys.stderr)
+    return 0
+
+
 def run(args) -> int:
+    if args.device is not None and is_ice40(args.device):
+        return run_ice40(args)
+    if args.post_route:
+        raise FlannError(f"--post-route needs an iCE40 part (--device {DEFAULT_ICE40_PART}): the Spartan-II is not "
+                         "placed and routed here (its mapped netlist is simulated unless --no-netlist-check)")
     if args.device is not None:
         parse_part(args.device)  # refuse a bad part before any slow step
     if args.work and Path(args.work).exists() and not Path(args.work).is_dir():
@@ -74,6 +120,10 @@ def run(args) -> int:
         print(report.table())
         for w in report.warnings:
             print(f"warning: yosys: {w}", file=sys.stderr)
+    if report.timing and not report.timing.meets(CLOCK_HZ):
+        print(f"warning: {report.top} is estimated at {report.timing.fmax_mhz:.1f} MHz on {report.part.name}, "
+              f"below the design's clock {CLOCK_HZ / 1e6:g} MHz: run it at most at "
+              f"{timing.safe_clock_mhz(report.timing):g} MHz (flann ise writes that PERIOD)", file=sys.stderr)
     if not report.fits:
         print(f"error: {synth.not_fit_message(report)}", file=sys.stderr)
         return 2

@@ -133,3 +133,49 @@ def parse_part(text: str) -> Part:
 
 def devices_in_package(package: str) -> list[Device]:
     return [d for d in DEVICES if d.user_io(package) is not None]
+
+
+# --------------------------------------------------------------------------- iCE40
+# A second target with a complete open-source flow (Yosys synth_ice40 -> nextpnr-ice40 ->
+# icepack): real place and route, static timing and a bitstream.  Logic cells (one LUT4 + one
+# flip-flop each) and 4 Kbit block RAMs (EBR) from Lattice's data sheets: iCE40 LP/HX family
+# (FPGA-DS-02029), Table 1.1; iCE40 UltraPlus (FPGA-DS-02008), Table 1.1.  ``chipdb`` and
+# ``pins`` name the IceStorm chip database and its package section (the pin names of the
+# example .pcf); ``nextpnr`` is nextpnr-ice40's device flag.
+ICE40_SOURCE = ("Lattice iCE40 LP/HX Family Data Sheet FPGA-DS-02029 Table 1.1; "
+                "iCE40 UltraPlus Family Data Sheet FPGA-DS-02008 Table 1.1")
+
+
+@dataclass(frozen=True)
+class Ice40Part:
+    name: str  # "ice40-hx8k-ct256"
+    nextpnr: str  # nextpnr-ice40 device flag without "--": "hx8k"
+    package: str  # nextpnr --package: "ct256"
+    chipdb: str  # IceStorm chip database: chipdb-<chipdb>.txt
+    pins: str  # its ".pins" section for this package
+    logic_cells: int
+    brams: int
+
+
+ICE40_PARTS: tuple[Ice40Part, ...] = (
+    Ice40Part("ice40-hx1k-vq100", "hx1k", "vq100", "1k", "vq100", 1280, 16),
+    Ice40Part("ice40-hx1k-tq144", "hx1k", "tq144", "1k", "tq144", 1280, 16),
+    Ice40Part("ice40-hx4k-tq144", "hx4k", "tq144", "8k", "tq144:4k", 3520, 20),
+    Ice40Part("ice40-hx8k-cb132", "hx8k", "cb132", "8k", "cb132", 7680, 32),
+    Ice40Part("ice40-hx8k-ct256", "hx8k", "ct256", "8k", "ct256", 7680, 32),
+    Ice40Part("ice40-lp8k-cm81", "lp8k", "cm81", "8k", "cm81", 7680, 32),
+    Ice40Part("ice40-up5k-sg48", "up5k", "sg48", "5k", "sg48", 5280, 30),
+)
+DEFAULT_ICE40_PART = "ice40-hx8k-ct256"
+_ICE40_BY_NAME = {p.name: p for p in ICE40_PARTS}
+
+
+def is_ice40(text: str) -> bool:
+    return text.strip().lower().startswith("ice40-")
+
+
+def parse_ice40(text: str) -> Ice40Part:
+    p = _ICE40_BY_NAME.get(text.strip().lower())
+    if p is None:
+        raise SpecError(f"--device {text!r}: unknown iCE40 part; allowed: {', '.join(_ICE40_BY_NAME)}")
+    return p

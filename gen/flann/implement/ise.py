@@ -35,7 +35,8 @@ from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
 from ..hardware.registry import read_design
-from .synth import Resources, shortfall, smallest_fit
+from .synth import Resources, shortfall, smallest_fit, synthesize
+from .timing import safe_clock_mhz
 
 CLOCK_PIN = "P77"  # GCK1
 RESET_PIN = "P57"
@@ -121,10 +122,13 @@ def check_ports(ports: list[Port], man) -> None:
     raise FlannError(f"entity {man.top} not found in the manifest's files")
 
 
+PIN_MAP_PACKAGES = ("pq208",)  # packages with an example pin map; on the others ISE chooses the pins
+
+
 def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
-    """(net, LOC, note) for every bit of every port."""
-    if part.package != "pq208":
-        raise FlannError(f"--device {part.name}: the example pin map is for the PQ208 package only")
+    """(net, LOC, note) for every bit of every port; empty on a package without an example map."""
+    if part.package not in PIN_MAP_PACKAGES:
+        return []
     ins, outs = iter(INPUT_PINS), iter(OUTPUT_PINS)
     rows = []
     for p in ports:
@@ -162,15 +166,25 @@ def check_fits(man, dp, part, force: bool = False) -> None:
                      "(--force writes the project anyway)")
 
 
+def check_directory_fits(directory, device: str, force: bool = False) -> None:
+    """:func:`check_fits` for a design directory, before anything slow runs."""
+    man, dp = read_design(directory)
+    check_fits(man, dp, parse_part(device), force)
+
+
+def check_clock_mhz(clock_mhz: float) -> None:
+    if not (0 < clock_mhz <= 200):
+        raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
+
+
 def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
               force: bool = False) -> list[str]:
     """Write the ISE 10.1 handoff for a generated design; returns the files written."""
     part = parse_part(device)
     man, dp = read_design(directory)
     check_fits(man, dp, part, force)
-    if not (0 < clock_mhz <= 200):
-        raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
-    if part.device.name not in PIN_MAP_DEVICES:
+    check_clock_mhz(clock_mhz)
+    if part.package in PIN_MAP_PACKAGES and part.device.name not in PIN_MAP_DEVICES:
         warnings.warn(
             f"{part.device.name} in PQ208 has {part.user_io} user I/O, the pin map was taken from "
             "XC2S200 boards (140): check every LOC against DS001 module 4 before building"
@@ -179,6 +193,7 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
     check_ports(ports, man)
     pins = pin_map(ports, part)
     sources = [f"src/{f.name}" for f in man.files]
+    pins_kind = "pq208" if pins else "unplaced"
     period_ns = 1000.0 / clock_mhz
     ctx = dict(
         version=__version__, part=part, top=man.top, sources=sources, ucf=f"{man.top}.ucf",
@@ -187,6 +202,8 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
         cycles_per_sample=man.data.get("cycles_per_sample"), latency=man.data.get("latency_cycles"),
         core_name=f"flann:lvdt:{man.top}:{__version__}", input_bits=man.data["input_bits"],
         output_bits=man.data["output_bits"],
+        pin_notes=f"implement/templates/ucf_pins/{pins_kind}_notes.j2",
+        pin_lines=f"implement/templates/ucf_pins/{pins_kind}_lines.j2",
     )
     texts = {
         f"{man.top}.tcl": template("implement/templates/ise_project.tcl.j2").render(**ctx),
@@ -204,6 +221,21 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
         for name, text in texts.items():
             (tmp / name).write_text(text, newline="")
     return [*texts, *sources, "src/manifest.json"]
+
+
+def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full") -> tuple[float, str | None]:
+    """The clock for the PERIOD constraint: ``clock_mhz`` when the Spartan-II timing estimate
+    (:mod:`flann.implement.timing`, on the Yosys-mapped netlist) meets it, else the highest
+    whole MHz the estimate meets with its margin.  Returns (MHz, why it was lowered or None)."""
+    check_clock_mhz(clock_mhz)
+    report = synthesize(directory, device, abc=abc)
+    t = report.timing
+    if t.meets(clock_mhz * 1e6):
+        return clock_mhz, None
+    safe = safe_clock_mhz(t)
+    return safe, (f"{report.top} is estimated at {t.fmax_mhz:.1f} MHz on {report.part.name} ({t.logic_levels} LUT "
+                  f"levels, {t.carry_bits} carry bits), below the requested {clock_mhz:g} MHz: PERIOD written for "
+                  f"{safe:g} MHz ({1000.0 / safe:.3f} ns)")
 
 
 def _is_ise_project(directory: Path) -> bool:

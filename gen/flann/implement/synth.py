@@ -22,8 +22,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..hardware.manifest import Manifest, read_manifest
-from ..hardware.target import DEFAULT_PART, DEVICES, Part, parse_part
+from ..hardware.target import CLOCK_HZ, DEFAULT_PART, DEVICES, Part, parse_part
 from ..errors import FlannError
+from . import timing as spartan2_timing
 
 FAMILY = "xcv"
 
@@ -127,6 +128,7 @@ class SynthReport:
     manifest: dict
     abc: str = "full"
     entities: dict = field(default_factory=dict)
+    timing: spartan2_timing.Timing | None = None
 
     @property
     def fits(self) -> bool:
@@ -163,6 +165,7 @@ class SynthReport:
             "top": self.top,
             "cycles_per_sample": self.manifest.get("cycles_per_sample"),
             "latency_cycles": self.manifest.get("latency_cycles"),
+            "timing": self.timing.to_dict(CLOCK_HZ) if self.timing else None,
             "cells": r.cells,
             "entities": self.entities,
             "warnings": list(self.warnings),
@@ -190,6 +193,12 @@ class SynthReport:
         cps = self.manifest.get("cycles_per_sample")
         if cps:
             lines.append(f"  {'cycles per sample':<20} {cps:>6}")
+        if self.timing:
+            t = self.timing
+            lines.append(f"  {'Fmax estimate':<20} {t.fmax_mhz:6.1f} MHz (-{t.grade}: {t.logic_levels} LUT levels, "
+                         f"{t.carry_bits} carry bits, {t.delay_ns:.1f} ns; DS001 figures + routing allowance)")
+            if not t.meets(CLOCK_HZ):
+                lines.append(f"  DOES NOT MEET the design's clock {CLOCK_HZ / 1e6:g} MHz (estimate)")
         if self.fits:
             lines.append(f"  fits {self.part.name}")
         else:
@@ -314,6 +323,7 @@ ABC_MODES = ("full", "fast")
 
 
 NETLIST = "netlist.v"  # the mapped Spartan-II netlist, written next to stat.json
+MAPPED_JSON = "mapped.json"  # the same netlist flattened, for the timing estimate (flann.implement.timing)
 
 
 def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.json") -> str:
@@ -328,7 +338,9 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
         raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
     head = [f"read_verilog {verilog}"]
     # the netlist the counts describe, for post-synthesis simulation (flann.verify.netlist)
-    tail = ["check", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}"]
+    tail = ["check", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}",
+            # last: flattening and dropping the cell library change nothing written above
+            "flatten", "delete =A:blackbox", f"write_json {MAPPED_JSON}"]
     if abc == "full":
         return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top}"] + tail)
     return "; ".join(head + [
@@ -420,7 +432,8 @@ def synthesize(directory: str | Path, device: str | None = None, work: str | Pat
                   file=sys.stderr)
         cells, warnings = yosys_cells(verilog, man.top, wdir, abc)
         modules = entity_breakdown(json.loads((wdir / "modules.json").read_text()))
-    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc, modules)
+        est = spartan2_timing.analyse(wdir / MAPPED_JSON, part, man.top)
+    return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc, modules, est)
 
 
 def not_fit_message(report: SynthReport) -> str:

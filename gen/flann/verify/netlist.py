@@ -57,9 +57,11 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     return work / synth.NETLIST
 
 
-def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cells: bool = True) -> Path:
+def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cells: bool = True,
+                    models: list | None = None, defines: tuple = ()) -> Path:
     """Verilator model of ``netlist`` with the sweep driver (and the Xilinx cell models for a
-    mapped netlist; GHDL's own Verilog has no cells)."""
+    mapped netlist; GHDL's own Verilog has no cells; ``models`` replaces them for another
+    family's netlist, with ``defines`` for its model files)."""
     exe_tool = shutil.which("verilator")
     if exe_tool is None:
         raise FlannError("verilator not found on PATH (Debian package verilator; `make tools` installs it)")
@@ -67,8 +69,9 @@ def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cel
     if build.exists():
         shutil.rmtree(build)
     build.mkdir(parents=True)
-    models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
-    cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *models,
+    if models is None:
+        models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
+    cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
            "--top-module", "flann_top", "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
            "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
            "-CFLAGS", f"-DIN_BITS={in_bits} -DOUT_BITS={out_bits}"]
