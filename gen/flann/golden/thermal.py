@@ -1,18 +1,25 @@
 """The two-input FLANN: displacement from voltage and temperature, ``x(v, T)``, and its file.
 
 The expansion is the one-input model's trigonometric expansion of v (:func:`.model.expand`,
-the same term order) times a low-order power series of the normalised temperature::
+the same term order) times a low-order power series of the normalised temperature, after
+the first-harmonic products (t_n v, t_n^2 v) and the temperature's own terms (t_n, t_n^2)
+have brought the voltage back to the mid temperature's gain and null::
 
-    v_n = (v - input_offset_v) / input_scale_v
     t_n = (T - temperature_offset_c) / temperature_scale_c        (calibration range -> [-1, 1])
+    v'  = v (1 + sum_k input_gain_t[k] t_n^(k+1)) + sum_k input_offset_t_v[k] t_n^(k+1)
+    v_n = (v' - input_offset_v) / input_scale_v
     f_j(v) = bias[j] + sum_{i < terms[j]} weights[j][i] phi_i(v_n)   (a one-input FLANN per order)
     x_mm = f_0(v) + t_n (f_1(v) + t_n (f_2(v) + ...))                (Horner in t_n)
 
 so order 0 is an ordinary FLANN at the mid temperature, and the cross terms
 ``t_n^j phi_i(v_n)`` of order j use only the first ``terms[j]`` terms of the expansion (the
-cheapest that reach the accuracy, see :mod:`.thermal_train`).  In hardware this is the same
-serial multiply-accumulate run once per order, each result folded in by one multiply by
-the temperature.
+cheapest that reach the accuracy, see :mod:`.thermal_train`).  Correcting the gain and null
+on the input first matters at the ends of the stroke: where the curve rolls off, x(v) is
+steep and curved, and a gain change of 1 % moves it by several % of the stroke, which a
+power series in T after the expansion only reaches with orders a 3-temperature
+calibration cannot determine.  In hardware the input correction is 2 multiplies by the
+temperature and one by v; the expansion is the same serial multiply-accumulate run once
+per order, each result folded in by one multiply by the temperature.
 
 ``model.json`` of a two-input model: format ``flann-thermal-model/1`` and ``"inputs":
 ["voltage_v", "temperature_c"]``; one-input models (``flann-model/1``) are unchanged.
@@ -65,6 +72,20 @@ def thermal_design(v_n, t_n, terms: tuple[int, ...]) -> np.ndarray:
     return np.hstack(cols)
 
 
+def corrected_voltage(voltage_v, t_n, gain_t, offset_t_v) -> np.ndarray:
+    """``v (1 + sum_k gain_t[k] t_n^(k+1)) + sum_k offset_t_v[k] t_n^(k+1)``."""
+    v = np.asarray(voltage_v, dtype=float)
+    t = np.asarray(t_n, dtype=float)
+    gain, offset, tk = np.ones(v.shape), np.zeros(v.shape), np.ones(v.shape)
+    for k in range(max(len(gain_t), len(offset_t_v))):
+        tk = tk * t
+        if k < len(gain_t):
+            gain = gain + gain_t[k] * tk
+        if k < len(offset_t_v):
+            offset = offset + offset_t_v[k] * tk
+    return v * gain + offset
+
+
 @dataclass(frozen=True)
 class ThermalModel:
     weights: tuple[tuple[float, ...], ...]   # per temperature order j
@@ -73,6 +94,8 @@ class ThermalModel:
     input_scale_v: float = 1.0
     temperature_offset_c: float = 0.0
     temperature_scale_c: float = 1.0
+    input_gain_t: tuple[float, ...] = ()       # v' = v (1 + g1 t_n + g2 t_n^2) + ...
+    input_offset_t_v: tuple[float, ...] = ()   # ... + o1 t_n + o2 t_n^2   (V)
     voltage_range_v: tuple[float, float] = (-1.0, 1.0)
     temperature_range_c: tuple[float, float] = (0.0, 1.0)
     displacement_range_mm: tuple[float, float] = (-1.0, 1.0)
@@ -95,21 +118,22 @@ class ThermalModel:
         return sum(self.terms) + self.orders
 
     def normalise(self, voltage_v, temperature_c) -> tuple[np.ndarray, np.ndarray]:
-        v_n = (np.asarray(voltage_v, dtype=float) - self.input_offset_v) / self.input_scale_v
-        t_n = (np.asarray(temperature_c, dtype=float) - self.temperature_offset_c) / self.temperature_scale_c
-        return v_n, t_n
+        """(v_n, t_n): the corrected, normalised voltage and the normalised temperature."""
+        v = np.asarray(voltage_v, dtype=float)
+        t_n = (np.broadcast_to(np.asarray(temperature_c, dtype=float), v.shape)
+               - self.temperature_offset_c) / self.temperature_scale_c
+        v_c = corrected_voltage(v, t_n, self.input_gain_t, self.input_offset_t_v)
+        return (v_c - self.input_offset_v) / self.input_scale_v, t_n
 
-    def order_outputs(self, voltage_v) -> list[np.ndarray]:
-        """f_j(v) of every temperature order j (mm)."""
-        v_n = (np.asarray(voltage_v, dtype=float) - self.input_offset_v) / self.input_scale_v
+    def order_outputs(self, v_n) -> list[np.ndarray]:
+        """f_j of every temperature order j (mm) at normalised voltages."""
         return [evaluate(v_n, w, b) if w else np.full(np.shape(v_n), b, dtype=float)
                 for w, b in zip(self.weights, self.bias)]
 
     def predict(self, voltage_v, temperature_c) -> np.ndarray:
         """Displacement (mm) at voltages (V) and temperatures (degC), float64."""
-        v = np.asarray(voltage_v, dtype=float)
-        _, t_n = self.normalise(v, np.broadcast_to(np.asarray(temperature_c, dtype=float), v.shape))
-        parts = self.order_outputs(v)
+        v_n, t_n = self.normalise(voltage_v, temperature_c)
+        parts = self.order_outputs(v_n)
         acc = parts[-1]
         for part in reversed(parts[:-1]):
             acc = acc * t_n + part
@@ -141,6 +165,8 @@ class ThermalModel:
             "input_scale_v": self.input_scale_v,
             "temperature_offset_c": self.temperature_offset_c,
             "temperature_scale_c": self.temperature_scale_c,
+            "input_gain_t": list(self.input_gain_t),
+            "input_offset_t_v": list(self.input_offset_t_v),
             "bias": list(self.bias),
             "weights": [list(w) for w in self.weights],
             "voltage_range_v": list(self.voltage_range_v),
@@ -171,6 +197,8 @@ class ThermalModel:
                 input_offset_v=float(d["input_offset_v"]), input_scale_v=float(d["input_scale_v"]),
                 temperature_offset_c=float(d["temperature_offset_c"]),
                 temperature_scale_c=float(d["temperature_scale_c"]),
+                input_gain_t=tuple(float(g) for g in d["input_gain_t"]),
+                input_offset_t_v=tuple(float(o) for o in d["input_offset_t_v"]),
                 voltage_range_v=tuple(float(x) for x in d["voltage_range_v"]),
                 temperature_range_c=tuple(float(x) for x in d["temperature_range_c"]),
                 displacement_range_mm=tuple(float(x) for x in d["displacement_range_mm"]),
@@ -183,7 +211,8 @@ class ThermalModel:
         if not bias or len(bias) != len(weights) or terms != model.terms:
             raise ModelFileError(f"{source}: 'terms' {list(terms)} does not match the weights "
                                  f"{[len(w) for w in weights]} and {len(bias)} biases")
-        values = (*bias, *(w for ws in weights for w in ws), model.input_offset_v, model.input_scale_v,
+        values = (*bias, *(w for ws in weights for w in ws), *model.input_gain_t,
+                  *model.input_offset_t_v, model.input_offset_v, model.input_scale_v,
                   model.temperature_offset_c, model.temperature_scale_c, *model.voltage_range_v,
                   *model.temperature_range_c, *model.displacement_range_mm)
         if not all(math.isfinite(x) for x in values):
@@ -212,5 +241,5 @@ def is_thermal(model) -> bool:
     return isinstance(model, ThermalModel)
 
 
-__all__ = ["FORMAT", "INPUTS", "TEMPERATURE_RESOLUTION_C", "ThermalModel", "is_thermal",
+__all__ = ["FORMAT", "INPUTS", "corrected_voltage", "TEMPERATURE_RESOLUTION_C", "ThermalModel", "is_thermal",
            "load_any_model", "power_columns", "temperature_groups", "thermal_design"]

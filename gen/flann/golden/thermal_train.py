@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FlannError, RecordingsError
-from .thermal import ThermalModel, temperature_groups, thermal_design
+from .thermal import ThermalModel, corrected_voltage, temperature_groups, thermal_design
 from .train import AUTO_PAIRED_Z, normalisation, solve_lstsq
 
 MAX_ORDER = 2
@@ -53,19 +53,59 @@ def _temperature_norm(temperature_c) -> tuple[float, float]:
     return (lo + hi) / 2.0, (hi - lo) / 2.0
 
 
+def input_correction(voltage_v, t_n, displacement_mm, labels, groups) -> tuple[tuple, tuple]:
+    """(input_gain_t, input_offset_t_v): the voltage at each calibration temperature of
+    ``groups`` mapped by least squares (a gain and an offset, over the positions both
+    hold) onto the temperature nearest the middle, and those gains and offsets fitted by a
+    polynomial in t_n of degree min(2, len(groups) - 1), normalised to gain 1 at t_n = 0."""
+    v = np.asarray(voltage_v, dtype=float)
+    x = np.asarray(displacement_mm, dtype=float)
+    curves, temps = [], []
+    for g in groups:
+        rows = labels == g
+        pos, inv = np.unique(np.round(x[rows], 9), return_inverse=True)
+        curves.append((pos, np.bincount(inv, weights=v[rows]) / np.bincount(inv)))
+        temps.append(float(np.mean(t_n[rows])))
+    degree = min(MAX_ORDER, len(groups) - 1)
+    if degree < 1:
+        return (), ()
+    ref = int(np.argmin(np.abs(temps)))
+    rp, rv = curves[ref]
+    gains, offsets = [], []
+    for pos, vk in curves:
+        inside = (pos >= rp[0]) & (pos <= rp[-1])
+        if inside.sum() < 2:
+            raise RecordingsError("the calibration temperatures share too few positions to "
+                                  "compare their gains")
+        a = np.column_stack([vk[inside], np.ones(int(inside.sum()))])
+        (g_k, o_k), *_ = np.linalg.lstsq(a, np.interp(pos[inside], rp, rv), rcond=None)
+        gains.append(g_k)
+        offsets.append(o_k)
+    powers = np.asarray(temps)[:, None] ** np.arange(degree + 1)[None, :]
+    gc, *_ = np.linalg.lstsq(powers, np.asarray(gains), rcond=None)
+    oc, *_ = np.linalg.lstsq(powers, np.asarray(offsets), rcond=None)
+    return (tuple(float(c / gc[0]) for c in gc[1:]), tuple(float(c / gc[0]) for c in oc[1:]))
+
+
 def fit_thermal(voltage_v, temperature_c, displacement_mm, terms: tuple[int, ...], *,
-                norm: str = "range", ridge: float = 0.0, offset_scale=None,
-                temperature_offset_scale=None, training: dict | None = None) -> ThermalModel:
-    """Least squares for ``terms`` (expansion terms per temperature order)."""
+                norm: str = "range", ridge: float = 0.0, correct_input: bool = True,
+                training: dict | None = None) -> ThermalModel:
+    """Least squares for ``terms`` (expansion terms per temperature order), after the
+    input correction (:func:`input_correction`) unless ``correct_input`` is False."""
     v = np.asarray(voltage_v, dtype=float)
     t = np.asarray(temperature_c, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     if not terms or any(n < 0 for n in terms):
         raise FlannError(f"terms per temperature order must be >= 0, got {list(terms)}")
-    offset, scale = offset_scale if offset_scale is not None else normalisation(v, norm)
-    t_off, t_scale = (temperature_offset_scale if temperature_offset_scale is not None
-                      else _temperature_norm(t))
-    a = thermal_design((v - offset) / scale, (t - t_off) / t_scale, terms)
+    t_off, t_scale = _temperature_norm(t)
+    t_n = (t - t_off) / t_scale
+    gain_t, offset_t = ((), ())
+    if correct_input:
+        levels, labels = temperature_groups(t)
+        gain_t, offset_t = input_correction(v, t_n, x, labels, range(levels.size))
+    v_c = corrected_voltage(v, t_n, gain_t, offset_t)
+    offset, scale = normalisation(v_c, norm)
+    a = thermal_design((v_c - offset) / scale, t_n, terms)
     coef = solve_lstsq(a, x, ridge)
     resid = x - a @ coef
     weights, bias, k = [], [], 0
@@ -78,7 +118,8 @@ def fit_thermal(voltage_v, temperature_c, displacement_mm, terms: tuple[int, ...
     info.update(training or {})
     return ThermalModel(weights=tuple(weights), bias=tuple(bias), input_offset_v=float(offset),
                         input_scale_v=float(scale), temperature_offset_c=float(t_off),
-                        temperature_scale_c=float(t_scale),
+                        temperature_scale_c=float(t_scale), input_gain_t=gain_t,
+                        input_offset_t_v=offset_t,
                         voltage_range_v=(float(v.min()), float(v.max())),
                         temperature_range_c=(float(t.min()), float(t.max())),
                         displacement_range_mm=(float(x.min()), float(x.max())), training=info)
@@ -125,22 +166,42 @@ def _folds(x: np.ndarray, labels: np.ndarray, n_groups: int) -> _Folds:
     return _Folds(position, temperature, n_groups)
 
 
-def _cv(v, t, x, folds: _Folds, terms, norm, ridge, offset_scale, t_norm) -> ThermalCv:
+@dataclass(frozen=True)
+class _Inputs:
+    """Normalised inputs of every fold: ``v_n`` with the input correction from every
+    temperature (position folds), ``v_n_without[k]`` from the temperatures but the k-th
+    held-out one (that fold's own calibration)."""
+    v_n: np.ndarray
+    t_n: np.ndarray
+    v_n_without: list[np.ndarray]
+
+
+def _inputs(v, t_n, x, labels, n_groups, folds: _Folds, norm: str) -> _Inputs:
+    gain_t, offset_t = input_correction(v, t_n, x, labels, range(n_groups))
+    v_c = corrected_voltage(v, t_n, gain_t, offset_t)
+    offset, scale = normalisation(v_c, norm)
+    without = []
+    for g in range(1, n_groups - 1):
+        gk, ok = input_correction(v, t_n, x, labels, [k for k in range(n_groups) if k != g])
+        without.append((corrected_voltage(v, t_n, gk, ok) - offset) / scale)
+    return _Inputs((v_c - offset) / scale, t_n, without)
+
+
+def _cv(x, folds: _Folds, inputs: _Inputs, terms, norm, ridge) -> ThermalCv:
     """Held-out squared errors of a candidate (normalisations fixed from all the data, so
     every fold expands the same way)."""
-    v_n = (v - offset_scale[0]) / offset_scale[1]
-    t_n = (t - t_norm[0]) / t_norm[1]
+    v_n, t_n = inputs.v_n, inputs.t_n
     full = thermal_design(v_n, t_n, terms)
     errs = []
     for held in folds.position:
-        train = np.ones(v.size, bool)
+        train = np.ones(v_n.size, bool)
         train[held] = False
         coef = solve_lstsq(full[train], x[train], ridge)
         errs.append((full[held] @ coef - x[held]) ** 2)
     usable = terms[:folds.n_temperatures - 1]   # orders the remaining temperatures determine
-    part = thermal_design(v_n, t_n, usable) if len(usable) < len(terms) else full
-    for held in folds.temperature:
-        train = np.ones(v.size, bool)
+    for held, v_fold in zip(folds.temperature, inputs.v_n_without):
+        part = thermal_design(v_fold, t_n, usable)
+        train = np.ones(v_n.size, bool)
         train[held] = False
         coef = solve_lstsq(part[train], x[train], ridge)
         errs.append((part[held] @ coef - x[held]) ** 2)
@@ -192,23 +253,23 @@ def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dic
     vs, ts, xs = v[sub], t[sub], x[sub]
     _, sub_labels = temperature_groups(ts)
     folds = _folds(xs, sub_labels, levels.size)
-    t_norm = _temperature_norm(t)
+    t_off, t_scale = _temperature_norm(t)
     orders = min(MAX_ORDER + 1, levels.size)
+    inputs = {norm: _inputs(vs, (ts - t_off) / t_scale, xs, sub_labels, levels.size, folds, norm)
+              for norm in AUTO_NORMS}
     results: list[ThermalCv] = []
     for norm in AUTO_NORMS:
-        off_scale = normalisation(v, norm)
         for ridge in AUTO_RIDGES:
             for n in AUTO_TERMS[1:]:
                 if (n + 1) * orders >= xs.size:
                     continue
-                results.append(_cv(vs, ts, xs, folds, (n,) * orders, norm, ridge, off_scale, t_norm))
+                results.append(_cv(xs, folds, inputs[norm], (n,) * orders, norm, ridge))
     if not results:
         raise RecordingsError(f"{source}: {v.size} points are too few for a two-input model")
     limit = WEIGHT_LIMIT * float(np.max(np.abs(x)))
     buildable = [r for r in results if r.max_coefficient <= limit] or results
     full = min(buildable, key=lambda r: r.mse)
-    off_scale = normalisation(v, full.norm)
-    narrow = [_cv(vs, ts, xs, folds, terms, full.norm, full.ridge, off_scale, t_norm)
+    narrow = [_cv(xs, folds, inputs[full.norm], terms, full.norm, full.ridge)
               for terms in _narrower(full.terms[0], orders) if terms != full.terms]
     everything = [full] + [r for r in narrow if r.max_coefficient <= limit]
     best = min(everything, key=lambda r: r.mse)
