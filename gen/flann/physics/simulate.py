@@ -75,7 +75,7 @@ def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=
 
 
 # Above this many distinct permeabilities (a temperature ramp) the inductances are
-# interpolated linearly between this many exact solutions spanning them.
+# interpolated (quadratically) between this many exact solutions spanning them.
 _MU_NODES = 16
 
 
@@ -92,14 +92,17 @@ def _inductances(s: Sensor, core_mm, permeability_scale, loop: bool) -> tuple[np
     nodes = levels if levels.size <= _MU_NODES else np.linspace(levels[0], levels[-1], _MU_NODES)
     at = [inductances_h(s.replace(core_permeability_ratio=max(1.0, s.core_permeability_ratio * float(k))),
                         core, loop=loop) for k in nodes]
-    hi = np.clip(np.searchsorted(nodes, scale), 1, nodes.size - 1)
-    frac = (scale - nodes[hi - 1]) / (nodes[hi] - nodes[hi - 1])
+    # quadratic (Lagrange) through the three nearest nodes: the inductances curve with mu
+    lo = np.clip(np.searchsorted(nodes, scale) - 2, 0, nodes.size - 3)
+    n0, n1, n2 = nodes[lo], nodes[lo + 1], nodes[lo + 2]
+    weights = ((scale - n1) * (scale - n2) / ((n0 - n1) * (n0 - n2)),
+               (scale - n0) * (scale - n2) / ((n1 - n0) * (n1 - n2)),
+               (scale - n0) * (scale - n1) / ((n2 - n0) * (n2 - n1)))
     out = []
     for k in range(len(at[0])):
         stack = np.stack([np.broadcast_to(a[k], core.shape) for a in at])   # (nodes, *shape)
-        lo_v = np.take_along_axis(stack, (hi - 1)[None], 0)[0]
-        hi_v = np.take_along_axis(stack, hi[None], 0)[0]
-        out.append(lo_v + frac * (hi_v - lo_v))
+        out.append(sum(w * np.take_along_axis(stack, (lo + j)[None], 0)[0]
+                       for j, w in enumerate(weights)))
     return tuple(out)
 
 
