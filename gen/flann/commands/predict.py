@@ -45,11 +45,11 @@ def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
     if outside.any():
         lo, hi = sorted(model.voltage_range_v)
         what = "extrapolated" if extrapolated else "clamped to the range as the hardware does (column clamped = 1)"
-        where = f"[{lo:g}, {hi:g}] V"
+        where, items = f"[{lo:g}, {hi:g}] V", "voltages"
         if is_thermal(model):
             tlo, thi = sorted(model.temperature_range_c)
-            where += f" or calibrated temperatures [{tlo:g}, {thi:g}] degC"
-        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} readings outside the "
+            where, items = where + f" or calibrated temperatures [{tlo:g}, {thi:g}] degC", "readings"
+        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} {items} outside the "
                       f"model's trained range {where}: {what}", stacklevel=2)
 
 
