@@ -59,7 +59,7 @@ def test_temperature_normalisation_and_clamping(spec, model):
 def test_options_are_checked(model):
     with pytest.raises(SpecError, match="temp"):
         derive_thermal_spec(model, input_bits=10, input_lsb_v=0.0025, temp_bits=7, temp_lsb_c=0.5)
-    with pytest.raises(SpecError, match="finer than"):
+    with pytest.raises(SpecError, match="finer than|coarser --output-lsb-mm"):
         derive_thermal_spec(model, input_bits=10, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0,
                             output_lsb_mm=1e-5)
     with pytest.raises(SpecError, match="input_bits"):

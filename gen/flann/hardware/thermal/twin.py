@@ -31,7 +31,7 @@ def _horner(coefs, t, frac_bits: int) -> np.ndarray:
 class ThermalTrace:
     t_n: np.ndarray          # at FT fraction bits
     gain: np.ndarray         # at FG fraction bits
-    fine_code: np.ndarray    # c' on the fine grid
+    fine_code: np.ndarray    # c' in grid codes at interp_bits fraction bits
     parts: tuple             # each order's out_data (q / 2^K)
     acc: np.ndarray          # after Horner, q / 2^K
     out_data: np.ndarray
@@ -55,14 +55,18 @@ class ThermalTop:
         t_n = round_shift(tau * s.t_scale_int + s.t_offset_int, s.t_shift)
         gain = _horner(s.gain_int, t_n, s.t_frac_bits)
         offset = _horner(s.offset_int, t_n, s.t_frac_bits)
-        fine = round_shift((c << s.fine_bits) * gain + offset, s.g_frac_bits)
+        fine = round_shift((c << (s.fine_bits + s.interp_bits)) * gain + offset, s.g_frac_bits)
+        node = fine >> s.interp_bits
+        frac = fine & ((1 << s.interp_bits) - 1)
         parts = []
+        # each order's datapath once per distinct grid code (a node and the next)
+        distinct, back = np.unique(np.concatenate([node.ravel(), node.ravel() + 1]), return_inverse=True)
+        back_a, back_b = back[:node.size].reshape(node.shape), back[node.size:].reshape(node.shape)
         for top in self.orders:
-            # each order's datapath once per distinct corrected code
-            distinct, back = np.unique(fine, return_inverse=True)
             out, osat = top.process(distinct)
-            parts.append(out[back].reshape(fine.shape))
-            sat = sat | osat[back].reshape(fine.shape)
+            a, b = out[back_a], out[back_b]
+            parts.append(a + round_shift((b - a) * frac, s.interp_bits))
+            sat = sat | osat[back_a]
         acc = parts[-1]
         for part in reversed(parts[:-1]):
             acc = round_shift(acc * t_n, s.t_frac_bits) + part
