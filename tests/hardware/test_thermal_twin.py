@@ -61,6 +61,17 @@ def test_options_are_checked(model):
         derive_thermal_spec(model, input_bits=10, input_lsb_v=0.0025, temp_bits=7, temp_lsb_c=0.5)
     with pytest.raises(SpecError, match="finer than|coarser --output-lsb-mm"):
         derive_thermal_spec(model, input_bits=10, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0,
-                            output_lsb_mm=1e-5)
+                            output_lsb_mm=1e-9)
     with pytest.raises(SpecError, match="input_bits"):
         derive_thermal_spec(model, input_bits=17, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0)
+
+
+def test_sixteen_bit_input_interpolates_below_the_adc_step(model):
+    """No finer grid than a 16-bit ADC's: the order datapaths are interpolated between codes,
+    so the output LSB is finer than half an ADC step over the steepest slope."""
+    spec = derive_thermal_spec(model, input_bits=16, input_lsb_v=2.0 / 32768, temp_bits=8,
+                               temp_lsb_c=1.0)
+    assert spec.fine_bits == 0 and spec.interp_bits > 0
+    assert spec.output_lsb_mm < 0.5 * spec.analysis["slope_mm_per_v"] * spec.input_lsb_v
+    res = ThermalTop(spec).error_vs_float([spec.temp_lo, 25, spec.temp_hi])
+    assert res["codes"] == 65536 and 0.05 < res["max_err_lsb"] <= 1.0
