@@ -35,7 +35,7 @@ AUTO_TERMS = (0, 1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41)
 # A candidate whose coefficients exceed this many times the largest |displacement| is not
 # taken: nearly collinear terms cancelling each other, which fixed point cannot carry (the
 # one-input selection asks the fixed-point design itself; its weights stay within ~3x).
-WEIGHT_LIMIT = 64.0
+WEIGHT_LIMIT = 16.0
 AUTO_NORMS = ("range", "half")
 AUTO_RIDGES = (0.0, 1e-12, 1e-10, 1e-8, 1e-6)
 POSITION_FOLDS = 5
