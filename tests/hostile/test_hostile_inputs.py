@@ -92,6 +92,11 @@ def p_subnormal(w):
     _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i * 5e-324!r},{i * 0.1}\n" for i in range(20)))
 
 
+def p_degenerate(w):
+    """Voltages that differ only in the last digits of a double (the diagnosis crashed)."""
+    _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i},{1 + i * 1e-15!r}\n" for i in range(20)))
+
+
 def _model(w, **changes):
     d = json.loads((w / "m.json").read_text())
     d.update(changes)
@@ -264,6 +269,8 @@ CASES = [
     Case("train-subnormal", "10", ("train", "bad.csv", "-o", "o.json", "--terms", "5"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("diagnose-subnormal", "10", ("diagnose", "bad.csv"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("gen-family-subnormal", "10", ("gen", "--family", "bad.csv", "-o", "newfam"), 2, "outside what flann computes", (), "p_subnormal"),
+    Case("diagnose-degenerate-span", "10", ("diagnose", "bad.csv"), 2, "no usable signal", (), "p_degenerate"),
+    Case("simulate-fit-degenerate-span", "10", ("simulate", "--fit", "bad.csv"), 2, "no usable signal", (), "p_degenerate"),
     # 11 model.json numbers
     Case("predict-terms-1e999", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "not finite", (), "p_terms_1e999"),
     Case("predict-bias-400-digits", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "not finite", (), "p_bias_400"),
