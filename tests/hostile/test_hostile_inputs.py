@@ -223,14 +223,14 @@ def p_stale(w):
 FAM = ("--design", "fam", "--diagnosis-points", "40", "-j", "1")
 
 
-def SANE(name: str) -> tuple:
+def sane(name: str) -> tuple:
     """What a calibrate of one sensor named ``name`` may write: its folder and the summary."""
     return ("out", "out/summary.csv", f"out/{name}", f"out/{name}/[!/]*")
 CASES = [
     # 1 path traversal and names from files
-    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_traversal"),
-    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_dotname"),
-    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", SANE("a_b"), "p_newline_name"),
+    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", sane("_"), "p_traversal"),
+    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", sane("_"), "p_dotname"),
+    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", sane("a_b"), "p_newline_name"),
     # 2 special files and symlinks as outputs
     Case("train-o-fifo", "2", ("train", "rec.csv", "-o", "pipe", "--terms", "5"), 2, "FIFO", (), "p_fifo"),
     Case("predict-o-fifo", "2", ("predict", "m.json", "rec.csv", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
