@@ -13,6 +13,7 @@ try:   # Ctrl-C while the interpreter imports this module: one line too, not a t
     import argparse
     import importlib
     import os
+    import signal
     import warnings
 
     from . import __version__
@@ -78,12 +79,31 @@ def _one_line_warnings() -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    interrupted = []
+
+    def on_sigint(signum, frame):
+        interrupted.append(signum)
+        raise KeyboardInterrupt
+
+    try:
+        previous = signal.signal(signal.SIGINT, on_sigint)
+    except ValueError:   # not the main thread (an embedding program): leave Ctrl-C alone
+        previous = None
     try:
         return _main(argv)
     except KeyboardInterrupt:
         # anywhere, even while a command's modules are still importing (the first ~0.2 s)
         print("error: interrupted", file=sys.stderr)
         return 130
+    except Exception:
+        # a KeyboardInterrupt inside a C extension's import comes out as an ImportError
+        if interrupted:
+            print("error: interrupted", file=sys.stderr)
+            return 130
+        raise
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 def _main(argv: list[str] | None) -> int:

@@ -1,9 +1,10 @@
 """A batch over a process pool that stops promptly on Ctrl-C and keeps what was done.
 
 Only ``jobs`` items are ever in flight (no queue of submitted work that would run on after
-an interrupt); the workers ignore SIGINT (the terminal sends it to the whole process
-group), so the parent alone decides: on Ctrl-C it submits nothing more, waits for the items
-already running (each writes its output whole or not at all), and returns what finished
+an interrupt).  While the batch runs, Ctrl-C only sets a flag (the workers ignore SIGINT:
+the terminal sends it to the whole process group), so no KeyboardInterrupt can land in the
+middle of recording a result: the parent submits nothing more, lets the items already
+running finish (each writes its output whole or not at all), and returns what finished
 with ``interrupted`` set, so the caller can still write its summary before exiting 130.
 """
 
@@ -13,6 +14,8 @@ import os
 import signal
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Callable, Iterable
+
+POLL_S = 0.1   # how often the parent looks at the Ctrl-C flag while workers run
 
 
 def _worker_init() -> None:
@@ -24,21 +27,36 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
     """Call ``fn(item)`` for every item (in this process when ``jobs == 1``) and
     ``on_result(item, result)`` as each finishes; True if Ctrl-C stopped the batch early."""
     items = list(items)
-    if jobs <= 1 or len(items) <= 1:
-        try:
+    stop = []
+
+    def on_sigint(signum, frame) -> None:
+        stop.append(signum)
+
+    try:
+        previous = signal.signal(signal.SIGINT, on_sigint)
+    except ValueError:   # not the main thread: Ctrl-C keeps its default meaning
+        previous = None
+    try:
+        if jobs <= 1 or len(items) <= 1:
             for item in items:
+                if stop:
+                    break
                 on_result(item, fn(item))
-        except KeyboardInterrupt:
-            return True
-        return False
-    interrupted = False
+        else:
+            _pool(fn, items, jobs, on_result, stop)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    return bool(stop)
+
+
+def _pool(fn, items, jobs, on_result, stop) -> None:
     pending = iter(items)
     end = object()
+    running: dict = {}
     with ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=_worker_init) as pool:
-        running: dict = {}
-
         def fill() -> None:
-            while not interrupted and len(running) < jobs:
+            while not stop and len(running) < jobs:
                 item = next(pending, end)
                 if item is end:
                     return
@@ -46,15 +64,10 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
 
         fill()
         while running:
-            try:
-                done, _ = wait(running, return_when=FIRST_COMPLETED)
-            except KeyboardInterrupt:
-                interrupted = True   # finish what is running (whole outputs), start nothing more
-                continue
+            done, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
             for fut in done:
                 on_result(running.pop(fut), fut.result())
             fill()
-    return interrupted
 
 
 __all__ = ["run_batch"]

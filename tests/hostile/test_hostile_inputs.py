@@ -92,6 +92,11 @@ def p_subnormal(w):
     _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i * 5e-324!r},{i * 0.1}\n" for i in range(20)))
 
 
+def p_degenerate(w):
+    """Voltages that differ only in the last digits of a double (the diagnosis crashed)."""
+    _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i},{1 + i * 1e-15!r}\n" for i in range(20)))
+
+
 def _model(w, **changes):
     d = json.loads((w / "m.json").read_text())
     d.update(changes)
@@ -218,14 +223,14 @@ def p_stale(w):
 FAM = ("--design", "fam", "--diagnosis-points", "40", "-j", "1")
 
 
-def SANE(name: str) -> tuple:
+def sane(name: str) -> tuple:
     """What a calibrate of one sensor named ``name`` may write: its folder and the summary."""
     return ("out", "out/summary.csv", f"out/{name}", f"out/{name}/[!/]*")
 CASES = [
     # 1 path traversal and names from files
-    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_traversal"),
-    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", SANE("_"), "p_dotname"),
-    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", SANE("a_b"), "p_newline_name"),
+    Case("calibrate-dots-name", "1", ("calibrate", "...csv", "-o", "out", *FAM), 0, "1 of 1", sane("_"), "p_traversal"),
+    Case("calibrate-dotdot-name", "1", ("calibrate", "..csv", "-o", "out", *FAM), 0, "1 of 1", sane("_"), "p_dotname"),
+    Case("calibrate-newline-name", "1", ("calibrate", "a\nb.csv", "-o", "out", *FAM), 0, "1 of 1", sane("a_b"), "p_newline_name"),
     # 2 special files and symlinks as outputs
     Case("train-o-fifo", "2", ("train", "rec.csv", "-o", "pipe", "--terms", "5"), 2, "FIFO", (), "p_fifo"),
     Case("predict-o-fifo", "2", ("predict", "m.json", "rec.csv", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
@@ -264,6 +269,8 @@ CASES = [
     Case("train-subnormal", "10", ("train", "bad.csv", "-o", "o.json", "--terms", "5"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("diagnose-subnormal", "10", ("diagnose", "bad.csv"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("gen-family-subnormal", "10", ("gen", "--family", "bad.csv", "-o", "newfam"), 2, "outside what flann computes", (), "p_subnormal"),
+    Case("diagnose-degenerate-span", "10", ("diagnose", "bad.csv"), 2, "no usable signal", (), "p_degenerate"),
+    Case("simulate-fit-degenerate-span", "10", ("simulate", "--fit", "bad.csv"), 2, "no usable signal", (), "p_degenerate"),
     # 11 model.json numbers
     Case("predict-terms-1e999", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "not finite", (), "p_terms_1e999"),
     Case("predict-bias-400-digits", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "not finite", (), "p_bias_400"),

@@ -17,7 +17,9 @@ are read as one: the canonical unit is used, the other must agree with it.
 Bounds (one ``error:`` line when exceeded, before anything is computed): at most
 :data:`MAX_ROWS` data rows and :data:`MAX_LINE_CHARS` characters per line; every value,
 after conversion to its canonical unit, finite and within :data:`VALUE_RANGE` (a number
-that overflows when converted, or a subnormal one, would turn a fit into NaN); a last line
+that overflows when converted, or a subnormal one, would turn a fit into NaN); displacement
+and voltage vary by more than :data:`MIN_RELATIVE_SPAN` of their size when they vary at
+all (a degenerate span is rounding, not signal); a last line
 without a line end that is shorter than every other line's cells looks cut off (a file
 copied while being written) and is refused as such.
 """
@@ -269,6 +271,22 @@ def _agree(source: str, header, col: str, used, other, a, b, lines) -> str:
            f"{col} from '{header[used]}'"
 
 
+# a column whose values differ by less than this fraction of their size varies only in the
+# last digits of a double: no signal, and a fit's normalisation would divide by rounding noise
+MIN_RELATIVE_SPAN = 1e-9
+
+
+def _check_span(source: str, column: str, a) -> None:
+    if a is None or a.size < 2:
+        return
+    span, size = float(np.ptp(a)), float(np.max(np.abs(a)))
+    if 0 < span <= MIN_RELATIVE_SPAN * size:
+        unit = column.rsplit("_", 1)[-1].replace("v", "V")
+        raise RecordingsError(
+            f"{source}: column '{column}' varies by only {span:.3g} {unit} around {size:.6g} {unit} "
+            f"(less than {MIN_RELATIVE_SPAN:g} of its size): no usable signal, only rounding")
+
+
 def _looks_cut(source: str, line_no: int, last: list[str], width: int, shortest: int | None) -> None:
     """The last line, without a line end: fewer cells than the header, or a last cell shorter
     than that column's on every other line, means it was cut off mid-line (a copy of a file
@@ -371,6 +389,8 @@ def parse_recordings(text: str, source: str = "<memory>",
     arrays = {c: np.asarray(v, dtype=float) for c, v in data.items()}
     del data
     lines = np.asarray(line_numbers, dtype=np.int64)
+    for c in REQUIRED:
+        _check_span(source, c, arrays.get(c))
     for c in also:
         col_notes.append(_agree(source, header, c, found[c][0], also[c][0], arrays[c], arrays.pop("+" + c), lines))
     if "direction" in arrays:
