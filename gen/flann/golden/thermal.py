@@ -37,7 +37,8 @@ import numpy as np
 
 from ..errors import ModelFileError
 from ..fileio import atomic_write_text
-from .model import FlannModel, evaluate, expand, load_model
+from ..inputs import number, parse_json, read_text
+from .model import MAX_TERMS, FlannModel, evaluate, expand
 
 FORMAT = "flann-thermal-model/1"
 INPUTS = ("voltage_v", "temperature_c")
@@ -188,21 +189,34 @@ class ThermalModel:
                                  f"expected {FORMAT!r}")
         if d.get("inputs") != list(INPUTS):
             raise ModelFileError(f"{source}: inputs must be {list(INPUTS)}, got {d.get('inputs')!r}")
+        def num(value, label, **kw):
+            return number(value, label, source, ModelFileError, **kw)
+
+        def nums(key, **kw):
+            values = d[key]
+            if not isinstance(values, list):
+                raise ModelFileError(f"{source}: {key} must be a list of numbers")
+            return tuple(num(x, f"{key}[{i}]", **kw) for i, x in enumerate(values))
+
         try:
-            weights = tuple(tuple(float(w) for w in ws) for ws in d["weights"])
-            bias = tuple(float(b) for b in d["bias"])
-            terms = tuple(int(n) for n in d["terms"])
+            if not isinstance(d["weights"], list) or not all(isinstance(ws, list) for ws in d["weights"]):
+                raise ModelFileError(f"{source}: weights must be a list of lists of numbers")
+            weights = tuple(tuple(num(w, f"weights[{k}][{i}]") for i, w in enumerate(ws))
+                            for k, ws in enumerate(d["weights"]))
+            bias = nums("bias")
+            terms = nums("terms", integer=True, lo=0, hi=MAX_TERMS)
             model = cls(
                 weights=weights, bias=bias,
-                input_offset_v=float(d["input_offset_v"]), input_scale_v=float(d["input_scale_v"]),
-                temperature_offset_c=float(d["temperature_offset_c"]),
-                temperature_scale_c=float(d["temperature_scale_c"]),
-                input_gain_t=tuple(float(g) for g in d["input_gain_t"]),
-                input_offset_t_v=tuple(float(o) for o in d["input_offset_t_v"]),
-                voltage_range_v=tuple(float(x) for x in d["voltage_range_v"]),
-                temperature_range_c=tuple(float(x) for x in d["temperature_range_c"]),
-                displacement_range_mm=tuple(float(x) for x in d["displacement_range_mm"]),
-                training=dict(d.get("training", {})),
+                input_offset_v=num(d["input_offset_v"], "input_offset_v"),
+                input_scale_v=num(d["input_scale_v"], "input_scale_v", tiny=1e-9),
+                temperature_offset_c=num(d["temperature_offset_c"], "temperature_offset_c"),
+                temperature_scale_c=num(d["temperature_scale_c"], "temperature_scale_c", tiny=1e-9),
+                input_gain_t=nums("input_gain_t"),
+                input_offset_t_v=nums("input_offset_t_v"),
+                voltage_range_v=nums("voltage_range_v"),
+                temperature_range_c=nums("temperature_range_c"),
+                displacement_range_mm=nums("displacement_range_mm"),
+                training=dict(d.get("training", {})) if isinstance(d.get("training", {}), dict) else {},
             )
         except KeyError as exc:
             raise ModelFileError(f"{source}: missing field {exc.args[0]!r}") from None
@@ -227,14 +241,10 @@ class ThermalModel:
 
 def load_any_model(path: str | Path) -> FlannModel | ThermalModel:
     """A one-input model (:func:`.model.load_model`) or a two-input one, by its format."""
-    path = Path(path)
-    try:
-        d = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-        return load_model(path)   # it names what is wrong with the file
+    d = parse_json(read_text(path, ModelFileError, "a model.json"), str(path), ModelFileError)
     if isinstance(d, dict) and d.get("format") == FORMAT:
         return ThermalModel.from_dict(d, source=str(path))
-    return load_model(path)
+    return FlannModel.from_dict(d, source=str(path))
 
 
 def is_thermal(model) -> bool:
