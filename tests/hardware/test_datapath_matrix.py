@@ -43,6 +43,8 @@ def designs(tmp_path_factory):
         assert r.returncode == 0, r.stderr
     # the seed architecture is written by flann explore only (for comparison)
     seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
+    # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
+    shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
     return {"dir": d, "model": model, "rec": recs[0]}
 
 
@@ -128,6 +130,8 @@ TAMPERED = [
     ("family", _set("family.widths.weight_bits", "22"), "family.widths.weight_bits"),
     ("family", _set("family.members", 5), "family.members"),
     ("fixed", _set("spec", "x"), "'spec'"),
+    ("plain", _set("spec", "x"), "'spec'"),
+    ("plain", _set("input_bits", "12"), "input_bits"),
     ("fixed", _set("input_bits", True), "input_bits"),
     ("float18", _drop("output.frac_bits"), "output.frac_bits"),
     ("fixed", _set("datapath", "quantum"), "datapath"),

@@ -19,8 +19,7 @@ from ..golden.model import load_model
 from ..recordings import read_recordings
 from ..analysis.trace import check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace, trace_design
 from ..hardware import options as gen_options
-from ..hardware.float18.spec import float18_options
-from ..hardware.registry import FORMATS as REGISTRY_FORMATS
+from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
 from ..verify.design import from_directory
 
 HELP = "stage-by-stage error of hardware against the golden model"
@@ -33,8 +32,8 @@ def add_arguments(parser) -> None:
                              "(traced as it is, with the model it keeps)")
     parser.add_argument("--model", dest="design_model", metavar="MODEL.json", default=None,
                         help="with DIR: the model DIR was generated from (checked against the manifest's sha256)")
-    parser.add_argument("--format", choices=FORMATS, default="fixed",
-                        help="number format of the datapath (default %(default)s)")
+    parser.add_argument("--format", choices=FORMATS, default=None,
+                        help=f"number format of the datapath (default {FORMATS[0]}; a design directory: its own)")
     parser.add_argument("--compare", action="store_true",
                         help="also trace the other format; --plot then shows both errors on one axis")
     parser.add_argument("--at", metavar="CSV", help="also report the error at these recordings' voltages")
@@ -47,17 +46,14 @@ def add_arguments(parser) -> None:
 
 
 def _options(args, fmt: str) -> dict:
-    opts = gen_options.from_args(args)
-    if fmt != FORMATS[0]:  # a datapath of its own number format takes the front end's options only
-        return float18_options(opts, fixed_too=args.compare)
-    return opts.to_kwargs()
+    return datapath(fmt).derive_options(gen_options.from_args(args), args.compare)
 
 
 def _design_dir(args):
     """A design directory: trace exactly that design (its manifest's options and model)."""
     if not Path(args.model).is_dir():
         return None
-    if args.format != FORMATS[0] or args.compare:
+    if args.format is not None or args.compare:
         raise FlannError(f"{args.model}: a design directory is traced as it is (no --format, no --compare)")
     return from_directory(args.model, args.design_model)
 
@@ -65,6 +61,7 @@ def _design_dir(args):
 def run(args) -> int:
     design = _design_dir(args)
     model = load_model(design.model if design else args.model)
+    args.format = args.format or FORMATS[0]
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:
         args.format = design.datapath.name

@@ -132,6 +132,8 @@ class Datapath:
     why_no_bench: str = ""
     why_no_stages: str = ""
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
+    derive_options: Callable | None = None  # (GenOptions, compared) -> keyword arguments of its derive
+    netlist: bool = False              # its mapped netlist can be simulated over every code (flann_top's ports)
     summary: Callable | None = None    # manifest -> lines flann gen prints
     common: tuple = COMMON_FIELDS      # the shared key set (a design flann did not write: fewer)
 

@@ -75,7 +75,7 @@ def simulate(design: Design, build_dir, **kw) -> dict:
     dp = design.datapath
     if dp.bench is None:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
-    if kw.get("netlist") and dp.bench != "sweep":
+    if kw.get("netlist") and not dp.netlist:
         raise FlannError(f"--netlist: the mapped-netlist check drives flann_top's ports; {design.directory} is "
                          f"a {dp.name} design ({dp.top})")
     return BENCHES[dp.bench](design, build_dir, **kw)

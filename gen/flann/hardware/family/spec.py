@@ -31,6 +31,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
+from ..fixed.latency import norm_latency
 from ..fixed.spec import BRAM_BITS, Spec, round_sig, check_fits, derive_spec, estimate_resources, nice_125
 from ..target import DEFAULT_PART
 
@@ -153,10 +154,9 @@ class FamilySpec:
 
     @property
     def latency_cycles(self) -> int:
-        """The fixed datapath's latency with flann_norm's ``input_bits + 1`` cycles replaced by
-        flann_family_norm's."""
+        """The fixed datapath's latency with flann_norm's replaced by flann_family_norm's."""
         s = self.spec
-        return s.latency_cycles - (s.input_bits + 1) + self.norm_latency
+        return s.latency_cycles - norm_latency(s.input_bits) + self.norm_latency
 
     @property
     def cycles_per_sample(self) -> int:

@@ -58,7 +58,8 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="fixed point, widths from the error budget",
     generate=generate, rebuild=rebuild, twin=FlannTop, estimate=estimate, fields=FIELDS,
-    bench="sweep", stages="fixed", summary=summary, eval_spec=eval_spec,
+    derive_options=lambda options, compared=False: options.to_kwargs(),
+    bench="sweep", stages="fixed", netlist=True, summary=summary, eval_spec=eval_spec,
 )
 
 __all__ = ["DATAPATH"]

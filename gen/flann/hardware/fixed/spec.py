@@ -28,6 +28,7 @@ import numpy as np
 from ... import __version__
 from .. import adc
 from .. import target as spartan2
+from .latency import ADDER_EDGES, EXPANSION_ADVANCES, MULTIPLIER_ADVANCES, SEQ_START_EDGES, norm_latency
 from ...errors import SpecError
 from ...numeric.fixed import FixedFormat, bits_needed
 from ...golden.model import FlannModel, term_kind
@@ -226,13 +227,16 @@ class Spec:
 
     @property
     def pipeline_advs(self) -> int:
-        """Pipeline advances: S issue steps + 3 expansion + 2 multiplier stages (adder adds at the last)."""
-        return self.steps + 5
+        """Pipeline advances: S issue steps, then the expansion's and the multiplier's own
+        (the adder adds at the last)."""
+        return self.steps + EXPANSION_ADVANCES + MULTIPLIER_ADVANCES
 
     @property
     def latency_cycles(self) -> int:
-        """Clock edges from the edge accepting a sample to the edge raising out_valid."""
-        return self.input_bits + 4 + (self.pipeline_advs - 1) * self.adv_period
+        """Clock edges from the edge accepting a sample to the edge raising out_valid: the
+        blocks' latencies summed (flann_norm, flann_seq's start, the advances, flann_adder)."""
+        return (norm_latency(self.input_bits) + SEQ_START_EDGES + (self.pipeline_advs - 1) * self.adv_period
+                + ADDER_EDGES)
 
     @property
     def cycles_per_sample(self) -> int:

@@ -20,6 +20,7 @@ import numpy as np
 
 from ...numeric.fixed import round_shift
 from ..twin import Record, TopOut
+from .latency import ADDER_EDGES, EXPANSION_ADVANCES, MULTIPLIER_ADVANCES, norm_latency
 from .spec import Spec
 
 
@@ -72,7 +73,7 @@ class FlannNorm:
 
     def __init__(self, spec: Spec):
         self.spec = spec
-        self.latency = spec.input_bits + 1
+        self.latency = norm_latency(spec.input_bits)
 
     def process(self, codes) -> NormOut:
         s = self.spec
@@ -91,7 +92,7 @@ class FlannExpansion:
     """Phase accumulation m*theta mod 2, quarter-wave table with first-order slope correction."""
 
     entity = "flann_expansion"
-    latency = 3  # advances from theta to the first term
+    latency = EXPANSION_ADVANCES  # advances from theta to the first term
 
     def __init__(self, spec: Spec):
         self.spec = spec
@@ -134,7 +135,7 @@ class FlannMultiplier:
     """Term x weight (weights from the per-lane ROM), rounded to the product format."""
 
     entity = "flann_multiplier"
-    latency = 2  # advances from term to product
+    latency = MULTIPLIER_ADVANCES  # advances from term to product
 
     def __init__(self, spec: Spec):
         self.spec = spec
@@ -151,7 +152,7 @@ class FlannAdder:
     """Start at the linear part, add every product, round to the output LSB, saturate."""
 
     entity = "flann_adder"
-    latency = 1  # clock edges from in_finish to out_valid (the rounded, saturated sum registered)
+    latency = ADDER_EDGES  # clock edges from in_finish to out_valid (the rounded, saturated sum registered)
 
     def __init__(self, spec: Spec):
         self.spec = spec

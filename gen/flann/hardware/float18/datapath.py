@@ -73,6 +73,8 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="the seed's 18-bit floating point after the fixed front end",
     generate=generate, rebuild=rebuild, twin=F18Top, estimate=estimate, fields=FIELDS,
+    # compared with the fixed design, fixed-only options are meant for that one
+    derive_options=lambda options, compared=False: float18_options(options, fixed_too=compared),
     bench="f18_top", stages="float18", summary=summary,
     why_no_eval="flann eval --design compares a fixed-point output LSB with the ADC's physical limit; "
                 "a float18 design has no output LSB: see its accuracy with flann sim DIR or flann trace DIR",

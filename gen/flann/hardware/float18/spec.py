@@ -31,11 +31,13 @@ import numpy as np
 from ...errors import SpecError
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
+from ..fixed.latency import EXPANSION_ADVANCES, SEQ_START_EDGES, norm_latency
 from ..fixed.spec import Spec, derive_spec
 from ..options import GenOptions
 from ..twin import TopOut
 
 TOP = "flann_f18_top"
+TOP_DRAIN_EDGES = 3  # flann_f18_top after the adder: sum register and count, done_r, output register
 CVT = "flann_f18_cvt"
 from ..fixed.twin import FlannExpansion, FlannNorm
 
@@ -89,18 +91,17 @@ class F18Spec:
 
     @property
     def n_advs(self) -> int:
-        """Expansion advances: one per trig term, plus 3 to bring the first term out."""
-        return self.base.steps + 3
+        """Expansion advances: one per trig term, plus the expansion's own to bring the first term out."""
+        return self.base.steps + EXPANSION_ADVANCES
 
     @property
     def latency_cycles(self) -> int:
         """Accepting edge to the edge that raises out_valid (checked by the top-level bench)."""
-        norm = self.base.input_bits + 2   # flann_norm: accept -> out_valid, serial over the code bits
-        # advance k is 1 + k * period edges after norm_valid; the last term is captured at
-        # advance n_advs - 1, then converter (1) + multiplier + adder; then the sum register
-        # and count (1), st_drain -> st_fin (1), the output register (1)
-        last_capture = 1 + (self.n_advs - 1) * self.adv_period
-        return norm + last_capture + 1 + F18Mul.latency + F18Add.latency + 3
+        # flann_norm, flann_seq's start, the advances (the last term is captured at advance
+        # n_advs - 1), then converter + multiplier + adder, then this top's own three edges:
+        # the sum register and count, done_r (flann_seq's in_done), the output register
+        return (norm_latency(self.base.input_bits) + SEQ_START_EDGES + (self.n_advs - 1) * self.adv_period
+                + F18Cvt.latency + F18Mul.latency + F18Add.latency + TOP_DRAIN_EDGES)
 
     @property
     def cycles_per_sample(self) -> int:
