@@ -70,6 +70,9 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
+        if args.post_route and not design.datapath.netlist:
+            raise FlannError(f"--post-route: the sweep driver drives flann_top's ports; this is a "
+                             f"{design.datapath.name} design")
         images = [{"name": Path(h).stem, "hex": str(Path(h).resolve())} for h in args.image or []]
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=terminal_progress, images=images or None)
