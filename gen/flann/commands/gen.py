@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 from ..hardware import options as gen_options
 from .family import add_family_arguments, run_family
 from ..hardware.fixed.render import generate as generate_fixed
 from ..hardware.float18.render import generate as generate_float18
 from ..hardware.float18.spec import float18_options
+from ..golden.model import load_model
+from ..golden.train import converter_mismatch
 
 HELP = "generate VHDL-93 for a model"
 
@@ -28,6 +31,9 @@ def run(args) -> int:
     opts = gen_options.from_args(args)
     if args.family is not None or args.model is None:
         return run_family(args, opts.to_kwargs())
+    other = converter_mismatch(load_model(args.model), opts.input_bits, opts.input_lsb_v)
+    if other:
+        warnings.warn(other)
     if args.format == "float18":
         man = generate_float18(args.model, args.out, **float18_options(opts))
     else:
