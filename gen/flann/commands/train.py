@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
-from ..recordings import converter_of, prepare_for_fit, read_recordings
+from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
@@ -86,7 +86,9 @@ def converter(args, rec) -> dict | None:
 def _screen(rec) -> tuple[object, dict, str]:
     """Gross outliers left out (one warning line), or refused above the stated share."""
     try:
-        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction)
+        # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
+        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction,
+                             converter_step(rec.voltage_v))
     except OutlierShareError as exc:
         raise FlannError(
             f"{rec.source}: {exc.n_out} of {exc.n} readings are more than {OUTLIER_K:g} noise units "
