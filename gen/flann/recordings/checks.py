@@ -143,7 +143,9 @@ def repeat_noise_v(displacement_mm, voltage_v, direction=None) -> tuple[float, i
     """(sigma V, pairs): the noise from readings repeated at one position and direction.
 
     Consecutive readings of one position (file order) differ by noise only: their difference
-    has standard deviation sigma sqrt 2; robustly sigma = median |d| / (0.6745 sqrt 2).
+    has standard deviation sigma sqrt 2.  sigma is the RMS of the differences over sqrt 2,
+    glitches (beyond 8 times the robust scale) left out; the robust scale alone (median |d|)
+    is 0 on a converter's grid when most repeats read the same code.
     (0, pairs) with fewer than ``MIN_REPEAT_PAIRS`` pairs.
     """
     x = np.asarray(displacement_mm, float)
@@ -155,7 +157,11 @@ def repeat_noise_v(displacement_mm, voltage_v, direction=None) -> tuple[float, i
     diffs = (vs[1:] - vs[:-1])[same]
     if diffs.size < MIN_REPEAT_PAIRS:
         return 0.0, int(diffs.size)
-    return float(np.median(np.abs(diffs)) / (0.6745 * np.sqrt(2.0))), int(diffs.size)
+    a = np.abs(diffs)
+    nonzero = a[a > 0]
+    scale = max(float(np.median(a)) / 0.6745, float(np.median(nonzero)) if nonzero.size else 0.0)
+    kept = a[a <= 8.0 * scale]
+    return float(np.sqrt(np.mean(kept ** 2) / 2.0)), int(diffs.size)
 
 
 def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01,
