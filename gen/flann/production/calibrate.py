@@ -40,7 +40,9 @@ import numpy as np
 from .. import __version__
 from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text
+from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
+from ..hardware.accuracy import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash, load_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
@@ -208,6 +210,13 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
+        reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
+                                        cost=lambda m: fixed_point_cost(m, (fam.spec.input_bits, fam.spec.input_lsb_v)))
+        if res.max_error_mm > REACH_FACTOR * reach:
+            res.warnings.append(
+                f"hardware max error {res.max_error_mm:.4g} mm is {res.max_error_mm / reach:.2f} x what this "
+                f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms; flagged above "
+                f"{REACH_FACTOR:g} x): the family design costs it accuracy")
         if max_error_mm is not None and res.max_error_mm > max_error_mm:
             raise FlannError(f"hardware max error {res.max_error_mm:.4g} mm > --max-error-mm {max_error_mm:g}")
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
