@@ -6,7 +6,7 @@ import argparse
 import json
 
 from ..errors import FlannError
-from ..hardware.family.build import generate_family
+from ..hardware.family.build import DEFAULT_TERMS, generate_family
 from ..hardware.family.spec import DEFAULT_MARGIN
 
 
@@ -24,9 +24,10 @@ def add_family_arguments(parser) -> None:
     g.add_argument("--family", nargs="+", metavar="REC_OR_MODEL", default=None,
                    help="size one design for these sensors (recordings .csv or model .json); per-sensor "
                         "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data")
-    g.add_argument("--terms", type=_terms, default="auto",
-                   help="--family: expansion terms when training recordings, or 'auto' (default): "
-                        "chosen like flann train --terms auto, for the member that needs the most")
+    g.add_argument("--terms", type=_terms, default=DEFAULT_TERMS,
+                   help="--family: expansion terms when training recordings (default %(default)s), or "
+                        "'auto': chosen like flann train --terms auto at the design's converter, for the "
+                        "member that needs the most (docs/production.md)")
     g.add_argument("--margin", type=float, default=DEFAULT_MARGIN,
                    help="--family: headroom for sensors like these, 0.5 = 50 %% larger weights and "
                         "ranges (default %(default)s)")

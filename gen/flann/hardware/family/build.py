@@ -17,7 +17,7 @@ from ...recordings import prepare_for_fit, read_recordings
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
 
-DEFAULT_TERMS = 15   # the family's terms when every member is a model.json and none is given
+DEFAULT_TERMS = 15
 NORMALISATION = "half"  # v_n in [-0.5, 0.5]: the periodic terms need not join the two ends
 RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in accuracy
 
@@ -29,7 +29,7 @@ def train_model(rec, terms: int = DEFAULT_TERMS, ridge: float = RIDGE, training:
     return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
 
 
-def auto_terms(sources, options: dict):
+def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN):
     """(terms, per-member choices) for the recordings among ``sources``, chosen like ``flann
     train --terms auto`` at the design's converter (:func:`flann.golden.family.family_terms`);
     (None, []) when every member is a model.json (their terms are used as they are)."""
@@ -45,7 +45,7 @@ def auto_terms(sources, options: dict):
     if not members:
         return None, []
     adc = (options.get("input_bits", 12), options.get("input_lsb_v"))
-    return family_terms(members, norm=NORMALISATION, ridge=RIDGE,
+    return family_terms(members, norm=NORMALISATION, ridge=RIDGE, margin=margin,
                         cost=lambda m: fixed_point_cost(m, adc))
 
 
@@ -66,7 +66,7 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
         raise FlannError("--family needs at least one recordings CSV or model.json")
     choices = []
     if terms == "auto":
-        terms, choices = auto_terms(sources, options)
+        terms, choices = auto_terms(sources, options, margin)
         terms = DEFAULT_TERMS if terms is None else max(2, terms)
     if not 2 <= int(terms) <= 200:
         raise FlannError(f"--terms {terms}: must be 2..200")
