@@ -253,7 +253,8 @@ def _reading_residuals(x, v, keep, pos: Positions, pred_pos, fitted_pos) -> np.n
 
 
 def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
-    """The forward fit of v(x) chosen by cross-validation, gross outliers left out.
+    """The forward fit of v(x) chosen by cross-validation, gross outliers left out (the fit
+    only says what each reading should have been: it need not be monotonic).
 
     Rounds: fit (choose by held-out error in v), residual of every reading against what the
     other data say, robust noise (repeats when there are enough, else the residuals' MAD),
@@ -269,7 +270,7 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
     outliers: dict[int, float] = {}
     for _ in range(MAX_OUTLIER_ROUNDS):
         pos = _positions(x, v, keep)
-        sm, pred, _score = choose(pos, robust=True)
+        sm, pred, _score = choose(pos, monotonic=False, robust=True)
         coef = sm.solve(pos)
         fitted = sm.predict(coef, pos.x)
         r = _reading_residuals(x, v, keep, _with_index(pos, x, keep), pred, fitted)
@@ -298,7 +299,7 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
         worst = max(outliers, key=outliers.get)
         raise OutlierShareError(worst, outliers[worst], int((~keep).sum()), x.size, sigma)
     pos = _with_index(_positions(x, v, keep), x, keep)
-    sm, _pred, score = choose(pos)
+    sm, _pred, score = choose(pos, monotonic=False)
     coef = sm.solve(pos)
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
 
