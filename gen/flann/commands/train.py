@@ -95,8 +95,9 @@ def _screen(rec) -> tuple[object, dict, str]:
             f"from the smooth fit of the others (more than {100 * MAX_OUTLIER_SHARE:g} % are refused): "
             f"worst {rec.line_of(exc.row)}, {exc.units:.3g} noise units (noise {exc.sigma:.3g} V); "
             "not isolated glitches: look at the recording (flann diagnose)") from None
-    if sc is None:
-        return rec, {}, ""
+    if sc is None:   # too few or too many positions to judge outliers: every reading is used
+        return rec, {"positions_used": int(np.unique(rec.displacement_mm).size), "readings_used": len(rec),
+                     "outliers_checked": False}, ""
     record = {"positions_used": sc.positions, "readings_used": int(sc.keep.sum()),
               "noise_v": float(f"{sc.noise_v:.4g}"), "noise_from": sc.noise_from}
     said = ""

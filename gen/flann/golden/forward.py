@@ -344,14 +344,17 @@ class Screen:
 
 
 MAX_SCREEN_POSITIONS = 5000   # a logger's continuous positions: the screen is skipped
+# fewer positions than this: a smooth fit's held-out error near the ends is not noise, and a
+# sound reading there would be called an outlier (13 positions of a sharp S-curve: 2 of 13)
+MIN_SCREEN_POSITIONS = 20
 
 
 def screen_outliers(x, v, direction=None, step_v: float = 0.0) -> Screen | None:
     """Gross outliers against the cross-validated forward fit (:func:`robust_forward`);
-    None when the recording has too many distinct positions to fit them this way.
+    None when the recording has too few or too many distinct positions to judge them this way.
     Raises :class:`OutlierShareError` above ``MAX_OUTLIER_SHARE``."""
     npos = np.unique(np.asarray(x, float)).size
-    if npos > MAX_SCREEN_POSITIONS or npos < 6:
+    if npos > MAX_SCREEN_POSITIONS or npos < MIN_SCREEN_POSITIONS:
         return None
     ff = robust_forward(x, v, direction, step_v)
     return Screen(ff.keep, tuple(ff.outliers), ff.noise_v, ff.noise_from, int(ff.positions.x.size))
