@@ -69,3 +69,22 @@ def test_converter_is_read_from_the_recordings_grid_and_gen_warns_for_another(tm
     rc, _, err = run(["gen", tmp_path / "m.json", "-o", tmp_path / "h14", "--input-bits", 14,
                       "--input-lsb-v", f"{lsb:.9g}"], capsys)
     assert rc == 0 and "14-bit converter" not in err
+
+
+def test_four_sweeps_train_and_their_repeats_give_the_noise(tmp_path, capsys):
+    # the recording, smaller: two forward and two reverse sweeps, 0.8 mV noise, 14 bits
+    rng = np.random.default_rng(1)
+    x = np.linspace(-10.0, 10.0, 300)
+    xs = np.concatenate([x, x[::-1], x, x[::-1]])
+    d = np.concatenate([np.ones(300), -np.ones(300)] * 2)
+    lsb = 16.0 / 2 ** 14
+    v = np.round((7.0 * np.tanh(xs / 9.0) + rng.normal(0.0, 8e-4, xs.size)) / lsb) * lsb
+    path = tmp_path / "four.csv"
+    path.write_text("displacement_mm,voltage_v,direction\n"
+                    + "".join(f"{a:.9g},{b:.9g},{int(c)}\n" for a, b, c in zip(xs, v, d)))
+    rc, _, err = run(["train", path, "-o", tmp_path / "m.json"], capsys)
+    assert rc == 0, err
+    t = json.loads((tmp_path / "m.json").read_text())["training"]
+    assert t["readings_used"] == 1200 and t["positions_used"] == 300
+    assert "repeated readings" in t["noise_from"] and 6e-4 < t["noise_v"] < 1.1e-3
+    assert t["converter"]["input_bits"] == 14

@@ -227,8 +227,11 @@ def converter_step(voltage_v, max_divisor: int = 64, tol: float = 0.02) -> float
     if not g0 > 0:
         return 0.0
     rel = u - u[0]
+    span = float(rel[-1])
     for k in range(1, max_divisor + 1):
-        q = g0 / k
+        # the smallest gap carries the readings' rounding (9 digits of a 16-bit code's volts):
+        # the step is refined over the whole span, where that rounding is negligible
+        q = span / round(span * k / g0)
         frac = rel / q
         if np.max(np.abs(frac - np.round(frac))) <= tol:
             return q
