@@ -173,6 +173,10 @@ def run(args) -> int:
                     f"held-out error (cross-validation, {t['cv_folds']} folds"
                     + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
                     + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
+        if conv is not None:
+            said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
+                        + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")
+                        + f" converter ({conv['from']}); positions used {t.get('positions_used')}")
         if "traded" in t:
             said.append(f"auto: {t['selected_by']}: {t['traded']}")
         elif "hardware_why" in t:
