@@ -93,3 +93,46 @@ def test_readings_repeated_at_each_step_within_noise_are_fine():
     v[31] += 0.3                                     # a reading far off its neighbours: refused
     with pytest.raises(RecordingsError, match="appears twice"):
         prepare_for_fit(Recordings(x, v, source="dwell.csv"))
+
+
+def _four_sweeps(noise_v=8e-4, n=200, seed=5):
+    rng = np.random.default_rng(seed)
+    x = np.linspace(-10.0, 10.0, n)
+    xs = np.concatenate([x, x[::-1], x, x[::-1]])
+    d = np.concatenate([np.ones(n), -np.ones(n)] * 2)
+    v = 7.0 * np.tanh(xs / 9.0) + rng.normal(0.0, noise_v, xs.size)
+    return xs, v, d
+
+
+def test_four_sweeps_with_noise_are_data():
+    # the case: two forward and two reverse sweeps, readings 0.87 mV apart are noise
+    xs, v, d = _four_sweeps()
+    rec = Recordings(xs, v, direction=d, source="four.csv")
+    assert len(prepare_for_fit(rec)) == xs.size
+
+
+def test_a_repeat_far_beyond_the_noise_is_refused_naming_line_and_noise_units():
+    xs, v, d = _four_sweeps()
+    v[450] += 0.5          # a glitch on the second forward sweep
+    with pytest.raises(RecordingsError, match=r"rows 51 and 451: .* they are [0-9.]+ noise units apart \(noise [0-9.e-]+ V from [0-9]+ repeated readings"):
+        prepare_for_fit(Recordings(xs, v, direction=d, source="four.csv"))
+
+
+def test_converter_of_finds_step_and_bits_of_the_grid():
+    from flann.recordings import converter_of
+    lsb = 2 * 7.35 / 2 ** 12          # 12-bit, the range 5 % above the largest reading
+    v = np.round(7.0 * np.tanh(np.linspace(-3, 3, 400)) / lsb) * lsb
+    bits, step = converter_of(v)
+    assert bits == 12 and abs(step - lsb) < 1e-9 * lsb
+    assert converter_of(v + np.random.default_rng(0).normal(0, 1e-4, v.size)) is None
+
+
+def test_repeat_noise_on_a_converter_grid_is_not_zero():
+    from flann.recordings.checks import repeat_noise_v
+    lsb = 5e-3
+    rng = np.random.default_rng(2)
+    x = np.repeat(np.arange(200.0), 4)
+    v = np.round((0.01 * x + rng.normal(0, 2e-3, x.size)) / lsb) * lsb   # most repeats read one code
+    sigma, pairs = repeat_noise_v(x, v)
+    assert pairs == 600
+    assert 1.5e-3 < sigma < 3.5e-3    # noise (2 mV) and quantisation (1.4 mV) together: 2.4 mV

@@ -7,13 +7,24 @@ from ..hardware.family.build import DEFAULT_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN
 
 
+def _terms(text: str):
+    if text == "auto":
+        return "auto"
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer or 'auto', got {text!r}") from None
+
+
 def add_family_arguments(parser) -> None:
     g = parser.add_argument_group("one design for a family of sensors (docs/production.md)")
     g.add_argument("--family", nargs="+", metavar="REC_OR_MODEL", default=None,
                    help="size one design for these sensors (recordings .csv or model .json); per-sensor "
                         "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data")
-    g.add_argument("--terms", type=int, default=DEFAULT_TERMS,
-                   help="--family: expansion terms when training recordings (default %(default)s)")
+    g.add_argument("--terms", type=_terms, default=DEFAULT_TERMS,
+                   help="--family: expansion terms when training recordings (default %(default)s), or "
+                        "'auto': chosen like flann train --terms auto at the design's converter, for the "
+                        "member that needs the most (docs/production.md)")
     g.add_argument("--margin", type=float, default=DEFAULT_MARGIN,
                    help="--family: headroom for sensors like these, 0.5 = 50 %% larger weights and "
                         "ranges (default %(default)s)")

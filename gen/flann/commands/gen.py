@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 
+from ..golden.thermal import load_any_model
+from ..golden.train import converter_mismatch
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
 from ..hardware.registry import FAMILY, FORMATS, datapath
@@ -33,6 +36,9 @@ def run(args) -> int:
     if args.family is not None or args.model is None:
         check_family_args(args)
         dp, source, extra = FAMILY, args.family, {"terms": args.terms, "margin": args.margin}
+        other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)
+        if other:
+            warnings.warn(other)
     else:
         dp, source, extra = datapath(args.format), args.model, {}
     replacing = is_design(args.out)

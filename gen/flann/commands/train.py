@@ -11,7 +11,8 @@ import numpy as np
 
 from ..argtypes import bounded
 from ..errors import FlannError
-from ..recordings import prepare_for_fit, read_recordings
+from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
+from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
@@ -61,6 +62,60 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--temperature", action="store_true",
                    help="a two-input model x(voltage, temperature) from a calibration at several "
                         "temperatures (the temperature_c column; docs/temperature.md)")
+    p.add_argument("--input-bits", type=int, default=None,
+                   help="--terms auto: the converter the model will be generated for (signed code "
+                        "width); default: read from the recording's converter grid")
+    p.add_argument("--input-lsb-v", type=float, default=None,
+                   help="--terms auto: volts per code of that converter (default: the grid's step, "
+                        "or flann gen's default for --input-bits)")
+
+
+def converter(args, rec) -> dict | None:
+    """The converter buildability is judged at: the user's (--input-bits/--input-lsb-v), else
+    the recording's grid (every reading a whole number of one step), else None (the generator's
+    default and widest converter, 12 and 16 bits)."""
+    if args.input_lsb_v is not None and not args.input_lsb_v > 0:
+        raise FlannError(f"--input-lsb-v must be a positive number of volts, got {args.input_lsb_v!r}")
+    if args.input_bits is not None:
+        if not 4 <= args.input_bits <= 32:
+            raise FlannError(f"--input-bits must be 4..32, got {args.input_bits}")
+        return {"input_bits": args.input_bits, "input_lsb_v": args.input_lsb_v, "from": "--input-bits"}
+    if args.input_lsb_v is not None:
+        raise FlannError("--input-lsb-v needs --input-bits")
+    grid = converter_of(rec.voltage_v)
+    if grid is None:
+        return None
+    return {"input_bits": grid[0], "input_lsb_v": float(f"{grid[1]:.9g}"),
+            "from": "the recording's converter grid"}
+
+
+def _screen(rec) -> tuple[object, dict, str]:
+    """Gross outliers left out (one warning line), or refused above the stated share."""
+    try:
+        # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
+        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction,
+                             converter_step(rec.voltage_v))
+    except OutlierShareError as exc:
+        raise FlannError(
+            f"{rec.source}: {exc.n_out} of {exc.n} readings are more than {OUTLIER_K:g} noise units "
+            f"from the smooth fit of the others (more than {100 * MAX_OUTLIER_SHARE:g} % are refused): "
+            f"worst {rec.line_of(exc.row)}, {exc.units:.3g} noise units (noise {exc.sigma:.3g} V); "
+            "not isolated glitches: look at the recording (flann diagnose)") from None
+    if sc is None:   # too few or too many positions to judge outliers: every reading is used
+        return rec, {"positions_used": int(np.unique(rec.displacement_mm).size), "readings_used": len(rec),
+                     "outliers_checked": False}, ""
+    record = {"positions_used": sc.positions, "readings_used": int(sc.keep.sum()),
+              "noise_v": float(f"{sc.noise_v:.4g}"), "noise_from": sc.noise_from}
+    said = ""
+    if sc.outliers:
+        record["outliers_left_out"] = [{"line": rec.line_of(i), "noise_units": round(u, 1)}
+                                       for i, u in sc.outliers]
+        listed = ", ".join(f"{rec.line_of(i)} ({u:.3g} noise units)" for i, u in sc.outliers[:5])
+        more = f" and {len(sc.outliers) - 5} more" if len(sc.outliers) > 5 else ""
+        said = (f"{rec.source}: left out {len(sc.outliers)} gross outlier reading(s) of {len(rec)}: "
+                f"{listed}{more} (noise {sc.noise_v:.3g} V, {sc.noise_from})")
+        rec = rec.subset(sc.keep)
+    return rec, record, said
 
 
 def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
@@ -114,18 +169,33 @@ def run(args) -> int:
         if positions < 4:
             raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
                              "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
+        conv = converter(args, rec)
+        rec, record, outlier_text = _screen(rec)
+        if outlier_text:
+            warnings.warn(outlier_text)
+        provenance.update(record)
+        if conv is not None:
+            provenance["converter"] = conv
+        adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
         model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
-                                 cost=fixed_point_cost)
+                                 cost=lambda m: fixed_point_cost(m, adc))
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
                     f"held-out error (cross-validation, {t['cv_folds']} folds"
                     + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
                     + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
+        if conv is not None:
+            said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
+                        + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")
+                        + f" converter ({conv['from']}); positions used {t.get('positions_used')}")
         if "traded" in t:
             said.append(f"auto: {t['selected_by']}: {t['traded']}")
         elif "hardware_why" in t:
             said.append(f"auto: no candidate builds in fixed point ({t['hardware_why']})")
     else:
+        if args.input_bits is not None or args.input_lsb_v is not None:
+            raise FlannError("--input-bits/--input-lsb-v choose among --terms auto's candidates; "
+                             "with --terms N give them to flann gen")
         norm = args.normalise or "range"
         check_fit_input(rec.voltage_v, rec.displacement_mm, args.terms, rec.source)
         if args.method == "lms":

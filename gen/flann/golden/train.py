@@ -508,3 +508,22 @@ def _cheapest(v, x, results: list[CvResult], cost) -> tuple[CvResult, FlannModel
                                                "phase_bits", "output_lsb_mm")},
             "traded": traded if choice != best else "nothing: the best candidate is also the cheapest"}
     return choice, model, info
+
+
+def converter_mismatch(model: FlannModel, input_bits: int, input_lsb_v: float | None) -> str:
+    """'' when ``model`` was judged buildable at this converter (or at none in particular),
+    else one line saying which converter it was judged for."""
+    conv = model.training.get("converter") if isinstance(model.training, dict) else None
+    if not isinstance(conv, dict) or not isinstance(conv.get("input_bits"), int):
+        return ""
+    bits, lsb = conv["input_bits"], conv.get("input_lsb_v")
+    same_lsb = (lsb is None or input_lsb_v is None
+                or abs(float(input_lsb_v) - float(lsb)) <= 1e-3 * abs(float(lsb)))
+    if bits == input_bits and same_lsb:
+        return ""
+    judged = f"{bits}-bit" + (f" x {lsb:.6g} V" if lsb is not None else "")
+    given = f"{input_bits}-bit" + (f" x {input_lsb_v:.6g} V" if input_lsb_v is not None else "")
+    return (f"the model's terms and widths were chosen for a {judged} converter ({conv.get('from', '?')}), "
+            f"this design is for {given}: retrain with flann train --input-bits {input_bits}"
+            + (f" --input-lsb-v {input_lsb_v:.6g}" if input_lsb_v is not None else "")
+            + " for a model judged at this converter")

@@ -29,7 +29,7 @@ COST_BITS = (MAX_DESIGN_INPUT_BITS, 12)   # a model must build at the default an
 MAX_BOUND_LSB = 1.0   # worst-case |hardware - float model| at the default widths, output LSB
 
 
-def fixed_point_cost(model: FlannModel) -> dict:
+def fixed_point_cost(model: FlannModel, adc: tuple[int, float | None] | None = None) -> dict:
     """Cost of the model in fixed point at the generator's defaults, and whether it builds.
 
     ``cost`` is the estimated LUT4 count + the weight ROM in LUT4 equivalents (16 bits each)
@@ -37,14 +37,15 @@ def fixed_point_cost(model: FlannModel) -> dict:
     and with the number of terms.  ``buildable`` is False when ``flann gen`` would refuse the
     model at 16 or at 12 input bits, or when the widths it allows cannot hold the hardware
     within one output LSB of the float model (capped table or term widths: the model's
-    accuracy would be lost in the datapath); the reason is in ``why``.
+    accuracy would be lost in the datapath); the reason is in ``why``.  ``adc`` = (bits, volts
+    per code or None for the default): judged at that converter only (the user's).
     """
     spec = None
-    for bits in COST_BITS:
+    for bits, lsb in ([adc] if adc is not None else [(b, None) for b in COST_BITS]):
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                spec = derive_spec(model, input_bits=bits)
+                spec = derive_spec(model, input_bits=bits, input_lsb_v=lsb)
         except SpecError as exc:
             return {"buildable": False, "why": f"{bits}-bit input: {exc}", "cost": math.inf}
         if spec.analysis["bound_total_lsb"] > MAX_BOUND_LSB:

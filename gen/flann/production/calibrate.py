@@ -39,7 +39,9 @@ import numpy as np
 from .. import __version__
 from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
+from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
+from ..hardware.accuracy import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, read_design
@@ -266,6 +268,13 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
         res.model_sha256 = hashlib.sha256(chk["model"].to_json().encode()).hexdigest()
+        reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
+                                        cost=lambda m: fixed_point_cost(m, (fam.spec.input_bits, fam.spec.input_lsb_v)))
+        if res.max_error_mm > REACH_FACTOR * reach:
+            res.warnings.append(
+                f"hardware max error {res.max_error_mm:.4g} mm is {res.max_error_mm / reach:.2f} x what this "
+                f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms; flagged above "
+                f"{REACH_FACTOR:g} x): the family design costs it accuracy")
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
         findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
         res.diagnosis = diagnosis_cell(named, groups)

@@ -11,6 +11,9 @@ from ..errors import RecordingsError
 from .csvio import Recordings
 
 MIN_FIT_POINTS = 3
+MIN_REPEAT_PAIRS = 8   # fewer repeats do not measure the noise
+# repeats scattering more than this many times the point-to-point noise: the sweeps drifted apart
+DRIFT_FACTOR = 2.0
 # An LVDT conditioner's output (and any ADC input) is at most a few tens of volts: a larger
 # number under a volts header is almost surely millivolts.
 MAX_PLAUSIBLE_V = 60.0
@@ -136,40 +139,114 @@ def _pair(rec: Recordings, j: int, i: int) -> str:
     return f"{a.split()[0]}s {a.split()[1]} and {b.split()[1]}"
 
 
+def repeat_noise_v(displacement_mm, voltage_v, direction=None) -> tuple[float, int]:
+    """(sigma V, pairs): the noise from readings repeated at one position and direction.
+
+    Consecutive readings of one position (file order) differ by noise only: their difference
+    has standard deviation sigma sqrt 2.  sigma is the RMS of the differences over sqrt 2,
+    glitches (beyond 8 times the robust scale) left out; the robust scale alone (median |d|)
+    is 0 on a converter's grid when most repeats read the same code.
+    (0, pairs) with fewer than ``MIN_REPEAT_PAIRS`` pairs.
+    """
+    x = np.asarray(displacement_mm, float)
+    v = np.asarray(voltage_v, float)
+    d = np.zeros_like(x) if direction is None else np.asarray(direction, float)
+    order = np.lexsort((np.arange(x.size), x, d))
+    xs, ds, vs = x[order], d[order], v[order]
+    same = (xs[1:] == xs[:-1]) & (ds[1:] == ds[:-1])
+    diffs = (vs[1:] - vs[:-1])[same]
+    if diffs.size < MIN_REPEAT_PAIRS:
+        return 0.0, int(diffs.size)
+    a = np.abs(diffs)
+    nonzero = a[a > 0]
+    scale = max(float(np.median(a)) / 0.6745, float(np.median(nonzero)) if nonzero.size else 0.0)
+    kept = a[a <= 8.0 * scale]
+    return float(np.sqrt(np.mean(kept ** 2) / 2.0)), int(diffs.size)
+
+
 def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01,
                      inferred: bool = False) -> None:
-    """One voltage per displacement per direction: a repeat with another voltage is refused.
+    """Repeated readings (same position and direction: dwells, repeated sweeps) are data.
 
-    Readings repeated while the actuator dwells (the same displacement on consecutive rows)
-    and, with a ``time_s`` column, repeated sweeps are accepted when they differ by no more
-    than the noise allows, ``max(k_sigma * noise, floor_frac * voltage span)`` with the noise
-    estimated on the first reading of each position; any other differing repeat (a second
-    sweep the same way without ``time_s``: two files joined?) is refused.
+    A repeat is refused only when it differs from the median of the other readings there by
+    more than ``max(k_sigma * noise, floor_frac * voltage span)``.  The noise comes from the
+    repeats themselves (pairwise differences, robust) when there are at least
+    ``MIN_REPEAT_PAIRS`` of them and they agree no worse than neighbouring positions do (the
+    point-to-point estimate on the first reading of each position; sweeps further apart
+    than that have drifted), else from that point-to-point estimate.  The message names the lines and the difference in noise units.
     """
     direction = rec.direction if rec.direction is not None else np.zeros(len(rec))
+    sigma, pairs = repeat_noise_v(rec.displacement_mm, rec.voltage_v, direction)
     keys = np.stack([direction, rec.displacement_mm], axis=1)
     first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
-    sub = rec.subset(first)
-    order = np.lexsort((sub.displacement_mm, direction[first]))
-    noise_tol = max(k_sigma * estimate_noise_v(sub.voltage_v[order]),
-                    floor_frac * float(np.ptp(rec.voltage_v)))
-    seen: dict[tuple[float, float], int] = {}
-    last: dict[tuple[float, float], int] = {}
-    for i, (d, x, v) in enumerate(zip(direction, rec.displacement_mm, rec.voltage_v)):
-        key = (float(d), float(x))
-        j = seen.setdefault(key, i)
-        dwell = last.get(key) == i - 1
-        last[key] = i
-        tol = noise_tol if (dwell or rec.time_s is not None) else 0.0
-        if j != i and abs(rec.voltage_v[j] - v) > tol:
+    order = np.lexsort((rec.displacement_mm[first], direction[first]))
+    p2p = estimate_noise_v(rec.voltage_v[first][order])
+    if pairs >= MIN_REPEAT_PAIRS and sigma <= DRIFT_FACTOR * p2p:
+        source = f"from {pairs} repeated readings"
+    else:
+        # sweeps that differ by more than the point-to-point noise drifted apart: that is not noise
+        sigma, source = p2p, "point to point"
+    tol = max(k_sigma * sigma, floor_frac * float(np.ptp(rec.voltage_v)))
+    groups: dict[tuple[float, float], list[int]] = {}
+    for i, (d, x) in enumerate(zip(direction, rec.displacement_mm)):
+        groups.setdefault((float(d), float(x)), []).append(i)
+    for (d, x), rows in groups.items():
+        if len(rows) < 2:
+            continue
+        vv = rec.voltage_v[rows]
+        for j, i in enumerate(rows):
+            ref = float(np.median(np.delete(vv, j)))
+            if abs(vv[j] - ref) <= tol:
+                continue
+            other = rows[int(np.argmin(np.abs(np.delete(vv, j) - ref)))] if len(rows) > 2 else rows[1 - j]
+            first_row, this_row = sorted((other, i))
             where = "" if rec.direction is None else f" in direction {int(d):+d}" + \
                 (" (sweeps told apart by the row order)" if inferred else "")
+            units = f"{abs(vv[j] - ref) / sigma:.3g} noise units" if sigma > 0 else "beyond the noise"
+            which = (f"they are {units} apart" if len(rows) == 2 else
+                     f"{rec.line_of(i)} is {units} from the other {len(rows) - 1} readings there")
             raise RecordingsError(
-                f"{rec.source}: {_pair(rec, j, i)}: displacement {x:g} mm appears twice"
-                f"{where} with different voltages ({rec.voltage_v[j]:.6g} V, {v:.6g} V); "
-                "average repeats or give each sweep its direction (+1/-1)"
-                + (f" (repeats may differ by {tol:.3g} V)" if tol else "")
-            )
+                f"{rec.source}: {_pair(rec, first_row, this_row)}: displacement {x:g} mm appears twice"
+                f"{where} with different voltages ({rec.voltage_v[first_row]:.6g} V, "
+                f"{rec.voltage_v[this_row]:.6g} V): {which} (noise {sigma:.3g} V {source}; "
+                f"repeats may differ by {tol:.3g} V): a glitch, or two files joined? "
+                "give each sweep its direction (+1/-1)")
+
+
+def converter_step(voltage_v, max_divisor: int = 64, tol: float = 0.02) -> float:
+    """The converter's step (V) when every reading is a whole number of one step, else 0.
+
+    The smallest gap between distinct readings is the step or a multiple of it; the largest
+    step that puts every reading on the grid (within ``tol`` of a step) is taken.  Readings
+    with analogue noise or averaging are on no grid and give 0.
+    """
+    u = np.unique(np.asarray(voltage_v, float))
+    if u.size < 8:
+        return 0.0
+    g0 = float(np.diff(u).min())
+    if not g0 > 0:
+        return 0.0
+    rel = u - u[0]
+    span = float(rel[-1])
+    for k in range(1, max_divisor + 1):
+        # the smallest gap carries the readings' rounding (9 digits of a 16-bit code's volts):
+        # the step is refined over the whole span, where that rounding is negligible
+        q = span / round(span * k / g0)
+        frac = rel / q
+        if np.max(np.abs(frac - np.round(frac))) <= tol:
+            return q
+    return 0.0
+
+
+def converter_of(voltage_v) -> tuple[int, float] | None:
+    """(bits, volts per code) of the converter the readings were taken with, from their grid:
+    the step, and the fewest two's-complement bits whose range holds every reading; None off-grid."""
+    step = converter_step(voltage_v)
+    if not step > 0:
+        return None
+    vmax = float(np.max(np.abs(np.asarray(voltage_v, float))))
+    bits = int(np.ceil(np.log2(max(vmax / step, 1.0) + 1.0))) + 1
+    return (bits, step) if 4 <= bits <= 32 else None
 
 
 def check_units(rec: Recordings) -> None:

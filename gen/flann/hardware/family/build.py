@@ -10,7 +10,9 @@ from pathlib import Path
 
 from ...errors import FlannError
 from ...golden.model import FlannModel, load_model
+from ...golden.family import family_terms
 from ...golden.train import fit_lstsq
+from ..accuracy import fixed_point_cost
 from ...recordings import prepare_for_fit, read_recordings
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
@@ -25,6 +27,26 @@ def train_model(rec, terms: int = DEFAULT_TERMS, ridge: float = RIDGE, training:
     rec = prepare_for_fit(rec)
     info = {"data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})}
     return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
+
+
+def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN):
+    """(terms, per-member choices) for the recordings among ``sources``, chosen like ``flann
+    train --terms auto`` at the design's converter (:func:`flann.golden.family.family_terms`);
+    (None, []) when every member is a model.json (their terms are used as they are)."""
+    members = []
+    for p in sources:
+        p = Path(p)
+        if p.suffix.lower() == ".csv":
+            try:
+                rec = prepare_for_fit(read_recordings(p))
+            except FlannError:
+                continue   # reported with every other bad member when the members are loaded
+            members.append((p.stem, rec.voltage_v, rec.displacement_mm))
+    if not members:
+        return None, []
+    adc = (options.get("input_bits", 12), options.get("input_lsb_v"))
+    return family_terms(members, norm=NORMALISATION, ridge=RIDGE, margin=margin,
+                        cost=lambda m: fixed_point_cost(m, adc))
 
 
 def load_member(path, terms: int = DEFAULT_TERMS) -> FlannModel:
@@ -42,6 +64,10 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
+    choices = []
+    if terms == "auto":
+        terms, choices = auto_terms(sources, options, margin)
+        terms = DEFAULT_TERMS if terms is None else max(2, terms)
     if not 2 <= int(terms) <= 200:
         raise FlannError(f"--terms {terms}: must be 2..200")
     models, bad = [], []
@@ -58,7 +84,10 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
     unique = dict(zip(names, models))
     if len(unique) < len(names):  # members with one file name: told apart by their place
         unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
-    return write(fam, out_dir, fam.spec.model, init_name=names[0], members=unique)
+    man = write(fam, out_dir, fam.spec.model, init_name=names[0], members=unique)
+    if choices:
+        man = {**man, "terms_chosen": [vars(c) for c in choices]}
+    return man
 
 
 __all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "NORMALISATION"]

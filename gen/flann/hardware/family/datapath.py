@@ -52,7 +52,11 @@ def summary(man: dict) -> list[str]:
             f"  {man['input_bits']}-bit input x {man['input_lsb_v']} V -> {man['output_bits']}-bit output x "
             f"{man['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample",
             f"  weight memory {mem['used_words']} of {mem['depth']} x {mem['data_bits']}-bit words "
-            f"(cfg_addr {mem['addr_bits']} bits); estimate {man['analysis']['estimate']}"]
+            f"(cfg_addr {mem['addr_bits']} bits); estimate {man['analysis']['estimate']}",
+            *(f"  {c['name']}: own design {c['own_terms']} terms (held-out RMS {c['own_rms_mm']:.4g} mm"
+              + (f", {c['own_cost']:.0f} LUT4-eq." if c["own_cost"] is not None else "")
+              + f"); in the family {fam['terms']} terms, held-out RMS {c['family_rms_mm']:.4g} mm "
+              f"({c['family_rms_mm'] / c['own_rms_mm']:.2f}x its own)" for c in man.get("terms_chosen", []))]
 
 
 FIELDS = (

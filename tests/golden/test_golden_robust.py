@@ -1,0 +1,90 @@
+"""--terms auto on recordings with glitches, repeats and a known converter."""
+
+import json
+
+import numpy as np
+
+from flann.cli import main
+from flann.golden.model import load_model
+
+
+def run(argv, capsys):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def cubic_rows():
+    x = np.arange(-20.0, 21.0, 2.0)
+    return [f"{a:g},{0.1 * a + 0.0002 * a ** 3:.9g}" for a in x]
+
+
+def write(path, rows):
+    path.write_text("displacement_mm,voltage_v\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_one_wrong_reading_is_left_out_with_one_warning(tmp_path, capsys):
+    # the issue's case: a clean cubic, 21 points, and one extra row `4,2.5` at the end
+    clean = write(tmp_path / "clean.csv", cubic_rows())
+    glitch = write(tmp_path / "glitch.csv", cubic_rows() + ["4,2.5"])
+    rc, _, err = run(["train", clean, "-o", tmp_path / "a.json"], capsys)
+    assert rc == 0 and "warning" not in err
+    rc, _, err = run(["train", glitch, "-o", tmp_path / "b.json"], capsys)
+    assert rc == 0
+    warned = [line for line in err.splitlines() if line.startswith("warning:")]
+    assert len(warned) == 1 and "line 23" in warned[0] and "noise units" in warned[0]
+    a, b = load_model(tmp_path / "a.json"), load_model(tmp_path / "b.json")
+    v = np.linspace(-2.5, 2.5, 2001)
+    assert np.max(np.abs(a.predict(v) - b.predict(v))) < 1e-6
+    assert b.training["outliers_left_out"][0]["line"] == "line 23"
+    assert b.training["positions_used"] == 21 and b.training["readings_used"] == 21
+
+
+def test_many_wrong_readings_are_refused(tmp_path, capsys):
+    rng = np.random.default_rng(1)
+    x = np.tile(np.linspace(-10.0, 10.0, 200), 2)
+    v = 7.0 * np.tanh(x / 9.0) + rng.normal(0.0, 1e-3, x.size)
+    v[rng.choice(x.size, 30, replace=False)] += 0.05      # 7.5 % of the readings, 50 sigma off
+    rows = [f"{a:.9g},{b:.9g}" for a, b in zip(x, v)]
+    rc, _, err = run(["train", write(tmp_path / "bad.csv", rows), "-o", tmp_path / "m.json"], capsys)
+    assert rc == 2 and err.startswith("error: ") and len(err.strip().splitlines()) == 1
+    assert "noise units" in err and "5 %" in err and "worst line" in err
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_converter_is_read_from_the_recordings_grid_and_gen_warns_for_another(tmp_path, capsys):
+    lsb = 20.0 / 2 ** 14
+    x = np.linspace(-10.0, 10.0, 81)
+    rng = np.random.default_rng(4)
+    v = np.round((7.0 * np.tanh(x / 9.0) + rng.normal(0, 1e-3, x.size)) / lsb) * lsb
+    path = tmp_path / "r.csv"
+    path.write_text("displacement_mm,voltage_v\n" + "".join(f"{a:.9g},{b:.9g}\n" for a, b in zip(x, v)))
+    rc, _, err = run(["train", path, "-o", tmp_path / "m.json"], capsys)
+    assert rc == 0, err
+    conv = json.loads((tmp_path / "m.json").read_text())["training"]["converter"]
+    assert conv["input_bits"] == 14 and abs(conv["input_lsb_v"] - lsb) < 1e-6 * lsb
+    rc, _, err = run(["gen", tmp_path / "m.json", "-o", tmp_path / "h12"], capsys)
+    assert rc == 0 and sum(line.startswith("warning:") and "14-bit" in line for line in err.splitlines()) == 1
+    rc, _, err = run(["gen", tmp_path / "m.json", "-o", tmp_path / "h14", "--input-bits", 14,
+                      "--input-lsb-v", f"{lsb:.9g}"], capsys)
+    assert rc == 0 and "14-bit converter" not in err
+
+
+def test_four_sweeps_train_and_their_repeats_give_the_noise(tmp_path, capsys):
+    # the issue's recording, smaller: two forward and two reverse sweeps, 0.8 mV noise, 14 bits
+    rng = np.random.default_rng(1)
+    x = np.linspace(-10.0, 10.0, 300)
+    xs = np.concatenate([x, x[::-1], x, x[::-1]])
+    d = np.concatenate([np.ones(300), -np.ones(300)] * 2)
+    lsb = 16.0 / 2 ** 14
+    v = np.round((7.0 * np.tanh(xs / 9.0) + rng.normal(0.0, 8e-4, xs.size)) / lsb) * lsb
+    path = tmp_path / "four.csv"
+    path.write_text("displacement_mm,voltage_v,direction\n"
+                    + "".join(f"{a:.9g},{b:.9g},{int(c)}\n" for a, b, c in zip(xs, v, d)))
+    rc, _, err = run(["train", path, "-o", tmp_path / "m.json"], capsys)
+    assert rc == 0, err
+    t = json.loads((tmp_path / "m.json").read_text())["training"]
+    assert t["readings_used"] == 1200 and t["positions_used"] == 300
+    assert "repeated readings" in t["noise_from"] and 6e-4 < t["noise_v"] < 1.1e-3
+    assert t["converter"]["input_bits"] == 14

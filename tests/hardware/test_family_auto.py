@@ -1,0 +1,47 @@
+"""flann gen --family --terms auto: terms chosen like train --terms auto, what sharing costs."""
+
+import json
+
+import numpy as np
+
+from flann.cli import main
+from flann.golden.family import FAMILY_SHARE, family_terms
+from flann.golden.train import fit_auto
+from flann.recordings import Recordings, write_recordings
+
+
+def s_curve_rec(amp, asym, seed, steps=150, lsb=2 * 3.6 / 2 ** 14):
+    x = np.linspace(-10.0, 10.0, steps)
+    xs = np.concatenate([x, x[::-1]])
+    u = xs / 7.0
+    v = amp * np.where(u >= 0, 1 + asym, 1 - asym) * u / (1 + np.abs(u) ** 2.5) ** 0.4
+    v = np.round((v + np.random.default_rng(seed).normal(0, 5e-4, xs.size)) / lsb) * lsb
+    return Recordings(displacement_mm=xs, voltage_v=v, direction=np.sign(np.gradient(xs)))
+
+
+def test_family_terms_keep_every_member_near_its_own_design():
+    recs = [s_curve_rec(3.0, 0.02, 1), s_curve_rec(3.1, -0.01, 2)]
+    terms, choices = family_terms([(str(i), r.voltage_v, r.displacement_mm) for i, r in enumerate(recs)],
+                                  norm="half", ridge=1e-6)
+    assert 2 <= terms <= max(c.own_terms for c in choices)
+    for c, r in zip(choices, recs):
+        # the member's own choice is what train --terms auto takes with the family's normalisation
+        _m, own = fit_auto(r.voltage_v, r.displacement_mm, norms=("half",),
+                           ridges=tuple(x for x in (1e-6, 1e-4, 1e-2, 1e-1, 1.0)))
+        assert c.own_terms == own.terms
+        assert c.family_rms_mm <= FAMILY_SHARE * c.own_rms_mm
+
+
+def test_gen_family_terms_auto_says_what_sharing_costs(tmp_path, capsys):
+    paths = []
+    for k, (amp, asym) in enumerate([(3.0, 0.02), (3.1, -0.01)]):
+        paths.append(tmp_path / f"m{k}.csv")
+        write_recordings(paths[-1], s_curve_rec(amp, asym, k))
+    rc = main(["gen", "--family", *map(str, paths), "--terms", "auto", "-o", str(tmp_path / "d"),
+               "--input-bits", "14"])
+    out = capsys.readouterr().out
+    assert rc == 0
+    man = json.loads((tmp_path / "d" / "manifest.json").read_text())
+    terms = man["family"]["terms"]
+    lines = [line for line in out.splitlines() if "own design" in line]
+    assert len(lines) == 2 and all(f"in the family {terms} terms" in line for line in lines)
