@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from ..errors import FlannError
 from ..hardware.family.build import DEFAULT_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN

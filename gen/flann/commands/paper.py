@@ -12,7 +12,7 @@ from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
 from ..golden.train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
 from ..golden import paper
-from ..hardware.accuracy import fixed_point_cost
+from ..hardware.fixed.cost import fixed_point_cost
 
 HELP = "reproduce the seed paper's tables and figures"
 

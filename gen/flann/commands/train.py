@@ -17,7 +17,7 @@ from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
 from ..golden.model import MAX_TERMS
-from ..hardware.accuracy import fixed_point_cost
+from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .train_thermal import compensation_hint, run_thermal
 

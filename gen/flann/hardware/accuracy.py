@@ -1,7 +1,7 @@
 """Hardware in view: what a model costs in fixed point, and how accurate the built design is.
 
-* :func:`fixed_point_cost` -- what ``flann train`` asks when it selects among candidate
-  models: can ``flann gen`` build it, and at what cost (LUT4 equivalents).
+* :func:`fixed_point_cost` (from :mod:`.fixed.cost`) -- what ``flann train`` asks when it
+  selects among candidate models: can ``flann gen`` build it, and at what cost.
 * :func:`design_spec` -- the :class:`Spec` of a generated design, rebuilt from the model and
   the design's ``manifest.json`` (and checked against it).
 * :func:`hardware_accuracy` -- the bit-true twin of that design on recordings (voltages
@@ -11,55 +11,17 @@
 
 from __future__ import annotations
 
-import math
-import warnings
 
 import numpy as np
 
-from ..errors import FlannError, SpecError
+from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
 from ..golden.model import FlannModel
-from .adc import MAX_DESIGN_INPUT_BITS
 from .registry import read_design
-from .fixed.spec import Spec, derive_spec
+from .fixed.cost import fixed_point_cost
+from .fixed.spec import Spec
 from .fixed.twin import FlannTop
-
-COST_BITS = (MAX_DESIGN_INPUT_BITS, 12)   # a model must build at the default and the widest ADC
-MAX_BOUND_LSB = 1.0   # worst-case |hardware - float model| at the default widths, output LSB
-
-
-def fixed_point_cost(model: FlannModel, adc: tuple[int, float | None] | None = None) -> dict:
-    """Cost of the model in fixed point at the generator's defaults, and whether it builds.
-
-    ``cost`` is the estimated LUT4 count + the weight ROM in LUT4 equivalents (16 bits each)
-    + 64 per block RAM: it grows with the weights' dynamic range (weight and term widths)
-    and with the number of terms.  ``buildable`` is False when ``flann gen`` would refuse the
-    model at 16 or at 12 input bits, or when the widths it allows cannot hold the hardware
-    within one output LSB of the float model (capped table or term widths: the model's
-    accuracy would be lost in the datapath); the reason is in ``why``.  ``adc`` = (bits, volts
-    per code or None for the default): judged at that converter only (the user's).
-    """
-    spec = None
-    for bits, lsb in ([adc] if adc is not None else [(b, None) for b in COST_BITS]):
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                spec = derive_spec(model, input_bits=bits, input_lsb_v=lsb)
-        except SpecError as exc:
-            return {"buildable": False, "why": f"{bits}-bit input: {exc}", "cost": math.inf}
-        if spec.analysis["bound_total_lsb"] > MAX_BOUND_LSB:
-            return {"buildable": False, "cost": math.inf,
-                    "why": f"{bits}-bit input: the default widths bound |hardware - float model| by "
-                           f"{spec.analysis['bound_total_lsb']:.3g} output LSB (> {MAX_BOUND_LSB:g})"}
-    est = spec.analysis["estimate"]
-    rom_luts = math.ceil(spec.steps * spec.weight_fmt.width / 16)
-    return {"buildable": True, "why": "",
-            "cost": float(est["luts"] + rom_luts + 64 * est["brams"]), "luts": est["luts"],
-            "brams": est["brams"], "weight_bits": spec.weight_fmt.width,
-            "term_bits": spec.term_fmt.width, "phase_bits": spec.phase_bits,
-            "output_lsb_mm": spec.output_lsb_mm, "cycles_per_sample": spec.cycles_per_sample}
-
 
 # -- a generated design, rebuilt ---------------------------------------------------------
 def design_spec(model_path, design_dir) -> Spec:

@@ -41,7 +41,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
-from ..hardware.accuracy import fixed_point_cost
+from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, read_design

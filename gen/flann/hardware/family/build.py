@@ -12,7 +12,7 @@ from ...errors import FlannError
 from ...golden.model import FlannModel, load_model
 from ...golden.family import family_terms
 from ...golden.train import fit_lstsq
-from ..accuracy import fixed_point_cost
+from ..fixed.cost import fixed_point_cost
 from ...recordings import prepare_for_fit, read_recordings
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
