@@ -36,11 +36,11 @@ def run(args) -> int:
     if args.family is not None or args.model is None:
         check_family_args(args)
         dp, source, extra = FAMILY, args.family, {"terms": args.terms, "margin": args.margin}
+    else:
+        dp, source, extra = datapath(args.format), args.model, {}
         other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)
         if other:
             warnings.warn(other)
-    else:
-        dp, source, extra = datapath(args.format), args.model, {}
     replacing = is_design(args.out)
     man = dp.generate(source, args.out, opts, **extra)
     if replacing:
