@@ -78,8 +78,14 @@ def _one_line_warnings() -> None:
     warnings.showwarning = show
 
 
+# Ctrl-C seen by our handler; a library that imports an optional module inside
+# ``try/except ImportError`` can swallow the KeyboardInterrupt, so the flag is checked again
+# once the command's modules are in.
+_interrupted: list[int] = []
+
+
 def main(argv: list[str] | None = None) -> int:
-    interrupted = []
+    interrupted = _interrupted
 
     def on_sigint(signum, frame):
         interrupted.append(signum)
@@ -115,6 +121,8 @@ def _main(argv: list[str] | None) -> int:
         parser.print_help()
         return 2
     _one_line_warnings()
+    if _interrupted:   # swallowed while the command's modules imported
+        raise KeyboardInterrupt
     try:
         with guarding_inputs():   # no output of this command overwrites one of its inputs
             code = int(_load(args.command).run(args) or 0)
