@@ -68,7 +68,7 @@ COMMANDS = {
 }
 # (datapath, command) that refuse, with a word the one line must hold
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map", ("family", "explore"): "members",
-           **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore")},
+           **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
            # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
            ("seed", "synth"): "does not fit"}
 

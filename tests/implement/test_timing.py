@@ -82,10 +82,16 @@ def test_block_ram_output_is_a_start_point(tmp_path):
     assert t.delay_ns > plain.delay_ns  # block RAM clock-to-out is slower than a flip-flop's
 
 
-def test_loop_and_unknown_cell_are_errors(tmp_path):
+def test_structural_loop_is_left_out_and_counted(tmp_path):
+    """abc can close a loop that is logically open (a swap's comparator reading the muxed
+    operands); the walk leaves the closing edge out, says so, and times the rest."""
     loop = [_ff(2, 10), ("LUT2", {"I0": [10], "I1": [12], "O": [11]}), ("LUT1", {"I0": [11], "O": [12]}), _ff(12, 3)]
-    with pytest.raises(FlannError, match="combinational loop"):
-        analyse(_netlist(tmp_path, loop), PART5)
+    t = analyse(_netlist(tmp_path, loop), PART5)
+    assert t.loops_broken == 1 and t.logic_levels == 2
+    assert "1 structural loop" in t.method()
+
+
+def test_unknown_cell_is_an_error(tmp_path):
     with pytest.raises(FlannError, match="no delay model for cell type DSP48"):
         analyse(_netlist(tmp_path, [_ff(2, 10), ("DSP48", {"A": [10], "O": [99]}), _ff(99, 3)]), PART5)
 

@@ -131,6 +131,7 @@ class Datapath:
     why_no_explore: str = ""           # empty: flann explore DIR explores the model the design keeps
     why_no_bench: str = ""
     why_no_stages: str = ""
+    why_no_ise: str = ""               # empty: flann ise writes a project for it
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
     derive_options: Callable | None = None  # (GenOptions, compared) -> keyword arguments of its derive
     netlist: bool = False              # its mapped netlist can be simulated over every code (flann_top's ports)

@@ -151,7 +151,10 @@ def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
 
 def check_fits(man, dp, part, force: bool = False) -> None:
     """Refuse (one line naming the smallest part that fits) a part the design's resource
-    estimate exceeds, unless ``force``; a datapath without an estimate is not checked."""
+    estimate exceeds, unless ``force``; a datapath without an estimate is not checked, one
+    without an ISE handoff is refused."""
+    if dp.why_no_ise:
+        raise FlannError(f"{man.directory}: {dp.why_no_ise}")
     est = dp.estimate(man)
     if est is None or force:
         return

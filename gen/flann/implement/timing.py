@@ -86,6 +86,7 @@ class Timing:
     routed_nets: int
     start: str
     end: str
+    loops_broken: int = 0  # structural loops of the mapped netlist left out of the walk
 
     @property
     def fmax_mhz(self) -> float:
@@ -99,7 +100,9 @@ class Timing:
         return (f"longest register-to-register path of the Yosys-mapped netlist: TCKO {g.tcko} + "
                 f"TILO {g.tilo} per LUT level + {ROUTE_NS} ns routing allowance per routed net + "
                 f"{g.carry_bit} ns per carry bit + setup (speed grade -{self.grade}; CLB figures from "
-                f"{SOURCE}; carry and block RAM figures assumed; estimate, not place and route)")
+                f"{SOURCE}; carry and block RAM figures assumed; estimate, not place and route"
+                + (f"; {self.loops_broken} structural loop(s) of abc's logic sharing left out" if self.loops_broken
+                   else "") + ")")
 
     def to_dict(self, clock_hz: float = CLOCK_HZ) -> dict:
         return {
@@ -114,6 +117,7 @@ class Timing:
             "meets_clock": self.meets(clock_hz),
             "from": self.start,
             "to": self.end,
+            "loops_broken": self.loops_broken,
         }
 
 
@@ -212,6 +216,13 @@ def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Tim
                     edges[b].append((o, delay + (ROUTE_NS if routed else 0.0), t in _LUTS, t == "MUXCY", routed))
                     indeg[o] += 1
 
+    # abc's logic sharing can close a structural loop that is logically open (the comparator of a
+    # swap reading its own muxed operands: x xor y = max xor min); yosys check refuses real ones.
+    # Such edges are left out so the walk stays a DAG; how many is part of the result.
+    back = _back_edges(edges)
+    for b, k in back:
+        indeg[edges[b][k][0]] -= 1
+    edges = {b: [e for k, e in enumerate(es) if (b, k) not in back] for b, es in edges.items()}
     # longest arrival per bit (Kahn order); bits with no register upstream never become reachable
     nodes = set(edges) | set(indeg) | set(sources)
     arrival: dict[int, float] = {b: d for b, d in sources.items()}
@@ -250,7 +261,36 @@ def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Tim
         carry += is_carry
         nets += r
     names = _bit_names(mod)
-    return Timing(part.speed, total, levels, carry, nets, names.get(b, f"bit {b}"), names.get(bit, end))
+    return Timing(part.speed, total, levels, carry, nets, names.get(b, f"bit {b}"), names.get(bit, end),
+                  len(back))
+
+
+def _back_edges(edges: dict) -> set[tuple[int, int]]:
+    """(bit, edge index) of every edge that closes a cycle in a depth-first walk (iterative:
+    carry chains are thousands of bits deep)."""
+    state: dict[int, int] = {}   # 1 on the stack, 2 done
+    back = set()
+    for root in list(edges):
+        if root in state:
+            continue
+        state[root] = 1
+        stack = [(root, 0)]
+        while stack:
+            b, k = stack[-1]
+            es = edges.get(b, ())
+            if k == len(es):
+                state[b] = 2
+                stack.pop()
+                continue
+            stack[-1] = (b, k + 1)
+            o = es[k][0]
+            s = state.get(o)
+            if s == 1:
+                back.add((b, k))
+            elif s is None:
+                state[o] = 1
+                stack.append((o, 0))
+    return back
 
 
 def _bit_names(mod: dict) -> dict[int, str]:

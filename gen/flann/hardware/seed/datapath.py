@@ -29,6 +29,7 @@ DATAPATH = Datapath(
     fields=(_num("output_lsb_mm", 0), _int("spec.terms")), model_field="",
     why_no_bench=WHY.format("simulation bench"), why_no_eval=WHY.format("twin rebuilt from a directory"),
     why_no_explore=WHY.format("model kept in its directory"), why_no_stages=WHY.format("stage model for flann trace"),
+    why_no_ise=WHY.format("ISE handoff (its parallel multipliers exceed every Spartan-II)"),
 )
 
 __all__ = ["DATAPATH"]
