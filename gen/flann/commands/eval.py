@@ -11,7 +11,8 @@ import json
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
 from ..errors import FlannError
-from ..golden.model import load_model
+from ..golden.thermal import is_thermal, load_any_model
+from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
 from ..recordings import read_recordings
 from .predict import predict_clamped, warn_outside_range
@@ -49,10 +50,15 @@ def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm
     fs = full_scale_mm(rec.displacement_mm) if fs_mm is None else float(fs_mm)
     x = rec.displacement_mm
     # outside the trained range the voltage is clamped, as the hardware does
-    compensated = error_report(predict_clamped(model, rec.voltage_v)[0], x, tol, band, fs, rec.direction)
-    raw = error_report(raw_output_mm(rec.voltage_v, x), x, tol, band, fs, rec.direction)
-    return {"points": len(rec), "full_scale_mm": fs, "tolerance_pct_fs": tol,
-            "band_pct_fs": band, "compensated": compensated, "raw": raw}
+    predicted = predict_clamped(model, rec.voltage_v, rec.temperature_c)[0]
+    compensated = error_report(predicted, x, tol, band, fs, rec.direction)
+    raw_mm = raw_output_mm(rec.voltage_v, x)
+    raw = error_report(raw_mm, x, tol, band, fs, rec.direction)
+    res = {"points": len(rec), "full_scale_mm": fs, "tolerance_pct_fs": tol,
+           "band_pct_fs": band, "compensated": compensated, "raw": raw}
+    if rec.temperature_c is not None:
+        res["_errors"] = {"raw": raw_mm - x, "float": predicted - x}
+    return res
 
 
 def run(args) -> int:
@@ -60,21 +66,35 @@ def run(args) -> int:
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
-    model = load_model(args.model)
+    model = load_any_model(args.model)
     rec = read_recordings(args.recordings)
-    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False)
+    if is_thermal(model) and rec.temperature_c is None:
+        raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
+                         "the recordings need a temperature_c column")
+    if is_thermal(model) and args.design:
+        raise FlannError(f"{args.model}: a two-input model has no generated design yet: "
+                         "evaluate it without --design")
+    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
+                       temperature_c=rec.temperature_c)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
+    errors = res.pop("_errors", None)
     if args.design:
         spec = design_spec(args.model, args.design)
         hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
                                adc=design_adc(args.design))
         pts = hw.pop("_points")
         res["hardware"] = hw
+        if errors is not None:
+            errors["hardware"] = pts["hardware"]
         if args.plot:
             raw = raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm
             plot_errors(args.plot, pts["x"], raw, pts["float"], pts["hardware"], pts["limit"],
                         title=f"{rec.source}: error vs displacement ({spec.input_bits}-bit ADC, "
                               f"{spec.output_lsb_mm:g} mm output LSB)")
+    if errors is not None:
+        errors.setdefault("hardware", None)
+        res.update(temperature_report(errors, rec.displacement_mm, rec.temperature_c,
+                                      res["full_scale_mm"]))
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
@@ -106,6 +126,13 @@ def run(args) -> int:
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
               f"max error / limit: hardware {hw['ratio_to_limit']:.2f}, float "
               f"{hw['float_ratio_to_limit']:.2f}")
+    if errors is not None and len(res["by_temperature"]["raw"]) > 1:
+        drift = res["drift_ppm_fs_per_c"]
+        print("by temperature (max error mm): " + "; ".join(
+            f"{r['temperature_c']:g} degC raw {r['max_error_mm']:.4g}, compensated {c['max_error_mm']:.4g}"
+            for r, c in zip(res["by_temperature"]["raw"], res["by_temperature"]["float"])))
+        print("drift (ppm FS/degC): " + ", ".join(
+            f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
     if args.plot:
         print(f"plot: {args.plot}")
     return 0

@@ -15,7 +15,8 @@ import warnings
 import numpy as np
 
 from ..fileio import atomic_write_text
-from ..golden.model import load_model
+from ..errors import FlannError
+from ..golden.thermal import is_thermal, load_any_model
 from ..recordings import read_recordings
 
 HELP = "apply a model to recordings"
@@ -30,40 +31,62 @@ def add_arguments(p) -> None:
                         "to it as the hardware does")
 
 
-def outside_range(model, voltage_v) -> np.ndarray:
+def outside_range(model, voltage_v, temperature_c=None) -> np.ndarray:
+    if is_thermal(model):
+        return model.clamp(voltage_v, temperature_c)[2]
     lo, hi = sorted(model.voltage_range_v)
     v = np.asarray(voltage_v, dtype=float)
     return (v < lo) | (v > hi)
 
 
-def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True) -> None:
-    outside = outside_range(model, voltage_v)
+def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
+                       temperature_c=None) -> None:
+    outside = outside_range(model, voltage_v, temperature_c)
     if outside.any():
         lo, hi = sorted(model.voltage_range_v)
         what = "extrapolated" if extrapolated else "clamped to the range as the hardware does (column clamped = 1)"
-        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} voltages outside the "
-                      f"model's trained range [{lo:g}, {hi:g}] V: {what}", stacklevel=2)
+        where, items = f"[{lo:g}, {hi:g}] V", "voltages"
+        if is_thermal(model):
+            tlo, thi = sorted(model.temperature_range_c)
+            where, items = where + f" or calibrated temperatures [{tlo:g}, {thi:g}] degC", "readings"
+        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} {items} outside the "
+                      f"model's trained range {where}: {what}", stacklevel=2)
 
 
-def predict_clamped(model, voltage_v) -> tuple[np.ndarray, np.ndarray]:
-    """(displacement mm, clamped flags): the voltage clamped to the trained range first."""
+def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement mm, clamped flags): the voltage (and a two-input model's temperature)
+    clamped to the trained range first."""
+    if is_thermal(model):
+        v, t, outside = model.clamp(voltage_v, temperature_c)
+        return model.predict(v, t), outside
     lo, hi = sorted(model.voltage_range_v)
     v = np.asarray(voltage_v, dtype=float)
     return model.predict(np.clip(v, lo, hi)), outside_range(model, v)
 
 
+def _predict_unclamped(model, voltage_v, temperature_c):
+    return model.predict(voltage_v, temperature_c) if is_thermal(model) else model.predict(voltage_v)
+
+
 def run(args) -> int:
-    model = load_model(args.model)
+    model = load_any_model(args.model)
     rec = read_recordings(args.recordings, required=("voltage_v",))
-    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=args.extrapolate)
+    temp = rec.temperature_c
+    if is_thermal(model) and temp is None:
+        raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
+                         "the recordings need a temperature_c column")
+    warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=args.extrapolate,
+                       temperature_c=temp)
     cols = {"voltage_v": rec.voltage_v}
+    if is_thermal(model):
+        cols["temperature_c"] = temp
     if rec.displacement_mm is not None:
         cols["displacement_mm"] = rec.displacement_mm
     if args.extrapolate:
-        cols["predicted_mm"] = model.predict(rec.voltage_v)
+        cols["predicted_mm"] = _predict_unclamped(model, rec.voltage_v, temp)
         flags = None
     else:
-        cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v)
+        cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v, temp)
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     w.writerow(list(cols) + (["clamped"] if flags is not None else []))

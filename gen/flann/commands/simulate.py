@@ -1,7 +1,8 @@
 """``flann simulate``: LVDT physics simulator (recordings from a sensor file) and calibration.
 
     flann simulate [SENSOR.toml] -o recordings.csv [--sweeps N] [--step-mm S] [--noise-v SIGMA]
-                   [--seed K] [--temperature-profile SPEC] [--from-mm A --to-mm B] [--plot P.png]
+                   [--seed K] [--temperature-profile SPEC | --temperatures T1,T2,...]
+                   [--from-mm A --to-mm B] [--plot P.png]
     flann simulate --fit RECORDINGS.csv [SENSOR.toml] [--params a,b,...] [--write-sensor OUT.toml]
                    [--json OUT.json] [--plot P.png]
 
@@ -10,6 +11,7 @@ Without SENSOR.toml the seed paper's LVDT (data/sensors/paper_lvdt.toml) is used
 
 from __future__ import annotations
 
+import re
 import sys
 import warnings
 
@@ -19,13 +21,20 @@ from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
 from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
 from ..physics.lvdt import describe
 from ..physics.sensor import default_sensor, format_sensor, load_sensor
-from ..physics.simulate import fold_back_mm, simulate_recordings
+from ..physics.simulate import (fold_back_mm, parse_temperatures, simulate_calibration,
+                                simulate_recordings)
 from ..recordings import read_recordings, write_recordings
 
 HELP = "LVDT physics simulator: write recordings from a sensor file"
 
 
+# "--temperatures -20,0,25" : a value that starts with a minus sign and a digit is a
+# value, not an option (argparse only knows single negative numbers)
+_NEGATIVE_VALUE = re.compile(r"^-\d[\d.,eE+-]*$")
+
+
 def add_arguments(p) -> None:
+    p._negative_number_matcher = _NEGATIVE_VALUE
     p.add_argument("sensor", nargs="?", default=None,
                    help="sensor TOML (default: the seed paper's LVDT)")
     p.add_argument("-o", "--output", help="recordings CSV to write (simulation mode)")
@@ -44,6 +53,10 @@ def add_arguments(p) -> None:
     p.add_argument("--temperature-profile", default="const:20",
                    help="const:T | ramp:T0:T1 (over the run) | sine:MEAN:AMP:PERIOD_S "
                         "(degC; default const:20)")
+    p.add_argument("--temperatures", default=None, metavar="T1,T2,...",
+                   help="a calibration at several temperatures: the sweeps at each of these "
+                        "(degC, e.g. -20,0,25,50,80) in turn, the sensor soaked at each; "
+                        "replaces --temperature-profile")
     p.add_argument("--no-effects", action="store_true",
                    help="ignore the sensor file's [effects] (ideal sensor)")
     p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
@@ -116,9 +129,19 @@ def run(args) -> int:
         s = s.without_effects()
     lo = -s.stroke_mm if args.from_mm is None else args.from_mm
     hi = s.stroke_mm if args.to_mm is None else args.to_mm
-    rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
-                              seed=args.seed, temperature_profile=args.temperature_profile,
-                              travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=True)
+    if args.temperatures is not None:
+        if args.temperature_profile != "const:20":
+            raise FlannError("simulate: give either --temperatures or --temperature-profile")
+        temps = parse_temperatures(args.temperatures)
+        rec = simulate_calibration(s, temps, sweeps=args.sweeps, step_mm=args.step_mm,
+                                   noise_v=args.noise_v, seed=args.seed, travel_mm=(lo, hi),
+                                   step_time_s=args.step_time_s, progress=True)
+        temperature = "calibration at " + ", ".join(f"{t:g}" for t in temps) + " degC"
+    else:
+        rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
+                                  seed=args.seed, temperature_profile=args.temperature_profile,
+                                  travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=True)
+        temperature = args.temperature_profile
     fold = fold_back_mm(s, (lo, hi))
     if fold is not None:
         warnings.warn(f"travel {lo:g}..{hi:g} mm goes past |x| = {fold:.1f} mm where the output "
@@ -129,7 +152,7 @@ def run(args) -> int:
         f"simulated by flann simulate: sensor {s.name} ({args.sensor or 'default'})",
         f"travel {lo:g}..{hi:g} mm, step {args.step_mm:g} mm, sweeps {args.sweeps}, "
         f"step time {args.step_time_s:g} s, noise {args.noise_v:g} V rms, seed {args.seed}, "
-        f"temperature {args.temperature_profile}",
+        f"temperature {temperature}",
         f"effects: {effects}",
     )
     if args.plot:

@@ -16,6 +16,7 @@ from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_
 from ..errors import SpecError
 from ..hardware.accuracy import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
+from .train_thermal import compensation_hint, run_thermal
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -55,6 +56,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="explicit normalisation scale (V); needs --input-offset-v")
     p.add_argument("--trim", action="store_true",
                    help="keep only the monotonic span when the voltage folds back")
+    p.add_argument("--temperature", action="store_true",
+                   help="a two-input model x(voltage, temperature) from a calibration at several "
+                        "temperatures (the temperature_c column; docs/temperature.md)")
 
 
 def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
@@ -79,6 +83,11 @@ def _check_generatable(model) -> None:
 
 def run(args) -> int:
     rec = read_recordings(args.recordings)
+    if args.temperature:
+        return run_thermal(args, rec)
+    hint = compensation_hint(rec)
+    if hint:   # before the checks: a multi-temperature recording may not pass them as one
+        print(hint, file=sys.stderr)
     rec = prepare_for_fit(rec, trim=args.trim)
     explicit = None
     if (args.input_offset_v is None) != (args.input_scale_v is None):

@@ -94,9 +94,26 @@ SPECS: dict[str, EffectSpec] = {
                "position-dependent inductance and resistance divide the e.m.f. (gain and phase)",
                "v_d *= R_L / (R_L + 2 R_s + j w L_loop(core))",
                (Param("load_ohm", "ohm", 100e3, _I, 1e-3, _I, "load resistance"),)),
+        EffectSpec("thermal_construction", "transformer",
+               "temperature from the construction: copper windings (+0.393 %/degC) against the "
+               "source and load impedances, the core's permeability, and the secondaries' "
+               "balance drifting apart",
+               "R_p, R_s *= 1 + copper_tempco_per_c dT;  Ip = V / (source_ohm + R_p + j w Lp(mu)); "
+               "mu_r *= 1 + permeability_tempco_per_c dT;  v1 *= 1 + e/2, v2 *= 1 - e/2 with "
+               "e = balance_drift_per_c dT;  dT = T - reference_temperature_c",
+               (Param("reference_temperature_c", "degC", 20.0, 20.0, -273.15, 1e3,
+                      "temperature of the sensor file's resistances and permeability"),
+                Param("copper_tempco_per_c", "1/degC", 0.00393, 0.0, -0.1, 0.1,
+                      "winding resistance temperature coefficient (copper: 0.00393 at 20 degC)"),
+                Param("source_resistance_ohm", "ohm", 0.0, 0.0, 0.0, 1e7,
+                      "excitation source output resistance in series with the primary "
+                      "(not heated with the sensor)"),
+                Param("permeability_tempco_per_c", "1/degC", 0.0002, 0.0, -0.1, 0.1,
+                      "relative change of the core's permeability per degC"),
+                Param("balance_drift_per_c", "1/degC", 2e-6, 0.0, -0.01, 0.01,
+                      "change per degC of the coupling mismatch of secondary 1 over 2"))),
     )
 }
-
 
 
 def validate_effects(effects: Mapping[str, Mapping[str, float]], source: str = "<memory>") -> None:

@@ -4,7 +4,8 @@ Public API (stable; ``flann diagnose`` uses the same catalogue):
 
 * :data:`EFFECTS` -- ordered ``name -> Effect``.  Names (exact): ``null_offset``,
   ``quadrature_null``, ``zero_shift``, ``secondary_imbalance``, ``backlash``,
-  ``thermal_drift``, ``adc_clipping``, ``leadscrew_periodic``, ``secondary_loading``.
+  ``thermal_drift``, ``adc_clipping``, ``leadscrew_periodic``, ``secondary_loading``,
+  ``thermal_construction``.
 * :class:`Effect`: ``name``, ``stage``, ``description`` (one line of physics), ``params``
   (tuple of :class:`Param`: ``name`` with unit suffix, ``unit``, ``default`` (a typical
   size), ``neutral`` (the value at which the effect does nothing), ``lower``/``upper``
@@ -22,7 +23,8 @@ Stages, applied in this order by :func:`flann.physics.simulate.simulate_output_v
 2. ``transformer`` -- on the primary drive and the secondaries (thermal_drift:
    ``drive_scale``; secondary_imbalance: ``s1_scale``/``s2_scale``; secondary_loading:
    ``load_ohm``; quadrature_null: ``quadrature_v``, output-referred, seen only by the
-   amplitude detector).
+   amplitude detector; thermal_construction: ``resistance_scale``, ``source_ohm``,
+   ``permeability_scale`` and the secondaries' balance).
 3. the magnetics and the demodulator (:mod:`flann.physics.lvdt`) -> ``output_v``.
 4. ``output`` -- on the demodulated volts (null_offset, then adc_clipping last).
 
@@ -39,6 +41,9 @@ y = output, y0(x) = ideal output, v1/v2 = secondary e.m.f.s, G = demodulator gai
 * adc_clipping:       y = clip(y, -rail_v, +rail_v)
 * leadscrew_periodic: core = x + a sin(2 pi x / period_mm + phase_rad)
 * secondary_loading:  v_d -> v_d R_L / (R_L + 2 R_s + j w L_loop(core))
+* thermal_construction: dT = T - T_ref; R_p, R_s *= 1 + a_cu dT (copper); Ip = V / (R_src +
+                      R_p + j w Lp); core mu_r *= 1 + a_mu dT (inductances recomputed);
+                      v1 *= 1 + e/2, v2 *= 1 - e/2 with e = balance_drift_per_c dT
 """
 
 from __future__ import annotations
@@ -75,6 +80,9 @@ class Signal:
     s2_scale: np.ndarray | float = 1.0
     quadrature_v: np.ndarray | float = 0.0
     load_ohm: float = math.inf
+    resistance_scale: np.ndarray | float = 1.0     # winding resistances (copper, heated)
+    source_ohm: float = 0.0                        # excitation source resistance
+    permeability_scale: np.ndarray | float = 1.0   # core relative permeability
     output_v: np.ndarray | None = None
 
 
@@ -129,6 +137,17 @@ def _thermal(p, ctx, sig):
     return _rep(sig, drive_scale=sig.drive_scale * scale)
 
 
+def _construction(p, ctx, sig):
+    if ctx.temperature_c is None:
+        return sig
+    dt = ctx.temperature_c - p["reference_temperature_c"]
+    e = p["balance_drift_per_c"] * dt
+    return _rep(sig, resistance_scale=sig.resistance_scale * (1.0 + p["copper_tempco_per_c"] * dt),
+                source_ohm=sig.source_ohm + p["source_resistance_ohm"],
+                permeability_scale=sig.permeability_scale * (1.0 + p["permeability_tempco_per_c"] * dt),
+                s1_scale=sig.s1_scale * (1 + e / 2), s2_scale=sig.s2_scale * (1 - e / 2))
+
+
 def _imbalance(p, ctx, sig):
     e = p["imbalance_fraction"]
     return _rep(sig, s1_scale=sig.s1_scale * (1 + e / 2), s2_scale=sig.s2_scale * (1 - e / 2))
@@ -155,7 +174,7 @@ def _clipping(p, ctx, sig):
 _APPLY = {"null_offset": _null_offset, "quadrature_null": _quadrature, "zero_shift": _zero_shift,
           "secondary_imbalance": _imbalance, "backlash": _backlash, "thermal_drift": _thermal,
           "adc_clipping": _clipping, "leadscrew_periodic": _leadscrew,
-          "secondary_loading": _loading}
+          "secondary_loading": _loading, "thermal_construction": _construction}
 EFFECTS: dict[str, Effect] = {
     spec.name: Effect(spec.name, spec.stage, spec.description, spec.formula, spec.params,
                       _APPLY[spec.name])

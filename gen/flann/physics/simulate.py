@@ -16,12 +16,16 @@ Public API (stable):
   :class:`flann.recordings.Recordings` with direction, time_s and temperature_c columns,
   reproducible from ``seed``.
 * :func:`parse_temperature_profile` ("20", "const:20", "ramp:20:45", "sine:25:5:600").
+* :func:`simulate_calibration` (sensor, temperatures, ...) -> the sweeps of
+  :func:`simulate_recordings` at each temperature in turn, one recording (``--temperatures``);
+  :func:`parse_temperatures` ("-20,0,25,50,80").
 * :func:`fold_back_mm` (sensor, travel) -> the first |displacement| in the travel beyond which
   the ideal output stops rising (the core leaving the secondaries), or None.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from typing import Callable
@@ -70,15 +74,48 @@ def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=
     return np.asarray(sig.output_v, dtype=float)
 
 
+# Above this many distinct permeabilities (a temperature ramp) the inductances are
+# interpolated (quadratically) between this many exact solutions spanning them.
+_MU_NODES = 16
+
+
+def _inductances(s: Sensor, core_mm, permeability_scale, loop: bool) -> tuple[np.ndarray, ...]:
+    """inductances_h with the core's permeability scaled per sample (thermal_construction)."""
+    core = np.asarray(core_mm, dtype=float)
+    scale = np.broadcast_to(np.asarray(permeability_scale, dtype=float), core.shape)
+    levels = np.unique(scale)
+    if levels.size == 1:
+        if levels[0] == 1.0:
+            return inductances_h(s, core, loop=loop)
+        return inductances_h(s.replace(core_permeability_ratio=max(
+            1.0, s.core_permeability_ratio * float(levels[0]))), core, loop=loop)
+    nodes = levels if levels.size <= _MU_NODES else np.linspace(levels[0], levels[-1], _MU_NODES)
+    at = [inductances_h(s.replace(core_permeability_ratio=max(1.0, s.core_permeability_ratio * float(k))),
+                        core, loop=loop) for k in nodes]
+    # quadratic (Lagrange) through the three nearest nodes: the inductances curve with mu
+    lo = np.clip(np.searchsorted(nodes, scale) - 2, 0, nodes.size - 3)
+    n0, n1, n2 = nodes[lo], nodes[lo + 1], nodes[lo + 2]
+    weights = ((scale - n1) * (scale - n2) / ((n0 - n1) * (n0 - n2)),
+               (scale - n0) * (scale - n2) / ((n1 - n0) * (n1 - n2)),
+               (scale - n0) * (scale - n1) / ((n2 - n0) * (n2 - n1)))
+    out = []
+    for k in range(len(at[0])):
+        stack = np.stack([np.broadcast_to(a[k], core.shape) for a in at])   # (nodes, *shape)
+        out.append(sum(w * np.take_along_axis(stack, (lo + j)[None], 0)[0]
+                       for j, w in enumerate(weights)))
+    return tuple(out)
+
+
 def _transformer(s: Sensor, sig: Signal) -> Signal:
     """Magnetics, primary circuit, (loaded) secondaries and demodulator -> output_v."""
     loaded = math.isfinite(sig.load_ohm)
-    m1, m2, lp, *rest = inductances_h(s, sig.core_mm, loop=loaded)
+    m1, m2, lp, *rest = _inductances(s, sig.core_mm, sig.permeability_scale, loaded)
     w = s.omega_rad_s
     m_diff = sig.s1_scale * m1 - sig.s2_scale * m2
-    z_primary = s.primary_resistance_ohm + 1j * w * lp
+    z_primary = sig.source_ohm + s.primary_resistance_ohm * sig.resistance_scale + 1j * w * lp
     if loaded:
-        z_loop = sig.load_ohm + 2 * s.secondary_resistance_ohm + 1j * w * rest[0]
+        z_loop = (sig.load_ohm + 2 * s.secondary_resistance_ohm * sig.resistance_scale
+                  + 1j * w * rest[0])
         # Secondary current reflects an impedance (w M)^2 / Z_loop into the primary.
         z_primary = z_primary + (w * m_diff) ** 2 / z_loop
     i_p = s.excitation_peak_v * sig.drive_scale / z_primary
@@ -86,9 +123,7 @@ def _transformer(s: Sensor, sig: Signal) -> Signal:
     if loaded:
         v_diff = v_diff * (sig.load_ohm / z_loop)
     out = demodulate_v(s, v_diff, quadrature_v=sig.quadrature_v)
-    return Signal(core_mm=sig.core_mm, drive_scale=sig.drive_scale, s1_scale=sig.s1_scale,
-                  s2_scale=sig.s2_scale, quadrature_v=sig.quadrature_v, load_ohm=sig.load_ohm,
-                  output_v=out)
+    return dataclasses.replace(sig, output_v=out)
 
 
 def contributions_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
@@ -213,6 +248,52 @@ def simulate_recordings(s: Sensor, sweeps: int = 1, step_mm: float = 1.0, noise_
         y = y + rng.normal(0.0, noise_v, size=y.shape)
     y = adc_convert(s, y)
     return Recordings(displacement_mm=x, voltage_v=y, direction=d, time_s=t, temperature_c=temp,
+                      source=f"simulate:{s.name}")
+
+
+MAX_TEMPERATURES = 64
+
+
+def parse_temperatures(text: str) -> tuple[float, ...]:
+    """``"-20,0,25,50,80"`` -> (-20.0, 0.0, 25.0, 50.0, 80.0): distinct, >= -273.15 degC."""
+    try:
+        temps = tuple(float(t) for t in str(text).split(",") if t.strip())
+    except ValueError:
+        raise FlannError(f"--temperatures {text!r}: expected comma-separated degC, "
+                         "e.g. -20,0,25,50,80") from None
+    if not temps or len(temps) > MAX_TEMPERATURES:
+        raise FlannError(f"--temperatures {text!r}: give 1 to {MAX_TEMPERATURES} temperatures")
+    if not all(math.isfinite(t) and t >= -273.15 for t in temps):
+        raise FlannError(f"--temperatures {text!r}: temperatures must be finite and >= -273.15 degC")
+    if len(set(temps)) != len(temps):
+        raise FlannError(f"--temperatures {text!r}: a temperature is repeated")
+    return temps
+
+
+def simulate_calibration(s: Sensor, temperatures, sweeps: int = 1, step_mm: float = 1.0,
+                         noise_v: float = 0.0, seed: int = 0,
+                         travel_mm: tuple[float, float] | None = None,
+                         step_time_s: float = 1.0, progress: bool = False) -> Recordings:
+    """A calibration at several temperatures: at each (in the order given, the sensor soaked
+    at it) the sweeps of :func:`simulate_recordings`, one after the other in one recording.
+    The noise of temperature k is drawn from ``seed + k``; time runs on across them."""
+    parts = []
+    t0 = 0.0
+    for k, temp in enumerate(temperatures):
+        rec = simulate_recordings(s, sweeps=sweeps, step_mm=step_mm, noise_v=noise_v,
+                                  seed=seed + k, temperature_profile=f"const:{float(temp)!r}",
+                                  travel_mm=travel_mm, step_time_s=step_time_s, progress=progress)
+        parts.append((rec, t0))
+        t0 += step_time_s * len(rec)
+    if sum(len(r) for r, _ in parts) > MAX_SAMPLES:
+        raise FlannError(f"{len(parts)} temperatures x {len(parts[0][0])} samples is more than "
+                         f"{MAX_SAMPLES} samples")
+    cat = np.concatenate
+    return Recordings(displacement_mm=cat([r.displacement_mm for r, _ in parts]),
+                      voltage_v=cat([r.voltage_v for r, _ in parts]),
+                      direction=cat([r.direction for r, _ in parts]),
+                      time_s=cat([r.time_s + t for r, t in parts]),
+                      temperature_c=cat([r.temperature_c for r, _ in parts]),
                       source=f"simulate:{s.name}")
 
 

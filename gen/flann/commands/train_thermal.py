@@ -1,0 +1,58 @@
+"""``flann train --temperature``: the two-input model x(v, T) (called by :mod:`.train`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FlannError
+from ..golden.thermal_train import MIN_TEMPERATURES, compensable, fit_thermal_auto
+from ..golden.thermal import temperature_groups
+from ..recordings import prepare_for_fit
+
+
+def compensation_hint(rec) -> str | None:
+    """One line when a recording spans 3 or more temperatures (and no --temperature)."""
+    temps = compensable(rec.temperature_c)
+    if len(temps) < 3:
+        return None
+    return (f"note: {rec.source} holds a calibration at {len(temps)} temperatures "
+            f"({', '.join(f'{t:g}' for t in temps)} degC): it could be compensated for "
+            "temperature with flann train --temperature")
+
+
+def _prepare(rec, trim: bool):
+    """The fit's checks (span, duplicates, fold-back) at each temperature on its own."""
+    levels, labels = temperature_groups(rec.temperature_c)
+    parts = [prepare_for_fit(rec.subset(labels == g), trim=trim) for g in range(levels.size)]
+    cat = np.concatenate
+    return (cat([p.voltage_v for p in parts]), cat([p.temperature_c for p in parts]),
+            cat([p.displacement_mm for p in parts]))
+
+
+def run_thermal(args, rec) -> int:
+    if args.terms != "auto" or args.method != "lstsq" or args.ridge or args.normalise \
+            or args.input_scale_v is not None or args.input_offset_v is not None:
+        raise FlannError("--temperature chooses terms, normalisation and ridge by cross-validation: "
+                         "give none of --terms/--method/--ridge/--normalise/--input-*")
+    if rec.temperature_c is None:
+        raise FlannError(f"{rec.source}: --temperature needs a temperature_c column")
+    if len(compensable(rec.temperature_c)) < MIN_TEMPERATURES:
+        raise FlannError(f"{rec.source}: --temperature needs a calibration at {MIN_TEMPERATURES} or "
+                         "more temperatures (4 or more rows each)")
+    v, t, x = _prepare(rec, args.trim)
+    provenance = {"data_file": Path(args.recordings).name, "data_sha256": rec.sha256}
+    if rec.comments:
+        provenance["data_provenance"] = rec.comments[0]
+    model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
+    model.save(args.output)
+    tr = model.training
+    full = tr["full_structure"]
+    print(f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "
+          f"coefficients; every order in full: {full['coefficients']}), normalisation {choice.norm}, "
+          f"ridge {choice.ridge:g}; held-out error (cross-validation over "
+          f"{tr['cv_position_folds']} position folds and {tr['cv_temperature_folds']} held-out "
+          f"temperatures): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+    return 0

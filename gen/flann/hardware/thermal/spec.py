@@ -1,0 +1,270 @@
+"""Fixed-point spec of the two-input FLANN x(v, T), composed of the one-input datapath.
+
+Datapath (one sample = an ADC code ``in_data`` and a temperature code ``in_temp``)::
+
+    in_temp --clamp to the calibrated codes--> tau --x const + const--> t_n  (FT fraction bits)
+    t_n --Horner (gain, offset polynomials)--> G(t_n) (FG bits), O(t_n) (fine codes)
+    in_data --clamp--> c --(c G + O), one rounding--> c' = node + frac  (grid lsb/2^E, FR more bits)
+    node, node + 1 --one-input datapath of order j (hardware/fixed, output LSB q / 2^K)--> a_j, b_j
+    f_j = a_j + (b_j - a_j) frac          (linear interpolation between two grid codes)
+    f_0 + t_n (f_1 + t_n f_2) --Horner, rounding at each multiply--> round to q, saturate
+
+Every one-input block is :mod:`flann.hardware.fixed` unchanged (its spec sized by its own
+error budget for the order's FLANN on the fine grid); the temperature terms and the cross
+products are multiplies by t_n, the same kind of multiply the serial multiplier does.
+
+Error analysis (|hardware - float| <= 1 output LSB q for every voltage and temperature
+code, the float model taken at the same clamped codes), pre-rounding share <= q/2:
+
+* each order's datapath: <= 1 of its LSBs at each node, q/2^K, + 1/2 for the interpolation
+  product's rounding, times |t_n|^j <= 1:  1.5 (orders) q / 2^K
+* the Horner roundings:   (orders - 1) q / 2^(K+1)
+* linear interpolation over one grid step h = lsb/2^E: max|d2x/dv'2| h^2 / 8
+* c' rounded to FR bits below the grid: max|dx/dv'| h 2^-(FR+1)
+* the gain's roundings: max|dx/dv'| |v|max (orders) 2^-FG
+* t_n's rounding:         max|dx/dt_n| 2^-(FT+1)
+
+The interpolation is what lets the output LSB go below the sensor's steepest slope times
+an ADC step: the one-input datapath takes at most 16-bit codes, so with a 16-bit ADC the
+corrected voltage has no finer grid to be rounded to.
+
+K, FR, FG and FT are the smallest that keep their share (``SHARE``), E = 16 - input_bits (the
+one-input datapath's widest input); the default output LSB q is, as for the one-input
+design, a quarter of the larger of the output step per input code and the model's held-out
+RMS error, on the 1-2-5 series, or coarser when the interpolation's curvature error needs it; ``ThermalSpec.analysis`` lists every bound.  The slopes are taken
+numerically from the float model over the calibrated voltage and temperature ranges.
+The VHDL of this datapath is not rendered yet (docs/temperature.md).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import SpecError
+from ...golden.model import FlannModel
+from ...golden.thermal import ThermalModel, corrected_voltage
+from ...numeric.fixed import FixedFormat, bits_needed
+from ..fixed.spec import Spec, derive_spec, nice_125
+
+MAX_FINE_BITS = 16          # the one-input datapath's widest input
+# Share of the 0.5-LSB pre-rounding budget per source (output LSBs).
+SHARE = {"orders": 0.2, "horner": 0.05, "curvature": 0.1, "fraction": 0.05, "gain": 0.05,
+         "temperature": 0.05}
+
+
+@dataclass(frozen=True)
+class ThermalSpec:
+    model: ThermalModel = field(repr=False, compare=False)
+    input_bits: int
+    input_lsb_v: float
+    temp_bits: int
+    temp_lsb_c: float
+    clamp_lo: int                  # voltage codes of the calibrated range
+    clamp_hi: int
+    temp_lo: int                   # temperature codes of the calibrated range
+    temp_hi: int
+    fine_bits: int                 # E: the order datapaths' grid is lsb / 2^E
+    interp_bits: int               # FR: bits of c' below that grid (interpolation fraction)
+    t_frac_bits: int               # FT
+    t_scale_int: int               # t_n = round((tau * t_scale_int + t_offset_int) / 2^t_shift)
+    t_offset_int: int
+    t_shift: int
+    g_frac_bits: int               # FG
+    gain_int: tuple[int, ...]      # 1, g1, g2 at FG bits
+    offset_int: tuple[int, ...]    # 0, o1, o2 in grid codes at FR + FG fraction bits
+    inner_bits: int                # K: order outputs in q / 2^K
+    output_lsb_mm: float           # q
+    out_fmt: FixedFormat
+    orders: tuple[Spec, ...] = field(repr=False)
+    analysis: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def code_min(self) -> int:
+        return -(1 << (self.input_bits - 1))
+
+    @property
+    def code_max(self) -> int:
+        return (1 << (self.input_bits - 1)) - 1
+
+    @property
+    def temp_code_min(self) -> int:
+        return -(1 << (self.temp_bits - 1))
+
+    @property
+    def temp_code_max(self) -> int:
+        return (1 << (self.temp_bits - 1)) - 1
+
+    def float_reference(self, codes, temp_codes) -> np.ndarray:
+        """The float model (mm) at the clamped voltage and temperature codes."""
+        c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
+        t = np.clip(np.asarray(temp_codes, dtype=np.int64), self.temp_lo, self.temp_hi)
+        return self.model.predict(c * self.input_lsb_v, t * self.temp_lsb_c)
+
+
+def _order_model(model: ThermalModel, j: int, vrange) -> FlannModel:
+    weights = model.weights[j] or (0.0,)
+    return FlannModel(weights=weights, bias=model.bias[j], input_offset_v=model.input_offset_v,
+                      input_scale_v=model.input_scale_v, voltage_range_v=vrange,
+                      displacement_range_mm=model.displacement_range_mm)
+
+
+def _grid(model: ThermalModel, n: int = 257):
+    vlo, vhi = sorted(model.voltage_range_v)
+    tlo, thi = sorted(model.temperature_range_c)
+    v, t = np.meshgrid(np.linspace(vlo, vhi, n), np.linspace(tlo, thi, 33))
+    return v.ravel(), t.ravel()
+
+
+def _slopes(model: ThermalModel) -> tuple[float, float, float, tuple[float, float]]:
+    """(max |dx/dv'| per V, max |d2x/dv'2| per V^2, max |dx/dt_n|, range of v') over the
+    calibrated ranges."""
+    v, t = _grid(model, 2049)
+    v_n, t_n = model.normalise(v, t)
+    v_c = v_n * model.input_scale_v + model.input_offset_v
+    h = 1e-4 * model.input_scale_v
+
+    def at(shift):
+        parts = model.order_outputs((v_c + shift - model.input_offset_v) / model.input_scale_v)
+        return sum(part * t_n ** j for j, part in enumerate(parts))
+
+    mid, up, down = at(0.0), at(h), at(-h)
+    dxdv = (up - down) / (2 * h)
+    d2xdv2 = (up - 2 * mid + down) / h ** 2
+    dt = 1e-6 * model.temperature_scale_c
+    dxdt = (model.predict(v, t + dt) - model.predict(v, t - dt)) / (2 * dt) * model.temperature_scale_c
+    return (float(np.max(np.abs(dxdv))), float(np.max(np.abs(d2xdv2))), float(np.max(np.abs(dxdt))),
+            (float(v_c.min()), float(v_c.max())))
+
+
+def _frac_bits_for(bound_per_unit: float, share: float, lo: int = 4, hi: int = 40) -> int:
+    """Smallest F with bound_per_unit * 2^-F <= share."""
+    for f in range(lo, hi + 1):
+        if bound_per_unit * 2.0 ** -f <= share:
+            return f
+    raise SpecError(f"no width up to {hi} bits keeps this error within {share:g}")
+
+
+MAX_LSB_RAISES = 12
+
+
+def _size(model, q, slope_v, slope_t, h, vmax, lsb, tlsb, fine, input_bits, vrange):
+    """Every width for output LSB q, and the order datapaths (SpecError if one cannot be built)."""
+    p = model.orders
+    fr = _frac_bits_for(slope_v * h * 0.5, SHARE["fraction"] * q, lo=0)
+    fg = _frac_bits_for(slope_v * vmax * p, SHARE["gain"] * q)
+    ft = _frac_bits_for(slope_t * 0.5, SHARE["temperature"] * q)
+    k = max(_frac_bits_for(1.5 * p, SHARE["orders"], lo=0),
+            _frac_bits_for(0.5 * (p - 1), SHARE["horner"], lo=0))
+    # t_n = (tau * tlsb - t_off) / t_scale at FT bits, by one multiply-add and a shift
+    shift = 24
+    t_scale_int = round(tlsb / model.temperature_scale_c * 2.0 ** (ft + shift))
+    t_offset_int = round(-model.temperature_offset_c / model.temperature_scale_c * 2.0 ** (ft + shift))
+    gain_int = (1 << fg,) + tuple(round(g * 2.0 ** fg) for g in model.input_gain_t)
+    offset_int = (0,) + tuple(round(o / h * 2.0 ** (fr + fg)) for o in model.input_offset_t_v)
+    # the order datapaths clamp c' to the corrected voltages' range (vrange: a little wider
+    # than the analysis grid saw, within the ADC's span), as the one-input design its code
+    specs = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for j in range(p):
+            specs.append(derive_spec(_order_model(model, j, vrange), input_bits=input_bits + fine,
+                                     input_lsb_v=lsb / 2 ** fine, output_lsb_mm=q / 2 ** k))
+    return fr, fg, ft, k, t_scale_int, t_offset_int, shift, gain_int, offset_int, tuple(specs)
+
+
+def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: float, temp_bits: int,
+                        temp_lsb_c: float, output_lsb_mm: float | None = None) -> ThermalSpec:
+    if not isinstance(model, ThermalModel):
+        raise SpecError("model must be a two-input ThermalModel")
+    if not (isinstance(input_bits, int) and 4 <= input_bits <= MAX_FINE_BITS):
+        raise SpecError(f"input_bits = {input_bits!r}: must be an integer in 4..{MAX_FINE_BITS}")
+    if not (isinstance(temp_bits, int) and 2 <= temp_bits <= 16):
+        raise SpecError(f"--temp-bits {temp_bits!r}: must be an integer in 2..16")
+    for name, val in (("input_lsb_v", input_lsb_v), ("--temp-lsb-c", temp_lsb_c)):
+        if not (isinstance(val, (int, float)) and math.isfinite(val) and val > 0):
+            raise SpecError(f"{name} = {val!r}: must be a positive number")
+    lsb, tlsb = float(input_lsb_v), float(temp_lsb_c)
+    vlo, vhi = sorted(model.voltage_range_v)
+    tlo_c, thi_c = sorted(model.temperature_range_c)
+    cmin, cmax = -(1 << (input_bits - 1)), (1 << (input_bits - 1)) - 1
+    clo, chi = max(cmin, math.ceil(vlo / lsb - 1e-9)), min(cmax, math.floor(vhi / lsb + 1e-9))
+    tmin, tmax = -(1 << (temp_bits - 1)), (1 << (temp_bits - 1)) - 1
+    tlo, thi = math.ceil(tlo_c / tlsb - 1e-9), math.floor(thi_c / tlsb + 1e-9)
+    if not (tmin <= tlo <= thi <= tmax):
+        raise SpecError(f"--temp-bits {temp_bits} x --temp-lsb-c {tlsb:g} degC cover "
+                        f"{tmin * tlsb:g}..{tmax * tlsb:g} degC, not the calibrated "
+                        f"{tlo_c:g}..{thi_c:g} degC")
+    if clo > chi:
+        raise SpecError(f"input_lsb_v = {lsb:g} V: the trained range holds no input code")
+
+    slope_v, curve_v, slope_t, (vc_lo, vc_hi) = _slopes(model)
+    fine = MAX_FINE_BITS - input_bits
+    h = lsb / 2 ** fine                        # the order datapaths' grid step (V)
+    vmax = max(abs(vlo), abs(vhi))
+    curvature_mm = curve_v * h * h / 8
+    if output_lsb_mm is None:
+        step = float(np.ptp(model.displacement_range_mm)) / max(1, chi - clo)
+        acc = float(model.training.get("cv_rms_error_mm", 0.0) or 0.0)
+        q = nice_125(max(step, acc) / 4, up=False)
+        q = max(q, nice_125(curvature_mm / SHARE["curvature"], up=True))
+    else:
+        q = output_lsb_mm
+    if not (isinstance(q, (int, float)) and math.isfinite(q) and q > 0):
+        raise SpecError(f"output_lsb_mm = {q!r}: must be a positive number of mm")
+    q = float(q)
+    if curvature_mm > SHARE["curvature"] * q * (1 + 1e-9):
+        raise SpecError(f"output LSB {q:g} mm is finer than the {input_bits}-bit input allows "
+                        f"(interpolating between codes alone is {curvature_mm / q:.3g} LSB): "
+                        f"use an output LSB >= {nice_125(curvature_mm / SHARE['curvature'], up=True):g} mm")
+    asked, why = q, ""
+    for _ in range(MAX_LSB_RAISES):
+        try:
+            parts = _size(model, q, slope_v, slope_t, h, vmax, lsb, tlsb, fine, input_bits,
+                          (max(vc_lo - 0.01 * (vc_hi - vc_lo), cmin * lsb),
+                           min(vc_hi + 0.01 * (vc_hi - vc_lo), cmax * lsb)))
+            break
+        except SpecError as exc:
+            if output_lsb_mm is not None:
+                raise
+            why = str(exc)
+            q = nice_125(q * 1.5, up=True)
+    else:
+        raise SpecError(f"no output LSB from {asked:g} mm up builds the order datapaths ({why})")
+    fr, fg, ft, k, t_scale_int, t_offset_int, shift, gain_int, offset_int, specs = parts
+    p = model.orders
+    ymax = float(np.max(np.abs(model.displacement_range_mm))) * 1.05
+    out_bits = bits_needed(-math.ceil(ymax / q), math.ceil(ymax / q))
+    analysis = {
+        "slope_mm_per_v": slope_v, "slope_mm_per_t_n": slope_t,
+        "curvature_mm_per_v2": curve_v,
+        "orders_lsb": 1.5 * p / 2 ** k, "horner_lsb": (p - 1) / 2 ** (k + 1),
+        "interpolation_lsb": curvature_mm / q, "fraction_lsb": slope_v * h * 0.5 * 2.0 ** -fr / q,
+        "gain_rounding_lsb": slope_v * vmax * p * 2.0 ** -fg / q,
+        "temperature_lsb": slope_t * 0.5 * 2.0 ** -ft / q,
+    }
+    analysis["pre_rounding_lsb"] = sum(v for key, v in analysis.items() if key.endswith("_lsb"))
+    if q != asked:
+        analysis["output_lsb_raised_from_mm"] = asked
+        analysis["output_lsb_raised_because"] = why
+    return ThermalSpec(model=model, input_bits=input_bits, input_lsb_v=lsb, temp_bits=temp_bits,
+                       temp_lsb_c=tlsb, clamp_lo=clo, clamp_hi=chi, temp_lo=tlo, temp_hi=thi,
+                       fine_bits=fine, interp_bits=fr, t_frac_bits=ft, t_scale_int=t_scale_int,
+                       t_offset_int=t_offset_int, t_shift=shift, g_frac_bits=fg,
+                       gain_int=gain_int, offset_int=offset_int, inner_bits=k, output_lsb_mm=q,
+                       out_fmt=FixedFormat(out_bits, out_bits, signed=True), orders=specs,
+                       analysis=analysis)
+
+
+def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
+    """c' in grid codes without rounding (what the twin's integers approximate)."""
+    m = spec.model
+    t_n = (np.asarray(temp_codes) * spec.temp_lsb_c - m.temperature_offset_c) / m.temperature_scale_c
+    v = corrected_voltage(np.asarray(codes) * spec.input_lsb_v, t_n, m.input_gain_t, m.input_offset_t_v)
+    return v / spec.input_lsb_v * 2 ** spec.fine_bits
+
+
+__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float"]
