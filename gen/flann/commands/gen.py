@@ -11,14 +11,15 @@ import sys
 
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
-from ..hardware.registry import FAMILY, FORMATS, datapath
+from ..hardware.registry import FAMILY, FORMATS, datapath_for_model
 from .family import add_family_arguments, check_family_args
 
 HELP = "generate VHDL-93 for a model"
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", nargs="?", help="model.json (flann-model/1); not with --family")
+    parser.add_argument("model", nargs="?", help="model.json (flann-model/1, or flann-thermal-model/1: the two-input datapath); "
+                        "not with --family")
     parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
     parser.add_argument("--format", choices=FORMATS, default=FORMATS[0],
@@ -34,7 +35,7 @@ def run(args) -> int:
         check_family_args(args)
         dp, source, extra = FAMILY, args.family, {"terms": args.terms, "margin": args.margin}
     else:
-        dp, source, extra = datapath(args.format), args.model, {}
+        dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
     replacing = is_design(args.out)
     man = dp.generate(source, args.out, opts, **extra)
     if replacing:

@@ -29,6 +29,9 @@ class GenOptions:
     device: str = _opt(DEFAULT_PART, "target part-package-speed (default %(default)s)", type=str)
     input_bits: int = _opt(12, "signed ADC code width (default %(default)s)", type=int)
     input_lsb_v: float | None = _opt(None, "volts per input code (default: trained range + 10%%)", type=float)
+    temp_bits: int = _opt(12, "two-input models: signed temperature code width (default %(default)s)", type=int)
+    temp_lsb_c: float = _opt(0.0625, "two-input models: degC per temperature code (default %(default)s)",
+                             type=float)
     clamp: bool = _opt(True, "do not clamp codes to the trained range", flag="--no-clamp")
     output_bits: int | None = _opt(None, "signed output width", type=int)
     output_lsb_mm: float | None = _opt(None, "mm per output code", type=float)

@@ -33,7 +33,7 @@ one-input datapath's widest input); the default output LSB q is, as for the one-
 design, a quarter of the larger of the output step per input code and the model's held-out
 RMS error, on the 1-2-5 series, or coarser when the interpolation's curvature error needs it; ``ThermalSpec.analysis`` lists every bound.  The slopes are taken
 numerically from the float model over the calibrated voltage and temperature ranges.
-The VHDL of this datapath is not rendered yet (docs/temperature.md).
+The VHDL is rendered by :mod:`.render` (``flann_thermal_top``).
 """
 
 from __future__ import annotations
@@ -97,6 +97,41 @@ class ThermalSpec:
     @property
     def temp_code_max(self) -> int:
         return (1 << (self.temp_bits - 1)) - 1
+
+    @property
+    def horner_degree(self) -> int:
+        """D: the gain and offset polynomials' degree in t_n."""
+        return len(self.gain_int) - 1
+
+    @property
+    def order_latency(self) -> int:
+        return max(o.latency_cycles for o in self.orders)
+
+    @property
+    def latency_cycles(self) -> int:
+        """Clock edges from the accepting edge to out_valid (flann_thermal_top's sequence: t_n,
+        the Horner start and D steps + 1, c', the node, then each order datapath run at the node
+        and the next node (start, wait, ready again), the interpolation, the Horner in t_n over
+        the orders (start, orders steps) and the output register)."""
+        return 1 + 1 + (self.horner_degree + 1) + 2 + 2 * (self.order_latency + 3) + 2 + len(self.orders) + 1
+
+    @property
+    def cycles_per_sample(self) -> int:
+        return self.latency_cycles + 1
+
+    def to_dict(self) -> dict:
+        """The spec as stamped in headers and manifest.json (every order's spec as its own)."""
+        return {
+            "number_format": "fixed", "input_bits": self.input_bits, "input_lsb_v": self.input_lsb_v,
+            "temp_bits": self.temp_bits, "temp_lsb_c": self.temp_lsb_c,
+            "clamp_codes": [self.clamp_lo, self.clamp_hi], "temp_clamp_codes": [self.temp_lo, self.temp_hi],
+            "fine_bits": self.fine_bits, "interp_bits": self.interp_bits, "t_frac_bits": self.t_frac_bits,
+            "t_scale_int": self.t_scale_int, "t_offset_int": self.t_offset_int, "t_shift": self.t_shift,
+            "g_frac_bits": self.g_frac_bits, "gain_int": list(self.gain_int),
+            "offset_int": list(self.offset_int), "inner_bits": self.inner_bits,
+            "output_lsb_mm": self.output_lsb_mm, "output": self.out_fmt.describe(),
+            "orders": [o.to_dict() for o in self.orders],
+        }
 
     def float_reference(self, codes, temp_codes) -> np.ndarray:
         """The float model (mm) at the clamped voltage and temperature codes."""
