@@ -11,7 +11,6 @@ spec's integer ranges; the template only places text.
 
 from __future__ import annotations
 
-import math
 import re
 import warnings
 from pathlib import Path
@@ -19,7 +18,7 @@ from pathlib import Path
 from ...errors import FlannError
 from ...golden.model import model_sha256
 from ...golden.thermal import ThermalModel, load_any_model
-from ...numeric.fixed import bits_literal, bits_needed
+from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..adc import default_input_lsb
 from ..datapath import rebuild_matching
@@ -27,7 +26,7 @@ from ..fixed import render as fixed_render
 from ..header import header
 from ..manifest import write_design
 from ..options import GenOptions
-from .spec import ThermalSpec, derive_thermal_spec
+from .spec import ThermalSpec, derive_thermal_spec, top_widths
 
 TOP = "flann_thermal_top"
 DATAPATH = "thermal"
@@ -48,51 +47,25 @@ def order_files(spec: ThermalSpec, j: int) -> dict[str, str]:
     return {rename(name): rename(text) for name, text in fixed_render.render(spec.orders[j]).items()}
 
 
-def _sbits(bound: float) -> int:
-    """Signed width holding +-bound."""
-    b = int(math.ceil(abs(bound)))
-    return bits_needed(-b, b)
-
-
 def contexts(spec: ThermalSpec) -> dict:
     s = spec
-    p, d = len(s.orders), s.horner_degree
-    t_max = max(abs(s.temp_lo), abs(s.temp_hi)) * abs(s.t_scale_int) + abs(s.t_offset_int)
-    tn_bits = _sbits((t_max >> s.t_shift) + 2)
-    t_scale_bits = _sbits(s.t_scale_int)
-    t_pre_bits = max(s.temp_bits + t_scale_bits, _sbits(s.t_offset_int)) + 1
-    growth = (2.0 ** (tn_bits - 1)) / 2.0 ** s.t_frac_bits      # |t_n| bound in units of 1
-    gain_bits = _sbits(sum(abs(g) * growth ** k for k, g in enumerate(s.gain_int)) + d + 1) + 1
-    offset_bits = _sbits(sum(abs(o) * growth ** k for k, o in enumerate(s.offset_int)) + d + 1) + 1
-    shift = s.fine_bits + s.interp_bits
-    fine_pre_bits = s.input_bits + shift + gain_bits + 1
-    fine_bound = (2 ** (s.input_bits - 1)) * 2 ** shift * 2 ** (gain_bits - 1) / 2 ** s.g_frac_bits \
-        + 2 ** (offset_bits - 1) / 2 ** s.g_frac_bits + 2
-    fine_bits_w = min(_sbits(fine_bound) + 1, fine_pre_bits)
-    node_bits = s.orders[0].input_bits
-    if any(o.input_bits != node_bits for o in s.orders):
-        raise FlannError("the order datapaths must share one input width")
-    node_w = max(fine_bits_w - s.interp_bits, node_bits) + 1
-    ord_bits = max(o.out_fmt.width for o in s.orders) + 1
-    part_bits = ord_bits + 2
-    acc_bits = part_bits + p + 1 + max(0, math.ceil(math.log2(max(growth, 1.0))) * p)
-    if s.out_fmt.width > acc_bits:
-        raise FlannError(f"output width {s.out_fmt.width} exceeds the accumulator's {acc_bits} bits")
+    w = top_widths(s)
+    d, p = s.horner_degree, len(s.orders)
+    gain_bits, offset_bits, t_scale_bits, t_pre_bits = w["gain_bits"], w["offset_bits"], w["t_scale_bits"], w["t_pre_bits"]
+    node_bits, node_w, acc_bits = w["node_bits"], w["node_w"], w["acc_bits"]
     orders = [dict(j=j, top=order_prefix(j) + "top", out_bits=o.out_fmt.width) for j, o in enumerate(s.orders)]
     return dict(
         in_bits=s.input_bits, temp_bits=s.temp_bits, out_bits=s.out_fmt.width,
         input_lsb_v=s.input_lsb_v, temp_lsb_c=s.temp_lsb_c, output_lsb_mm=s.output_lsb_mm,
         latency=s.latency_cycles, fine_bits=s.fine_bits, degree=d, n_orders=p, orders=orders,
-        gain_bits=gain_bits, offset_bits=offset_bits, ord_bits=ord_bits, part_bits=part_bits, acc_bits=acc_bits,
+        **w,
         gain_words=[bits_literal(g, gain_bits) for g in s.gain_int],
         offset_words=[bits_literal(o, offset_bits) for o in s.offset_int],
         clamp_lo=bits_literal(s.clamp_lo, s.input_bits), clamp_hi=bits_literal(s.clamp_hi, s.input_bits),
         temp_lo=bits_literal(s.temp_lo, s.temp_bits), temp_hi=bits_literal(s.temp_hi, s.temp_bits),
-        t_scale_bits=t_scale_bits, t_scale=bits_literal(s.t_scale_int, t_scale_bits),
-        t_pre_bits=t_pre_bits, t_offset=bits_literal(s.t_offset_int, t_pre_bits), t_shift=s.t_shift,
-        tn_bits=tn_bits, t_frac_bits=s.t_frac_bits, g_frac_bits=s.g_frac_bits,
-        fine_pre_bits=fine_pre_bits, fine_bits_w=fine_bits_w, fine_shift=shift, interp_bits=s.interp_bits,
-        node_bits=node_bits, node_w=node_w,
+        t_scale=bits_literal(s.t_scale_int, t_scale_bits),
+        t_offset=bits_literal(s.t_offset_int, t_pre_bits), t_shift=s.t_shift,
+        t_frac_bits=s.t_frac_bits, g_frac_bits=s.g_frac_bits, interp_bits=s.interp_bits,
         node_max=bits_literal((1 << (node_bits - 1)) - 1, node_w),
         node_min=bits_literal(-(1 << (node_bits - 1)), node_w),
         inner_bits=s.inner_bits,
@@ -105,8 +78,10 @@ def render(spec: ThermalSpec, sha: str = "") -> dict[str, str]:
     out = {}
     for j in range(len(spec.orders)):
         out.update(order_files(spec, j))
+    # each order's spec is in its own files' headers
+    stamped = {**spec.to_dict(), "orders": [order_prefix(j) + "top" for j in range(len(spec.orders))]}
     h = header(f"{TOP}.vhd", "two-input (voltage, temperature) FLANN LVDT compensator, top level",
-               "flann gen", spec.to_dict(), sha)
+               "flann gen", stamped, sha)
     out[f"{TOP}.vhd"] = template(f"{TEMPLATES}/{TOP}.vhd.j2").render(h=h, **contexts(spec))
     return out
 

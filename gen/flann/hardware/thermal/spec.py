@@ -113,7 +113,10 @@ class ThermalSpec:
         the Horner start and D steps + 1, c', the node, then each order datapath run at the node
         and the next node (start, wait, ready again), the interpolation, the Horner in t_n over
         the orders (start, orders steps) and the output register)."""
-        return 1 + 1 + (self.horner_degree + 1) + 2 + 2 * (self.order_latency + 3) + 2 + len(self.orders) + 1
+        m, d, p = top_widths(self)["mul_b_bits"], self.horner_degree, len(self.orders)
+        base = 1 + 1 + (self.horner_degree + 1) + 2 + 2 * (self.order_latency + 3) + 2 + p + 1
+        # each product through the serial multiplier: load, one cycle per multiplier bit, use
+        return base + (m + 1) + d * (2 * m + 2) + (m + 1) + (p * (m + 2) - 1) + (p - 1) * (m + 1)
 
     @property
     def cycles_per_sample(self) -> int:
@@ -294,6 +297,46 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
                        analysis=analysis)
 
 
+def _sbits(bound: float) -> int:
+    """Signed width holding +-bound."""
+    b = int(math.ceil(abs(bound)))
+    return bits_needed(-b, b)
+
+
+def top_widths(spec: "ThermalSpec") -> dict:
+    """Every register width of flann_thermal_top, from the integer ranges of the spec: each
+    value's bound, with one bit of margin where a bound is a sum of bounds."""
+    s = spec
+    p, d = len(s.orders), s.horner_degree
+    t_max = max(abs(s.temp_lo), abs(s.temp_hi)) * abs(s.t_scale_int) + abs(s.t_offset_int)
+    tn_bits = _sbits((t_max >> s.t_shift) + 2)
+    t_scale_bits = _sbits(s.t_scale_int)
+    t_pre_bits = max(s.temp_bits + t_scale_bits, _sbits(s.t_offset_int)) + 1
+    growth = (2.0 ** (tn_bits - 1)) / 2.0 ** s.t_frac_bits      # |t_n| bound in units of 1
+    gain_bits = _sbits(sum(abs(g) * growth ** k for k, g in enumerate(s.gain_int)) + d + 1) + 1
+    offset_bits = _sbits(sum(abs(o) * growth ** k for k, o in enumerate(s.offset_int)) + d + 1) + 1
+    shift = s.fine_bits + s.interp_bits
+    fine_pre_bits = s.input_bits + shift + gain_bits + 1
+    fine_bound = (2 ** (s.input_bits - 1)) * 2 ** shift * 2 ** (gain_bits - 1) / 2 ** s.g_frac_bits \
+        + 2 ** (offset_bits - 1) / 2 ** s.g_frac_bits + 2
+    fine_bits_w = min(_sbits(fine_bound) + 1, fine_pre_bits)
+    node_bits = s.orders[0].input_bits
+    if any(o.input_bits != node_bits for o in s.orders):
+        raise SpecError("the order datapaths must share one input width")
+    node_w = max(fine_bits_w - s.interp_bits, node_bits) + 1
+    ord_bits = max(o.out_fmt.width for o in s.orders) + 1
+    part_bits = ord_bits + 2
+    acc_bits = part_bits + p + 1 + max(0, math.ceil(math.log2(max(growth, 1.0))) * p)
+    if s.out_fmt.width > acc_bits:
+        raise SpecError(f"output width {s.out_fmt.width} exceeds the accumulator's {acc_bits} bits")
+    mul_b_bits = max(s.temp_bits, tn_bits, gain_bits, s.interp_bits + 1)
+    mul_a_bits = max(t_scale_bits, gain_bits, offset_bits, s.input_bits + shift, ord_bits + 1, acc_bits)
+    return dict(tn_bits=tn_bits, t_scale_bits=t_scale_bits, t_pre_bits=t_pre_bits, gain_bits=gain_bits,
+                offset_bits=offset_bits, fine_shift=shift, fine_pre_bits=fine_pre_bits, fine_bits_w=fine_bits_w,
+                node_bits=node_bits, node_w=node_w, ord_bits=ord_bits, part_bits=part_bits, acc_bits=acc_bits,
+                mul_a_bits=mul_a_bits, mul_b_bits=mul_b_bits)
+
+
 def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
     """c' in grid codes without rounding (what the twin's integers approximate)."""
     m = spec.model
@@ -302,4 +345,4 @@ def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
     return v / spec.input_lsb_v * 2 ** spec.fine_bits
 
 
-__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float"]
+__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float", "top_widths"]
