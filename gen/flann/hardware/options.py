@@ -16,6 +16,7 @@ from ..errors import SpecError
 from .target import DEFAULT_PART
 
 MULT_STYLES = ("lut", "shiftadd")
+TWO_INPUT = ("temp_bits", "temp_lsb_c")  # options only a two-input (temperature) model uses
 
 
 def _opt(default, help: str, *, flag: str | None = None, type=None, choices=None):
@@ -46,7 +47,8 @@ class GenOptions:
     product_frac_bits: int | None = _opt(None, "fraction bits kept after each product", type=int)
 
     def to_kwargs(self) -> dict:
-        return asdict(self)
+        """The one-input datapaths' keyword arguments (the two-input ones' read as attributes)."""
+        return {k: v for k, v in asdict(self).items() if k not in TWO_INPUT}
 
     def changed(self) -> dict:
         """The options that differ from their defaults."""

@@ -99,6 +99,8 @@ def manifest(spec: ThermalSpec, files: list[str], sha: str) -> dict:
         "spec": spec.to_dict(),
         "analysis": dict(spec.analysis),
         "model_sha256": sha,
+        # the port beyond the common interface, as the ISE pin map reads a datapath's extra ports
+        "cfg_port": {"ports": {"in_temp": f"in std_logic_vector({spec.temp_bits - 1} downto 0)"}},
     }
 
 
