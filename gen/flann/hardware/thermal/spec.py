@@ -16,8 +16,10 @@ products are multiplies by t_n, the same kind of multiply the serial multiplier 
 Error analysis (|hardware - float| <= 1 output LSB q for every voltage and temperature
 code, the float model taken at the same clamped codes), pre-rounding share <= q/2:
 
-* each order's datapath: <= 1 of its LSBs at each node, q/2^K, + 1/2 for the interpolation
-  product's rounding, times |t_n|^j <= 1:  1.5 (orders) q / 2^K
+* each order's datapath: its own bound (its error analysis, in its LSBs q/2^K) at each node,
+  + 1/2 for the interpolation product's rounding, times |t_n|^j <= 1; K is sized for 1 LSB
+  per order, then each order's quarter-wave table is made smaller (fewer block RAMs) where
+  the whole bound stays within 1/2 LSB (``_smaller_tables``)
 * the Horner roundings:   (orders - 1) q / 2^(K+1)
 * linear interpolation over one grid step h = lsb/2^E: max|d2x/dv'2| h^2 / 8
 * c' rounded to FR bits below the grid: max|dx/dv'| h 2^-(FR+1)
@@ -214,6 +216,37 @@ def _size(model, q, slope_v, slope_t, h, vmax, lsb, tlsb, fine, input_bits, vran
     return fr, fg, ft, k, t_scale_int, t_offset_int, shift, gain_int, offset_int, tuple(specs)
 
 
+def _orders_lsb(specs, k: int) -> float:
+    """Each order's datapath bound (its own error analysis, in its LSBs q / 2^K) + 1/2 for the
+    interpolation product's rounding, times |t_n|^j <= 1, in output LSBs."""
+    return sum(o.analysis["bound_total_lsb"] + 0.5 for o in specs) / 2 ** k
+
+
+TABLE_STEPS = 2   # at most this many address bits fewer than the order's own error budget picks
+
+
+def _smaller_tables(specs, k: int, rest: float) -> tuple:
+    """The order datapaths with fewer quarter-wave table words where the whole pre-rounding bound
+    (``rest`` from the other sources) stays within 1/2 LSB and it saves block RAMs: every order
+    has a table of its own, each sized by its own budget, where the orders share the output's."""
+    specs = list(specs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for j, o in enumerate(list(specs)):
+            for a in range(o.table_addr_bits - 1, o.table_addr_bits - 1 - TABLE_STEPS, -1):
+                try:
+                    cand = derive_spec(o.model, input_bits=o.input_bits, input_lsb_v=o.input_lsb_v,
+                                       output_lsb_mm=o.output_lsb_mm, table_addr_bits=a)
+                except SpecError:
+                    break
+                trial = specs[:j] + [cand] + specs[j + 1:]
+                if (cand.analysis["estimate"]["brams"] >= specs[j].analysis["estimate"]["brams"]
+                        or rest + _orders_lsb(trial, k) > 0.5):
+                    break
+                specs = trial
+    return tuple(specs)
+
+
 def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: float, temp_bits: int,
                         temp_lsb_c: float, output_lsb_mm: float | None = None) -> ThermalSpec:
     if not isinstance(model, ThermalModel):
@@ -284,7 +317,11 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
         "gain_rounding_lsb": slope_v * vmax * p * 2.0 ** -fg / q,
         "temperature_lsb": slope_t * 0.5 * 2.0 ** -ft / q,
     }
-    analysis["pre_rounding_lsb"] = sum(v for key, v in analysis.items() if key.endswith("_lsb"))
+    analysis["orders_lsb"] = _orders_lsb(specs, k)
+    rest = sum(v for key, v in analysis.items() if key.endswith("_lsb") and key != "orders_lsb")
+    specs = _smaller_tables(specs, k, rest)
+    analysis["orders_lsb"] = _orders_lsb(specs, k)
+    analysis["pre_rounding_lsb"] = rest + analysis["orders_lsb"]
     if q != asked:
         analysis["output_lsb_raised_from_mm"] = asked
         analysis["output_lsb_raised_because"] = why
