@@ -125,3 +125,12 @@ def test_bad_options_are_one_line(design, tmp_path, args, word):
     r = flann("gen", design["model"], "-o", out, "--input-bits", 8, *args)
     assert r.returncode == 2 and r.stderr.startswith("error: ") and len(r.stderr.splitlines()) == 1, r.stderr
     assert word in r.stderr and not out.exists()
+
+
+def test_synth_reads_a_two_level_hierarchy_stat():
+    """Yosys 0.23 writes hierarchy text lines into `stat -json` for a top of tops."""
+    from flann.implement.synth import _stat_json
+
+    text = ('{\n   "modules": {\n   },\n       flann_t0_adder                1\n       flann_t1_seq   1\n'
+            '      "design": {\n         "num_cells_by_type": {\n            "LUT4": 12\n         }\n      }\n}\n')
+    assert json.loads(_stat_json(text))["design"]["num_cells_by_type"] == {"LUT4": 12}
