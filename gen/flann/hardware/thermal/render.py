@@ -43,7 +43,10 @@ def order_prefix(j: int) -> str:
 def order_files(spec: ThermalSpec, j: int) -> dict[str, str]:
     """Order j's one-input datapath, its entities prefixed (file and entity names)."""
     prefix = order_prefix(j)
-    rename = lambda text: _ENTITY_RE.sub(lambda m: prefix + m.group(1)[len("flann_"):], text)
+
+    def rename(text: str) -> str:
+        return _ENTITY_RE.sub(lambda m: prefix + m.group(1)[len("flann_"):], text)
+
     return {rename(name): rename(text) for name, text in fixed_render.render(spec.orders[j]).items()}
 
 
