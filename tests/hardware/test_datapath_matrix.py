@@ -10,8 +10,10 @@ import sys
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from flann.golden.thermal_train import fit_thermal
 from flann.golden.train import fit_lstsq
 from flann.hardware.seed import render as seed_render
 from flann.hardware.seed.spec import derive_seed_spec
@@ -41,6 +43,14 @@ def designs(tmp_path_factory):
                  ("--family", *recs, "--terms", 5, "-o", d / "family")):
         r = flann("gen", *args, "--input-bits", BITS)
         assert r.returncode == 0, r.stderr
+    # a two-input model of a closed-form sensor whose gain, null and roll-off move with temperature
+    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    u, k = x / 8.0, 2.5 * (1 + 1e-4 * (t - 25))
+    v = 1.5 * (1 - 2.5e-4 * (t - 25)) * u / (1 + np.abs(u) ** k) ** (1 / k) + 6e-6 * (t - 25)
+    thermal = d / "m_thermal.json"
+    thermal.write_text(fit_thermal(v, t, x, (5, 3), norm="range").to_json())
+    r = flann("gen", thermal, "-o", d / "thermal", "--input-bits", BITS, "--temp-bits", 5, "--temp-lsb-c", 6)
+    assert r.returncode == 0, r.stderr
     # the seed architecture is written by flann explore only (for comparison)
     seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
     # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
@@ -69,13 +79,15 @@ COMMANDS = {
 # (datapath, command) that refuse, with a word the one line must hold
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map", ("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
+           ("thermal", "trace"): "stage model", ("thermal", "eval"): "one-input",
+           ("thermal", "explore"): "two-input",
            # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
            ("seed", "synth"): "does not fit"}
 
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed"])
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed", "thermal"])
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_command_on_datapath(designs, datapath, command):
     r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))
@@ -135,6 +147,8 @@ TAMPERED = [
     ("fixed", _set("input_bits", True), "input_bits"),
     ("float18", _drop("output.frac_bits"), "output.frac_bits"),
     ("fixed", _set("datapath", "quantum"), "datapath"),
+    ("thermal", _drop("spec.temp_bits"), "spec.temp_bits"),
+    ("thermal", _set("temp_lsb_c", "0.5"), "temp_lsb_c"),
 ]
 TAMPER_COMMANDS = {
     "sim": lambda d, fx: ("sim", d),
@@ -160,7 +174,7 @@ def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field):
 
 @pytest.mark.skipif(shutil.which("vsg") is None and not (Path(sys.executable).parent / "vsg").exists(),
                     reason="vsg not installed")
-@pytest.mark.parametrize("datapath", ["fixed", "float18", "family"])
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "thermal"])
 def test_generated_vhdl_passes_vsg(designs, datapath):
     files = sorted((designs["dir"] / datapath).glob("*.vhd"))
     assert files and lint_vhdl(files, start=REPO) == []

@@ -14,14 +14,15 @@ from ..golden.thermal import load_any_model
 from ..golden.train import converter_mismatch
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
-from ..hardware.registry import FAMILY, FORMATS, datapath
+from ..hardware.registry import FAMILY, FORMATS, datapath_for_model
 from .family import add_family_arguments, check_family_args
 
 HELP = "generate VHDL-93 for a model"
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("model", nargs="?", help="model.json (flann-model/1); not with --family")
+    parser.add_argument("model", nargs="?", help="model.json (flann-model/1, or flann-thermal-model/1: the two-input datapath); "
+                        "not with --family")
     parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
     parser.add_argument("--format", choices=FORMATS, default=FORMATS[0],
@@ -37,7 +38,7 @@ def run(args) -> int:
         check_family_args(args)
         dp, source, extra = FAMILY, args.family, {"terms": args.terms, "margin": args.margin}
     else:
-        dp, source, extra = datapath(args.format), args.model, {}
+        dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
         other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)
         if other:
             warnings.warn(other)

@@ -60,7 +60,7 @@ def _design_dir(args):
 
 def run(args) -> int:
     design = _design_dir(args)
-    model = load_model(design.model if design else args.model)
+    model = None if design else load_model(args.model)  # a design's datapath says whether it has stages
     args.format = args.format or FORMATS[0]
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:

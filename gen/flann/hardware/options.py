@@ -16,6 +16,7 @@ from ..errors import SpecError
 from .target import DEFAULT_PART
 
 MULT_STYLES = ("lut", "shiftadd")
+TWO_INPUT = ("temp_bits", "temp_lsb_c")  # options only a two-input (temperature) model uses
 
 
 def _opt(default, help: str, *, flag: str | None = None, type=None, choices=None):
@@ -29,6 +30,9 @@ class GenOptions:
     device: str = _opt(DEFAULT_PART, "target part-package-speed (default %(default)s)", type=str)
     input_bits: int = _opt(12, "signed ADC code width (default %(default)s)", type=int)
     input_lsb_v: float | None = _opt(None, "volts per input code (default: trained range + 10%%)", type=float)
+    temp_bits: int = _opt(12, "two-input models: signed temperature code width (default %(default)s)", type=int)
+    temp_lsb_c: float = _opt(0.0625, "two-input models: degC per temperature code (default %(default)s)",
+                             type=float)
     clamp: bool = _opt(True, "do not clamp codes to the trained range", flag="--no-clamp")
     output_bits: int | None = _opt(None, "signed output width", type=int)
     output_lsb_mm: float | None = _opt(None, "mm per output code", type=float)
@@ -43,7 +47,8 @@ class GenOptions:
     product_frac_bits: int | None = _opt(None, "fraction bits kept after each product", type=int)
 
     def to_kwargs(self) -> dict:
-        return asdict(self)
+        """The one-input datapaths' keyword arguments (the two-input ones' read as attributes)."""
+        return {k: v for k, v in asdict(self).items() if k not in TWO_INPUT}
 
     def changed(self) -> dict:
         """The options that differ from their defaults."""

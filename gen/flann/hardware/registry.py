@@ -9,12 +9,14 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import FlannError
+from ..golden.thermal import is_thermal, load_any_model
 from .datapath import Datapath, Field, _int
 from .family.datapath import DATAPATH as FAMILY
 from .fixed.datapath import DATAPATH as FIXED
 from .float18.datapath import DATAPATH as FLOAT18
 from .manifest import MANIFEST, Manifest, read_manifest
 from .seed.datapath import DATAPATH as SEED
+from .thermal.datapath import DATAPATH as THERMAL
 
 def _no(what: str):
     def refuse(*_args, **_kw):
@@ -33,7 +35,7 @@ PLAIN = Datapath(
     model_field="", why_no_bench=f"{WHY_PLAIN} bench", why_no_stages=f"{WHY_PLAIN} stage model",
     why_no_eval=f"{WHY_PLAIN} twin", why_no_explore=f"{WHY_PLAIN} model",
 )
-DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED, PLAIN)}
+DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED, THERMAL, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)
 FORMATS = (FIXED.name, FLOAT18.name)
 
@@ -42,6 +44,20 @@ def datapath(name: str) -> Datapath:
     if name not in DATAPATHS:
         raise FlannError(f"datapath {name!r}: known ones are {', '.join(DATAPATHS)}")
     return DATAPATHS[name]
+
+
+def datapath_for_model(model, format_name: str) -> Datapath:
+    """The datapath ``flann gen MODEL --format F`` builds: a two-input model has its own (the
+    model file says which it is); a one-input model the format's."""
+    try:
+        two_inputs = is_thermal(load_any_model(model))
+    except FlannError:
+        two_inputs = False  # the format's datapath names what is wrong with the file
+    if not two_inputs:
+        return datapath(format_name)
+    if format_name != FORMATS[0]:
+        raise FlannError(f"--format {format_name}: a two-input model is generated in fixed point only")
+    return THERMAL
 
 
 def _legacy_name(data: dict) -> str:
@@ -73,4 +89,4 @@ def read_design(directory) -> tuple[Manifest, Datapath]:
     return man, dp
 
 
-__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "SEED", "datapath", "read_design"]
+__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design"]

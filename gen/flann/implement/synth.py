@@ -356,6 +356,15 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
     ] + tail)
 
 
+# Yosys 0.23's `stat -json` writes the text of its design hierarchy ("  name  count" lines) into
+# the JSON when the hierarchy is more than one level deep (a top instantiating tops)
+_HIERARCHY_LINE = re.compile(r"^\s+[A-Za-z_\\$][^\s\"]*\s+\d+\s*$")
+
+
+def _stat_json(text: str) -> str:
+    return "\n".join(ln for ln in text.splitlines() if not _HIERARCHY_LINE.match(ln))
+
+
 def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
     """Run Yosys synth_xilinx -family xcv; return (cells by type, warnings that matter)."""
     yosys = _need_tool("yosys")
@@ -379,7 +388,7 @@ def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple
             msg = ln[len("Warning:"):].strip()
             if not any(b in msg for b in BENIGN_YOSYS_WARNINGS) and msg not in warnings:
                 warnings.append(msg)
-    data = json.loads(stat.read_text())
+    data = json.loads(_stat_json(stat.read_text()))
     cells = data["design"]["num_cells_by_type"]
     (work / "modules.json").write_text(json.dumps({
         str(name).lstrip("\\"): mod.get("num_cells_by_type", {}) for name, mod in data.get("modules", {}).items()

@@ -16,7 +16,14 @@ from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
 from .design import Design
 from .float18 import run_design
-from .runner import run_family_bench, simulate as simulate_fixed, throughput
+from .benches import BENCH_DIR
+from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
+
+# a two-input sweep over every voltage code at every temperature code up to this many samples;
+# above it, every voltage code at THERMAL_TEMPS temperature codes (both ends of the code range,
+# both ends of the calibrated range, evenly spaced codes between)
+THERMAL_MAX_SAMPLES = 2_000_000
+THERMAL_TEMPS = 17
 
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
@@ -67,7 +74,47 @@ def _fixed(design: Design, build_dir, *, seed=1, netlist=False, engine="auto", p
     return simulate_fixed(design, build_dir, seed=seed, netlist=netlist, engine=engine, progress=progress)
 
 
-BENCHES = {"sweep": _fixed, "f18_top": _float18, "family": _family}
+def thermal_temperature_codes(spec) -> tuple[list[int], bool]:
+    """(temperature codes the sweep runs, every code?)."""
+    every = list(range(spec.temp_code_min, spec.temp_code_max + 1))
+    if len(every) * (spec.code_max - spec.code_min + 1) <= THERMAL_MAX_SAMPLES:
+        return every, True
+    inner = np.linspace(spec.temp_lo, spec.temp_hi, THERMAL_TEMPS - 2).round().astype(int).tolist()
+    return sorted({spec.temp_code_min, spec.temp_code_max, *inner}), False
+
+
+def _thermal(design: Design, build_dir, *, seed=1, **_) -> dict:
+    spec, man = design.spec, design.manifest
+    temps, every = thermal_temperature_codes(spec)
+    build_dir = Path(build_dir).resolve()
+    samples = len(temps) * (spec.code_max - spec.code_min + 1)
+    backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
+    work = build_dir / "thermal_sweep"
+    temps_file, out_file = build_dir / "thermal_temps.txt", build_dir / "thermal_sweep.txt"
+    build_dir.mkdir(parents=True, exist_ok=True)
+    temps_file.write_text("".join(f"{t}\n" for t in temps))
+    sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps}
+    params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
+              "code_lo_g": spec.code_min, "code_hi_g": spec.code_max, "temps_file_g": str(temps_file),
+              "out_file_g": str(out_file)}
+    res = run_cocotb([*design.files, BENCH_DIR / "flann_thermal_sweep.vhd"], "flann_thermal_sweep",
+                     "test_thermal_sweep", work, {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
+                     name="thermal_sweep", parameters=params, seed=seed, backend=backend)
+    rec = res.records.get("thermal_sweep", {})
+    benches = {"thermal_sweep": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
+                                 "seconds": round(res.seconds, 1)}}
+    lsb = spec.output_lsb_mm
+    err = rec.get("max_err_lsb")
+    s = _summary(design, rec.get("samples", 0), rec.get("mismatches"), None if err is None else err * lsb,
+                 benches, res.ok and bool(rec), lsb)
+    s["temperature_codes"] = "every" if every else temps
+    s["temperature_codes_tested"] = len(temps)
+    s["voltage_codes_tested"] = spec.code_max - spec.code_min + 1
+    s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
+    return {"summary": s, "curve": None, "spec": spec}
+
+
+BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "family": _family}
 
 
 def simulate(design: Design, build_dir, **kw) -> dict:

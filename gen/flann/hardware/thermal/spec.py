@@ -16,8 +16,10 @@ products are multiplies by t_n, the same kind of multiply the serial multiplier 
 Error analysis (|hardware - float| <= 1 output LSB q for every voltage and temperature
 code, the float model taken at the same clamped codes), pre-rounding share <= q/2:
 
-* each order's datapath: <= 1 of its LSBs at each node, q/2^K, + 1/2 for the interpolation
-  product's rounding, times |t_n|^j <= 1:  1.5 (orders) q / 2^K
+* each order's datapath: its own bound (its error analysis, in its LSBs q/2^K) at each node,
+  + 1/2 for the interpolation product's rounding, times |t_n|^j <= 1; K is sized for 1 LSB
+  per order, then each order's quarter-wave table is made smaller (fewer block RAMs) where
+  the whole bound stays within 1/2 LSB (``_smaller_tables``)
 * the Horner roundings:   (orders - 1) q / 2^(K+1)
 * linear interpolation over one grid step h = lsb/2^E: max|d2x/dv'2| h^2 / 8
 * c' rounded to FR bits below the grid: max|dx/dv'| h 2^-(FR+1)
@@ -33,7 +35,7 @@ one-input datapath's widest input); the default output LSB q is, as for the one-
 design, a quarter of the larger of the output step per input code and the model's held-out
 RMS error, on the 1-2-5 series, or coarser when the interpolation's curvature error needs it; ``ThermalSpec.analysis`` lists every bound.  The slopes are taken
 numerically from the float model over the calibrated voltage and temperature ranges.
-The VHDL of this datapath is not rendered yet (docs/temperature.md).
+The VHDL is rendered by :mod:`.render` (``flann_thermal_top``).
 """
 
 from __future__ import annotations
@@ -97,6 +99,44 @@ class ThermalSpec:
     @property
     def temp_code_max(self) -> int:
         return (1 << (self.temp_bits - 1)) - 1
+
+    @property
+    def horner_degree(self) -> int:
+        """D: the gain and offset polynomials' degree in t_n."""
+        return len(self.gain_int) - 1
+
+    @property
+    def order_latency(self) -> int:
+        return max(o.latency_cycles for o in self.orders)
+
+    @property
+    def latency_cycles(self) -> int:
+        """Clock edges from the accepting edge to out_valid (flann_thermal_top's sequence: t_n,
+        the Horner start and D steps + 1, c', the node, then each order datapath run at the node
+        and the next node (start, wait, ready again), the interpolation, the Horner in t_n over
+        the orders (start, orders steps) and the output register)."""
+        m, d, p = top_widths(self)["mul_b_bits"], self.horner_degree, len(self.orders)
+        base = 1 + 1 + (self.horner_degree + 1) + 2 + 2 * (self.order_latency + 3) + 2 + p + 1
+        # each product through the serial multiplier: load, one cycle per multiplier bit, use
+        return base + (m + 1) + d * (2 * m + 2) + (m + 1) + (p * (m + 2) - 1) + (p - 1) * (m + 1)
+
+    @property
+    def cycles_per_sample(self) -> int:
+        return self.latency_cycles + 1
+
+    def to_dict(self) -> dict:
+        """The spec as stamped in headers and manifest.json (every order's spec as its own)."""
+        return {
+            "number_format": "fixed", "input_bits": self.input_bits, "input_lsb_v": self.input_lsb_v,
+            "temp_bits": self.temp_bits, "temp_lsb_c": self.temp_lsb_c,
+            "clamp_codes": [self.clamp_lo, self.clamp_hi], "temp_clamp_codes": [self.temp_lo, self.temp_hi],
+            "fine_bits": self.fine_bits, "interp_bits": self.interp_bits, "t_frac_bits": self.t_frac_bits,
+            "t_scale_int": self.t_scale_int, "t_offset_int": self.t_offset_int, "t_shift": self.t_shift,
+            "g_frac_bits": self.g_frac_bits, "gain_int": list(self.gain_int),
+            "offset_int": list(self.offset_int), "inner_bits": self.inner_bits,
+            "output_lsb_mm": self.output_lsb_mm, "output": self.out_fmt.describe(),
+            "orders": [o.to_dict() for o in self.orders],
+        }
 
     def float_reference(self, codes, temp_codes) -> np.ndarray:
         """The float model (mm) at the clamped voltage and temperature codes."""
@@ -176,6 +216,37 @@ def _size(model, q, slope_v, slope_t, h, vmax, lsb, tlsb, fine, input_bits, vran
     return fr, fg, ft, k, t_scale_int, t_offset_int, shift, gain_int, offset_int, tuple(specs)
 
 
+def _orders_lsb(specs, k: int) -> float:
+    """Each order's datapath bound (its own error analysis, in its LSBs q / 2^K) + 1/2 for the
+    interpolation product's rounding, times |t_n|^j <= 1, in output LSBs."""
+    return sum(o.analysis["bound_total_lsb"] + 0.5 for o in specs) / 2 ** k
+
+
+TABLE_STEPS = 2   # at most this many address bits fewer than the order's own error budget picks
+
+
+def _smaller_tables(specs, k: int, rest: float) -> tuple:
+    """The order datapaths with fewer quarter-wave table words where the whole pre-rounding bound
+    (``rest`` from the other sources) stays within 1/2 LSB and it saves block RAMs: every order
+    has a table of its own, each sized by its own budget, where the orders share the output's."""
+    specs = list(specs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for j, o in enumerate(list(specs)):
+            for a in range(o.table_addr_bits - 1, o.table_addr_bits - 1 - TABLE_STEPS, -1):
+                try:
+                    cand = derive_spec(o.model, input_bits=o.input_bits, input_lsb_v=o.input_lsb_v,
+                                       output_lsb_mm=o.output_lsb_mm, table_addr_bits=a)
+                except SpecError:
+                    break
+                trial = specs[:j] + [cand] + specs[j + 1:]
+                if (cand.analysis["estimate"]["brams"] >= specs[j].analysis["estimate"]["brams"]
+                        or rest + _orders_lsb(trial, k) > 0.5):
+                    break
+                specs = trial
+    return tuple(specs)
+
+
 def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: float, temp_bits: int,
                         temp_lsb_c: float, output_lsb_mm: float | None = None) -> ThermalSpec:
     if not isinstance(model, ThermalModel):
@@ -246,7 +317,11 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
         "gain_rounding_lsb": slope_v * vmax * p * 2.0 ** -fg / q,
         "temperature_lsb": slope_t * 0.5 * 2.0 ** -ft / q,
     }
-    analysis["pre_rounding_lsb"] = sum(v for key, v in analysis.items() if key.endswith("_lsb"))
+    analysis["orders_lsb"] = _orders_lsb(specs, k)
+    rest = sum(v for key, v in analysis.items() if key.endswith("_lsb") and key != "orders_lsb")
+    specs = _smaller_tables(specs, k, rest)
+    analysis["orders_lsb"] = _orders_lsb(specs, k)
+    analysis["pre_rounding_lsb"] = rest + analysis["orders_lsb"]
     if q != asked:
         analysis["output_lsb_raised_from_mm"] = asked
         analysis["output_lsb_raised_because"] = why
@@ -259,6 +334,46 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
                        analysis=analysis)
 
 
+def _sbits(bound: float) -> int:
+    """Signed width holding +-bound."""
+    b = int(math.ceil(abs(bound)))
+    return bits_needed(-b, b)
+
+
+def top_widths(spec: "ThermalSpec") -> dict:
+    """Every register width of flann_thermal_top, from the integer ranges of the spec: each
+    value's bound, with one bit of margin where a bound is a sum of bounds."""
+    s = spec
+    p, d = len(s.orders), s.horner_degree
+    t_max = max(abs(s.temp_lo), abs(s.temp_hi)) * abs(s.t_scale_int) + abs(s.t_offset_int)
+    tn_bits = _sbits((t_max >> s.t_shift) + 2)
+    t_scale_bits = _sbits(s.t_scale_int)
+    t_pre_bits = max(s.temp_bits + t_scale_bits, _sbits(s.t_offset_int)) + 1
+    growth = (2.0 ** (tn_bits - 1)) / 2.0 ** s.t_frac_bits      # |t_n| bound in units of 1
+    gain_bits = _sbits(sum(abs(g) * growth ** k for k, g in enumerate(s.gain_int)) + d + 1) + 1
+    offset_bits = _sbits(sum(abs(o) * growth ** k for k, o in enumerate(s.offset_int)) + d + 1) + 1
+    shift = s.fine_bits + s.interp_bits
+    fine_pre_bits = s.input_bits + shift + gain_bits + 1
+    fine_bound = (2 ** (s.input_bits - 1)) * 2 ** shift * 2 ** (gain_bits - 1) / 2 ** s.g_frac_bits \
+        + 2 ** (offset_bits - 1) / 2 ** s.g_frac_bits + 2
+    fine_bits_w = min(_sbits(fine_bound) + 1, fine_pre_bits)
+    node_bits = s.orders[0].input_bits
+    if any(o.input_bits != node_bits for o in s.orders):
+        raise SpecError("the order datapaths must share one input width")
+    node_w = max(fine_bits_w - s.interp_bits, node_bits) + 1
+    ord_bits = max(o.out_fmt.width for o in s.orders) + 1
+    part_bits = ord_bits + 2
+    acc_bits = part_bits + p + 1 + max(0, math.ceil(math.log2(max(growth, 1.0))) * p)
+    if s.out_fmt.width > acc_bits:
+        raise SpecError(f"output width {s.out_fmt.width} exceeds the accumulator's {acc_bits} bits")
+    mul_b_bits = max(s.temp_bits, tn_bits, gain_bits, s.interp_bits + 1)
+    mul_a_bits = max(t_scale_bits, gain_bits, offset_bits, s.input_bits + shift, ord_bits + 1, acc_bits)
+    return dict(tn_bits=tn_bits, t_scale_bits=t_scale_bits, t_pre_bits=t_pre_bits, gain_bits=gain_bits,
+                offset_bits=offset_bits, fine_shift=shift, fine_pre_bits=fine_pre_bits, fine_bits_w=fine_bits_w,
+                node_bits=node_bits, node_w=node_w, ord_bits=ord_bits, part_bits=part_bits, acc_bits=acc_bits,
+                mul_a_bits=mul_a_bits, mul_b_bits=mul_b_bits)
+
+
 def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
     """c' in grid codes without rounding (what the twin's integers approximate)."""
     m = spec.model
@@ -267,4 +382,4 @@ def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
     return v / spec.input_lsb_v * 2 ** spec.fine_bits
 
 
-__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float"]
+__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float", "top_widths"]

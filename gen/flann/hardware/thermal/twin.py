@@ -3,8 +3,7 @@
 ``ThermalTop(spec).process(in_data, in_temp)`` returns the output ports ``out_data`` (in
 output LSBs) and ``out_sat`` (an input outside the calibrated codes, clamped, or the output
 saturated), plus the internal stages in :class:`ThermalTrace`.  The order datapaths are
-:class:`flann.hardware.fixed.twin.FlannTop`, unchanged.  The entity name is what the
-VHDL will carry once it is rendered.
+:class:`flann.hardware.fixed.twin.FlannTop`, unchanged.  The entity is the rendered top's (:mod:`.render`).
 """
 
 from __future__ import annotations
@@ -43,6 +42,7 @@ class ThermalTop:
 
     def __init__(self, spec: ThermalSpec):
         self.spec = spec
+        self.latency = spec.latency_cycles
         self.orders = [FlannTop(s) for s in spec.orders]
 
     def trace(self, in_data, in_temp) -> ThermalTrace:
@@ -77,12 +77,19 @@ class ThermalTop:
         t = self.trace(in_data, in_temp)
         return TopOut(out_data=t.out_data, out_sat=t.out_sat)
 
-    def error_vs_float(self, temp_codes, codes=None) -> dict:
+    def all_codes(self) -> np.ndarray:
+        """Every voltage code (each is checked at the temperature codes the bench states)."""
+        return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
+
+    def all_temp_codes(self) -> np.ndarray:
+        return np.arange(self.spec.temp_code_min, self.spec.temp_code_max + 1, dtype=np.int64)
+
+    def error_vs_float(self, temp_codes=None, codes=None) -> dict:
         """max |twin - float| (output LSBs) over every voltage code (default) at each of
-        ``temp_codes``; output clipping is not an error."""
+        ``temp_codes`` (default: every temperature code); output clipping is not an error."""
         s = self.spec
-        codes = (np.arange(s.code_min, s.code_max + 1, dtype=np.int64) if codes is None
-                 else np.asarray(codes, dtype=np.int64))
+        codes = self.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
+        temp_codes = self.all_temp_codes() if temp_codes is None else temp_codes
         worst = 0.0
         for tau in np.asarray(temp_codes, dtype=np.int64):
             out, sat = self.process(codes, tau)

@@ -1,0 +1,152 @@
+"""Render the two-input datapath: each temperature order's one-input datapath plus the top.
+
+Every order is the fixed datapath's own rendering (:func:`flann.hardware.fixed.render.render`,
+its templates unchanged) with its entities given the order's prefix (``flann_t<j>_norm`` ...):
+one VHDL library holds every order, and each order's constants (ROMs, widths) differ.
+``flann_thermal_top`` (this folder's one template) instantiates them and adds what is new:
+the temperature normalisation, the input's gain and offset in t_n, the interpolation between
+two grid nodes and the Horner combination of the orders.  Widths are computed here from the
+spec's integer ranges; the template only places text.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+from ...errors import FlannError
+from ...golden.model import model_sha256
+from ...golden.thermal import ThermalModel, load_any_model
+from ...numeric.fixed import bits_literal
+from ...textgen import template
+from ..adc import default_input_lsb
+from ..datapath import rebuild_matching
+from ..fixed import render as fixed_render
+from ..header import header
+from ..manifest import write_design
+from ..options import GenOptions
+from .spec import ThermalSpec, derive_thermal_spec, top_widths
+
+TOP = "flann_thermal_top"
+DATAPATH = "thermal"
+MODEL_FILE = fixed_render.MODEL_FILE
+TEMPLATES = "hardware/thermal/templates"
+# the fixed datapath's entities, renamed per order
+_ENTITY_RE = re.compile(r"\b(" + "|".join(name for name, _ in fixed_render.ENTITIES) + r")\b")
+
+
+def order_prefix(j: int) -> str:
+    return f"flann_t{j}_"
+
+
+def order_files(spec: ThermalSpec, j: int) -> dict[str, str]:
+    """Order j's one-input datapath, its entities prefixed (file and entity names)."""
+    prefix = order_prefix(j)
+
+    def rename(text: str) -> str:
+        return _ENTITY_RE.sub(lambda m: prefix + m.group(1)[len("flann_"):], text)
+
+    return {rename(name): rename(text) for name, text in fixed_render.render(spec.orders[j]).items()}
+
+
+def contexts(spec: ThermalSpec) -> dict:
+    s = spec
+    w = top_widths(s)
+    d, p = s.horner_degree, len(s.orders)
+    gain_bits, offset_bits, t_scale_bits, t_pre_bits = w["gain_bits"], w["offset_bits"], w["t_scale_bits"], w["t_pre_bits"]
+    node_bits, node_w, acc_bits = w["node_bits"], w["node_w"], w["acc_bits"]
+    orders = [dict(j=j, top=order_prefix(j) + "top", out_bits=o.out_fmt.width) for j, o in enumerate(s.orders)]
+    return dict(
+        in_bits=s.input_bits, temp_bits=s.temp_bits, out_bits=s.out_fmt.width,
+        input_lsb_v=s.input_lsb_v, temp_lsb_c=s.temp_lsb_c, output_lsb_mm=s.output_lsb_mm,
+        latency=s.latency_cycles, fine_bits=s.fine_bits, degree=d, n_orders=p, orders=orders,
+        **w,
+        gain_words=[bits_literal(g, gain_bits) for g in s.gain_int],
+        offset_words=[bits_literal(o, offset_bits) for o in s.offset_int],
+        clamp_lo=bits_literal(s.clamp_lo, s.input_bits), clamp_hi=bits_literal(s.clamp_hi, s.input_bits),
+        temp_lo=bits_literal(s.temp_lo, s.temp_bits), temp_hi=bits_literal(s.temp_hi, s.temp_bits),
+        t_scale=bits_literal(s.t_scale_int, t_scale_bits),
+        t_offset=bits_literal(s.t_offset_int, t_pre_bits), t_shift=s.t_shift,
+        t_frac_bits=s.t_frac_bits, g_frac_bits=s.g_frac_bits, interp_bits=s.interp_bits,
+        node_max=bits_literal((1 << (node_bits - 1)) - 1, node_w),
+        node_min=bits_literal(-(1 << (node_bits - 1)), node_w),
+        inner_bits=s.inner_bits,
+        out_max=bits_literal(s.out_fmt.max_int, acc_bits + 1), out_min=bits_literal(s.out_fmt.min_int, acc_bits + 1),
+    )
+
+
+def render(spec: ThermalSpec, sha: str = "") -> dict[str, str]:
+    """{file name: VHDL text} in compile order: every order's entities, then the top."""
+    out = {}
+    for j in range(len(spec.orders)):
+        out.update(order_files(spec, j))
+    # each order's spec is in its own files' headers
+    stamped = {**spec.to_dict(), "orders": [order_prefix(j) + "top" for j in range(len(spec.orders))]}
+    h = header(f"{TOP}.vhd", "two-input (voltage, temperature) FLANN LVDT compensator, top level",
+               "flann gen", stamped, sha)
+    out[f"{TOP}.vhd"] = template(f"{TEMPLATES}/{TOP}.vhd.j2").render(h=h, **contexts(spec))
+    return out
+
+
+def manifest(spec: ThermalSpec, files: list[str], sha: str) -> dict:
+    return {
+        "top": TOP, "datapath": DATAPATH, "files": list(files), "model": MODEL_FILE,
+        "input_bits": spec.input_bits, "input_lsb_v": spec.input_lsb_v,
+        "adc_bits": spec.input_bits, "adc_lsb_v": spec.input_lsb_v,
+        "temp_bits": spec.temp_bits, "temp_lsb_c": spec.temp_lsb_c,
+        "output_bits": spec.out_fmt.width, "output_lsb_mm": spec.output_lsb_mm,
+        "latency_cycles": spec.latency_cycles, "cycles_per_sample": spec.cycles_per_sample,
+        "clamp_codes": [spec.clamp_lo, spec.clamp_hi], "temp_clamp_codes": [spec.temp_lo, spec.temp_hi],
+        "generator_version": spec.orders[0].generator_version,
+        "spec": spec.to_dict(),
+        "analysis": dict(spec.analysis),
+        "model_sha256": sha,
+        # the port beyond the common interface, as the ISE pin map reads a datapath's extra ports
+        "cfg_port": {"ports": {"in_temp": f"in std_logic_vector({spec.temp_bits - 1} downto 0)"}},
+    }
+
+
+def _load(model) -> tuple[ThermalModel, str, str]:
+    """(model, sha256, file text) of a two-input model file."""
+    path = Path(model)
+    m = load_any_model(path)
+    if not isinstance(m, ThermalModel):
+        raise FlannError(f"{path}: a one-input model (the thermal datapath takes a two-input model)")
+    return m, model_sha256(path), path.read_bytes().decode("utf-8")
+
+
+def derive(model: ThermalModel, options: GenOptions) -> ThermalSpec:
+    lsb = options.input_lsb_v if options.input_lsb_v is not None else default_input_lsb(model, options.input_bits)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return derive_thermal_spec(model, input_bits=options.input_bits, input_lsb_v=lsb,
+                                   temp_bits=options.temp_bits, temp_lsb_c=options.temp_lsb_c,
+                                   output_lsb_mm=options.output_lsb_mm)
+
+
+def generate(model, out_dir, options: GenOptions | None = None) -> dict:
+    """Derive, render and write the design directory as a whole (VHDL, manifest.json, model)."""
+    m, sha, text = _load(model)
+    spec = derive(m, GenOptions.of(options))
+    texts = render(spec, sha)
+    return write_design({**texts, MODEL_FILE: text}, manifest(spec, list(texts), sha), out_dir)
+
+
+def manifest_options(man: dict) -> GenOptions:
+    s = man["spec"]
+    try:
+        return GenOptions.of(input_bits=s["input_bits"], input_lsb_v=s["input_lsb_v"], temp_bits=s["temp_bits"],
+                             temp_lsb_c=s["temp_lsb_c"], output_lsb_mm=s["output_lsb_mm"])
+    except KeyError as exc:
+        raise FlannError(f"manifest.json spec has no field {exc.args[0]!r}: regenerate the design") from None
+
+
+def rebuild(model, man: dict, where="design") -> tuple[ThermalSpec, dict]:
+    """from_manifest: the spec derived again from the kept model, checked field for field."""
+    m, _, _ = _load(model)
+    spec, options = rebuild_matching(man, where, lambda o: derive(m, o), lambda clamp: manifest_options(man))
+    return spec, options.changed()
+
+
+__all__ = ["TOP", "DATAPATH", "render", "contexts", "manifest", "generate", "rebuild", "derive", "order_files"]

@@ -1,0 +1,136 @@
+"""flann gen of a two-input model: the thermal datapath's directory (VHDL compiling under GHDL
+--std=93c, each order the fixed datapath's entities under its own prefix, a flat in_temp port),
+its manifest read back through the registry, the option checks, and the twin protocol."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from flann.golden.thermal_train import fit_thermal
+from flann.hardware.fixed.render import ENTITIES
+from flann.hardware.registry import DATAPATHS, read_design
+from flann.verify.datapaths import THERMAL_MAX_SAMPLES, thermal_temperature_codes
+from flann.verify.design import from_directory
+
+FLANN = [sys.executable, "-m", "flann.cli"]
+
+
+def flann(*args):
+    return subprocess.run([*FLANN, *map(str, args)], capture_output=True, text=True)
+
+
+def sensor_v(x, temp):
+    """An S-curve sensor (+-10 mm) whose gain falls 0.025 %/degC, null and roll-off move."""
+    dt = np.asarray(temp, dtype=float) - 25.0
+    k = 2.5 * (1 + 1e-4 * dt)
+    u = x / 8.0
+    return 1.5 * (1 - 2.5e-4 * dt) * u / (1 + np.abs(u) ** k) ** (1 / k) + 1.5 * 4e-6 * dt
+
+
+@pytest.fixture(scope="module")
+def design(tmp_path_factory):
+    d = tmp_path_factory.mktemp("thermal")
+    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    model = d / "m.json"
+    model.write_text(fit_thermal(sensor_v(x, t), t, x, (5, 3), norm="range").to_json())
+    r = flann("gen", model, "-o", d / "hdl", "--input-bits", 8, "--temp-bits", 5, "--temp-lsb-c", 6)
+    assert r.returncode == 0, r.stderr
+    return {"dir": d / "hdl", "model": model, "out": r.stdout}
+
+
+def test_directory_and_manifest(design):
+    man, dp = read_design(design["dir"])
+    assert dp is DATAPATHS["thermal"] and man["top"] == "flann_thermal_top" == dp.top
+    assert man["temp_bits"] == 5 and man["temp_lsb_c"] == 6.0 and man["input_bits"] == 8
+    assert man["temp_clamp_codes"] == [-3, 13]          # -20 / 6 rounded up, 80 / 6 rounded down
+    assert "(thermal, top flann_thermal_top)" in design["out"]
+    files = man["files"]
+    assert files[-1] == "flann_thermal_top.vhd"
+    orders = len(man["spec"]["orders"])
+    # every order is the fixed datapath's set of entities, renamed; nothing else
+    names = {re.match(r"flann_t(\d+)_(\w+)\.vhd$", f).groups() for f in files[:-1]}
+    assert names == {(str(j), e[len("flann_"):]) for j in range(orders) for e, _ in ENTITIES}
+    for f in files[:-1]:
+        text = (design["dir"] / f).read_text()
+        declared = re.findall(r"^entity (\w+) is", text, re.M)
+        assert len(declared) == 1 and declared[0] == f[:-4]
+        assert not re.search(r"\bflann_(norm|expansion|multiplier|adder|seq|top)\b", text)
+    top = (design["dir"] / "flann_thermal_top.vhd").read_text()
+    assert re.search(r"in_temp\s+: in\s+std_logic_vector\(4 downto 0\)", top)
+    assert top.count("entity work.flann_t") == orders
+
+
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_vhdl_compiles_under_ghdl_93c(design, tmp_path):
+    man = json.loads((design["dir"] / "manifest.json").read_text())
+    r = subprocess.run(["ghdl", "-a", "--std=93c", f"--workdir={tmp_path}",
+                        *[str(design["dir"] / f) for f in man["files"]]], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run(["ghdl", "-e", "--std=93c", f"--workdir={tmp_path}", "-o", str(tmp_path / "top"),
+                        "flann_thermal_top"], capture_output=True, text=True, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+
+
+def test_regenerating_gives_identical_bytes(design, tmp_path):
+    r = flann("gen", design["model"], "-o", tmp_path / "again", "--input-bits", 8, "--temp-bits", 5,
+              "--temp-lsb-c", 6)
+    assert r.returncode == 0, r.stderr
+    for f in design["dir"].iterdir():
+        assert (tmp_path / "again" / f.name).read_bytes() == f.read_bytes(), f.name
+
+
+def test_rebuilt_twin_follows_the_protocol(design):
+    d = from_directory(design["dir"])
+    twin = d.twin()
+    assert twin.entity == "flann_thermal_top" and twin.latency == d.manifest["latency_cycles"] > 0
+    codes = twin.all_codes()
+    assert codes[0] == -128 and codes[-1] == 127
+    rec = twin.process(codes, d.spec.temp_hi)
+    assert rec.out_data.shape == rec.out_sat.shape == codes.shape
+    e = twin.error_vs_float()
+    assert e["temperature_codes"] == 32 and e["codes"] == 256 and 0 < e["max_err_lsb"] <= 1.0
+    # the float model, computed here, at one code: the twin within one output LSB
+    m, s = d.spec.model, d.spec
+    ref = m.predict(np.array([50 * s.input_lsb_v]), np.array([4 * s.temp_lsb_c]))[0]
+    assert abs(twin.process([50], 4).out_data[0] * s.output_lsb_mm - ref) <= s.output_lsb_mm
+
+
+def test_sweep_covers_every_temperature_code_or_a_stated_set_with_both_ends(design):
+    spec = from_directory(design["dir"]).spec
+    temps, every = thermal_temperature_codes(spec)
+    assert every and temps == list(range(-16, 16))
+    wide = type("S", (), dict(temp_code_min=-2048, temp_code_max=2047, temp_lo=-320, temp_hi=1280,
+                              code_min=-32768, code_max=32767))()
+    temps, every = thermal_temperature_codes(wide)
+    assert not every and 4096 * 65536 > THERMAL_MAX_SAMPLES
+    assert {-2048, 2047, -320, 1280} <= set(temps) and len(temps) == 17
+
+
+@pytest.mark.parametrize("args,word", [
+    (("--temp-bits", 1), "--temp-bits"),
+    (("--temp-bits", 17), "--temp-bits"),
+    (("--temp-lsb-c", -1), "--temp-lsb-c"),
+    (("--temp-bits", 5, "--temp-lsb-c", 1), "not the calibrated -20..80 degC"),
+    (("--format", "float18"), "fixed point only"),
+])
+def test_bad_options_are_one_line(design, tmp_path, args, word):
+    out = tmp_path / "bad"
+    r = flann("gen", design["model"], "-o", out, "--input-bits", 8, *args)
+    assert r.returncode == 2 and r.stderr.startswith("error: ") and len(r.stderr.splitlines()) == 1, r.stderr
+    assert word in r.stderr and not out.exists()
+
+
+def test_synth_reads_a_two_level_hierarchy_stat():
+    """Yosys 0.23 writes hierarchy text lines into `stat -json` for a top of tops."""
+    from flann.implement.synth import _stat_json
+
+    text = ('{\n   "modules": {\n   },\n       flann_t0_adder                1\n       flann_t1_seq   1\n'
+            '      "design": {\n         "num_cells_by_type": {\n            "LUT4": 12\n         }\n      }\n}\n')
+    assert json.loads(_stat_json(text))["design"]["num_cells_by_type"] == {"LUT4": 12}
