@@ -154,6 +154,8 @@ def test_train_eval_predict_with_temperature(tmp_path, capsys):
     assert res["drift_ppm_fs_per_c"]["raw"] > 10 * res["drift_ppm_fs_per_c"]["float"]
     assert [r["temperature_c"] for r in res["by_temperature"]["float"]] == [10.0, 40.0]
     assert set(res["by_temperature"]["raw"][0]) >= {"temperature_c", "max_error_mm", "rms_error_mm"}
+    assert res["compensated"]["by_temperature"] == res["by_temperature"]["float"]
+    assert res["raw"]["by_temperature"] == res["by_temperature"]["raw"]
     rc, out, _ = run(["eval", model, held], capsys)
     assert rc == 0 and "drift (ppm FS/degC)" in out
     pred = tmp_path / "p.csv"

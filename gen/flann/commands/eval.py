@@ -95,6 +95,10 @@ def run(args) -> int:
         errors.setdefault("hardware", None)
         res.update(temperature_report(errors, rec.displacement_mm, rec.temperature_c,
                                       res["full_scale_mm"]))
+        # each figure's own section carries its list too (raw, compensated = the float model, hardware)
+        for name, section in (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware")):
+            if res["by_temperature"].get(name) is not None and section in res:
+                res[section]["by_temperature"] = res["by_temperature"][name]
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
