@@ -124,7 +124,9 @@ module RAMB4_S16 (DO, ADDR, DI, EN, CLK, WE, RST);
 endmodule
 
 // Dual-port block RAMs with both ports of the same width (a ROM read at two addresses maps to
-// one of these): each port as the single-port model, one shared memory.
+// one of these): each port as the single-port model, one shared memory.  Both ports are
+// modelled on CLKA (the generator's designs have one clock; two processes writing one memory
+// made Verilator's model abort at exit).
 
 module RAMB4_S1_S1 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA, WEB, RSTA, RSTB);
   parameter INIT_00 = 256'h0; parameter INIT_01 = 256'h0; parameter INIT_02 = 256'h0; parameter INIT_03 = 256'h0;
@@ -142,20 +144,20 @@ module RAMB4_S1_S1 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA,
     DOA = 0;
     DOB = 0;
   end
-  always @(posedge CLKA)
+  always @(posedge CLKA) begin
     if (ENA) begin
-      if (WEA) mem[ADDRA * 1 +: 1] <= DIA;
       if (RSTA) DOA <= 0;
       else if (WEA) DOA <= DIA;
       else DOA <= mem[ADDRA * 1 +: 1];
     end
-  always @(posedge CLKB)
     if (ENB) begin
-      if (WEB) mem[ADDRB * 1 +: 1] <= DIB;
       if (RSTB) DOB <= 0;
       else if (WEB) DOB <= DIB;
       else DOB <= mem[ADDRB * 1 +: 1];
     end
+    if (ENA && WEA) mem[ADDRA * 1 +: 1] <= DIA;
+    if (ENB && WEB) mem[ADDRB * 1 +: 1] <= DIB;
+  end
 endmodule
 
 module RAMB4_S2_S2 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA, WEB, RSTA, RSTB);
@@ -174,20 +176,20 @@ module RAMB4_S2_S2 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA,
     DOA = 0;
     DOB = 0;
   end
-  always @(posedge CLKA)
+  always @(posedge CLKA) begin
     if (ENA) begin
-      if (WEA) mem[ADDRA * 2 +: 2] <= DIA;
       if (RSTA) DOA <= 0;
       else if (WEA) DOA <= DIA;
       else DOA <= mem[ADDRA * 2 +: 2];
     end
-  always @(posedge CLKB)
     if (ENB) begin
-      if (WEB) mem[ADDRB * 2 +: 2] <= DIB;
       if (RSTB) DOB <= 0;
       else if (WEB) DOB <= DIB;
       else DOB <= mem[ADDRB * 2 +: 2];
     end
+    if (ENA && WEA) mem[ADDRA * 2 +: 2] <= DIA;
+    if (ENB && WEB) mem[ADDRB * 2 +: 2] <= DIB;
+  end
 endmodule
 
 module RAMB4_S4_S4 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA, WEB, RSTA, RSTB);
@@ -206,20 +208,20 @@ module RAMB4_S4_S4 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA,
     DOA = 0;
     DOB = 0;
   end
-  always @(posedge CLKA)
+  always @(posedge CLKA) begin
     if (ENA) begin
-      if (WEA) mem[ADDRA * 4 +: 4] <= DIA;
       if (RSTA) DOA <= 0;
       else if (WEA) DOA <= DIA;
       else DOA <= mem[ADDRA * 4 +: 4];
     end
-  always @(posedge CLKB)
     if (ENB) begin
-      if (WEB) mem[ADDRB * 4 +: 4] <= DIB;
       if (RSTB) DOB <= 0;
       else if (WEB) DOB <= DIB;
       else DOB <= mem[ADDRB * 4 +: 4];
     end
+    if (ENA && WEA) mem[ADDRA * 4 +: 4] <= DIA;
+    if (ENB && WEB) mem[ADDRB * 4 +: 4] <= DIB;
+  end
 endmodule
 
 module RAMB4_S8_S8 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA, WEB, RSTA, RSTB);
@@ -238,20 +240,20 @@ module RAMB4_S8_S8 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA,
     DOA = 0;
     DOB = 0;
   end
-  always @(posedge CLKA)
+  always @(posedge CLKA) begin
     if (ENA) begin
-      if (WEA) mem[ADDRA * 8 +: 8] <= DIA;
       if (RSTA) DOA <= 0;
       else if (WEA) DOA <= DIA;
       else DOA <= mem[ADDRA * 8 +: 8];
     end
-  always @(posedge CLKB)
     if (ENB) begin
-      if (WEB) mem[ADDRB * 8 +: 8] <= DIB;
       if (RSTB) DOB <= 0;
       else if (WEB) DOB <= DIB;
       else DOB <= mem[ADDRB * 8 +: 8];
     end
+    if (ENA && WEA) mem[ADDRA * 8 +: 8] <= DIA;
+    if (ENB && WEB) mem[ADDRB * 8 +: 8] <= DIB;
+  end
 endmodule
 
 module RAMB4_S16_S16 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WEA, WEB, RSTA, RSTB);
@@ -270,18 +272,18 @@ module RAMB4_S16_S16 (DOA, DOB, ADDRA, ADDRB, DIA, DIB, ENA, ENB, CLKA, CLKB, WE
     DOA = 0;
     DOB = 0;
   end
-  always @(posedge CLKA)
+  always @(posedge CLKA) begin
     if (ENA) begin
-      if (WEA) mem[ADDRA * 16 +: 16] <= DIA;
       if (RSTA) DOA <= 0;
       else if (WEA) DOA <= DIA;
       else DOA <= mem[ADDRA * 16 +: 16];
     end
-  always @(posedge CLKB)
     if (ENB) begin
-      if (WEB) mem[ADDRB * 16 +: 16] <= DIB;
       if (RSTB) DOB <= 0;
       else if (WEB) DOB <= DIB;
       else DOB <= mem[ADDRB * 16 +: 16];
     end
+    if (ENA && WEA) mem[ADDRA * 16 +: 16] <= DIA;
+    if (ENB && WEB) mem[ADDRB * 16 +: 16] <= DIB;
+  end
 endmodule
