@@ -14,6 +14,7 @@
 --   phase_bits = 23
 --   table_addr_bits = 9
 --   interp = true
+--   table_style = "shared"
 --   dq_bits = 11
 --   slope_guard = 11
 --   norm_guard = 13

@@ -103,12 +103,18 @@ def test_every_variant_fragment_has_its_place(entity, variants):
 
 
 @pytest.mark.parametrize("opts,expansion_has,expansion_lacks", [
-    ({}, ["icnt <= icnt - 1;", "slope_rom_c", "par(l) <= not par(l);"], [" * signed('0' & s2_slope(l))"]),
-    ({"mult_style": "lut"}, [" * signed('0' & s2_slope(l))", "slope_rom_c"], ["icnt"]),
-    ({"interp": False, "table_addr_bits": 8}, ["s2_slope(l) <= (others => '0');"], ["slope_rom_c", "prod :="]),
+    # one table for value and slope (fewer block RAMs): its second port reads the next sample
+    ({}, ["icnt <= icnt - 1;", "value_rom_s(to_integer(s1_addr(l) + 1))", "par(l) <= not par(l);",
+          "sampled at bin edges"],
+     [" * signed('0' & s2_slope(l))", "slope_rom_c", "not dqf(", "s2_slope(l) <="]),
+    ({"mult_style": "lut"}, ["* signed('0' & (s2_next(l)(", "value_rom_s(to_integer(s1_addr(l) + 1))"],
+     ["icnt", "slope_rom_c"]),
+    ({"interp": False, "table_addr_bits": 8}, ["s2_slope(l) <= (others => '0');", "sampled at bin centres",
+                                               "not dqf("],
+     ["slope_rom_c", "prod :=", "value_rom_s"]),
     # an even lane count: a lane's terms are all sin or all cos, its parity never flips
-    ({"lanes": 2}, ["slope_rom_c"], ["par(l) <= not par(l);"]),
-], ids=["serial", "array", "plain", "lanes2"])
+    ({"lanes": 2}, ["value_rom_s"], ["par(l) <= not par(l);"]),
+], ids=["serial_shared", "array_shared", "plain", "lanes2"])
 def test_each_architecture_choice_places_its_own_fragment(model_file, opts, expansion_has, expansion_lacks):
     text = render(derive_spec(load_model(model_file), **opts))["flann_expansion.vhd"]
     for s in expansion_has:

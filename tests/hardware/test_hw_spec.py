@@ -15,7 +15,7 @@ import pytest
 from flann.errors import SpecError
 from flann.numeric.fixed import FixedFormat, bits_literal, bits_needed, round_shift, saturate, wrap
 from flann.golden.model import FlannModel, expand
-from flann.hardware.fixed.spec import derive_spec, parse_device
+from flann.hardware.fixed.spec import derive_spec, parse_device, table_brams
 from flann.hardware.fixed.twin import FlannExpansion, FlannNorm, FlannTop
 
 
@@ -233,3 +233,32 @@ def test_refusals_name_the_option_the_user_gave(model, opts, says, not_says):
     with pytest.raises(SpecError) as exc:
         derive_spec(model, **opts)
     assert says in str(exc.value) and not_says not in str(exc.value)
+
+
+# ---- shared sin/slope table ------------------------------------------------------------
+def test_interpolated_designs_take_the_one_table_when_it_saves_block_rams(model):
+    s = derive_spec(model)
+    assert s.table_style == "shared" and s.interp_style == "serial_shared" and s.slope_rom == ()
+    two_tables = table_brams(s.table_addr_bits, [s.value_fmt.width, s.slope_fmt.width])
+    assert s.analysis["estimate"]["brams"] == table_brams(s.table_addr_bits, [s.value_fmt.width]) < two_tables
+    assert derive_spec(model, mult_style="lut").interp_style == "array_shared"
+    with pytest.warns(UserWarning):
+        assert derive_spec(model, interp=False, table_addr_bits=6).table_style == "separate"
+
+
+@pytest.mark.parametrize("opts", [{}, {"table_addr_bits": 5, "term_frac_bits": 14}])
+def test_shared_table_term_is_within_its_bound_at_every_quarter_wave_phase(model, opts):
+    """sin(pi v) (term 1, harmonic 1) over every phase of the first quadrant against numpy:
+    the samples' and the product's rounding (2^-Tf), linear interpolation between samples
+    h apart (h^2/8) and the offset truncated to Dq bits (< 2^-Dq times a difference <= h + 2^-Tf)."""
+    s = derive_spec(model, check_device=False, **opts)
+    assert s.table_style == "shared"
+    P, Tf, A, Dq = s.phase_bits, s.term_fmt.frac_bits, s.table_addr_bits, s.dq_bits
+    theta = np.arange(1 << (P - 2))
+    terms = FlannExpansion(s).process(theta)["terms"][:, 0, 0]  # j = 0: sin(m pi v_n), m = 1
+    ref = np.sin((theta + 0.5) * math.pi / 2.0 ** (P - 1))  # the phase LSB's centre
+    h = math.pi / 2 * 2.0 ** -A
+    bound = 2.0 ** -Tf + h * h / 8 + 2.0 ** -Dq * (h + 2.0 ** -Tf)
+    err = np.abs(terms / 2.0 ** Tf - ref)
+    assert err.max() <= bound, (err.max(), bound)
+    assert err.max() > bound / 20  # the check sees the table's error, not a vacuous bound

@@ -82,7 +82,12 @@ def contexts(spec: Spec) -> dict[str, dict]:
         fragments=f"{TEMPLATES}/expansion/interp/{s.interp_style}",
         parity=f"{TEMPLATES}/expansion/parity/{'alternate' if s.lane_kind_alternates else 'fixed'}.vhd.j2",
         slope_round=f"{TEMPLATES}/expansion/slope_round/{'half_up' if s.slope_guard > 0 else 'exact'}.vhd.j2",
-        interp_note="; a slope table corrects to first order inside a bin" if s.interp else "",
+        offset=f"{TEMPLATES}/expansion/offset/{'edge' if s.shared_table else 'centre'}.vhd.j2",
+        table_samples="bin edges" if s.shared_table else "bin centres",
+        value_table="value_rom_s" if s.shared_table else "value_rom_c",
+        interp_note=("; the difference of neighbouring samples (its second port) corrects to first order "
+                     "inside a bin" if s.shared_table else
+                     "; a slope table corrects to first order inside a bin" if s.interp else ""),
         mult_bits=_ubits(max([de, do, *starts])),
         start_mults=", ".join(f"{l} => {x}" for l, x in enumerate(starts)),
         start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
@@ -93,7 +98,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
         prod_bits=s.interp_prod_bits,
         slope_guard=s.slope_guard, slope_half=(1 << (s.slope_guard - 1)) if s.slope_guard > 0 else 0,
         value_words=[s.value_fmt.literal(v) for v in s.value_rom],
-        slope_words=[s.slope_fmt.literal(v) for v in s.slope_rom] if s.interp else [],
+        slope_words=[s.slope_fmt.literal(v) for v in s.slope_rom] if s.interp and not s.shared_table else [],
     )
     step_bits = _ubits(max(1, s.steps - 1))
     depth = 1 << step_bits

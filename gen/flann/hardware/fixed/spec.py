@@ -122,6 +122,9 @@ class Spec:
     weight_rom: tuple = field(repr=False)  # [lane][step]
     analysis: dict = field(repr=False, compare=False, default_factory=dict)
     term_bound: int = 0  # largest |term| the expansion can produce (sizes products and acc)
+    # 'separate': sin at bin centres + a slope table; 'shared': sin at bin edges, the slope is the
+    # difference of neighbouring samples read through the same table's second port (no slope ROM)
+    table_style: str = "separate"
 
     # -- derived ------------------------------------------------------------------------
     @property
@@ -173,7 +176,13 @@ class Spec:
 
     @property
     def slope_rom_bits(self) -> int:
+        """Width of the slope the correction multiplies: the slope ROM's word, or (shared table)
+        the low bits of the difference of two neighbouring samples."""
         return self.slope_fmt.width if self.interp else 1
+
+    @property
+    def shared_table(self) -> bool:
+        return self.interp and self.table_style == "shared"
 
     @property
     def serial_interp(self) -> bool:
@@ -187,7 +196,7 @@ class Spec:
         array multiplier) or 'serial' (the same product formed serially between advances)."""
         if not self.interp:
             return "plain"
-        return "serial" if self.serial_interp else "array"
+        return ("serial" if self.serial_interp else "array") + ("_shared" if self.shared_table else "")
 
     @property
     def interp_digit(self) -> int:
@@ -202,7 +211,10 @@ class Spec:
 
     @property
     def interp_prod_bits(self) -> int:
-        return self.dq_bits + 1 + self.slope_reg_bits if self.serial_interp else self.dq_bits + self.slope_rom_bits + 1
+        if self.serial_interp:
+            return self.dq_bits + 1 + self.slope_reg_bits
+        # shared: an unsigned offset ('0' & dq) times the unsigned difference ('0' & delta)
+        return self.dq_bits + self.slope_rom_bits + (2 if self.shared_table else 1)
 
     # -- constants with the rounding half-LSB folded in (the VHDL adds them, then shifts) --
     @property
@@ -266,6 +278,7 @@ class Spec:
             "phase_bits": self.phase_bits,
             "table_addr_bits": self.table_addr_bits,
             "interp": self.interp,
+            "table_style": self.table_style,
             "dq_bits": self.dq_bits,
             "slope_guard": self.slope_guard,
             "norm_guard": self.norm_guard,
@@ -304,6 +317,20 @@ def _table(A: int, value_fmt: FixedFormat, Dq: int, Gs: int, interp: bool):
     else:
         slope = np.zeros_like(value)
     return value, slope
+
+
+def _edge_table(A: int, value_fmt: FixedFormat):
+    """sin at the bin edges k/N pi/2 (k = 0..N-1) and the largest neighbour difference
+    (sample N is sin(pi/2) = 2^Tf)."""
+    value = value_fmt.quantize(np.sin(np.arange(1 << A) / (1 << A) * (math.pi / 2)))
+    return value, int(np.diff(np.append(value, 1 << value_fmt.frac_bits)).max())
+
+
+def table_brams(A: int, widths) -> int:
+    """Block RAMs of 2^A-word ROMs of the given widths (a 4-Kbit block is 4096/depth bits wide,
+    at most 16), one lane."""
+    per_block = min(16, max(1, BRAM_BITS >> A))
+    return sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in widths)
 
 
 def derive_spec(
@@ -435,6 +462,22 @@ def derive_spec(
     value_rom, slope_rom = _table(A, value_fmt, Dq, Gs, interp)
     slope_fmt = FixedFormat(max(1, bits_needed(0, int(slope_rom.max()), signed=False)), 0, signed=False)
     corr_max = (int(slope_rom.max()) << (Dq - 1)) >> Gs if interp else 0
+    table_style = "separate"
+    if interp:
+        # the shared table: same residual (linear interpolation between samples h apart, h^2/8),
+        # no slope ROM; its difference is formed modulo 2^C, exact when C <= Tf (2^Tf = 0 mod 2^C
+        # and sample 0 is 0, so the wrapped read of sample N-1's neighbour gives sin(pi/2))
+        edge_rom, delta_max = _edge_table(A, value_fmt)
+        C = max(1, bits_needed(0, delta_max, signed=False))
+        if C <= Tf and table_brams(A, [Tf + 1]) < table_brams(A, [Tf + 1, slope_fmt.width]):
+            table_style = "shared"
+            # offset truncation 2^-Dq (h + 2^-Tf) <= e_t/8; the product's shift rounds to the term LSB
+            h = math.pi / 2 * 2.0 ** -A
+            Dq = min(D + 1, max(2, math.ceil(math.log2(8 * (h + 2.0 ** -Tf) / e_t))))
+            Gs = Dq
+            value_rom, slope_rom = edge_rom, np.zeros(0, dtype=np.int64)
+            slope_fmt = FixedFormat(C, 0, signed=False)
+            corr_max = delta_max  # dq < 2^Dq: the rounded product stays <= the difference
     term_max = int(value_rom.max()) + corr_max + 1
     term_fmt = FixedFormat(bits_needed(-term_max, term_max), bits_needed(-term_max, term_max) - Tf)
 
@@ -499,7 +542,7 @@ def derive_spec(
         weight_fmt=weight_fmt, product_fmt=product_fmt, product_shift=shift, acc_fmt=acc_fmt,
         out_fmt=out_fmt, output_lsb_mm=q, steps=S, adv_period=adv_period,
         value_rom=tuple(int(x) for x in value_rom), slope_rom=tuple(int(x) for x in slope_rom),
-        weight_rom=weight_rom, term_bound=int(term_max),
+        weight_rom=weight_rom, term_bound=int(term_max), table_style=table_style,
     )
     analysis = error_analysis(spec, Sw=Sw, Swm=Swm, N=N)
     spec = replace(spec, analysis=analysis)
@@ -519,7 +562,12 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
     Wf, Pf = spec.weight_fmt.frac_bits, spec.product_fmt.frac_bits
     term_max = spec.term_fmt.max_int / 2.0 ** Tf
     e_phase = math.pi * (Swm * 1.5 + Sw) * 2.0 ** -(F + 1)
-    if spec.interp:
+    if spec.shared_table:
+        # samples' rounding (their convex combination), the product's rounding, linear
+        # interpolation h^2/8, offset truncation < 2^-Dq times the difference (<= h + 2^-Tf)
+        h = math.pi / 2 * 2.0 ** -A
+        e_tab = 2 * 2.0 ** -(Tf + 1) + h * h / 8 + 2.0 ** -Dq * (h + 2.0 ** -Tf)
+    elif spec.interp:
         e_tab = 2 * 2.0 ** -(Tf + 1) + (math.pi / 2 * 2.0 ** -(A + 1)) ** 2 / 2 \
             + math.pi / 2 * 2.0 ** -(A + Dq) + 2.0 ** (Dq - 2 - Gs - Tf)
     else:
@@ -533,7 +581,8 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
     }
     bounds["output_rounding"] = 0.5
     total = sum(bounds.values())
-    rom_bits = (1 << A) * (spec.value_fmt.width + (spec.slope_fmt.width if spec.interp else 0))
+    slope_rom_bits = spec.slope_fmt.width if spec.interp and not spec.shared_table else 0
+    rom_bits = (1 << A) * (spec.value_fmt.width + slope_rom_bits)
     wrom_bits = spec.steps * spec.weight_fmt.width
     est = estimate_resources(spec)
     return {
@@ -543,8 +592,9 @@ def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
         "cost": {
             "phase_bits": f"{spec.phase_bits}: phase accumulators {spec.lanes}x{spec.phase_bits} FF + adders; "
                           f"each bit less doubles the phase bound ({bounds['phase']:.3g} LSB)",
-            "table": f"{1 << A} x ({spec.value_fmt.width}+{spec.slope_fmt.width if spec.interp else 0}) bits "
-                     f"= {rom_bits} ROM bits per lane; one address bit less x4 interpolation residual",
+            "table": f"{1 << A} x ({spec.value_fmt.width}+{slope_rom_bits}) bits "
+                     f"= {rom_bits} ROM bits per lane; one address bit less x4 interpolation residual"
+                     + ("; slope = difference of neighbouring samples (second port)" if spec.shared_table else ""),
             "interp": (f"slope product {Dq}x{spec.slope_fmt.width} per lane, "
                        + ("serial between advances" if spec.serial_interp else "array multiplier"))
                       if spec.interp else "off: table step error dominates",
@@ -570,15 +620,16 @@ def estimate_resources(spec: Spec) -> dict:
     mult = 5.3 * T * W if spec.mult_style == "lut" else 5.5 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1)
     # slope correction: array multiplier, or serial between advances (shift-add designs)
     interp = 0 if not spec.interp else (6.3 * (Dq + C) if serial else 4.6 * Dq * (C + 1))
+    if spec.shared_table:  # the difference's subtractor and the second port's address increment
+        interp += C + A
     expansion = interp + 3.4 * P
     norm = 2 * (P + spec.norm_guard + spec.lin_width)
     adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
     luts = L * (mult + expansion) + norm + adder + 30
     ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
-    # a 4-Kbit block is 4096/depth bits wide (at most 16); each lane reads its own copy
-    per_block = min(16, max(1, BRAM_BITS >> A))
-    tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp else [])
-    brams = L * sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in tables)
+    # each lane reads its own copy
+    tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp and not spec.shared_table else [])
+    brams = L * table_brams(A, tables)
     if spec.steps * W > 2048:  # small weight ROMs go to LUTs
         brams += L * math.ceil(spec.steps * W / BRAM_BITS)
     return {"luts": int(luts), "ffs": int(ffs), "brams": int(brams)}
@@ -601,5 +652,5 @@ def check_fits(spec: Spec, part: str) -> None:
     )
 
 
-__all__ = ["Spec", "derive_spec", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["Spec", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ"]

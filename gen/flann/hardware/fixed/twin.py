@@ -89,7 +89,8 @@ class FlannNorm:
 
 
 class FlannExpansion:
-    """Phase accumulation m*theta mod 2, quarter-wave table with first-order slope correction."""
+    """Phase accumulation m*theta mod 2, quarter-wave table with first-order slope correction
+    (a slope table, or the shared table's difference of neighbouring samples)."""
 
     entity = "flann_expansion"
     latency = EXPANSION_ADVANCES  # advances from theta to the first term
@@ -119,10 +120,19 @@ class FlannExpansion:
         r = np.where(quad & 1, ((1 << (P - 2)) - 1) - r, r)
         addr = r >> D
         low = r & ((1 << D) - 1)
-        dq = 2 * low + 1 - (1 << D)
+        if s.shared_table:  # unsigned offset from the bin's lower edge
+            dq = 2 * low + 1
+        else:  # signed offset from the bin centre
+            dq = 2 * low + 1 - (1 << D)
         dq_t = dq >> (D + 1 - s.dq_bits)
         val = self.value_rom[addr]
-        if s.interp:
+        if s.shared_table:
+            # the second port reads address + 1 mod N; the difference keeps its low C bits
+            # (modular on purpose: sample 0 = 0 = 2^Tf mod 2^C stands for sin(pi/2))
+            n, cmod = 1 << s.table_addr_bits, 1 << s.slope_rom_bits
+            delta = (self.value_rom[(addr + 1) % n] - val) % cmod
+            corr = round_shift(dq_t * delta, s.slope_guard)
+        elif s.interp:
             corr = round_shift(dq_t * self.slope_rom[addr], s.slope_guard)
         else:
             corr = np.zeros_like(val)
