@@ -10,7 +10,7 @@ import json
 import numpy as np
 
 from flann.cli import main
-from flann.diagnose.data import reading_step
+from flann.recordings import converter_step as reading_step
 
 PAPER = "data/sensors/paper_lvdt.toml"
 

@@ -140,29 +140,6 @@ def pseudo_residuals(x: np.ndarray, r: np.ndarray, order: np.ndarray) -> tuple[n
     return np.concatenate(idx), np.concatenate(val)
 
 
-def reading_step(y: np.ndarray, max_divisor: int = 64, tol: float = 0.02) -> float:
-    """The converter's step (V) when every reading is a whole number of one step, else 0.
-
-    The smallest gap between distinct readings is the step or a multiple of it; the largest
-    step that puts every reading on the grid (within ``tol`` of a step) is taken.  Readings
-    with analogue noise or averaging are on no grid and give 0.
-    """
-    u = np.unique(np.asarray(y, float))
-    if u.size < 8:
-        return 0.0
-    gaps = np.diff(u)
-    g0 = float(gaps.min())
-    if not g0 > 0:
-        return 0.0
-    rel = u - u[0]
-    for k in range(1, max_divisor + 1):
-        q = g0 / k
-        frac = rel / q
-        if np.max(np.abs(frac - np.round(frac))) <= tol:
-            return q
-    return 0.0
-
-
 def estimate_noise(x: np.ndarray, r: np.ndarray, passes: Passes,
                    exclude: np.ndarray | None = None) -> float:
     """Per-point noise (V, one sigma) of residuals ``r``, robust to smooth structure."""

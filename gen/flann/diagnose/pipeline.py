@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import RecordingsError
 from ..physics.effects import EFFECTS
 from ..physics.sensor import default_sensor
-from ..recordings import Recordings, monotonic_span
+from ..recordings import Recordings, converter_step, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
@@ -279,7 +279,7 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     candidates = tuple(c for c in family.candidates
                        if not (rails.rails and c == "adc_clipping"))
     # readings on a converter's grid with less noise than one step are not dithered
-    step_v = D.reading_step(shape.data.y[rails.off])
+    step_v = converter_step(shape.data.y[rails.off])
     sel = forward_select(family, candidates, calib.fit_idx, progress=progress,
                          resolution_v=step_v if step_v > calib.noise_v else 0.0)
     order = [s.name for s in sel.steps]
