@@ -92,7 +92,9 @@ def main(argv: list[str] | None = None) -> int:
         raise KeyboardInterrupt
 
     try:
-        previous = signal.signal(signal.SIGINT, on_sigint)
+        # an ignored SIGINT (a background job of a script, nohup) stays ignored
+        previous = (None if signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+                    else signal.signal(signal.SIGINT, on_sigint))
     except ValueError:   # not the main thread (an embedding program): leave Ctrl-C alone
         previous = None
     try:

@@ -16,6 +16,12 @@ from flann.cli import main
 
 from test_hostile_inputs import snapshot
 
+
+def as_on_a_terminal() -> None:
+    """The child takes Ctrl-C as a program started from a terminal does, even when this suite
+    runs as a background job of a script (which starts its children with SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 FLANN = Path(sys.executable).with_name("flann")
 FAM = ("--diagnosis-points", "40", "-j", "1")
 
@@ -111,7 +117,7 @@ def test_ctrl_c_stops_a_calibrate_pool_promptly_and_writes_the_summary(world, jo
         recs.append(f"r{k:02d}.csv")
     p = subprocess.Popen([str(FLANN), "calibrate", *recs, "-o", "out", "--design", "fam", "-j", str(jobs),
                           "--diagnosis-points", "40"], stderr=subprocess.PIPE, stdout=subprocess.PIPE,
-                         text=True, start_new_session=True, cwd=world)
+                         text=True, start_new_session=True, cwd=world, preexec_fn=as_on_a_terminal)
     # the state we interrupt in: the first sensor's folder is in place
     deadline = time.monotonic() + 120
     while not any(d.is_dir() and not d.name.startswith(".") for d in (world / "out").glob("*")):
@@ -143,7 +149,8 @@ def test_ctrl_c_during_start_up_is_one_line(delay, tmp_path):
 
     os.mkfifo(tmp_path / "rec.csv")
     p = subprocess.Popen([str(FLANN), "train", str(tmp_path / "rec.csv"), "-o", str(tmp_path / "m.json")],
-                         stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, start_new_session=True)
+                         stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, start_new_session=True,
+                         preexec_fn=as_on_a_terminal)
     time.sleep(delay)   # the start-up has no state to wait for: several instants are tried
     os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=60)
@@ -169,3 +176,17 @@ def test_ctrl_c_in_imports_is_caught_by_the_entry_point(monkeypatch, capsys):
         pytest.fail("KeyboardInterrupt escaped flann.cli.main")
     assert rc == 130
     assert capsys.readouterr().err == "error: interrupted\n"
+
+
+def test_an_ignored_ctrl_c_stays_ignored(monkeypatch):
+    """A background job of a script runs with SIGINT ignored: flann keeps it so."""
+    from flann import cli
+
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        seen = []
+        monkeypatch.setattr(cli, "_main", lambda argv: seen.append(signal.getsignal(signal.SIGINT)) or 0)
+        assert cli.main([]) == 0
+        assert seen == [signal.SIG_IGN] and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, previous)

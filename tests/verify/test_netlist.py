@@ -42,7 +42,7 @@ def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):
     build = tmp_path / "build"
     p = subprocess.Popen([str(flann), "sim", str(model), "--input-bits", "10", "--build", str(build)],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                         cwd=tmp_path)
+                         cwd=tmp_path, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     # the state we interrupt: the build has started (its first files are in place); the whole
     # run takes seconds more, so the interrupt lands inside the build or the sweep
     deadline = time.monotonic() + 120
