@@ -36,12 +36,12 @@ test: venv tools
 
 # Main job: train (unless MODEL= is given), generate VHDL, verify every input code (RTL sweep,
 # reactive benches, post-synthesis netlist), summarise.  DESIGN=dir verifies that generated
-# directory as it is (its model: MODEL=, default the checked-in default model).
+# directory as it is (with the model it keeps; MODEL= names another).
 DESIGN   ?=
 sim: venv tools
 	@mkdir -p $(BUILD)
 ifneq ($(strip $(DESIGN)),)
-	$(BIN)/flann sim $(DESIGN) --model $(or $(strip $(MODEL)),$(DEFAULT_MODEL)) --netlist --plot $(BUILD)/sim.png
+	$(BIN)/flann sim $(DESIGN) $(if $(strip $(MODEL)),--model $(MODEL)) --netlist --plot $(BUILD)/sim.png
 else ifeq ($(strip $(MODEL)),)
 	$(BIN)/flann train data/paper_table1.csv $(TRAIN_ARGS) -o $(BUILD)/model.json
 	$(BIN)/flann sim $(BUILD)/model.json --netlist --plot $(BUILD)/sim.png
@@ -54,12 +54,12 @@ gen: venv
 	$(BIN)/flann gen $(DEFAULT_MODEL) -o hdl --device $(DEVICE)
 
 synth: venv tools
-	$(BIN)/flann synth hdl --device $(DEVICE) --model $(DEFAULT_MODEL)
+	$(BIN)/flann synth hdl --device $(DEVICE)
 
 # Real place and route of hdl/ on an iCE40: nextpnr Fmax, bitstream, routed design over every code.
 ICE40 ?= ice40-hx8k-ct256
 pnr: venv tools
-	$(BIN)/flann synth hdl --device $(ICE40) --post-route --model $(DEFAULT_MODEL) -o $(BUILD)/ice40
+	$(BIN)/flann synth hdl --device $(ICE40) --post-route -o $(BUILD)/ice40
 
 paper: venv
 	$(BIN)/flann paper --plot $(BUILD)/paper
