@@ -29,22 +29,29 @@ MAX_INT_DIGITS = 19      # 64-bit integers
 MAX_TEXT_BYTES = 64 << 20  # a model, sensor or manifest is a few kB
 
 
-def read_text(path: str | os.PathLike, error: type[FlannError], what: str) -> str:
-    """UTF-8 text of an input file, or one ``error`` line (missing, a directory, too large,
-    not text)."""
+def read_bytes(path: str | os.PathLike, error: type[FlannError], what: str, limit: int | None = None) -> bytes:
+    """The bytes of an input file (noted as an input of the running command), or one
+    ``error`` line: missing, a directory, unreadable, or more than ``limit`` bytes."""
     path = Path(path)
     try:
         with open(path, "rb") as fh:
-            raw = fh.read(MAX_TEXT_BYTES + 1)
+            raw = fh.read() if limit is None else fh.read(limit + 1)
     except FileNotFoundError:
         raise error(f"{path}: no such file") from None
     except IsADirectoryError:
         raise error(f"{path}: is a directory, expected {what}") from None
     except OSError as exc:
         raise error(f"{path}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
-    if len(raw) > MAX_TEXT_BYTES:
-        raise error(f"{path}: larger than {MAX_TEXT_BYTES >> 20} MB, not {what}")
+    if limit is not None and len(raw) > limit:
+        raise error(f"{path}: larger than {limit >> 20} MB, not {what}")
     note_input(path)
+    return raw
+
+
+def read_text(path: str | os.PathLike, error: type[FlannError], what: str) -> str:
+    """UTF-8 text of an input file, or one ``error`` line (missing, a directory, too large,
+    not text)."""
+    raw = read_bytes(path, error, what, MAX_TEXT_BYTES)
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError:
@@ -141,4 +148,4 @@ def _show(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-__all__ = ["MAX_DEPTH", "MAX_INT_DIGITS", "read_text", "parse_json", "parse_toml", "number"]
+__all__ = ["MAX_DEPTH", "MAX_INT_DIGITS", "read_bytes", "read_text", "parse_json", "parse_toml", "number"]

@@ -39,7 +39,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingsError, one_line
-from ..fileio import atomic_write_text, note_input
+from ..fileio import atomic_write_text
+from ..inputs import read_bytes
 
 REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
@@ -415,15 +416,7 @@ def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
     how it was read (``announce``)."""
     path = Path(path)
     note = ""
-    try:
-        raw = path.read_bytes()
-        note_input(path)
-    except FileNotFoundError:
-        raise RecordingsError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise RecordingsError(f"{path}: is a directory, expected a CSV file") from None
-    except OSError as exc:
-        raise RecordingsError(f"{path}: cannot read ({exc.__class__.__name__})") from None
+    raw = read_bytes(path, RecordingsError, "a CSV file")   # no byte cap: MAX_ROWS bounds a recording
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
