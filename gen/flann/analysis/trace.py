@@ -32,9 +32,9 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
-from ..hardware.fixed.spec import derive_spec
 from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import F18Top, derive_f18_spec
+from ..hardware.float18.spec import F18Top
+from ..hardware.registry import FORMATS, datapath
 from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
 from ..hardware.family.twin import FlannFamilyTop
@@ -122,7 +122,7 @@ def stages_fixed(spec, codes=None) -> Stages:
     running = t.adder["running"].astype(float) * 2.0 ** -Pf * q
     step_cols = [[j for j in range(k * L, min((k + 1) * L, N - 1))] for k in range(spec.steps)]
     return Stages(
-        fmt="fixed", codes=codes, volts=codes * spec.input_lsb_v,
+        fmt=spec.number_format, codes=codes, volts=codes * spec.input_lsb_v,
         valid=(codes >= spec.clamp_lo) & (codes <= spec.clamp_hi), term_index=idx,
         g_terms=g_terms, g_weights=g_w, g_start=m.bias + m.weights[0] * vn,
         h_fixed_terms=h_terms, h_terms=h_terms, h_weights=h_w, h_products=h_p,
@@ -148,7 +148,7 @@ def stages_float18(fspec, codes=None) -> Stages:
     g_terms[:, 0] = t.code * 2.0 ** -Tf              # term 0 enters as the code (see float18_top)
     dec = fmt.decode_array
     return Stages(
-        fmt="float18", codes=codes, volts=codes * base.input_lsb_v,
+        fmt=fspec.number_format, codes=codes, volts=codes * base.input_lsb_v,
         valid=(codes >= base.clamp_lo) & (codes <= base.clamp_hi), term_index=list(range(N)),
         g_terms=g_terms, g_weights=fspec.golden_weights(),
         g_start=np.full(codes.size, fspec.golden_start()),
@@ -442,7 +442,7 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    colours = {"float18": "tab:red", "fixed": "tab:blue"}
+    colours = {fmt: f"C{k}" for k, fmt in enumerate(results)}
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for fmt, r in results.items():
         o = np.argsort(r.volts)
@@ -462,28 +462,42 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     plt.close(fig)
 
 
+def _hdl_sweep(model_path, options: dict, build_dir: Path, stage_codes, design_model) -> tuple:
+    """The fixed-point sweep harness; the design's blocks are checked by their own block benches."""
+    design = open_design(model_path, build_dir, options, model=design_model)
+    sw = sweep(design, build_dir)
+    if sw["codes"].size == 0:
+        raise FlannError(f"fixed-point simulation produced no outputs (see {build_dir})")
+    spec = design.spec
+    codes, data = sw["codes"], sw["data"]
+    mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
+    return codes, data * spec.output_lsb_mm, mism, design.manifest["top"], None
+
+
+def _hdl_f18_top(model_path, options: dict, build_dir: Path, stage_codes, design_model) -> tuple:
+    r = run_top(model_path, build_dir, stage_codes=stage_codes, **options)
+    return r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"], r["stages"]
+
+
+# how flann trace --hdl simulates a model's design, by its datapath's bench (Datapath.bench)
+HDL_CHECKS = {"sweep": _hdl_sweep, "f18_top": _hdl_f18_top}
+
+
 def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64,
               design_model=None) -> dict:
     """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
     HDL's own outputs with the twin and the golden model; stores the summary in ``result.hdl``.
-    ``model_path`` may be a design directory (fixed point; ``design_model`` = its model)."""
-    build_dir = Path(build_dir)
-    if result.fmt == "float18":
-        # internal stages (terms, products, running sums) captured at a spread of codes
-        stage_codes = result.codes[np.linspace(0, result.codes.size - 1, stage_samples).astype(int)]
-        r = run_top(model_path, build_dir, stage_codes=stage_codes, **options)
-        codes, hdl_mm, mism, top = r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"]
-        stages = r["stages"]
-    else:
-        design = open_design(model_path, build_dir, options, model=design_model)
-        sw = sweep(design, build_dir)
-        if sw["codes"].size == 0:
-            raise FlannError(f"fixed-point simulation produced no outputs (see {build_dir})")
-        spec = design.spec
-        codes, data = sw["codes"], sw["data"]
-        mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
-        hdl_mm, top = data * spec.output_lsb_mm, "flann_top"
-        stages = None       # the fixed design's blocks are checked by its own block benches
+    ``model_path`` may be a design directory (fixed point; ``design_model`` = its model).  A
+    datapath whose bench captures internal stages (``stage_capture``) also compares those at a
+    spread of ``stage_samples`` codes."""
+    dp = datapath(result.fmt)
+    if dp.bench not in HDL_CHECKS:
+        raise FlannError(f"--hdl: the {dp.name} datapath's bench does not simulate a model's design "
+                         "(generate it with flann gen -o DIR, then flann trace DIR --hdl)")
+    stage_codes = (result.codes[np.linspace(0, result.codes.size - 1, stage_samples).astype(int)]
+                   if dp.stage_capture else ())
+    codes, hdl_mm, mism, top, stages = HDL_CHECKS[dp.bench](model_path, options, Path(build_dir), stage_codes,
+                                                            design_model)
     pos = {int(c): k for k, c in enumerate(result.codes)}
     sel = np.array([int(c) in pos for c in codes])
     idx = np.array([pos[int(c)] for c in codes[sel]], dtype=np.int64)
@@ -500,15 +514,17 @@ def stages_family(fam, codes=None) -> Stages:
 
 
 # the stage model a datapath names (Datapath.stages)
-STAGE_MODELS = {"fixed": stages_fixed, "float18": stages_float18, "family": stages_family}
-# the spec each --format derives (a model traced without a design directory)
-DERIVE = {"fixed": derive_spec, "float18": derive_f18_spec}
+STAGE_MODELS = {"fixed_point": stages_fixed, "float18_terms": stages_float18, "family_member": stages_family}
 
 
-def run_trace(model: FlannModel, fmt: str = "fixed", codes=None, **spec_options) -> TraceResult:
-    if fmt not in DERIVE:
-        raise FlannError(f"--format {fmt!r}: allowed {', '.join(DERIVE)}")
-    return trace(STAGE_MODELS[fmt](DERIVE[fmt](model, **spec_options), codes))
+def run_trace(model: FlannModel, fmt: str = FORMATS[0], codes=None, **spec_options) -> TraceResult:
+    """The stages of ``model`` in the datapath ``fmt`` (a model without a design directory)."""
+    if fmt not in FORMATS:
+        raise FlannError(f"--format {fmt!r}: allowed {', '.join(FORMATS)}")
+    dp = datapath(fmt)
+    st = STAGE_MODELS[dp.stages](dp.derive(model, **spec_options), codes)
+    st.fmt = dp.name  # check_hdl finds the datapath again by it
+    return trace(st)
 
 
 def trace_design(design: Design, codes=None) -> TraceResult:

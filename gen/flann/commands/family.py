@@ -7,6 +7,7 @@ import argparse
 from ..errors import FlannError
 from ..hardware.family.build import DEFAULT_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN
+from ..hardware.registry import FAMILY
 
 
 def _terms(text: str):
@@ -37,5 +38,6 @@ def check_family_args(args) -> None:
         raise FlannError("give a model.json, or --family REC_OR_MODEL...")
     if args.model is not None:
         raise FlannError(f"{args.model}: give either a model or --family, not both")
-    if args.format != "fixed":
-        raise FlannError("--family generates the fixed-point datapath only (--format fixed)")
+    if args.format != FAMILY.number_format:
+        raise FlannError(f"--family generates the {FAMILY.number_format} datapath only "
+                         f"(--format {FAMILY.number_format})")

@@ -15,6 +15,11 @@ it), look the datapath up there, and call it:
   one reader refuses a tampered manifest in one line naming the field;
 * ``bench`` / ``stages``: which verification bench and which stage model of ``flann trace``
   apply (``None``: the command refuses in one line saying why);
+* ``derive(model, **options)``: the spec of a model traced or fuzzed without a design directory;
+* ``number_format``, ``stage_capture``, ``fuzz_share`` / ``fuzz_options``: what the datapath can
+  do, asked instead of its name (``flann gen --family`` takes the family's number format only,
+  ``flann trace --hdl`` compares captured stages where the bench captures them, the fuzzer draws
+  each datapath's share of cases and its own options);
 * ``estimate(manifest)``: resources before synthesis (LUT4, flip-flops, block RAMs), so
   ``flann ise`` can refuse a part the design cannot fit.
 """
@@ -136,6 +141,11 @@ class Datapath:
     derive_options: Callable | None = None  # (GenOptions, compared) -> keyword arguments of its derive
     netlist: bool = False              # its mapped netlist can be simulated over every code (flann_top's ports)
     summary: Callable | None = None    # manifest -> lines flann gen prints
+    derive: Callable | None = None     # (FlannModel, **derive options) -> spec of a model with no design directory
+    number_format: str = ""            # the arithmetic of its products and sum (what flann gen --format names)
+    stage_capture: bool = False        # its bench also captures internal stages at chosen codes (trace --hdl)
+    fuzz_share: float = 0.0            # share of the generator fuzz cases (verify/fuzz.py) drawn on it
+    fuzz_options: Callable | None = None  # rng -> its own generator options drawn at random (fuzzing)
     common: tuple = COMMON_FIELDS      # the shared key set (a design flann did not write: fewer)
 
     def check(self, man: dict, where) -> None:

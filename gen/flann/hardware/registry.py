@@ -55,8 +55,9 @@ def datapath_for_model(model, format_name: str) -> Datapath:
         two_inputs = False  # the format's datapath names what is wrong with the file
     if not two_inputs:
         return datapath(format_name)
-    if format_name != FORMATS[0]:
-        raise FlannError(f"--format {format_name}: a two-input model is generated in fixed point only")
+    if format_name != THERMAL.number_format:
+        raise FlannError(f"--format {format_name}: a two-input model is generated in fixed point only "
+                         f"(--format {THERMAL.number_format})")
     return THERMAL
 
 

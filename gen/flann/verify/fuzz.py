@@ -25,9 +25,9 @@ import numpy as np
 from ..errors import FlannError
 from ..golden.train import fit_lstsq
 from ..hardware.fixed.render import write
-from ..hardware.fixed.spec import derive_spec
 from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import F18Top, derive_f18_spec
+from ..hardware.float18.spec import F18Top
+from ..hardware.registry import DATAPATHS, datapath
 from .design import Design
 from .float18 import run_top
 from .runner import sweep
@@ -67,23 +67,30 @@ def _sensor(rng) -> tuple[np.ndarray, np.ndarray, float, int]:
     return v, x, lsb, bits
 
 
+# the datapaths fuzzed, the smallest share first (one uniform draw picks one)
+FUZZED = tuple(sorted((dp for dp in DATAPATHS.values() if dp.fuzz_share > 0), key=lambda dp: dp.fuzz_share))
+
+
+def _draw_datapath(rng):
+    r, upto = rng.random() * sum(dp.fuzz_share for dp in FUZZED), 0.0
+    for dp in FUZZED:
+        upto += dp.fuzz_share
+        if r < upto:
+            return dp
+    return FUZZED[-1]
+
+
 def draw_case(rng, index: int):
     """A model and generator options; the options are valid on their face (the generator may
     still refuse a combination, e.g. a design too large for every Spartan-II)."""
     v, x, lsb, bits = _sensor(rng)
     terms = int(rng.integers(3, 52))
     model = fit_lstsq(v, x, terms)
-    fmt = "float18" if rng.random() < 0.2 else "fixed"
+    dp = _draw_datapath(rng)
     opts = {"input_bits": bits, "input_lsb_v": float(f"{lsb:.6g}"), "interp": bool(rng.random() < 0.8)}
-    if fmt == "fixed":
-        opts["lanes"] = int(rng.choice([1, 1, 2, 3]))
-        opts["mult_style"] = str(rng.choice(["shiftadd", "lut"]))
-        if opts["mult_style"] == "shiftadd":
-            opts["mult_digit_bits"] = int(rng.choice([1, 2, 4]))
-        if rng.random() < 0.5:
-            opts["output_bits"] = int(rng.choice([14, 16, 18, 20]))
-        opts["check_device"] = False  # verify every datapath, not only those that fit a part
-    return model, Case(index, opts, terms, fmt)
+    if dp.fuzz_options is not None:
+        opts.update(dp.fuzz_options(rng))
+    return model, Case(index, opts, terms, dp.name)
 
 
 def _window(lo: int, hi: int, rng, n: int) -> tuple[int, int]:
@@ -95,12 +102,15 @@ def _window(lo: int, hi: int, rng, n: int) -> tuple[int, int]:
 def check_case(model, case: Case, rng, work: Path, hdl_codes: int = 24) -> Case:
     work = Path(work)
     try:
-        if case.number_format == "float18":
-            return _check_float18(model, case, rng, work, hdl_codes)
-        spec = derive_spec(model, **case.options)
+        dp = datapath(case.number_format)
+        spec = dp.derive(model, **case.options)
     except FlannError as exc:
         case.outcome, case.detail = "refused", str(exc)
         return case
+    return CHECKS[dp.bench](model, case, spec, rng, work, hdl_codes)
+
+
+def _check_sweep(model, case: Case, spec, rng, work: Path, hdl_codes: int) -> Case:
     try:
         top = FlannTop(spec)
         codes = top.all_codes()
@@ -136,8 +146,7 @@ def check_case(model, case: Case, rng, work: Path, hdl_codes: int = 24) -> Case:
     return case
 
 
-def _check_float18(model, case: Case, rng, work: Path, hdl_codes: int) -> Case:
-    fspec = derive_f18_spec(model, **case.options)  # FlannError: refused
+def _check_f18_top(model, case: Case, fspec, rng, work: Path, hdl_codes: int) -> Case:
     try:
         top = F18Top(fspec)
         codes = top.all_codes()
@@ -150,6 +159,10 @@ def _check_float18(model, case: Case, rng, work: Path, hdl_codes: int) -> Case:
     except Exception:
         case.outcome, case.detail = "FAIL", traceback.format_exc(limit=3).strip().splitlines()[-1]
     return case
+
+
+# how a fuzz case is checked, by the datapath's bench (Datapath.bench)
+CHECKS = {"sweep": _check_sweep, "f18_top": _check_f18_top}
 
 
 def run_cases(seed: int, n: int, work, hdl_codes: int = 24, progress=None) -> list[Case]:

@@ -7,6 +7,7 @@ import warnings
 from ...errors import FlannError, SpecError
 from ...golden.model import load_model
 from ..datapath import Datapath, Field, _int, _num
+from ..fixed.datapath import DATAPATH as FIXED
 from ..options import GenOptions
 from . import render
 from .build import DEFAULT_TERMS, generate_family
@@ -74,7 +75,8 @@ DATAPATH = Datapath(
     generate=generate, rebuild=rebuild, twin=FlannFamilyTop, estimate=estimate, fields=FIELDS,
     why_no_explore="flann explore sizes one sensor's design from its model; a family design is sized by "
                    "its members (flann gen --family): explore one of them, e.g. DIR/init_model.json",
-    bench="family", stages="family", summary=summary, eval_spec=eval_spec,
+    bench="family", stages="family_member", summary=summary, eval_spec=eval_spec,
+    number_format=FIXED.number_format,  # the fixed blocks, weights from a memory
 )
 
 __all__ = ["DATAPATH"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..datapath import Datapath, Field, _int, _num
+from ..fixed.datapath import DATAPATH as FIXED
 from . import render
 from .twin import ThermalTop
 
@@ -32,7 +33,7 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP,
     about="two inputs (voltage, temperature): one fixed datapath per temperature order",
     generate=render.generate, rebuild=render.rebuild, twin=ThermalTop, estimate=estimate, fields=FIELDS,
-    bench="thermal_sweep", summary=summary,
+    bench="thermal_sweep", summary=summary, number_format=FIXED.number_format,
     why_no_stages="flann trace's stage model is the one-input datapath's; a thermal design has one per "
                   "temperature order and no stage model of its own yet",
     why_no_eval="flann eval --design evaluates a one-input fixed design; the thermal design's hardware "
