@@ -74,7 +74,8 @@ COMMANDS = {
     "ise": lambda d, fx: ("ise", d, "-o", fx["dir"] / f"ise_{d.name}"),
     # lint on; the mapped netlist checked where a bench drives it; abc -fast: the seed is parallel
     "synth": lambda d, fx: ("synth", d, "--abc", "fast"),
-    "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--mult", "shiftadd", "--widths", "budget", "--no-seed"),
+    # one lane: the fixed design's two multiplier styles; the float18 design's one (it has no --mult)
+    "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--widths", "budget", "--no-seed"),
 }
 # (datapath, command) that refuse, with a word the one line must hold
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map", ("family", "explore"): "members",
@@ -97,6 +98,27 @@ def test_command_on_datapath(designs, datapath, command):
         assert why in r.stderr
     else:
         assert r.returncode == 0, r.stderr
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_explore_float18_dir_explores_its_own_widths(designs):
+    """A float18 design explores the float18 design (its term widths), not the fixed rows; the
+    budget row is the design in the directory (its cycles and its trace's error)."""
+    d = designs["dir"] / "float18"
+    r = flann("explore", d, "--widths", "budget,narrow", "--no-seed", "--json")
+    assert r.returncode == 0, r.stderr
+    rows = json.loads(r.stdout)
+    assert [(x["lanes"], x["mult_style"], x["widths"]) for x in rows] == [(1, "float18", "budget"),
+                                                                           (1, "float18", "narrow")]
+    man = json.loads((d / "manifest.json").read_text())
+    tr = json.loads(flann("trace", d, "--json").stdout)
+    assert rows[0]["cycles_per_sample"] == man["cycles_per_sample"]
+    assert rows[0]["max_err_mm"] == pytest.approx(tr["total"]["max_mm"], rel=1e-9)
+    assert all(x["luts"] and x["fits"] is not None for x in rows)
+    for args, word in ((("--mult", "lut"), "multiplier style"), (("--lanes", "1,2"), "one lane")):
+        one_line_refusal(r := flann("explore", d, *args, "--no-seed"))
+        assert word in r.stderr
 
 
 def test_ise_refuses_a_part_too_small(designs):

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..argtypes import bounded
 from ..implement import explore
 from ..errors import FlannError
-from ..hardware.registry import read_design
+from ..hardware.registry import FORMATS, datapath_for_model, read_design
 from ..hardware.target import DEFAULT_PART
 from ..verify.design import design_model
 
@@ -28,10 +28,13 @@ def add_arguments(p):
     p.add_argument("model", metavar="MODEL|DIR",
                    help="model.json, or a design directory written by flann gen (its model and its ADC)")
     p.add_argument("--device", default=DEFAULT_PART, metavar="PART", help="target part (default %(default)s)")
-    p.add_argument("--lanes", default="1,2,4", help="lane counts to try (default 1,2,4)")
-    p.add_argument("--mult", default="lut,shiftadd", help="multiplier styles (default lut,shiftadd)")
+    p.add_argument("--lanes", default=None,
+                   help="lane counts to try (default 1,2,4; a float18 design has one lane)")
+    p.add_argument("--mult", default=None,
+                   help="multiplier styles (default lut,shiftadd; not for a float18 design: the seed's multiplier)")
     p.add_argument("--widths", default=",".join(explore.WIDTH_PRESETS),
-                   help="width presets: budget (error budget <= 1 LSB), narrow (4 fraction bits fewer)")
+                   help="width presets: budget (error budget <= 1 LSB), narrow (4 fraction bits fewer; "
+                        "a float18 design: of its terms)")
     p.add_argument("--no-seed", action="store_true", help="leave out the seed architecture (its synthesis is slow)")
     p.add_argument("--seed-only", action="store_true", help="only the seed architecture rows")
     p.add_argument("--float18", action="store_true",
@@ -45,21 +48,22 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
-def _design_model(args) -> None:
-    """DIR: explore the model the design keeps, at the design's ADC unless given."""
-    if not Path(args.model).is_dir():
-        return
-    man, dp = read_design(args.model)
-    if dp.why_no_explore:
+def _design_model(args):
+    """The datapath whose design space is explored: a design directory's own (its model and,
+    unless given, its ADC), else the one flann gen MODEL builds."""
+    is_dir = Path(args.model).is_dir()
+    man, dp = read_design(args.model) if is_dir else ({}, datapath_for_model(args.model, FORMATS[0]))
+    if dp.explore is None:
         raise FlannError(f"{args.model}: {dp.why_no_explore}")
-    model = design_model(args.model, man, dp)
-    args.model = str(model)
-    args.input_bits = man["input_bits"] if args.input_bits is None else args.input_bits
-    args.input_lsb_v = man["input_lsb_v"] if args.input_lsb_v is None else args.input_lsb_v
+    if is_dir:
+        args.model = str(design_model(args.model, man, dp))
+        args.input_bits = man["input_bits"] if args.input_bits is None else args.input_bits
+        args.input_lsb_v = man["input_lsb_v"] if args.input_lsb_v is None else args.input_lsb_v
+    return dp
 
 
 def run(args) -> int:
-    _design_model(args)
+    dp = _design_model(args)
     progress = sys.stderr.isatty()   # progress lines on a terminal only, never into a log
     if args.seed_only:
         rows = explore.seed_rows(args.model, args.device, abc=args.abc, progress=progress)
@@ -67,8 +71,9 @@ def run(args) -> int:
             rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
         print(json.dumps([r.to_dict() for r in rows], indent=2) if args.json else explore.markdown(rows, args.device))
         return 0
-    rows = explore.explore(
-        args.model, args.device, lanes=_ints(args.lanes), styles=tuple(args.mult.split(",")),
+    rows = explore.EXPLORERS[dp.explore](
+        args.model, args.device, lanes=None if args.lanes is None else _ints(args.lanes),
+        styles=None if args.mult is None else tuple(args.mult.split(",")),
         widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=progress, abc=args.abc,
         adc={k: v for k, v in (("input_bits", args.input_bits), ("input_lsb_v", args.input_lsb_v)) if v is not None},
     )

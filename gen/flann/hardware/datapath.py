@@ -13,8 +13,8 @@ it), look the datapath up there, and call it:
   ``all_codes``, ``error_vs_float``);
 * ``fields``: the manifest fields this datapath's readers rely on, with their types, so
   one reader refuses a tampered manifest in one line naming the field;
-* ``bench`` / ``stages``: which verification bench and which stage model of ``flann trace``
-  apply (``None``: the command refuses in one line saying why);
+* ``bench`` / ``stages`` / ``explore``: which verification bench, which stage model of
+  ``flann trace`` and which design space of ``flann explore`` apply (``None``: the command refuses in one line saying why);
 * ``derive(model, **options)``: the spec of a model traced or fuzzed without a design directory;
 * ``number_format``, ``stage_capture``, ``fuzz_share`` / ``fuzz_options``: what the datapath can
   do, asked instead of its name (``flann gen --family`` takes the family's number format only,
@@ -131,9 +131,10 @@ class Datapath:
     model_field: str = "model"         # manifest field naming the model file in the directory
     bench: str | None = None           # verification bench (flann.verify.design.BENCHES)
     stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
+    explore: str | None = None         # design space of flann explore (flann.implement.explore.EXPLORERS)
     eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design
     why_no_eval: str = ""
-    why_no_explore: str = ""           # empty: flann explore DIR explores the model the design keeps
+    why_no_explore: str = ""           # why flann explore refuses it (no ``explore``)
     why_no_bench: str = ""
     why_no_stages: str = ""
     why_no_ise: str = ""               # empty: flann ise writes a project for it

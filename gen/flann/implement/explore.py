@@ -24,6 +24,7 @@ from ..hardware.fixed import render as hdlgen
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.render import render_block
 from ..hardware.manifest import write_design
+from ..hardware.registry import FLOAT18
 from ..hardware.seed import render as seed_render
 from ..hardware.seed.spec import derive_seed_spec
 from ..hardware.seed.twin import SeedTop
@@ -80,7 +81,10 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
         row.note = (row.note + "; " if row.note else "") + f"{len(d['warnings'])} yosys warning(s)"
 
 
-def explore(model_path, device: str = DEFAULT_PART, lanes=(1, 2, 4), styles=("lut", "shiftadd"),
+DEFAULT_LANES, DEFAULT_STYLES = (1, 2, 4), ("lut", "shiftadd")
+
+
+def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=DEFAULT_STYLES,
             widths=WIDTH_PRESETS, seed: bool = True, progress: bool = True, abc: str = "fast",
             adc: dict | None = None) -> list[Row]:
     """Generate, synthesise and score each candidate; the seed architecture last.  ``adc``:
@@ -199,18 +203,16 @@ def markdown(rows: list[Row], device: str) -> str:
 
 
 # ----------------------------------------------------------------------------- float18 rows
-def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | None = None,
-                 progress: bool = True) -> list[Row]:
-    """The paper's 18-bit floating point: the project's serial float18 design, and the
-    seed architecture's arithmetic in float18 (N multipliers + N-1 adders, each block
-    synthesised once with this flow and multiplied by its count; tables not included).
-    """
-    rows = []
-    if progress:
-        print("explore: float18 design (serial)", file=sys.stderr)
-    r = Row("float18 (serial)", 1, "float18", "float18")
+F18 = FLOAT18.number_format
+
+
+def _float18_row(model_path, device: str, widths: str, options: dict, abc: str = "full") -> Row:
+    """The serial float18 design with ``options`` (derive options of the float18 datapath), measured."""
+    r = Row(f"{F18} (serial)", 1, F18, widths)
     try:
-        m = measure(model_path, device)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the front end's fixed output-LSB bound: no output LSB here
+            m = measure(model_path, device, abc=abc, **options)
         r.luts, r.ffs, r.brams, r.fits = m["luts"], m["ffs"], m["brams"], m["fits"]
         r.cycles_per_sample, r.samples_per_s = m["cycles_per_sample"], m["samples_per_s_at_50mhz"]
         r.max_err_mm = m["max_err_mm"]
@@ -220,7 +222,61 @@ def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | N
         r.smallest_device = best.name if best else None
     except FlannError as exc:
         r.note = str(exc)
-    rows.append(r)
+    return r
+
+
+def explore_float18(model_path, device: str = DEFAULT_PART, lanes=None, styles=None, widths=WIDTH_PRESETS,
+                    seed: bool = True, progress: bool = True, abc: str = "fast", adc: dict | None = None) -> list[Row]:
+    """The float18 design's own choices: the width presets of its fixed front end's terms
+    (budget: the error budget's term width, widened to the code's; narrow: NARROW_BITS fraction
+    bits fewer), each generated, synthesised and scored by its twin.  Its float format is the
+    seed's 18 bits (the float blocks are written for it) and it has one lane and the seed's
+    float multiplier, so --lanes other than 1 and --mult are refused."""
+    parse_part(device)
+    if lanes is not None and tuple(lanes) != (1,):
+        raise FlannError(f"--lanes {','.join(map(str, lanes))}: a {F18} design has one lane (its float sum "
+                         "is sequential, in model term order); explore its --widths")
+    if styles is not None:
+        raise FlannError(f"--mult {','.join(styles)}: a {F18} design multiplies with the seed's {F18} "
+                         "multiplier, it has no multiplier style; explore its --widths")
+    rows = []
+    for k, preset in enumerate(widths, 1):
+        if progress:
+            print(f"explore [{k}/{len(widths)}] {F18} widths={preset}", file=sys.stderr)
+        if preset not in WIDTH_PRESETS:
+            raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
+        options = dict(adc or {})
+        if preset == "narrow":
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    ref = FLOAT18.derive(load_model(model_path), **options)
+            except FlannError as exc:
+                rows.append(Row(f"{F18} (serial)", 1, F18, preset, note=str(exc)))
+                continue
+            options["term_frac_bits"] = max(4, ref.term_frac_bits - NARROW_BITS)
+        rows.append(_float18_row(model_path, device, preset, options, abc))
+    if seed:
+        rows += seed_rows(model_path, device, abc=abc, progress=progress)
+    return rows
+
+
+def explore_fixed(model_path, device: str = DEFAULT_PART, lanes=None, styles=None, **kw) -> list[Row]:
+    return explore(model_path, device, lanes=DEFAULT_LANES if lanes is None else lanes,
+                   styles=DEFAULT_STYLES if styles is None else styles, **kw)
+
+
+# the design space a datapath names (Datapath.explore); None for lanes/styles: the default
+EXPLORERS = {"fixed_space": explore_fixed, "float18_widths": explore_float18}
+def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | None = None,
+                 progress: bool = True) -> list[Row]:
+    """The paper's 18-bit floating point: the project's serial float18 design, and the
+    seed architecture's arithmetic in float18 (N multipliers + N-1 adders, each block
+    synthesised once with this flow and multiplied by its count; tables not included).
+    """
+    if progress:
+        print("explore: float18 design (serial)", file=sys.stderr)
+    rows = [_float18_row(model_path, device, F18, {})]
 
     n = seed_terms or load_model(model_path).terms
     per = {}
@@ -240,7 +296,7 @@ def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | N
     res = Resources(luts, ffs, brams, 0, 0, 0, 0, 0, 0)
     best = smallest_fit(res, part)
     rows.append(Row(
-        f"seed arithmetic in float18, {n} terms", None, "float18", "float18", luts=luts, ffs=ffs, brams=brams,
+        f"seed arithmetic in {F18}, {n} terms", None, F18, F18, luts=luts, ffs=ffs, brams=brams,
         cycles_per_sample=1, samples_per_s=CLOCK_HZ, fits=not shortfall(res, part),
         smallest_device=best.name if best else None,
         note=(f"{n} x flann_f18_mul ({per['mul'][0]} LUT4, {per['mul'][1]} FF) + {n - 1} x flann_f18_add "

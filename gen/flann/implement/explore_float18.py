@@ -11,20 +11,22 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from ..hardware.float18.render import generate
 from ..golden.model import load_model
+from ..hardware.float18.render import generate
+from ..hardware.registry import FLOAT18
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART
 from ..analysis.trace import run_trace
 from . import synth
 
 
-def measure(model_path, device: str = DEFAULT_PART, **options) -> dict:
+def measure(model_path, device: str = DEFAULT_PART, abc: str = "full", **options) -> dict:
     with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:
-        man = generate(model_path, Path(tmp) / "float18", **options)
-        rep = synth.synthesize(Path(tmp) / "float18", device, progress=False).to_dict()
-    tr = run_trace(load_model(model_path), "float18", **options)
+        out = Path(tmp) / FLOAT18.name
+        man = generate(model_path, out, **options)
+        rep = synth.synthesize(out, device, progress=False, abc=abc).to_dict()
+    tr = run_trace(load_model(model_path), FLOAT18.name, **options)
     return {
-        "format": "float18", "top": man["top"], "device": device,
+        "format": FLOAT18.number_format, "top": man["top"], "device": device,
         "luts": rep["luts"], "ffs": rep["ffs"], "brams": rep["brams"], "fits": rep["fits"],
         "cycles_per_sample": man["cycles_per_sample"],
         "samples_per_s_at_50mhz": round(CLOCK_HZ / man["cycles_per_sample"], 1),
