@@ -78,7 +78,7 @@ COMMANDS = {
     "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--widths", "budget", "--no-seed"),
 }
 # (datapath, command) that refuse, with a word the one line must hold
-REFUSED = {("float18", "eval"): "no output LSB", ("family", "ise"): "pin map", ("family", "explore"): "members",
+REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
            ("thermal", "trace"): "stage model", ("thermal", "eval"): "one-input",
            ("thermal", "explore"): "two-input",

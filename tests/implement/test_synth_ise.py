@@ -110,6 +110,27 @@ def test_missing_manifest(tmp_path, capsys):
     assert "manifest.json not found" in capsys.readouterr().err
 
 
+def test_pin_map_spills_inputs_onto_spare_output_pins():
+    """46 input bits (a family's cfg port: 1 + 4 + 32 beside in_valid and an 8-bit in_data) and
+    14 output bits: every bit gets its own pin, inputs take every left-side pin first."""
+    from flann.hardware.target import parse_part
+    from flann.implement.ise import INPUT_PINS, OUTPUT_PINS, Port, pin_map
+
+    ports = [Port("clk", "in", 0), Port("rst", "in", 0), Port("in_valid", "in", 0), Port("in_ready", "out", 0),
+             Port("in_data", "in", 8), Port("out_valid", "out", 0), Port("out_data", "out", 11),
+             Port("out_sat", "out", 0), Port("cfg_we", "in", 0), Port("cfg_addr", "in", 4),
+             Port("cfg_data", "in", 32)]
+    rows = pin_map(ports, parse_part("xc2s200-pq208-5"))
+    locs = [loc for _, loc, _ in rows]
+    assert len(rows) == 2 + 46 + 14 and len(set(locs)) == len(locs)
+    ins = {loc for _, loc, d in rows if d == "in"}
+    assert set(INPUT_PINS) <= ins and len(ins - set(INPUT_PINS)) == 10
+    assert ins - set(INPUT_PINS) <= set(OUTPUT_PINS)
+    # 71 bits beside clk and rst: more than the 70 example pins, refused naming the widest port
+    with pytest.raises(FlannError, match="57 input and 14 output bits.*cfg_data 43"):
+        pin_map([*ports[:-1], Port("cfg_data", "in", 43)], parse_part("xc2s200-pq208-5"))
+
+
 def test_ports_must_match_the_vhdl(tmp_path):
     import json
     import shutil

@@ -7,8 +7,9 @@ be carried to the machine that runs ISE, and renders from ``templates/ise_*.j2``
 * ``flann_top.tcl``: ``xtclsh flann_top.tcl`` creates ``flann_top.ise`` (family Spartan2,
   device/package/speed of the part), adds sources and UCF, sets the XST options and runs
   the flow up to "Generate Programming File";
-* ``flann_top.ucf``: clock PERIOD constraint and a LOC for every bit of every top-level
-  port.  The pin map is an *example assignment* to edit for the real board;
+* ``flann_top.ucf``: clock PERIOD constraint and a LOC for every bit of every port the top
+  entity's VHDL declares (a family's cfg port too).  The pin map is an *example assignment*
+  to edit for the real board;
 * ``flann_top.core``: FuseSoC CAPI2 description (GHDL simulation target; its ISE target
   is for ISE 11+ because Edalize writes .xise projects);
 * ``README.txt``: the steps.
@@ -17,7 +18,8 @@ Pin map source.  Global clock input GCK1 is P77 on Spartan-II PQ208 (DS001 modul
 public BurchED B3 XC2S200-PQ208 board files use P77 for the system clock and P185 as a
 global clock input).  The user I/O pins below are the ones those board files use as plain
 I/O on the same PQ208 footprint (B3 connectors, B5 slots): P57 for reset; inputs on the
-left side (P3..P49), outputs on the right (P55..P68, P161..P194).  XC2S50..XC2S200 in
+left side (P3..P49), outputs on the right (P55..P68, P161..P194), either taking the other
+side's spare pins when it has more bits than its own side has pins.  XC2S50..XC2S200 in
 PQ208 have 140 user I/O; the XC2S30 has 132, so some of these pins may be unbonded there.
 """
 
@@ -109,16 +111,18 @@ def vhdl_ports(text: str, entity: str) -> list[Port]:
     return [Port(n.lower(), d.lower(), int(hi) + 1 if hi else 0) for n, d, hi in _PORT_RE.findall(m.group(1))]
 
 
-def check_ports(ports: list[Port], man) -> None:
-    """The UCF must pin the entity's real ports: compare with the top file's declaration."""
+def design_ports(man) -> list[Port]:
+    """The top entity's ports as its VHDL declares them (every top: fixed, float18, family,
+    thermal, a hand-written one), checked against the ports the manifest implies."""
+    implied = top_ports(man.data)
     for f in man.files:
         declared = vhdl_ports(f.read_text(errors="replace"), man.top)
         if declared:
-            if sorted(declared, key=lambda p: p.name) != sorted(ports, key=lambda p: p.name):
-                want = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in ports)
+            if sorted(declared, key=lambda p: p.name) != sorted(implied, key=lambda p: p.name):
+                want = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in implied)
                 got = ", ".join(f"{p.name}:{p.direction}{p.width or ''}" for p in declared)
                 raise FlannError(f"{f.name}: entity {man.top} declares ports ({got}), the manifest implies ({want})")
-            return
+            return declared
     raise FlannError(f"entity {man.top} not found in the manifest's files")
 
 
@@ -126,10 +130,22 @@ PIN_MAP_PACKAGES = ("pq208",)  # packages with an example pin map; on the others
 
 
 def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
-    """(net, LOC, note) for every bit of every port; empty on a package without an example map."""
+    """(net, LOC, note) for every bit of every port; empty on a package without an example map.
+
+    Inputs take the left-side pins, outputs the right-side ones; a design with more input bits
+    (a family's cfg port) or output bits than its side has takes the other side's spare pins,
+    from the far end, so any mix of up to len(INPUT_PINS) + len(OUTPUT_PINS) bits is placed."""
     if part.package not in PIN_MAP_PACKAGES:
         return []
-    ins, outs = iter(INPUT_PINS), iter(OUTPUT_PINS)
+    bits = {d: sum(len(p.bits()) for p in ports if p.direction == d and p.name not in ("clk", "rst"))
+            for d in ("in", "out")}
+    room = len(INPUT_PINS) + len(OUTPUT_PINS)
+    if bits["in"] + bits["out"] > room:
+        widest = ", ".join(f"{p.name} {len(p.bits())}" for p in sorted(ports, key=lambda p: -len(p.bits()))[:3])
+        raise FlannError(f"the design's ports have {bits['in']} input and {bits['out']} output bits beside clk "
+                         f"and rst (widest: {widest}); the example pin map has {room} user I/O pins: assign them "
+                         "in the UCF by hand")
+    pools = {"in": iter(INPUT_PINS + OUTPUT_PINS[::-1]), "out": iter(OUTPUT_PINS + INPUT_PINS[::-1])}
     rows = []
     for p in ports:
         for net in p.bits():
@@ -138,14 +154,7 @@ def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
             elif p.name == "rst":
                 rows.append((net, RESET_PIN, "synchronous reset, active high"))
             else:
-                pool = ins if p.direction == "in" else outs
-                try:
-                    rows.append((net, next(pool), p.direction))
-                except StopIteration:
-                    raise FlannError(
-                        f"the example pin map has {len(INPUT_PINS)} input and {len(OUTPUT_PINS)} output "
-                        f"pins; port {p.name} needs more: assign the rest in the UCF by hand"
-                    ) from None
+                rows.append((net, next(pools[p.direction]), p.direction))
     return rows
 
 
@@ -192,8 +201,7 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
             f"{part.device.name} in PQ208 has {part.user_io} user I/O, the pin map was taken from "
             "XC2S200 boards (140): check every LOC against DS001 module 4 before building"
         )
-    ports = top_ports(man.data)
-    check_ports(ports, man)
+    ports = design_ports(man)
     pins = pin_map(ports, part)
     sources = [f"src/{f.name}" for f in man.files]
     pins_kind = "pq208" if pins else "unplaced"
@@ -251,5 +259,5 @@ def summary(files: list[str], out_dir, part: Part | str) -> str:
             f"with ISE 10.1 (see README.txt)")
 
 
-__all__ = ["write_ise", "pin_map", "top_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
+__all__ = ["write_ise", "pin_map", "top_ports", "design_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
            "INPUT_PINS", "OUTPUT_PINS"]
