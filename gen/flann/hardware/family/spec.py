@@ -32,7 +32,10 @@ from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...numeric.fixed import FixedFormat, bits_needed
 from ..fixed.latency import norm_latency
-from ..fixed.spec import BRAM_BITS, Spec, round_sig, check_fits, derive_spec, estimate_resources, nice_125
+from ..fixed.spec import (BRAM_BITS, Blocks, Spec, acc_bound_for, assemble, check_fits, compose, derive_adder,
+                          derive_blocks, derive_multiplier, derive_normaliser, derive_sequencer, derive_spec,
+                          estimate_resources, lin_acc_width, nice_125, round_sig)
+from ..options import GenOptions
 from ..target import DEFAULT_PART
 
 DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
@@ -252,35 +255,31 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
     forced = dict(phase_bits=phase_bits, table_addr_bits=table_addr_bits, term_frac_bits=term_frac_bits,
                   weight_frac_bits=weight_frac_bits, product_frac_bits=product_frac_bits)
     if any(v is None for v in forced.values()):
-        big = [_quiet(derive_spec, _scaled(m, 1 + mu), **common) for m in models]
-        picks = dict(phase_bits=max(s.phase_bits for s in big),
-                     table_addr_bits=max(s.table_addr_bits for s in big),
-                     term_frac_bits=max(s.term_fmt.frac_bits for s in big),
-                     weight_frac_bits=max(s.weight_fmt.frac_bits for s in big),
-                     product_frac_bits=max(s.product_fmt.frac_bits for s in big))
+        o = GenOptions.of(None, **{k: v for k, v in common.items() if k != "check_device"})
+        big = [_quiet(derive_blocks, _scaled(m, 1 + mu), o) for m in models]
+        picks = dict(phase_bits=max(b.normaliser.phase_bits for b in big),
+                     table_addr_bits=max(b.expansion.table_addr_bits for b in big),
+                     term_frac_bits=max(b.expansion.term_fmt.frac_bits for b in big),
+                     weight_frac_bits=max(b.multiplier.weight_fmt.frac_bits for b in big),
+                     product_frac_bits=max(b.multiplier.product_fmt.frac_bits for b in big))
         forced = {k: (picks[k] if v is None else v) for k, v in forced.items()}
     options = {**{k: v for k, v in common.items() if k != "check_device"}, **forced, "output_bits": output_bits}
-    specs = [derive_spec(m, **options, check_device=False) for m in models]
+    blocks = [derive_blocks(m, GenOptions.of(None, **options)) for m in models]
+    specs = [assemble(b, device=device, check_device=False) for b in blocks]
 
     def grow(n: int) -> int:  # (1 + margin) x the family's largest magnitude
         return int(math.ceil(n * (1 + mu)))
 
-    s0 = specs[0]
+    b0 = blocks[0]
     wmax = grow(max(max(abs(w) for lane in s.weight_rom for w in lane) for s in specs))
-    W = bits_needed(-wmax, wmax)
-    weight_fmt = FixedFormat(W, W - s0.weight_fmt.frac_bits)
-    shift = s0.product_shift
-    pmax = (s0.term_bound * wmax + (1 << (shift - 1))) >> shift
-    product_fmt = FixedFormat(bits_needed(-pmax, pmax), bits_needed(-pmax, pmax) - s0.product_fmt.frac_bits)
     kmax = grow(max(max(abs(s.k1), abs(s.k0) + (1 << (s.lin_guard - 1))) for s in specs))
-    B = input_bits
-    lin_width = bits_needed(-(kmax << (B - 1)) - kmax, (kmax << (B - 1)) + kmax) + 1
     lin_bound = grow(max(s.lin_fmt.max_int for s in specs))
-    Pf = s0.product_fmt.frac_bits
-    lin_fmt = FixedFormat(bits_needed(-lin_bound, lin_bound), bits_needed(-lin_bound, lin_bound) - Pf)
-    acc_bound = lin_bound + s0.steps * (pmax + 1)
-    acc_fmt = FixedFormat(bits_needed(-acc_bound, acc_bound), bits_needed(-acc_bound, acc_bound) - Pf)
-    fam = FamilySpec(spec=_envelope(s0, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt),
+    shift = specs[0].product_shift
+    pmax = (b0.expansion.term_max * wmax + (1 << (shift - 1))) >> shift
+    fam = FamilySpec(spec=_envelope(b0, specs[0], weight_bound=wmax, lin_width=lin_acc_width(kmax, kmax, input_bits),
+                                    lin_bound=lin_bound,
+                                    acc_bound=acc_bound_for(lin_bound, [wmax] * specs[0].steps,
+                                                            b0.expansion.term_max, shift)),
                      margin=mu, options=options, members=tuple(names))
     _check_memory(fam)
     for s in specs:  # every member fits by construction; keep the check honest
@@ -290,18 +289,24 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
     return fam
 
 
-def _envelope(s: Spec, weight_fmt, product_fmt, lin_width, lin_fmt, acc_fmt) -> Spec:
-    fam = replace(s, weight_fmt=weight_fmt, product_fmt=product_fmt, lin_width=lin_width, lin_fmt=lin_fmt,
-                  acc_fmt=acc_fmt)
-    K = fam.mult_digit_bits
-    if K > weight_fmt.width:
-        raise SpecError(f"mult_digit_bits = {K}: must be <= the weight width {weight_fmt.width}")
-    adv = -(-weight_fmt.width // K) + 1
-    fam = replace(fam, adv_period=adv)
+def _envelope(b: Blocks, s: Spec, *, weight_bound: int, lin_width: int, lin_bound: int, acc_bound: int,
+              product_bound: int | None = None) -> Spec:
+    """The family's spec: the first member's blocks (``b``; its spec ``s``) derived again with the
+    family's bounds (weights, linear part and running sums (1 + margin) x the family's largest),
+    and the sequencer paced by the wider weights."""
+    Pf = s.product_fmt.frac_bits
+    mult = derive_multiplier(b.budget, b.expansion, s.weight_fmt.frac_bits, Pf, s.lanes, weight_bound=weight_bound,
+                             product_bound=product_bound)
+    norm = derive_normaliser(b.input, s.phase_bits, s.output_lsb_mm, Pf, lin_width=lin_width, lin_bound=lin_bound)
+    env = Blocks(b.input, b.output, b.budget, norm, b.expansion, mult,
+                 derive_adder(norm, b.expansion, mult, acc_bound=acc_bound),
+                 derive_sequencer(s.mult_style, s.mult_digit_bits, mult.weight_fmt.width))
+    fam = compose(env, model_sha256=s.model_sha256, device=s.device, number_format=s.number_format)
     analysis = dict(s.analysis)
     est = estimate_resources(fam)
     # the weights live in the weight memory (one block RAM), not in a ROM
-    rom = math.ceil(s.steps * weight_fmt.width / BRAM_BITS) if s.steps * weight_fmt.width > 2048 else 0
+    W = mult.weight_fmt.width
+    rom = math.ceil(s.steps * W / BRAM_BITS) if s.steps * W > 2048 else 0
     analysis["estimate"] = {**est, "brams": est["brams"] - rom + 1}
     return replace(fam, analysis=analysis)
 
@@ -325,11 +330,15 @@ def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
         terms = int(d["terms"])
     except (KeyError, TypeError, ValueError) as exc:
         raise SpecError(f"manifest 'family' entry is incomplete ({exc})") from None
-    s = _quiet(derive_spec, _padded(init_model, terms), **options, check_device=False)
-    Pf, Wf = s.product_fmt.frac_bits, s.weight_fmt.frac_bits
-    spec = _envelope(s, FixedFormat(w["weight_bits"], w["weight_bits"] - Wf),
-                     FixedFormat(w["product_bits"], w["product_bits"] - Pf), int(w["lin_width"]),
-                     FixedFormat(w["lin_bits"], w["lin_bits"] - Pf), FixedFormat(w["acc_bits"], w["acc_bits"] - Pf))
+    try:
+        o = GenOptions.of(None, **options)
+        b = _quiet(derive_blocks, _padded(init_model, terms), o)
+        s = _quiet(assemble, b, device=o.device, check_device=False)
+        top = {k: (1 << (int(w[k]) - 1)) - 1 for k in ("weight_bits", "product_bits", "lin_bits", "acc_bits")}
+        spec = _envelope(b, s, weight_bound=top["weight_bits"], product_bound=top["product_bits"],
+                         lin_width=int(w["lin_width"]), lin_bound=top["lin_bits"], acc_bound=top["acc_bits"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SpecError(f"manifest 'family' entry is incomplete ({exc})") from None
     fam = FamilySpec(spec=spec, margin=margin, options=options, members=tuple(d.get("members", ())))
     _check_memory(fam)
     return fam

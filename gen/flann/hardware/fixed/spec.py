@@ -333,30 +333,40 @@ def table_brams(A: int, widths) -> int:
     return sum(math.ceil(w / per_block) * max(1, (1 << A) // BRAM_BITS) for w in widths)
 
 
-def derive_spec(
-    model: FlannModel,
-    options: GenOptions | None = None,
-    *,
-    model_sha256: str = "",
-    number_format: str = "fixed",
-    check_device: bool = True,
-    **overrides,
-) -> Spec:
-    """Validate options, size every signal by the error budget, compute every constant.
+# -- the blocks, each derived by one short, checked function ----------------------------------
+# derive_spec composes them in the order the error budget needs them: the input stage (the
+# normaliser's clamp), the output stage (the adder's rounding), the budget shares, the
+# normaliser's phase width, the expansion, the multiplier, the normaliser's constants (its linear
+# part is in the accumulator's units), the adder, the sequencer.  The float18 front end and the
+# family envelope call the same functions with their own constraints.
+def sfix(bound: int, frac_bits: int) -> FixedFormat:
+    """The signed format that holds -bound..bound (integer units) with ``frac_bits`` fraction bits."""
+    width = bits_needed(-bound, bound)
+    return FixedFormat(width, width - frac_bits)
 
-    ``options`` (default: :class:`GenOptions`'s defaults) with ``overrides`` by keyword.
-    """
-    o = GenOptions.of(options, **overrides)
-    device, input_bits, input_lsb_v, clamp = o.device, o.input_bits, o.input_lsb_v, o.clamp
-    output_bits, output_lsb_mm, lanes = o.output_bits, o.output_lsb_mm, o.lanes
-    mult_style, mult_digit_bits, interp = o.mult_style, o.mult_digit_bits, o.interp
-    phase_bits, table_addr_bits, term_frac_bits = o.phase_bits, o.table_addr_bits, o.term_frac_bits
-    weight_frac_bits, product_frac_bits = o.weight_frac_bits, o.product_frac_bits
-    if not isinstance(model, FlannModel):
-        raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
-    if number_format != "fixed":
-        raise SpecError(f"number format {number_format!r}: only 'fixed' is generated")
-    part, _pkg, _speed = parse_device(device)
+
+def _at_least(name: str, bound: int | None, own: int) -> int:
+    """A bound a caller imposes (the family's envelope), which must hold the block's own values."""
+    if bound is None:
+        return own
+    if bound < own:
+        raise SpecError(f"{name} reach {own}, the format given holds {bound}")
+    return int(bound)
+
+
+@dataclass(frozen=True)
+class InputStage:
+    """The codes in use: the normaliser's clamp range and the model over it."""
+
+    model: FlannModel = field(repr=False)  # at least one sin/cos term
+    input_bits: int
+    input_lsb_v: float
+    clamp_lo: int
+    clamp_hi: int
+    y: np.ndarray = field(repr=False)  # the model's output (mm) at every code in use
+
+
+def derive_input(model: FlannModel, input_bits, input_lsb_v, clamp) -> InputStage:
     if model.terms < 2:
         # A straight line (trained with --terms 1): the datapath has at least one sin/cos lane,
         # so the line gets sin(pi v_n) with weight 0 -- the same output, bit for bit.
@@ -365,10 +375,6 @@ def derive_spec(
     for note in plan.notes:
         warnings.warn(note)
     B, input_lsb_v = _check_int("input_bits", plan.input_bits, 4, 16), plan.input_lsb_v
-    L = _check_int("lanes", lanes, 1, max(1, model.terms - 1))
-    if mult_style not in MULT_STYLES:
-        raise SpecError(f"mult_style {mult_style!r}: must be one of {', '.join(MULT_STYLES)}")
-
     vlo, vhi = sorted(model.voltage_range_v)
     cmin, cmax = -(1 << (B - 1)), (1 << (B - 1)) - 1
     if input_lsb_v is None:
@@ -389,14 +395,24 @@ def derive_spec(
             f"trained range {vlo:.4g}..{vhi:.4g} V"
         )
     codes = np.arange(clo, chi + 1)
-    y = model.predict(codes * lsb)
-    ymax = float(np.max(np.abs(y)))
+    return InputStage(model, B, lsb, int(clo), int(chi), model.predict(codes * lsb))
 
-    # ---- output format --------------------------------------------------------------
+
+@dataclass(frozen=True)
+class OutputStage:
+    """The adder's output: code width and mm per LSB."""
+
+    output_lsb_mm: float
+    out_fmt: FixedFormat
+
+
+def derive_output(inp: InputStage, output_bits, output_lsb_mm) -> OutputStage:
+    y = inp.y
+    ymax = float(np.max(np.abs(y)))
     if output_lsb_mm is None:
         if output_bits is None:
-            step = (float(y.max() - y.min()) or 1.0) / max(1, codes.size - 1)
-            output_lsb_mm = nice_125(adc.default_output_step_mm(model, step), up=False)
+            step = (float(y.max() - y.min()) or 1.0) / max(1, y.size - 1)
+            output_lsb_mm = nice_125(adc.default_output_step_mm(inp.model, step), up=False)
         else:
             ob = _check_int("output_bits", output_bits, 4, 32)
             output_lsb_mm = nice_125(ymax * 1.05 / ((1 << (ob - 1)) - 1), up=True)
@@ -415,33 +431,76 @@ def derive_spec(
             f"output_bits = {Bout} at {q} mm/LSB holds +-{((1 << (Bout - 1)) - 1) * q:.4g} mm, but the "
             f"model reaches {ymax:.4g} mm over the input range: use >= {need_out} bits or a coarser LSB"
         )
+    return OutputStage(q, FixedFormat(Bout, Bout, signed=True))
 
-    # ---- error-budget widths -----------------------------------------------------------
-    # said when a width the user did not ask for comes out of range
-    hint = adc.pathological_hint(model, q)
-    given = {k for k, v in dict(phase_bits=phase_bits, term_frac_bits=term_frac_bits,
-                                weight_frac_bits=weight_frac_bits).items() if v is not None}
+
+@dataclass(frozen=True)
+class Budget:
+    """What the error budget's shares are divided by: the trig weights in output LSB."""
+
+    wt: np.ndarray = field(repr=False)  # trig weights / output LSB, model term order
+    Sw: float                           # sum |wt|
+    Swm: float                          # sum |wt| x harmonic
+    hint: str                           # said when a width the user did not give comes out of range
+    given: frozenset                    # widths the user gave
+
+    @property
+    def N(self) -> int:
+        return int(self.wt.size)
+
+    @property
+    def e_t(self) -> float:
+        """Allowed error per term (term units)."""
+        return BUDGET["table"] / self.Sw
+
+    def why(self, name: str) -> str:
+        return "" if name in self.given else self.hint
+
+
+def error_budget(model: FlannModel, q: float, given) -> Budget:
     w = np.asarray(model.weights, dtype=float)
     wt = w[1:] / q  # trig weights in output LSB
     m = np.array([term_kind(i)[1] for i in range(1, model.terms)], dtype=float)
-    Sw = float(np.sum(np.abs(wt))) or 1e-9
-    Swm = float(np.sum(np.abs(wt) * m)) or 1e-9
-    N = model.terms - 1
-    a = lsb / model.input_scale_v
-    b = -model.input_offset_v / model.input_scale_v
+    return Budget(wt, float(np.sum(np.abs(wt))) or 1e-9, float(np.sum(np.abs(wt) * m)) or 1e-9,
+                  adc.pathological_hint(model, q), frozenset(given))
 
+
+def derive_phase_bits(budget: Budget, phase_bits) -> int:
+    """The normaliser's phase width P (v_n mod 2 with P - 1 fraction bits)."""
     # phase: error per lookup <= m*(1/2 + 1/4) LSB_v (rounding of v, of ka) + 1/2 LSB (mid-sample bias)
     if phase_bits is None:
-        F = math.ceil(math.log2(math.pi * (1.5 * Swm + Sw) / (2 * BUDGET["phase"])))
+        F = math.ceil(math.log2(math.pi * (1.5 * budget.Swm + budget.Sw) / (2 * BUDGET["phase"])))
         # trig weights under an output LSB need less than the narrowest phase: take that
         phase_bits = max(6, F + 1)
-    P = _check_int("phase_bits", phase_bits, 6, 40, derived="" if "phase_bits" in given else hint)
-    F = P - 1
-    e_t = BUDGET["table"] / Sw  # allowed error per term (term units)
+    return _check_int("phase_bits", phase_bits, 6, 40, derived=budget.why("phase_bits"))
+
+
+@dataclass(frozen=True)
+class Expansion:
+    """The sin/cos table and its interpolation, and the terms it puts out."""
+
+    interp: bool
+    table_addr_bits: int
+    dq_bits: int
+    slope_guard: int
+    value_fmt: FixedFormat
+    slope_fmt: FixedFormat
+    table_style: str
+    term_fmt: FixedFormat
+    term_max: int  # largest |term| (sizes products and accumulator)
+    value_rom: tuple = field(repr=False)
+    slope_rom: tuple = field(repr=False)
+
+
+def derive_expansion(budget: Budget, P: int, term_frac_bits, table_addr_bits, interp,
+                     min_term_bits: int = 0) -> Expansion:
+    """``min_term_bits``: the terms share a converter with wider values (float18's code): terms
+    the budget sizes narrower get more fraction bits, unless the user gave them."""
+    e_t = budget.e_t
     if term_frac_bits is None:
         # value and correction rounding: 2 x 2^-(Tf+1) <= e_t / 2
         term_frac_bits = max(4, math.ceil(-math.log2(e_t / 2)))
-    Tf = _check_int("term_frac_bits", term_frac_bits, 4, 30, derived="" if "term_frac_bits" in given else hint)
+    Tf = _check_int("term_frac_bits", term_frac_bits, 4, 30, derived=budget.why("term_frac_bits"))
     if table_addr_bits is None:
         if interp:  # residual of first-order interpolation (pi/2 2^-(A+1))^2 / 2 <= e_t / 4
             A = math.ceil(math.log2(math.pi / 2 / math.sqrt(e_t / 2)) - 1)
@@ -451,6 +510,14 @@ def derive_spec(
     A = _check_int("table_addr_bits", table_addr_bits, 2, 16)
     if A > P - 3:
         raise SpecError(f"table_addr_bits = {A}: must be <= phase_bits - 3 = {P - 3}")
+    exp = _expansion_tables(e_t, P, Tf, A, bool(interp))
+    short = min_term_bits - exp.term_fmt.width
+    if short > 0 and "term_frac_bits" not in budget.given:
+        exp = _expansion_tables(e_t, P, _check_int("term_frac_bits", Tf + short, 4, 30), A, bool(interp))
+    return exp
+
+
+def _expansion_tables(e_t: float, P: int, Tf: int, A: int, interp: bool) -> Expansion:
     D = _offset_bits(P, A)
     if interp:
         # offset truncation (pi/2) 2^-(A+Dq) <= e_t/8 ; slope rounding 2^(Dq-2-Gs-Tf) <= e_t/8
@@ -480,71 +547,208 @@ def derive_spec(
             corr_max = delta_max  # dq < 2^Dq: the rounded product stays <= the difference
     term_max = int(value_rom.max()) + corr_max + 1
     term_fmt = FixedFormat(bits_needed(-term_max, term_max), bits_needed(-term_max, term_max) - Tf)
+    return Expansion(interp, A, Dq, Gs, value_fmt, slope_fmt, table_style, term_fmt, term_max,
+                     tuple(int(x) for x in value_rom), tuple(int(x) for x in slope_rom))
 
+
+@dataclass(frozen=True)
+class Multiplier:
+    """Terms x weights (the weight ROM, one per lane) -> products."""
+
+    weight_fmt: FixedFormat
+    product_fmt: FixedFormat
+    product_shift: int
+    lanes: int
+    steps: int
+    weight_rom: tuple = field(repr=False)  # [lane][step]
+
+
+def product_frac_bits_for(budget: Budget, product_frac_bits) -> int:
+    """The products' (and accumulator's) fraction bits: the budget's share over N roundings."""
+    if product_frac_bits is None:
+        product_frac_bits = max(0, math.ceil(math.log2(budget.N / (2 * BUDGET["products"]))))
+    return _check_int("product_frac_bits", product_frac_bits, 0, 30)
+
+
+def derive_multiplier(budget: Budget, exp: Expansion, weight_frac_bits, Pf: int, lanes: int,
+                      weight_bound: int | None = None, product_bound: int | None = None) -> Multiplier:
+    """``weight_bound`` / ``product_bound``: the largest magnitudes (integer units) the formats
+    hold, at least the model's own (default: exactly those)."""
+    Tf, term_max, N = exp.term_fmt.frac_bits, exp.term_max, budget.N
     if weight_frac_bits is None:
         weight_frac_bits = max(0, math.ceil(math.log2(N * term_max / 2.0 ** Tf / (2 * BUDGET["weights"]))))
-    Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30, derived="" if "weight_frac_bits" in given else hint)
-    w_int = np.floor(wt * 2.0 ** Wf + 0.5).astype(np.int64)
+    Wf = _check_int("weight_frac_bits", weight_frac_bits, 0, 30, derived=budget.why("weight_frac_bits"))
+    w_int = np.floor(budget.wt * 2.0 ** Wf + 0.5).astype(np.int64)
     # at least +-1: weights that all round to 0 (a straight line) still get a 2-bit word,
     # which the default 2-bit shift-add digit needs
-    wmax = max(1, int(np.max(np.abs(w_int)))) if w_int.size else 1
-    weight_fmt = FixedFormat(bits_needed(-wmax, wmax), bits_needed(-wmax, wmax) - Wf)
-
-    if product_frac_bits is None:
-        product_frac_bits = max(0, math.ceil(math.log2(N / (2 * BUDGET["products"]))))
-    Pf = _check_int("product_frac_bits", product_frac_bits, 0, 30)
+    own = max(1, int(np.max(np.abs(w_int)))) if w_int.size else 1
+    wmax = _at_least("weights", weight_bound, own)
     shift = Tf + Wf - Pf
     if shift < 1:
         raise SpecError(f"product_frac_bits = {Pf}: must be < term_frac_bits + weight_frac_bits = {Tf + Wf}")
-    pmax = (term_max * wmax + (1 << (shift - 1))) >> shift
-    product_fmt = FixedFormat(bits_needed(-pmax, pmax), bits_needed(-pmax, pmax) - Pf)
+    if product_bound is None:
+        pmax = (term_max * wmax + (1 << (shift - 1))) >> shift
+    else:
+        pmax = _at_least("products", product_bound, (term_max * own + (1 << (shift - 1))) >> shift)
+    S = math.ceil(N / lanes)
+    rom = np.zeros(S * lanes, dtype=np.int64)
+    rom[:N] = w_int
+    return Multiplier(sfix(wmax, Wf), sfix(pmax, Pf), shift, lanes, S,
+                      tuple(tuple(int(x) for x in rom[l::lanes]) for l in range(lanes)))
 
+
+@dataclass(frozen=True)
+class Normaliser:
+    """theta = v_n mod 2 (the expansion's phase) and lin = bias + w0 v_n (the adder's start value)."""
+
+    phase_bits: int
+    norm_guard: int
+    ka: int
+    kb: int
+    lin_guard: int
+    k1: int
+    k0: int
+    lin_width: int       # serial accumulator of k1 x code (exact, no wrap)
+    lin_fmt: FixedFormat
+    lin_bound: int       # largest |lin| + 1 the formats after it hold
+    lin_peak: int        # largest |lin| + 1 of this model (= lin_bound unless an envelope's is given)
+
+
+def lin_acc_width(k1_bound: int, k0_bound: int, input_bits: int) -> int:
+    """The serial k1 x code + k0 accumulator, exact for every code (one guard bit)."""
+    return bits_needed(-(k1_bound << (input_bits - 1)) - k0_bound, (k1_bound << (input_bits - 1)) + k0_bound) + 1
+
+
+def derive_normaliser(inp: InputStage, P: int, q: float, Pf: int, lin_width: int | None = None,
+                      lin_bound: int | None = None) -> Normaliser:
+    """``lin_width`` / ``lin_bound``: an envelope's (the family's), at least the model's own."""
+    model, B = inp.model, inp.input_bits
+    w0 = float(model.weights[0])
+    a = inp.input_lsb_v / model.input_scale_v
+    b = -model.input_offset_v / model.input_scale_v
     # linear term + bias, straight into the accumulator (accumulator units 2^-Pf LSB)
     Gl = B + 3
-    k1 = int(math.floor(w[0] * a / q * 2.0 ** (Pf + Gl) + 0.5))
-    k0 = int(math.floor((w[0] * b + model.bias) / q * 2.0 ** (Pf + Gl) + 0.5))
-    lin_width = bits_needed(-(abs(k1) << (B - 1)) - abs(k0), (abs(k1) << (B - 1)) + abs(k0)) + 1
-    lin_vals = [(k1 * c + k0 + (1 << (Gl - 1))) >> Gl for c in (clo, chi)]
-    lin_bound = max(abs(v) for v in lin_vals) + 1
-    lin_fmt = FixedFormat(bits_needed(-lin_bound, lin_bound), bits_needed(-lin_bound, lin_bound) - Pf)
-
+    k1 = int(math.floor(w0 * a / q * 2.0 ** (Pf + Gl) + 0.5))
+    k0 = int(math.floor((w0 * b + model.bias) / q * 2.0 ** (Pf + Gl) + 0.5))
+    width = _at_least("the linear accumulator's values", lin_width, lin_acc_width(abs(k1), abs(k0), B))
+    lin_vals = [(k1 * c + k0 + (1 << (Gl - 1))) >> Gl for c in (inp.clamp_lo, inp.clamp_hi)]
+    peak = max(abs(v) for v in lin_vals) + 1
+    bound = _at_least("linear part", lin_bound, peak)
     # normaliser: theta = v_n mod 2 with F fraction bits; guard bits make ka's rounding
     # cost at most 1/4 LSB_v over the code range
-    Gn = B + 1
+    F, Gn = P - 1, B + 1
     ka = int(math.floor(a * 2.0 ** (F + Gn) + 0.5)) % (1 << (P + Gn))
     kb = int(math.floor(b * 2.0 ** (F + Gn) + 0.5)) % (1 << (P + Gn))
+    return Normaliser(P, Gn, ka, kb, Gl, k1, k0, width, sfix(bound, Pf), bound, peak)
 
-    S = math.ceil(N / L)
-    rom = np.zeros(S * L, dtype=np.int64)
-    rom[:N] = w_int
-    weight_rom = tuple(tuple(int(x) for x in rom[l::L]) for l in range(L))
-    acc_bound = lin_bound + sum(
-        ((term_max * abs(int(x)) + (1 << (shift - 1))) >> shift) + 1 for x in rom
-    )
-    acc_fmt = FixedFormat(bits_needed(-acc_bound, acc_bound), bits_needed(-acc_bound, acc_bound) - Pf)
-    out_fmt = FixedFormat(Bout, Bout, signed=True)
-    for name, width in (("lin accumulator", lin_width), ("normaliser", P + Gn), ("accumulator", acc_fmt.width),
-                        ("product", term_fmt.width + weight_fmt.width)):
+
+def acc_bound_for(lin_bound: int, weights, term_max: int, shift: int) -> int:
+    """Largest |running sum| + 1: the start value, then every product (rounded) of ``weights``."""
+    return lin_bound + sum(((term_max * abs(int(x)) + (1 << (shift - 1))) >> shift) + 1 for x in weights)
+
+
+def derive_adder(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_bound: int | None = None) -> FixedFormat:
+    """The accumulator's format; ``acc_bound``: an envelope's, at least the model's own sums."""
+    words = [w for lane in mult.weight_rom for w in lane]
+    if acc_bound is None:
+        acc_bound = acc_bound_for(norm.lin_bound, words, exp.term_max, mult.product_shift)
+    else:
+        acc_bound = _at_least("the running sums", acc_bound,
+                              acc_bound_for(norm.lin_peak, words, exp.term_max, mult.product_shift))
+    return sfix(acc_bound, mult.product_fmt.frac_bits)
+
+
+@dataclass(frozen=True)
+class Sequencer:
+    """The advance period: one step every ``adv_period`` cycles (the multiplier's pace)."""
+
+    mult_style: str
+    mult_digit_bits: int
+    adv_period: int
+
+
+def check_mult_style(mult_style) -> None:
+    if mult_style not in MULT_STYLES:
+        raise SpecError(f"mult_style {mult_style!r}: must be one of {', '.join(MULT_STYLES)}")
+
+
+def derive_sequencer(mult_style: str, mult_digit_bits, weight_bits: int) -> Sequencer:
+    check_mult_style(mult_style)
+    K = _check_int("mult_digit_bits", mult_digit_bits, 1, weight_bits)
+    # shift-add: ceil(W/K) cycles per product, then the advance that hands it on
+    return Sequencer(mult_style, K, 1 if mult_style == "lut" else -(-weight_bits // K) + 1)
+
+
+@dataclass(frozen=True)
+class Blocks:
+    """A fixed datapath's blocks, before they are stamped into one :class:`Spec`."""
+
+    input: InputStage
+    output: OutputStage
+    budget: Budget
+    normaliser: Normaliser
+    expansion: Expansion
+    multiplier: Multiplier
+    acc_fmt: FixedFormat
+    sequencer: Sequencer
+
+
+def derive_blocks(model: FlannModel, o: GenOptions, *, terms_hold_code: bool = False) -> Blocks:
+    """Every block of the fixed datapath for ``model`` under the options ``o``, composed.
+    ``terms_hold_code``: the terms share a converter with the input code (the float18 front
+    end), so they are at least as wide as the code."""
+    parse_device(o.device)
+    # the lanes and the multiplier style are checked before the widths they shape
+    L = _check_int("lanes", o.lanes, 1, max(1, model.terms - 1))
+    check_mult_style(o.mult_style)
+    inp = derive_input(model, o.input_bits, o.input_lsb_v, o.clamp)
+    out = derive_output(inp, o.output_bits, o.output_lsb_mm)
+    given = {k for k in ("phase_bits", "term_frac_bits", "weight_frac_bits") if getattr(o, k) is not None}
+    budget = error_budget(inp.model, out.output_lsb_mm, given)
+    P = derive_phase_bits(budget, o.phase_bits)
+    exp = derive_expansion(budget, P, o.term_frac_bits, o.table_addr_bits, o.interp,
+                           min_term_bits=inp.input_bits if terms_hold_code else 0)
+    Pf = product_frac_bits_for(budget, o.product_frac_bits)
+    mult = derive_multiplier(budget, exp, o.weight_frac_bits, Pf, L)
+    norm = derive_normaliser(inp, P, out.output_lsb_mm, Pf)
+    acc_fmt = derive_adder(norm, exp, mult)
+    check_widths(norm, exp, mult, acc_fmt, budget)
+    return Blocks(inp, out, budget, norm, exp, mult, acc_fmt, derive_sequencer(o.mult_style, o.mult_digit_bits,
+                                                                                mult.weight_fmt.width))
+
+
+def check_widths(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_fmt: FixedFormat, budget: Budget) -> None:
+    for name, width in (("lin accumulator", norm.lin_width), ("normaliser", norm.phase_bits + norm.norm_guard),
+                        ("accumulator", acc_fmt.width), ("product", exp.term_fmt.width + mult.weight_fmt.width)):
         if width > 62:
             raise SpecError(f"{name} would need {width} bits (> 62): "
-                            + ("reduce the requested widths" if given else hint))
+                            + ("reduce the requested widths" if budget.given else budget.hint))
 
-    K = _check_int("mult_digit_bits", mult_digit_bits, 1, weight_fmt.width)
-    # shift-add: ceil(W/K) cycles per product, then the advance that hands it on
-    adv_period = 1 if mult_style == "lut" else -(-weight_fmt.width // K) + 1
-    spec = Spec(
-        model=model, model_sha256=model_sha256, generator_version=__version__, device=device.lower(),
-        number_format=number_format, lanes=L, mult_style=mult_style, mult_digit_bits=K, interp=bool(interp),
-        input_bits=B, input_lsb_v=lsb, clamp_lo=int(clo), clamp_hi=int(chi),
-        phase_bits=P, norm_guard=Gn, ka=ka, kb=kb, lin_guard=Gl, k1=k1, k0=k0,
-        lin_width=lin_width, lin_fmt=lin_fmt, table_addr_bits=A, value_fmt=value_fmt,
-        slope_fmt=slope_fmt, dq_bits=Dq, slope_guard=Gs, term_fmt=term_fmt,
-        weight_fmt=weight_fmt, product_fmt=product_fmt, product_shift=shift, acc_fmt=acc_fmt,
-        out_fmt=out_fmt, output_lsb_mm=q, steps=S, adv_period=adv_period,
-        value_rom=tuple(int(x) for x in value_rom), slope_rom=tuple(int(x) for x in slope_rom),
-        weight_rom=weight_rom, term_bound=int(term_max), table_style=table_style,
+
+def compose(b: Blocks, *, model_sha256: str, device: str, number_format: str) -> Spec:
+    """The :class:`Spec` the twin and the templates read: every block's fields, stamped."""
+    n, e, m, s = b.normaliser, b.expansion, b.multiplier, b.sequencer
+    return Spec(
+        model=b.input.model, model_sha256=model_sha256, generator_version=__version__, device=device.lower(),
+        number_format=number_format, lanes=m.lanes, mult_style=s.mult_style, mult_digit_bits=s.mult_digit_bits,
+        interp=e.interp, input_bits=b.input.input_bits, input_lsb_v=b.input.input_lsb_v,
+        clamp_lo=b.input.clamp_lo, clamp_hi=b.input.clamp_hi,
+        phase_bits=n.phase_bits, norm_guard=n.norm_guard, ka=n.ka, kb=n.kb, lin_guard=n.lin_guard, k1=n.k1,
+        k0=n.k0, lin_width=n.lin_width, lin_fmt=n.lin_fmt, table_addr_bits=e.table_addr_bits,
+        value_fmt=e.value_fmt, slope_fmt=e.slope_fmt, dq_bits=e.dq_bits, slope_guard=e.slope_guard,
+        term_fmt=e.term_fmt, weight_fmt=m.weight_fmt, product_fmt=m.product_fmt, product_shift=m.product_shift,
+        acc_fmt=b.acc_fmt, out_fmt=b.output.out_fmt, output_lsb_mm=b.output.output_lsb_mm, steps=m.steps,
+        adv_period=s.adv_period, value_rom=e.value_rom, slope_rom=e.slope_rom, weight_rom=m.weight_rom,
+        term_bound=int(e.term_max), table_style=e.table_style,
     )
-    analysis = error_analysis(spec, Sw=Sw, Swm=Swm, N=N)
+
+
+def assemble(b: Blocks, *, model_sha256: str = "", device: str, number_format: str = "fixed",
+             check_device: bool = True) -> Spec:
+    """The composed :class:`Spec` with its error analysis (a warning when it exceeds 1 LSB) and,
+    with ``check_device``, refused when the part cannot hold it."""
+    spec = compose(b, model_sha256=model_sha256, device=device, number_format=number_format)
+    analysis = error_analysis(spec, Sw=b.budget.Sw, Swm=b.budget.Swm, N=b.budget.N)
     spec = replace(spec, analysis=analysis)
     if not analysis["guaranteed_1lsb"]:
         warnings.warn(
@@ -552,8 +756,30 @@ def derive_spec(
             f"(> 1): see the spec analysis for the dominant source"
         )
     if check_device:
-        check_fits(spec, part)
+        check_fits(spec, parse_device(device)[0])
     return spec
+
+
+def derive_spec(
+    model: FlannModel,
+    options: GenOptions | None = None,
+    *,
+    model_sha256: str = "",
+    number_format: str = "fixed",
+    check_device: bool = True,
+    **overrides,
+) -> Spec:
+    """Validate options, size every signal by the error budget, compute every constant.
+
+    ``options`` (default: :class:`GenOptions`'s defaults) with ``overrides`` by keyword.
+    """
+    o = GenOptions.of(options, **overrides)
+    if not isinstance(model, FlannModel):
+        raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
+    if number_format != "fixed":
+        raise SpecError(f"number format {number_format!r}: only 'fixed' is generated")
+    return assemble(derive_blocks(model, o), model_sha256=model_sha256, device=o.device,
+                    number_format=number_format, check_device=check_device)
 
 
 def error_analysis(spec: Spec, *, Sw: float, Swm: float, N: int) -> dict:
@@ -653,4 +879,8 @@ def check_fits(spec: Spec, part: str) -> None:
 
 
 __all__ = ["Spec", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
-           "error_analysis", "BUDGET", "CLOCK_HZ"]
+           "error_analysis", "BUDGET", "CLOCK_HZ", "Blocks", "derive_blocks", "compose", "assemble", "sfix",
+           "InputStage", "derive_input", "OutputStage", "derive_output", "Budget", "error_budget",
+           "derive_phase_bits", "Expansion", "derive_expansion", "Multiplier", "product_frac_bits_for",
+           "derive_multiplier", "Normaliser", "derive_normaliser", "lin_acc_width", "acc_bound_for", "derive_adder",
+           "Sequencer", "derive_sequencer", "check_mult_style", "check_widths"]

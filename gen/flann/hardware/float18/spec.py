@@ -32,7 +32,7 @@ from ...errors import SpecError
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
 from ..fixed.latency import EXPANSION_ADVANCES, SEQ_START_EDGES, norm_latency
-from ..fixed.spec import Spec, derive_spec
+from ..fixed.spec import Spec, assemble, derive_blocks
 from ..options import GenOptions
 from ..twin import TopOut
 
@@ -150,13 +150,14 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     # design's device estimate (multiplier, accumulator) does not apply: `flann synth`
     # measures the float18 design itself.
     options.pop("check_device", None)
-    base = derive_spec(model, mult_style="lut", check_device=False, **options)
-    short = base.input_bits - base.term_fmt.width
-    if short > 0 and "term_frac_bits" not in options:
-        # small trig weights need only narrow terms, but the code shares the term converter:
-        # widen the terms to the code's width (more precision than the budget asks)
-        base = derive_spec(model, mult_style="lut", check_device=False,
-                           term_frac_bits=base.term_fmt.frac_bits + short, **options)
+    sha = options.pop("model_sha256", "")
+    o = GenOptions.of(None, mult_style="lut", **options)
+    if not isinstance(model, FlannModel):
+        raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
+    # small trig weights need only narrow terms, but the code shares the term converter: the
+    # expansion widens the terms to the code's width (more precision than the budget asks)
+    base = assemble(derive_blocks(model, o, terms_hold_code=True), model_sha256=sha, device=o.device,
+                    check_device=False)
     fmt = FLOAT18
     Tf = base.term_fmt.frac_bits
     if base.input_bits > fmt.sig_bits:
