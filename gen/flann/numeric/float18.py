@@ -311,7 +311,7 @@ class _PipelinedTwin:
 
     def process(self, in_a, in_b) -> FloatOut:
         """Every (in_a, in_b) pair, vectorised; ``out_y`` as the entity gives it ``latency`` cycles later."""
-        return FloatOut(out_y=self.compute_array(in_a, in_b))
+        return FloatOut(out_y=self._compute_array(in_a, in_b))
 
     def step(self, in_valid: bool, a: int = 0, b: int = 0) -> tuple[bool, int | None]:
         """One rising edge: returns (out_valid, out_y) after the edge."""
@@ -329,7 +329,7 @@ class F18Mul(_PipelinedTwin):
     def compute(self, a: int, b: int) -> int:
         return self.fmt.mul(a, b)
 
-    def compute_array(self, a, b) -> np.ndarray:
+    def _compute_array(self, a, b) -> np.ndarray:
         return self.fmt.mul_array(a, b)
 
 
@@ -342,7 +342,7 @@ class F18Add(_PipelinedTwin):
     def compute(self, a: int, b: int) -> int:
         return self.fmt.add(a, b)
 
-    def compute_array(self, a, b) -> np.ndarray:
+    def _compute_array(self, a, b) -> np.ndarray:
         return self.fmt.add_array(a, b)
 
 

@@ -191,14 +191,16 @@ class F18Cvt:
         self.frac_bits = frac_bits
         self.fmt = fmt
 
-    def compute_array(self, ints) -> np.ndarray:
+    def process(self, in_data) -> FloatOut:
+        """Every value of ``in_data`` (any shape), vectorised; ``out_y`` as the entity gives it
+        ``latency`` cycles later."""
+        return FloatOut(out_y=self._convert(in_data))
+
+    def _convert(self, ints) -> np.ndarray:
         a = np.asarray(ints, dtype=np.int64)
         if a.size and np.abs(a).max() >= 2 ** 53:
             raise ValueError("fixed value too wide for the float64 path")
         return self.fmt.encode_array(np.ldexp(a.astype(float), -self.frac_bits))
-
-    def process(self, in_data) -> FloatOut:
-        return FloatOut(out_y=self.compute_array(in_data))
 
 
 @dataclass
@@ -237,7 +239,7 @@ class F18Top:
         e = self.expansion.process(n.out_theta)
         trig = e.out_terms.reshape(codes.size, -1)[:, : s.terms - 1]
         fixed = np.concatenate([n.code[:, None], trig], axis=1)
-        terms = self.cvt.compute_array(fixed)
+        terms = self.cvt.process(fixed).out_y
         w = np.asarray(s.weight_codes, dtype=np.int64)[None, :]
         products = fmt.mul_array(terms, np.broadcast_to(w, terms.shape))
         running = np.empty_like(products)
