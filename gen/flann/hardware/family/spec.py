@@ -30,7 +30,7 @@ import numpy as np
 
 from ...errors import SpecError
 from ...golden.model import FlannModel
-from ...numeric.fixed import FixedFormat, bits_needed
+from ...numeric.fixed import bits_needed
 from ..fixed.latency import norm_latency
 from ..fixed.spec import (BRAM_BITS, Blocks, Spec, acc_bound_for, assemble, check_fits, compose, derive_adder,
                           derive_blocks, derive_multiplier, derive_normaliser, derive_sequencer, derive_spec,
