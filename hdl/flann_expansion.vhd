@@ -729,6 +729,7 @@ begin
   p_term : process (clk)
     variable prod : signed(21 downto 0);
     variable mag  : signed(19 downto 0);
+    variable neg  : signed(20 downto 0);
   begin
     if rising_edge(clk) then
       if in_adv = '1' then
@@ -737,11 +738,10 @@ begin
           prod := s2_hi(l) & signed(s2_sh(l));
           prod := shift_right(prod + 1024, 11);
           mag  := mag + resize(prod, 20);
-          if s2_neg(l) = '1' then
-            s3_term(l) <= -mag;
-          else
-            s3_term(l) <= mag;
-          end if;
+          -- -mag as (not mag) + 1: the inversion and the +1 (through a low '1' bit) in one adder
+          neg := (mag xor (mag'range => s2_neg(l))) & '1';
+          neg := neg + ((neg'high downto 1 => '0') & s2_neg(l));
+          s3_term(l) <= neg(20 downto 1);
         end loop;
         s3_valid <= s2_valid;
       end if;

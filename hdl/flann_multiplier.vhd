@@ -156,9 +156,12 @@ begin
   end generate g_rom;
 
   p_mult : process (clk)
-    variable a  : signed(21 downto 0);
-    variable hv : signed(20 downto 0);
-    variable wv : signed(19 downto 0);
+    variable a   : signed(21 downto 0);
+    variable t   : signed(21 downto 0);
+    variable c   : signed(22 downto 0);
+    variable sub : std_logic;
+    variable hv  : signed(20 downto 0);
+    variable wv  : signed(19 downto 0);
   begin
     if rising_edge(clk) then
       if in_start = '1' then
@@ -185,14 +188,15 @@ begin
           hv := hi(l);
           wv := op_w(l);
           for d in 0 to 1 loop
-            a := resize(hv, 22);
-            if wv(0) = '1' then
-              if cnt = 1 and d = 1 then
-                a := a - op_term(l);
-              else
-                a := a + op_term(l);
-              end if;
+            -- one adder: the term ANDed with the weight bit, inverted (+1 in through a low
+            -- '1' bit) where it subtracts; no multiplexer between sums
+            sub := '0';
+            if cnt = 1 and d = 1 then
+              sub := wv(0);
             end if;
+            t := (resize(op_term(l), 22) xor (t'range => sub)) and (t'range => wv(0));
+            c := (resize(hv, 22) & '1') + (t & sub);
+            a := c(22 downto 1);
             hv := a(21 downto 1);
             wv := a(0) & wv(19 downto 1);
           end loop;

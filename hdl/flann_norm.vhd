@@ -36,9 +36,12 @@ use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
 
 -- Clamp the ADC code to the trained range, then two serial code x constant products
--- (one code bit per cycle, MSB first; the sign bit weighs -2^(B-1)):
+-- (one code bit per cycle, LSB first, each sum halved as it is formed):
 --   theta = (ka * c + kb) / 2^13 mod 2^23  (v_n mod 2 in units of pi: modular on purpose)
 --   lin   = (k1 * c + k0) / 2^15                 (bias + w0 v_n in accumulator units, exact)
+-- The code is taken offset binary (u = c + 2^11, sign bit inverted) and the offsets, with
+-- -2^11 times the constant folded in, are the accumulators' start values: each cycle
+-- is one add and a shift, the bits shifted out are final, so there is no offset adder.
 -- Serial because the Spartan-II has no multiplier and a sample takes many cycles anyway.
 entity flann_norm is
   port (
@@ -56,20 +59,19 @@ end entity flann_norm;
 architecture rtl of flann_norm is
   constant clamp_lo_c : signed(11 downto 0) := "100011011111";
   constant clamp_hi_c : signed(11 downto 0) := "011101000001";
+  -- the clamp limits offset binary
+  constant ulo_c      : unsigned(11 downto 0) := "000011011111";
+  constant uhi_c      : unsigned(11 downto 0) := "111101000001";
   constant ka_c       : unsigned(35 downto 0) := "000000000001000111001010110000010101";
-  -- kb_c and k0_c include the half LSB that makes the final shift round to nearest
-  constant kb_c       : unsigned(35 downto 0) := "111111101110001011110100101100001101";
-  constant k1_c       : signed(41 downto 0) := "000000000000010000010010100000000010111100";
-  constant k0_c       : signed(41 downto 0) := "111111111100000011001001011011011000010110";
-  -- the sign bit's product, -ka mod 2^36 and -k1
-  constant nka_c      : unsigned(35 downto 0) := "111111111110111000110101001111101011";
-  constant nk1_c      : signed(41 downto 0) := "111111111111101111101101011111111101000100";
+  constant k1_c       : signed(40 downto 0) := "00000000000010000010010100000000010111100";
+  -- start values: the offset with the rounding half LSB, minus the constant x 2^11
+  constant kb_c       : unsigned(35 downto 0) := "011100001000110011101010001100001101";
+  constant k0_c       : signed(40 downto 0) := "10111110010110011000111111101011000010110";
 
-  signal code_r  : signed(11 downto 0);
+  signal code_r  : unsigned(11 downto 0);
   signal acc_v   : unsigned(35 downto 0);
-  signal acc_l   : signed(41 downto 0);
+  signal acc_l   : signed(40 downto 0);
   signal cnt     : unsigned(3 downto 0);
-  signal first   : std_logic;
   signal busy    : std_logic;
   signal fin     : std_logic;
   signal sat_r   : std_logic;
@@ -80,58 +82,44 @@ begin
 
   p_norm : process (clk)
     variable sum_v : unsigned(35 downto 0);
-    variable sum_l : signed(41 downto 0);
+    variable sum_l : signed(40 downto 0);
   begin
     if rising_edge(clk) then
       valid_r <= '0';
       if in_valid = '1' then
         -- ---- accept: clamp (out-of-range codes saturate, flagged) ----
         if signed(in_code) < clamp_lo_c then
-          code_r <= clamp_lo_c;
+          code_r <= ulo_c;
           sat_r  <= '1';
         elsif signed(in_code) > clamp_hi_c then
-          code_r <= clamp_hi_c;
+          code_r <= uhi_c;
           sat_r  <= '1';
         else
-          code_r <= signed(in_code);
+          code_r <= unsigned((not in_code(11)) & in_code(10 downto 0));
           sat_r  <= '0';
         end if;
-        acc_v <= (others => '0');
-        acc_l <= (others => '0');
+        acc_v <= kb_c;
+        acc_l <= k0_c;
         cnt   <= "1100";
-        first <= '1';
         busy  <= '1';
         fin   <= '0';
       elsif busy = '1' then
-        -- ---- one code bit per cycle, MSB (negative weight) first ----
-        if first = '1' then
-          if code_r(code_r'high) = '1' then
-            acc_v <= nka_c;
-            acc_l <= nk1_c;
-          end if;
-        else
-          sum_v := shift_left(acc_v, 1);
-          sum_l := shift_left(acc_l, 1);
-          if code_r(code_r'high) = '1' then
-            sum_v := sum_v + ka_c;
-            sum_l := sum_l + k1_c;
-          end if;
-          acc_v <= sum_v;
-          acc_l <= sum_l;
-        end if;
-        first  <= '0';
-        code_r <= shift_left(code_r, 1);
+        -- ---- one code bit per cycle, LSB first: add, halve (theta modular, lin exact) ----
+        -- the constant ANDed with the bit, not a choice between two sums: one adder, no multiplexer
+        sum_v := acc_v + (ka_c and (ka_c'range => code_r(0)));
+        sum_l := acc_l + (k1_c and (k1_c'range => code_r(0)));
+        acc_v  <= shift_right(sum_v, 1);
+        acc_l  <= shift_right(sum_l, 1);
+        code_r <= shift_right(code_r, 1);
         cnt    <= cnt - 1;
         if cnt = 1 then
           busy <= '0';
           fin  <= '1';
         end if;
       elsif fin = '1' then
-        -- ---- add the offsets, round, hand over ----
-        sum_v   := acc_v + kb_c;
-        sum_l   := acc_l + k0_c;
-        theta_r <= sum_v(35 downto 13);
-        lin_r   <= resize(shift_right(sum_l, 15), 25);
+        -- ---- hand over the rounded results ----
+        theta_r <= acc_v(23 downto 1);
+        lin_r   <= resize(shift_right(acc_l, 3), 25);
         valid_r <= '1';
         fin     <= '0';
       end if;

@@ -53,6 +53,17 @@ def test_default_design_each_block_vs_twin(default_design, block):
     assert r.records[block]["mismatches"] == 0
 
 
+@pytest.mark.parametrize("bits", [6, 12])
+def test_norm_every_code_vs_twin(tmp_path_factory, bits):
+    """flann_norm (LSB first, the offsets as start values, no offset adder) against its twin over
+    every input code: theta and the linear part bit for bit, clamped codes flagged."""
+    d = tmp_path_factory.mktemp(f"norm{bits}")
+    design = from_model(MODEL, d, {**DEFAULT, "input_bits": bits})
+    r = run_bench(design, "norm", d / "build", extra={"block_every_code": True})
+    assert r.tests == 1 and r.ok, f"failed (see {d}/build/norm)"
+    assert r.records["norm"] == {"samples": 1 << bits, "mismatches": 0}
+
+
 @pytest.mark.parametrize("opts,benches", [
     ({"mult_style": "lut"}, ["top", "multiplier"]),
     # 3 lanes need 15 block RAMs (a table copy per lane): no Spartan-II, simulated anyway

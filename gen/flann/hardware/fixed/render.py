@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ...errors import FlannError, SpecError
 from ...textgen import template
-from ...numeric.fixed import bits_literal
+from ...numeric.fixed import bits_literal, bits_needed
 from ...golden.model import FlannModel, load_model, model_sha256
 from ..adc import AdcPlan, plan_adc
 from ..header import header
@@ -52,6 +52,29 @@ def seq_context(steps: int, n_advs: int, adv_period: int) -> dict:
                 adv_cnt_bits=_ubits(n_advs))
 
 
+def _lsb_first_norm(s: Spec) -> dict:
+    """flann_norm's LSB-first form: the code offset binary (u = c + 2^(B-1)), the offsets with
+    -2^(B-1) x the constant folded in as the accumulators' start values, each cycle one add and
+    a halving (the bits shifted out are final: floor of floors), so after B cycles the
+    accumulators hold the sums over 2^B and the guard bits left are a fixed slice."""
+    B, NV = s.input_bits, s.phase_bits + s.norm_guard
+    theta_lo, lin_shift = s.norm_guard - B, s.lin_guard - B
+    if theta_lo < 0 or lin_shift < 0:
+        raise SpecError(f"internal: normaliser guard bits ({s.norm_guard}, {s.lin_guard}) below the code's {B} bits")
+    half = 1 << (B - 1)
+    kb_start = (s.kb_rounded - s.ka * half) % (1 << NV)  # theta is modular: every sum mod 2^NV
+    k0_start = s.k0_rounded - s.k1 * half
+    # every sum before its halving: |start| / 2^k + |k1| (2 - 2^-k), + 1 for the floors
+    bound = abs(k0_start) + 2 * abs(s.k1) + 1
+    lsb_l_bits = bits_needed(-bound, bound)
+    return dict(
+        clamp_lo_u=bits_literal(s.clamp_lo + half, B, False), clamp_hi_u=bits_literal(s.clamp_hi + half, B, False),
+        kb_start=bits_literal(kb_start, NV, False), lsb_l_bits=lsb_l_bits,
+        k1_lsb=bits_literal(s.k1, lsb_l_bits), k0_start=bits_literal(k0_start, lsb_l_bits),
+        theta_lo=theta_lo, theta_hi=theta_lo + s.phase_bits - 1, lin_shift=lin_shift,
+    )
+
+
 def contexts(spec: Spec) -> dict[str, dict]:
     """Template context of every entity."""
     s = spec
@@ -68,10 +91,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
         code_bits=B, phase_bits=P, lin_bits=lin_bits, lin_type=s.lin_fmt.vhdl_type, acc_v_bits=NV, acc_l_bits=s.lin_width,
         guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
-        ka=bits_literal(s.ka, NV, False), nka=bits_literal((-s.ka) % (1 << NV), NV, False),
-        nk1=bits_literal(-s.k1, s.lin_width),
-        kb=bits_literal(s.kb_rounded, NV, False),
-        k1=bits_literal(s.k1, s.lin_width), k0=bits_literal(s.k0_rounded, s.lin_width),
+        ka=bits_literal(s.ka, NV, False), **_lsb_first_norm(s),
     )
     de, do = s.delta_steps
     starts = [s.lane_start(l) for l in range(L)]

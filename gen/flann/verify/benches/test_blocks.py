@@ -71,6 +71,8 @@ async def norm_vs_twin(dut):
                s.clamp_hi - 1, s.clamp_hi, s.clamp_hi + 1, s.code_max - 1, s.code_max]
     codes = [c for c in corners if s.code_min <= c <= s.code_max]
     codes += [r.randint(s.code_min, s.code_max) for _ in range(int(cfg.get("block_samples", 150)))]
+    if cfg.get("block_every_code"):
+        codes = list(range(s.code_min, s.code_max + 1))
     exp = twin.process(np.array(codes))
     bad = 0
     for i, c in enumerate(codes):
