@@ -113,6 +113,25 @@ def test_sweep_covers_every_temperature_code_or_a_stated_set_with_both_ends(desi
     assert {-2048, 2047, -320, 1280} <= set(temps) and len(temps) == 17
 
 
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path):
+    """An order whose weights are all far below an output LSB (order 2 here is about 3.5e-6 v_n):
+    its fixed datapath once wrapped in the linear accumulator and lost the adder's rounding half,
+    so the VHDL disagreed with the twin. Every voltage code at every temperature code."""
+    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    m = fit_thermal(sensor_v(x, t), t, x, (5, 3, 1), norm="range")
+    assert max(abs(w) for w in (*m.weights[2], m.bias[2])) < 1e-4
+    (tmp_path / "m.json").write_text(m.to_json())
+    r = flann("gen", tmp_path / "m.json", "-o", tmp_path / "d", "--input-bits", 8, "--temp-bits", 3,
+              "--temp-lsb-c", 30)
+    assert r.returncode == 0, r.stderr
+    r = flann("sim", tmp_path / "d", "--json", "--build", tmp_path / "b")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["codes_tested"] == 256 * 8 and out["mismatches"] == 0
+
+
 @pytest.mark.parametrize("args,word", [
     (("--temp-bits", 1), "--temp-bits"),
     (("--temp-bits", 17), "--temp-bits"),

@@ -503,7 +503,11 @@ def derive_spec(
     Gl = B + 3
     k1 = int(math.floor(w[0] * a / q * 2.0 ** (Pf + Gl) + 0.5))
     k0 = int(math.floor((w[0] * b + model.bias) / q * 2.0 ** (Pf + Gl) + 0.5))
-    lin_width = bits_needed(-(abs(k1) << (B - 1)) - abs(k0), (abs(k1) << (B - 1)) + abs(k0)) + 1
+    # the serial accumulator holds k1's partial products (|k1 c| <= |k1| 2^(B-1)) and then
+    # k1 c + k0 + 2^(Gl-1) (k0 with its rounding half): a tiny linear weight makes the half
+    # the largest of them
+    lin_reach = (abs(k1) << (B - 1)) + abs(k0) + (1 << (Gl - 1))
+    lin_width = bits_needed(-lin_reach, lin_reach) + 1
     lin_vals = [(k1 * c + k0 + (1 << (Gl - 1))) >> Gl for c in (clo, chi)]
     lin_bound = max(abs(v) for v in lin_vals) + 1
     lin_fmt = FixedFormat(bits_needed(-lin_bound, lin_bound), bits_needed(-lin_bound, lin_bound) - Pf)
@@ -521,7 +525,10 @@ def derive_spec(
     acc_bound = lin_bound + sum(
         ((term_max * abs(int(x)) + (1 << (shift - 1))) >> shift) + 1 for x in rom
     )
-    acc_fmt = FixedFormat(bits_needed(-acc_bound, acc_bound), bits_needed(-acc_bound, acc_bound) - Pf)
+    # at least one integer bit: the adder rounds by adding 2^(Pf-1) in acc_bits + 1 bits, which
+    # must hold it when every weight is far below an output LSB (an order of a two-input model)
+    acc_w = max(bits_needed(-acc_bound, acc_bound), Pf + 1)
+    acc_fmt = FixedFormat(acc_w, acc_w - Pf)
     out_fmt = FixedFormat(Bout, Bout, signed=True)
     for name, width in (("lin accumulator", lin_width), ("normaliser", P + Gn), ("accumulator", acc_fmt.width),
                         ("product", term_fmt.width + weight_fmt.width)):
