@@ -16,7 +16,7 @@ import pytest
 from flann.golden.thermal_train import fit_thermal
 from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
-from flann.verify.datapaths import THERMAL_MAX_SAMPLES, thermal_temperature_codes
+from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
 from flann.verify.design import from_directory
 
 FLANN = [sys.executable, "-m", "flann.cli"]
@@ -130,6 +130,24 @@ def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path):
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert out["codes_tested"] == 256 * 8 and out["mismatches"] == 0
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
+    """An ADC wider than the order datapaths (18 bits: their grid is 4 codes, the low bits go
+    through the interpolation fraction): HDL and twin bit for bit over the codes around the top
+    of the calibrated range (the steepest slope, and clamped codes beyond it), the stated temperature codes."""
+    r = flann("gen", design["model"], "-o", tmp_path / "d", "--input-bits", 18, "--temp-bits", 3,
+              "--temp-lsb-c", 30)
+    assert r.returncode == 0, r.stderr
+    d = from_directory(tmp_path / "d")
+    assert d.spec.fine_bits == -2
+    hi = d.spec.clamp_hi
+    out = simulate(d, tmp_path / "b", codes=(hi - 150, hi + 50))
+    temps, _ = thermal_temperature_codes(d.spec)
+    assert {d.spec.temp_code_min, d.spec.temp_code_max} <= set(temps)
+    assert out["summary"]["mismatches"] == 0 and out["summary"]["codes_tested"] == 201 * len(temps), out["summary"]
 
 
 @pytest.mark.parametrize("args,word", [
