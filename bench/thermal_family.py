@@ -140,13 +140,13 @@ def one(p, rng, work: Path, analog=False) -> dict:
         return {"error": "eval failed"}
     h, c = json.loads(out1), json.loads(out2)
     hw = hardware_drift(p, model, held, h["full_scale_mm"])
-    cal_max = max(r["max_error_mm"] for r in c["by_temperature"]["float"])
-    ratios = [r["max_error_mm"] / cal_max for r in h["by_temperature"]["float"]]
+    cal_max = max(r["max_error_mm"] for r in c["compensated"]["by_temperature"])
+    ratios = [r["max_error_mm"] / cal_max for r in h["compensated"]["by_temperature"]]
     m = json.loads(model.read_text())
     return {"raw_drift": h["drift_ppm_fs_per_c"]["raw"], "drift": h["drift_ppm_fs_per_c"]["float"],
             "ideal_drift": ideal_drift(p, held, h["full_scale_mm"]),
             "cal_max_ppm": cal_max / h["full_scale_mm"] * 1e6,
-            "held_max_ppm": max(r["max_error_mm"] for r in h["by_temperature"]["float"])
+            "held_max_ppm": max(r["max_error_mm"] for r in h["compensated"]["by_temperature"])
             / h["full_scale_mm"] * 1e6,
             "worst_ratio": max(ratios), "terms": m["terms"], **hw}
 

@@ -16,6 +16,7 @@ import pytest
 from flann.golden.thermal_train import fit_thermal
 from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
+from flann.hardware.thermal.twin import ThermalTop
 from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
 from flann.verify.design import from_directory
 
@@ -148,6 +149,64 @@ def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
     temps, _ = thermal_temperature_codes(d.spec)
     assert {d.spec.temp_code_min, d.spec.temp_code_max} <= set(temps)
     assert out["summary"]["mismatches"] == 0 and out["summary"]["codes_tested"] == 201 * len(temps), out["summary"]
+
+
+def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path):
+    """flann eval --design of a two-input design: the twin at the recordings' codes, by temperature
+    and the drift figure; the codes computed here (nearest code of each reading) give the same
+    max error per temperature."""
+    x = np.tile(np.linspace(-9.5, 9.5, 77), 3)
+    t = np.repeat([-10.0, 40.0, 65.0], 77)
+    v = sensor_v(x, t)
+    rec = tmp_path / "held.csv"
+    rec.write_text("displacement_mm,voltage_v,temperature_c\n"
+                   + "".join(f"{a:.17g},{b:.17g},{c:g}\n" for a, b, c in zip(x, v, t)))
+    r = flann("eval", design["model"], rec, "--design", design["dir"], "--json")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    hw = res["hardware"]
+    assert "by_temperature" not in res and set(res["drift_ppm_fs_per_c"]) == {"raw", "float", "hardware"}
+    assert res["drift_ppm_fs_per_c"]["hardware"] > 0
+    assert [row["temperature_c"] for row in hw["by_temperature"]] == [-10.0, 40.0, 65.0]
+    assert hw["temp_bits"] == 5 and hw["temp_lsb_c"] == 6.0
+    d = from_directory(design["dir"])
+    s = d.spec
+    codes = np.clip(np.floor(v / s.input_lsb_v + 0.5), s.code_min, s.code_max).astype(np.int64)
+    tcodes = np.floor(t / 6.0 + 0.5).astype(np.int64)
+    err = d.twin().process(codes, tcodes).out_data * s.output_lsb_mm - x
+    for k, row in enumerate(hw["by_temperature"]):
+        assert row["max_error_mm"] == pytest.approx(np.abs(err[77 * k:77 * (k + 1)]).max(), abs=1e-12)
+        assert row["points"] == 77
+    r = flann("eval", design["model"], rec, "--design", design["dir"])
+    assert r.returncode == 0 and "5-bit temperature x 6 degC" in r.stdout and ", hardware " in r.stdout
+    # another two-input model than the design's, and a one-input model: one line each
+    other = tmp_path / "other.json"
+    xc, tc = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    other.write_text(fit_thermal(sensor_v(xc, tc), tc, xc, (3, 1), norm="range").to_json())
+    r = flann("eval", other, rec, "--design", design["dir"])
+    assert r.returncode == 2 and "generated from another model" in r.stderr and len(r.stderr.splitlines()) == 1
+
+
+def test_trace_design_splits_the_error_into_its_stages(design, tmp_path):
+    """flann trace DIR of a two-input design: the stages add up to the whole error, which is the
+    twin against the float model at the same codes, and each stage stays within its bound from
+    the spec's error analysis."""
+    r = flann("trace", design["dir"], "--json", "--plot", tmp_path / "t.png")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert res["format"] == "thermal" and (tmp_path / "t.png").stat().st_size > 0
+    assert res["identity_residual_mm"] < 1e-9
+    s = from_directory(design["dir"]).spec
+    temps = res["temperature_codes"]
+    assert temps[0] == s.temp_lo and temps[-1] == s.temp_hi
+    c = np.arange(s.clamp_lo, s.clamp_hi + 1)
+    worst = max(np.abs(ThermalTop(s).process(c, tau).out_data * s.output_lsb_mm - s.float_reference(c, tau)).max()
+                for tau in temps)
+    assert res["total"]["max_mm"] == pytest.approx(worst, abs=1e-12) and worst <= s.output_lsb_mm
+    for name, st in res["stages"].items():
+        assert st["max_mm"] <= st["bound_mm"] * (1 + 1e-9) + 1e-15, name
+    r = flann("trace", design["dir"])
+    assert r.returncode == 0 and "dominant stage" in r.stdout
 
 
 @pytest.mark.parametrize("args,word", [
