@@ -49,13 +49,20 @@ def designs(tmp_path_factory):
     v = 1.5 * (1 - 2.5e-4 * (t - 25)) * u / (1 + np.abs(u) ** k) ** (1 / k) + 6e-6 * (t - 25)
     thermal = d / "m_thermal.json"
     thermal.write_text(fit_thermal(v, t, x, (5, 3), norm="range").to_json())
+    # its held-out recording (between and beside the calibration temperatures), for flann eval
+    xh, th = np.tile(np.linspace(-9.5, 9.5, 39), 2), np.repeat([10.0, 65.0], 39)
+    uh, kh = xh / 8.0, 2.5 * (1 + 1e-4 * (th - 25))
+    vh = 1.5 * (1 - 2.5e-4 * (th - 25)) * uh / (1 + np.abs(uh) ** kh) ** (1 / kh) + 6e-6 * (th - 25)
+    held = d / "held_thermal.csv"
+    held.write_text("displacement_mm,voltage_v,temperature_c\n"
+                    + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, vh, th)))
     r = flann("gen", thermal, "-o", d / "thermal", "--input-bits", BITS, "--temp-bits", 5, "--temp-lsb-c", 6)
     assert r.returncode == 0, r.stderr
     # the seed architecture is written by flann explore only (for comparison)
     seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
     # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
     shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
-    return {"dir": d, "model": model, "rec": recs[0]}
+    return {"dir": d, "model": model, "rec": recs[0], "eval": {"thermal": (thermal, held)}}
 
 
 def one_line_refusal(r) -> None:
@@ -70,7 +77,7 @@ def one_line_refusal(r) -> None:
 COMMANDS = {
     "sim": lambda d, fx: ("sim", d),
     "trace": lambda d, fx: ("trace", d),
-    "eval": lambda d, fx: ("eval", fx["model"], fx["rec"], "--design", d),
+    "eval": lambda d, fx: ("eval", *fx["eval"].get(d.name, (fx["model"], fx["rec"])), "--design", d),
     "ise": lambda d, fx: ("ise", d, "-o", fx["dir"] / f"ise_{d.name}"),
     # lint on; the mapped netlist checked where a bench drives it; abc -fast: the seed is parallel
     "synth": lambda d, fx: ("synth", d, "--abc", "fast"),
@@ -80,7 +87,6 @@ COMMANDS = {
 # (datapath, command) that refuse, with a word the one line must hold
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
-           ("thermal", "trace"): "stage model", ("thermal", "eval"): "one-input",
            ("thermal", "explore"): "two-input",
            # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
            ("seed", "synth"): "does not fit"}
@@ -175,7 +181,7 @@ TAMPERED = [
 TAMPER_COMMANDS = {
     "sim": lambda d, fx: ("sim", d),
     "trace": lambda d, fx: ("trace", d),
-    "eval": lambda d, fx: ("eval", fx["model"], fx["rec"], "--design", d),
+    "eval": lambda d, fx: ("eval", *fx["eval"].get(d.name, (fx["model"], fx["rec"])), "--design", d),
     "synth": lambda d, fx: ("synth", d, "--no-netlist-check"),
     "ise": lambda d, fx: ("ise", d, "-o", d.parent / f"ise_{d.name}"),
 }

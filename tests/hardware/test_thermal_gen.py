@@ -16,7 +16,8 @@ import pytest
 from flann.golden.thermal_train import fit_thermal
 from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
-from flann.verify.datapaths import THERMAL_MAX_SAMPLES, thermal_temperature_codes
+from flann.hardware.thermal.twin import ThermalTop
+from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
 from flann.verify.design import from_directory
 
 FLANN = [sys.executable, "-m", "flann.cli"]
@@ -111,6 +112,101 @@ def test_sweep_covers_every_temperature_code_or_a_stated_set_with_both_ends(desi
     temps, every = thermal_temperature_codes(wide)
     assert not every and 4096 * 65536 > THERMAL_MAX_SAMPLES
     assert {-2048, 2047, -320, 1280} <= set(temps) and len(temps) == 17
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path):
+    """An order whose weights are all far below an output LSB (order 2 here is about 3.5e-6 v_n):
+    its fixed datapath once wrapped in the linear accumulator and lost the adder's rounding half,
+    so the VHDL disagreed with the twin. Every voltage code at every temperature code."""
+    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    m = fit_thermal(sensor_v(x, t), t, x, (5, 3, 1), norm="range")
+    assert max(abs(w) for w in (*m.weights[2], m.bias[2])) < 1e-4
+    (tmp_path / "m.json").write_text(m.to_json())
+    r = flann("gen", tmp_path / "m.json", "-o", tmp_path / "d", "--input-bits", 8, "--temp-bits", 3,
+              "--temp-lsb-c", 30)
+    assert r.returncode == 0, r.stderr
+    r = flann("sim", tmp_path / "d", "--json", "--build", tmp_path / "b")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["codes_tested"] == 256 * 8 and out["mismatches"] == 0
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
+    """An ADC wider than the order datapaths (18 bits: their grid is 4 codes, the low bits go
+    through the interpolation fraction): HDL and twin bit for bit over the codes around the top
+    of the calibrated range (the steepest slope, and clamped codes beyond it), the stated temperature codes."""
+    r = flann("gen", design["model"], "-o", tmp_path / "d", "--input-bits", 18, "--temp-bits", 3,
+              "--temp-lsb-c", 30)
+    assert r.returncode == 0, r.stderr
+    d = from_directory(tmp_path / "d")
+    assert d.spec.fine_bits == -2
+    hi = d.spec.clamp_hi
+    out = simulate(d, tmp_path / "b", codes=(hi - 150, hi + 50))
+    temps, _ = thermal_temperature_codes(d.spec)
+    assert {d.spec.temp_code_min, d.spec.temp_code_max} <= set(temps)
+    assert out["summary"]["mismatches"] == 0 and out["summary"]["codes_tested"] == 201 * len(temps), out["summary"]
+
+
+def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path):
+    """flann eval --design of a two-input design: the twin at the recordings' codes, by temperature
+    and the drift figure; the codes computed here (nearest code of each reading) give the same
+    max error per temperature."""
+    x = np.tile(np.linspace(-9.5, 9.5, 77), 3)
+    t = np.repeat([-10.0, 40.0, 65.0], 77)
+    v = sensor_v(x, t)
+    rec = tmp_path / "held.csv"
+    rec.write_text("displacement_mm,voltage_v,temperature_c\n"
+                   + "".join(f"{a:.17g},{b:.17g},{c:g}\n" for a, b, c in zip(x, v, t)))
+    r = flann("eval", design["model"], rec, "--design", design["dir"], "--json")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    hw = res["hardware"]
+    assert "by_temperature" not in res and set(res["drift_ppm_fs_per_c"]) == {"raw", "float", "hardware"}
+    assert res["drift_ppm_fs_per_c"]["hardware"] > 0
+    assert [row["temperature_c"] for row in hw["by_temperature"]] == [-10.0, 40.0, 65.0]
+    assert hw["temp_bits"] == 5 and hw["temp_lsb_c"] == 6.0
+    d = from_directory(design["dir"])
+    s = d.spec
+    codes = np.clip(np.floor(v / s.input_lsb_v + 0.5), s.code_min, s.code_max).astype(np.int64)
+    tcodes = np.floor(t / 6.0 + 0.5).astype(np.int64)
+    err = d.twin().process(codes, tcodes).out_data * s.output_lsb_mm - x
+    for k, row in enumerate(hw["by_temperature"]):
+        assert row["max_error_mm"] == pytest.approx(np.abs(err[77 * k:77 * (k + 1)]).max(), abs=1e-12)
+        assert row["points"] == 77
+    r = flann("eval", design["model"], rec, "--design", design["dir"])
+    assert r.returncode == 0 and "5-bit temperature x 6 degC" in r.stdout and ", hardware " in r.stdout
+    # another two-input model than the design's, and a one-input model: one line each
+    other = tmp_path / "other.json"
+    xc, tc = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    other.write_text(fit_thermal(sensor_v(xc, tc), tc, xc, (3, 1), norm="range").to_json())
+    r = flann("eval", other, rec, "--design", design["dir"])
+    assert r.returncode == 2 and "generated from another model" in r.stderr and len(r.stderr.splitlines()) == 1
+
+
+def test_trace_design_splits_the_error_into_its_stages(design, tmp_path):
+    """flann trace DIR of a two-input design: the stages add up to the whole error, which is the
+    twin against the float model at the same codes, and each stage stays within its bound from
+    the spec's error analysis."""
+    r = flann("trace", design["dir"], "--json", "--plot", tmp_path / "t.png")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert res["format"] == "thermal" and (tmp_path / "t.png").stat().st_size > 0
+    assert res["identity_residual_mm"] < 1e-9
+    s = from_directory(design["dir"]).spec
+    temps = res["temperature_codes"]
+    assert temps[0] == s.temp_lo and temps[-1] == s.temp_hi
+    c = np.arange(s.clamp_lo, s.clamp_hi + 1)
+    worst = max(np.abs(ThermalTop(s).process(c, tau).out_data * s.output_lsb_mm - s.float_reference(c, tau)).max()
+                for tau in temps)
+    assert res["total"]["max_mm"] == pytest.approx(worst, abs=1e-12) and worst <= s.output_lsb_mm
+    for name, st in res["stages"].items():
+        assert st["max_mm"] <= st["bound_mm"] * (1 + 1e-9) + 1e-15, name
+    r = flann("trace", design["dir"])
+    assert r.returncode == 0 and "dominant stage" in r.stdout
 
 
 @pytest.mark.parametrize("args,word", [

@@ -63,7 +63,7 @@ def test_options_are_checked(model):
         derive_thermal_spec(model, input_bits=10, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0,
                             output_lsb_mm=1e-9)
     with pytest.raises(SpecError, match="input_bits"):
-        derive_thermal_spec(model, input_bits=17, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0)
+        derive_thermal_spec(model, input_bits=25, input_lsb_v=0.0025, temp_bits=8, temp_lsb_c=1.0)
 
 
 def test_sixteen_bit_input_interpolates_below_the_adc_step(model):
@@ -75,3 +75,20 @@ def test_sixteen_bit_input_interpolates_below_the_adc_step(model):
     assert spec.output_lsb_mm < 0.5 * spec.analysis["slope_mm_per_v"] * spec.input_lsb_v
     res = ThermalTop(spec).error_vs_float([spec.temp_lo, 25, spec.temp_hi])
     assert res["codes"] == 65536 and 0.05 < res["max_err_lsb"] <= 1.0
+
+
+def test_an_adc_wider_than_the_order_datapaths_keeps_its_low_bits(model):
+    """An 18-bit ADC: the order datapaths' grid is 4 codes wide (fine_bits -2) and the two low
+    bits reach them through the interpolation fraction; every code within 1 output LSB of the
+    float model, and finer than the same ADC cut to 16 bits could give."""
+    lsb = 2.0 / (1 << 17)
+    spec = derive_thermal_spec(model, input_bits=18, input_lsb_v=lsb, temp_bits=8, temp_lsb_c=1.0)
+    assert spec.fine_bits == -2 and spec.interp_bits >= 2
+    top = ThermalTop(spec)
+    res = top.error_vs_float([spec.temp_lo, 25, spec.temp_hi])
+    assert res["codes"] == 1 << 18 and res["max_err_lsb"] <= 1.0
+    # where a code moves the output by more than an LSB, neighbouring codes give distinct
+    # outputs (cut to 16 bits, every 4 codes would share one)
+    c = np.arange(40000, 40400)
+    out = top.process(c, 25).out_data
+    assert np.ptp(out) > c.size and np.unique(out).size > c.size // 2

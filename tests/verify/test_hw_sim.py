@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
+from flann.golden.model import FlannModel
 from flann.verify.design import from_directory, from_model
 from flann.verify.runner import run_bench, sweep
 
@@ -88,6 +89,25 @@ def test_adder_saturates_both_ways(tmp_path_factory):
     r = run_bench(design, "adder", d / "build")
     assert r.ok, r.failed_tests
     assert r.records["adder"]["sat_cases"] >= 2
+
+
+def test_weights_far_below_an_output_lsb(tmp_path_factory):
+    """A FLANN whose weights and bias are all far below an output LSB (a temperature order of a
+    two-input model that carries almost nothing): the linear accumulator must hold the rounding
+    half that k0 carries, and the adder's rounding half must fit its sum; HDL and twin agree."""
+    d = tmp_path_factory.mktemp("tiny")
+    model = d / "tiny.json"
+    model.write_text(FlannModel(weights=(3.5e-6, 2e-7), bias=-1e-15, input_offset_v=0.01,
+                                input_scale_v=1.3, voltage_range_v=(-1.3, 1.3),
+                                displacement_range_mm=(-10.0, 10.0)).to_json())
+    design = from_model(model, d, {"input_bits": 8, "output_lsb_mm": 0.000625})
+    assert design.spec.weight_fmt.int_bits < 0          # the case: weights under an output LSB
+    r = sweep(design, d / "build")
+    assert r["bench"].ok and r["codes"].size == 256, r["bench"].failed_tests
+    assert np.all(r["data"] == 0)                       # |x| < 1e-5 mm everywhere: 0 LSB
+    for block in ("norm", "adder"):
+        r = run_bench(design, block, d / "build", seed=5)
+        assert r.ok and r.records[block]["mismatches"] == 0, f"{block}: {r.failed_tests}"
 
 
 def test_sweep_detects_a_wrong_design(tmp_path_factory):

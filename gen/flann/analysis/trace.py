@@ -41,6 +41,9 @@ from ..hardware.family.twin import FlannFamilyTop
 from ..verify.datapaths import simulate as simulate_design
 from ..verify.design import Design, open_design
 from ..verify.runner import sweep
+from .thermal_trace import ThermalTraceResult, plot_thermal_trace, trace_thermal
+
+THERMAL_STAGES = "thermal"   # a two-input design's stage model (its own result type)
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
 STAGE_TEXT = {
@@ -401,8 +404,10 @@ def _ulp(x: float, sig_bits: int) -> float:
 
 
 # -- plot ---------------------------------------------------------------------------------
-def plot_trace(result: TraceResult, path, title: str = "") -> None:
+def plot_trace(result: TraceResult | ThermalTraceResult, path, title: str = "") -> None:
     """Error per stage vs input voltage (PNG)."""
+    if isinstance(result, ThermalTraceResult):
+        return plot_thermal_trace(result, path, title)
     # matplotlib is heavy and only needed for plots: imported when one is drawn
     import matplotlib
     matplotlib.use("Agg")
@@ -527,11 +532,14 @@ def run_trace(model: FlannModel, fmt: str = FORMATS[0], codes=None, **spec_optio
     return trace(st)
 
 
-def trace_design(design: Design, codes=None) -> TraceResult:
-    """The stages of a written design (any datapath with a stage model), from its own spec."""
+def trace_design(design: Design, codes=None) -> TraceResult | ThermalTraceResult:
+    """The stages of a written design (any datapath with a stage model), from its own spec; a
+    two-input design has its own (:mod:`.thermal_trace`)."""
     dp = design.datapath
     if dp.stages is None:
         raise FlannError(f"{design.directory}: {dp.why_no_stages}")
+    if dp.stages == THERMAL_STAGES:
+        return trace_thermal(design.spec)
     return trace(STAGE_MODELS[dp.stages](design.spec, codes))
 
 

@@ -18,6 +18,8 @@ from ..recordings import read_recordings
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
+# (figure name of drift_ppm_fs_per_c, the JSON section whose by_temperature it is)
+SECTIONS = (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware"))
 
 
 def add_arguments(p) -> None:
@@ -71,9 +73,6 @@ def run(args) -> int:
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
-    if is_thermal(model) and args.design:
-        raise FlannError(f"{args.model}: a two-input model has no generated design yet: "
-                         "evaluate it without --design")
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
                        temperature_c=rec.temperature_c)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
@@ -93,12 +92,13 @@ def run(args) -> int:
                               f"{spec.output_lsb_mm:g} mm output LSB)")
     if errors is not None:
         errors.setdefault("hardware", None)
-        res.update(temperature_report(errors, rec.displacement_mm, rec.temperature_c,
-                                      res["full_scale_mm"]))
-        # each figure's own section carries its list too (raw, compensated = the float model, hardware)
-        for name, section in (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware")):
-            if res["by_temperature"].get(name) is not None and section in res:
-                res[section]["by_temperature"] = res["by_temperature"][name]
+        report = temperature_report(errors, rec.displacement_mm, rec.temperature_c, res["full_scale_mm"])
+        # by_temperature lives in each figure's own section (raw; compensated = the float model;
+        # hardware), drift_ppm_fs_per_c once, keyed by figure (raw, float, hardware)
+        for name, section in SECTIONS:
+            if report["by_temperature"][name] is not None and section in res:
+                res[section]["by_temperature"] = report["by_temperature"][name]
+        res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
@@ -124,17 +124,20 @@ def run(args) -> int:
         lim = hw["physical_limit_mm"]
         dropped = (f" (a {hw['adc_bits']}-bit ADC x {hw['adc_lsb_v']:g} V, {hw['dropped_low_bits']} low bits "
                    "dropped)" if hw["dropped_low_bits"] else "")
-        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}, output LSB "
+        temp = (f", {hw['temp_bits']}-bit temperature x {hw['temp_lsb_c']:g} degC" if "temp_bits" in hw else "")
+        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, output LSB "
               f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; "
               f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
               f"max error / limit: hardware {hw['ratio_to_limit']:.2f}, float "
               f"{hw['float_ratio_to_limit']:.2f}")
-    if errors is not None and len(res["by_temperature"]["raw"]) > 1:
+    if errors is not None and len(res["raw"]["by_temperature"]) > 1:
         drift = res["drift_ppm_fs_per_c"]
+        rows = zip(res["raw"]["by_temperature"], res["compensated"]["by_temperature"],
+                   (hw or {}).get("by_temperature") or [None] * len(res["raw"]["by_temperature"]))
         print("by temperature (max error mm): " + "; ".join(
             f"{r['temperature_c']:g} degC raw {r['max_error_mm']:.4g}, compensated {c['max_error_mm']:.4g}"
-            for r, c in zip(res["by_temperature"]["raw"], res["by_temperature"]["float"])))
+            + (f", hardware {h['max_error_mm']:.4g}" if h else "") for r, c, h in rows))
         print("drift (ppm FS/degC): " + ", ".join(
             f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
     if args.plot:

@@ -22,6 +22,8 @@ from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
 from .fixed.twin import FlannTop
+from .thermal.spec import ThermalSpec
+from .thermal.twin import ThermalTop
 
 # -- a generated design, rebuilt ---------------------------------------------------------
 def design_spec(model_path, design_dir) -> Spec:
@@ -82,6 +84,8 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
     the error they cost is in the hardware figures.  Returns the ``"hardware"`` block of
     ``flann eval --design --json`` plus per-point arrays (``_points``) for the plot.
     """
+    if isinstance(spec, ThermalSpec):
+        return thermal_accuracy(spec, rec, tol=tol, band=band, fs_mm=fs_mm)
     adc_bits, adc_lsb = adc if adc is not None else (spec.input_bits, spec.input_lsb_v)
     x = rec.displacement_mm
     codes = adc_codes(spec, rec.voltage_v, (adc_bits, adc_lsb))
@@ -110,6 +114,52 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
         "ratio_to_limit": float(np.max(np.abs(e_hw)) / lim_max),
         "float_ratio_to_limit": float(np.max(np.abs(e_fl)) / lim_max),
         "worst_pointwise_ratio": float(np.max(np.abs(e_hw) / limit)),
+    })
+    rep["_points"] = {"x": x, "hardware": e_hw, "float": e_fl, "limit": limit}
+    return rep
+
+
+def thermal_accuracy(spec: ThermalSpec, rec, *, tol, band, fs_mm) -> dict:
+    """:func:`hardware_accuracy` of a two-input design: its twin at the recordings' voltages and
+    temperatures as the design's codes (nearest code, saturated to the code range; the design
+    clamps both to the calibrated codes), the float model at the recorded (clamped) values, and
+    the physical limit (half an ADC LSB over the model's local slope at each reading's temperature)."""
+    if rec.temperature_c is None:
+        raise FlannError(f"{rec.source}: a two-input design needs a temperature_c column")
+    m, x = spec.model, rec.displacement_mm
+    codes = np.clip(np.floor(np.asarray(rec.voltage_v, dtype=float) / spec.input_lsb_v + 0.5),
+                    spec.code_min, spec.code_max).astype(np.int64)
+    tcodes = np.clip(np.floor(np.asarray(rec.temperature_c, dtype=float) / spec.temp_lsb_c + 0.5),
+                     spec.temp_code_min, spec.temp_code_max).astype(np.int64)
+    # the twin once per distinct (code, temperature code)
+    pairs, back = np.unique(np.stack([codes, tcodes], axis=1), axis=0, return_inverse=True)
+    back = back.ravel()
+    out, sat = ThermalTop(spec).process(pairs[:, 0], pairs[:, 1])
+    hw_mm = out[back] * spec.output_lsb_mm
+    v, t, _ = m.clamp(rec.voltage_v, rec.temperature_c)
+    fl_mm = m.predict(v, t)
+    vlo, vhi = sorted(m.voltage_range_v)
+    h = 0.5 * spec.input_lsb_v
+    v1, v2 = np.clip(v - h, vlo, vhi), np.clip(v + h, vlo, vhi)
+    slope = np.abs(m.predict(v2, t) - m.predict(v1, t)) / np.maximum(v2 - v1, 1e-300)
+    limit = 0.5 * spec.input_lsb_v * slope
+    e_hw, e_fl = hw_mm - x, fl_mm - x
+    rep = error_report(hw_mm, x, tol, band, fs_mm, rec.direction)
+    lim_max = float(limit.max())
+    rep.update({
+        "input_bits": spec.input_bits, "input_lsb_v": spec.input_lsb_v,
+        "adc_bits": spec.input_bits, "adc_lsb_v": spec.input_lsb_v, "dropped_low_bits": 0,
+        "temp_bits": spec.temp_bits, "temp_lsb_c": spec.temp_lsb_c,
+        "output_lsb_mm": spec.output_lsb_mm,
+        "points_clamped": int(np.count_nonzero(sat[back])),
+        "max_abs_hardware_minus_float_mm": float(np.max(np.abs(hw_mm - fl_mm))),
+        "max_abs_hardware_minus_float_at_codes_mm": float(np.max(np.abs(
+            out * spec.output_lsb_mm - spec.float_reference(pairs[:, 0], pairs[:, 1])))),
+        "physical_limit_mm": {"max": lim_max, "median": float(np.median(limit)),
+                              "min": float(limit.min())},
+        "ratio_to_limit": float(np.max(np.abs(e_hw)) / lim_max),
+        "float_ratio_to_limit": float(np.max(np.abs(e_fl)) / lim_max),
+        "worst_pointwise_ratio": float(np.max(np.abs(e_hw) / np.maximum(limit, 1e-300))),
     })
     rep["_points"] = {"x": x, "hardware": e_hw, "float": e_fl, "limit": limit}
     return rep

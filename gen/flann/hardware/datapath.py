@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import FlannError
+from ..golden.model import model_sha256
 
 NUMBER = (int, float)
 
@@ -116,6 +117,15 @@ def rebuild_matching(man: dict, where, derive: Callable, options_of: Callable) -
                      "version of flann; regenerate the design")
 
 
+def check_design_model(model, man: dict, directory) -> None:
+    """``model`` must be the model the design in ``directory`` was generated from (its sha256)."""
+    sha = model_sha256(model)
+    if man.get("model_sha256") != sha:
+        raise FlannError(f"{directory}: generated from another model (sha256 {str(man.get('model_sha256'))[:12]}, "
+                         f"{Path(model).name} is {sha[:12]}): evaluate the model the design keeps "
+                         f"({Path(directory) / man.get('model', 'model.json')})")
+
+
 @dataclass(frozen=True)
 class Datapath:
     """One datapath: its name (the manifest's ``datapath``), its top entity and its hooks."""
@@ -160,4 +170,4 @@ class Datapath:
         return (Path(directory) / name) if isinstance(name, str) and name else None
 
 
-__all__ = ["rebuild_matching", "Datapath", "Field", "COMMON_FIELDS", "check_fields", "NUMBER"]
+__all__ = ["check_design_model", "rebuild_matching", "Datapath", "Field", "COMMON_FIELDS", "check_fields", "NUMBER"]

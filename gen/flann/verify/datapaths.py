@@ -83,19 +83,21 @@ def thermal_temperature_codes(spec) -> tuple[list[int], bool]:
     return sorted({spec.temp_code_min, spec.temp_code_max, *inner}), False
 
 
-def _thermal(design: Design, build_dir, *, seed=1, **_) -> dict:
+def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
+    """``codes``: (lo, hi), a narrower voltage code range than every code (tests of wide inputs)."""
     spec, man = design.spec, design.manifest
     temps, every = thermal_temperature_codes(spec)
+    code_lo, code_hi = (spec.code_min, spec.code_max) if codes is None else codes
     build_dir = Path(build_dir).resolve()
-    samples = len(temps) * (spec.code_max - spec.code_min + 1)
+    samples = len(temps) * (code_hi - code_lo + 1)
     backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
     work = build_dir / "thermal_sweep"
     temps_file, out_file = build_dir / "thermal_temps.txt", build_dir / "thermal_sweep.txt"
     build_dir.mkdir(parents=True, exist_ok=True)
     temps_file.write_text("".join(f"{t}\n" for t in temps))
-    sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps}
+    sweep = {"file": str(out_file), "code_lo": code_lo, "code_hi": code_hi, "temps": temps}
     params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
-              "code_lo_g": spec.code_min, "code_hi_g": spec.code_max, "temps_file_g": str(temps_file),
+              "code_lo_g": code_lo, "code_hi_g": code_hi, "temps_file_g": str(temps_file),
               "out_file_g": str(out_file)}
     res = run_cocotb([*design.files, BENCH_DIR / "flann_thermal_sweep.vhd"], "flann_thermal_sweep",
                      "test_thermal_sweep", work, {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
@@ -109,7 +111,7 @@ def _thermal(design: Design, build_dir, *, seed=1, **_) -> dict:
                  benches, res.ok and bool(rec), lsb)
     s["temperature_codes"] = "every" if every else temps
     s["temperature_codes_tested"] = len(temps)
-    s["voltage_codes_tested"] = spec.code_max - spec.code_min + 1
+    s["voltage_codes_tested"] = code_hi - code_lo + 1
     s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
     return {"summary": s, "curve": None, "spec": spec}
 

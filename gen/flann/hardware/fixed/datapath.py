@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
-from ...errors import FlannError
-from ...golden.model import load_model, model_sha256
+from ...golden.model import load_model
 
-from ..datapath import Datapath, Field, _int, _num
+from ..datapath import Datapath, Field, _int, _num, check_design_model
 from ..options import GenOptions
 from . import render
 from .spec import derive_spec
@@ -28,11 +26,7 @@ def rebuild(model, man: dict, where="design"):
 def eval_spec(model, man: dict, directory):
     """The design's Spec for ``model``, which must be the model it was generated from."""
     load_model(model)  # a file that is not a model says so before the hash is compared
-    sha = model_sha256(model)
-    if man.get("model_sha256") != sha:
-        raise FlannError(f"{directory}: generated from another model (sha256 {str(man.get('model_sha256'))[:12]}, "
-                         f"{Path(model).name} is {sha[:12]}): evaluate the model the design keeps "
-                         f"({Path(directory) / man.get('model', 'model.json')})")
+    check_design_model(model, man, directory)
     return rebuild(model, man, directory)[0]
 
 

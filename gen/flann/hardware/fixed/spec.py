@@ -615,8 +615,11 @@ class Normaliser:
 
 
 def lin_acc_width(k1_bound: int, k0_bound: int, input_bits: int) -> int:
-    """The serial k1 x code + k0 accumulator, exact for every code (one guard bit)."""
-    return bits_needed(-(k1_bound << (input_bits - 1)) - k0_bound, (k1_bound << (input_bits - 1)) + k0_bound) + 1
+    """The serial k1 x code + k0 accumulator, exact for every code (one guard bit). It holds
+    k1's partial products (|k1 c| <= |k1| 2^(B-1)) and then k1 c + k0 + 2^(Gl-1) (k0 with its
+    rounding half, Gl = B + 3): a tiny linear weight makes the half the largest of them."""
+    reach = (k1_bound << (input_bits - 1)) + k0_bound + (1 << (input_bits + 2))
+    return bits_needed(-reach, reach) + 1
 
 
 def derive_normaliser(inp: InputStage, P: int, q: float, Pf: int, lin_width: int | None = None,
@@ -655,7 +658,11 @@ def derive_adder(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_bound: 
     else:
         acc_bound = _at_least("the running sums", acc_bound,
                               acc_bound_for(norm.lin_peak, words, exp.term_max, mult.product_shift))
-    return sfix(acc_bound, mult.product_fmt.frac_bits)
+    # at least one integer bit: the adder rounds by adding 2^(Pf-1) in acc_bits + 1 bits, which
+    # must hold it when every weight is far below an output LSB (an order of a two-input model)
+    Pf = mult.product_fmt.frac_bits
+    fmt = sfix(acc_bound, Pf)
+    return fmt if fmt.width > Pf else FixedFormat(Pf + 1, 1)
 
 
 @dataclass(frozen=True)

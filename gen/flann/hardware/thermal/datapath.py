@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
-from ..datapath import Datapath, Field, _int, _num
+from ..datapath import Datapath, Field, _int, _num, check_design_model
 from ..fixed.datapath import DATAPATH as FIXED
 from . import render
 from .twin import ThermalTop
+
+
+def eval_spec(model, man: dict, directory):
+    """The design's ThermalSpec for ``model``, which must be the two-input model it was generated
+    from (a one-input model is refused by the rebuild in one line)."""
+    render.load_model(model)
+    check_design_model(model, man, directory)
+    return render.rebuild(model, man, directory)[0]
 
 
 def estimate(man: dict) -> dict | None:
@@ -34,10 +42,8 @@ DATAPATH = Datapath(
     about="two inputs (voltage, temperature): one fixed datapath per temperature order",
     generate=render.generate, rebuild=render.rebuild, twin=ThermalTop, estimate=estimate, fields=FIELDS,
     bench="thermal_sweep", summary=summary, number_format=FIXED.number_format,
-    why_no_stages="flann trace's stage model is the one-input datapath's; a thermal design has one per "
-                  "temperature order and no stage model of its own yet",
-    why_no_eval="flann eval --design evaluates a one-input fixed design; the thermal design's hardware "
-                "figures come from its twin (not wired into eval yet)",
+    stages="thermal",
+    eval_spec=eval_spec,
     why_no_explore="flann explore explores one-input models; a thermal design keeps a two-input model",
 )
 

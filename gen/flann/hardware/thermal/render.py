@@ -107,13 +107,18 @@ def manifest(spec: ThermalSpec, files: list[str], sha: str) -> dict:
     }
 
 
+def load_model(model) -> ThermalModel:
+    """A two-input model file; a one-input one is refused in one line."""
+    m = load_any_model(model)
+    if not isinstance(m, ThermalModel):
+        raise FlannError(f"{model}: a one-input model (the thermal datapath takes a two-input model)")
+    return m
+
+
 def _load(model) -> tuple[ThermalModel, str, str]:
     """(model, sha256, file text) of a two-input model file."""
     path = Path(model)
-    m = load_any_model(path)
-    if not isinstance(m, ThermalModel):
-        raise FlannError(f"{path}: a one-input model (the thermal datapath takes a two-input model)")
-    return m, model_sha256(path), path.read_bytes().decode("utf-8")
+    return load_model(path), model_sha256(path), path.read_bytes().decode("utf-8")
 
 
 def derive(model: ThermalModel, options: GenOptions) -> ThermalSpec:
@@ -149,4 +154,4 @@ def rebuild(model, man: dict, where="design") -> tuple[ThermalSpec, dict]:
     return spec, options.changed()
 
 
-__all__ = ["TOP", "DATAPATH", "render", "contexts", "manifest", "generate", "rebuild", "derive", "order_files"]
+__all__ = ["TOP", "DATAPATH", "load_model", "render", "contexts", "manifest", "generate", "rebuild", "derive", "order_files"]

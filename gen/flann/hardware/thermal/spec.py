@@ -31,7 +31,8 @@ an ADC step: the one-input datapath takes at most 16-bit codes, so with a 16-bit
 corrected voltage has no finer grid to be rounded to.
 
 K, FR, FG and FT are the smallest that keep their share (``SHARE``), E = 16 - input_bits (the
-one-input datapath's widest input); the default output LSB q is, as for the one-input
+one-input datapath's widest input; negative for a wider ADC, up to ``MAX_INPUT_BITS``, whose
+low bits then reach the orders through the interpolation fraction: FR >= -E); the default output LSB q is, as for the one-input
 design, a quarter of the larger of the output step per input code and the model's held-out
 RMS error, on the 1-2-5 series, or coarser when the interpolation's curvature error needs it; ``ThermalSpec.analysis`` lists every bound.  The slopes are taken
 numerically from the float model over the calibrated voltage and temperature ranges.
@@ -53,6 +54,9 @@ from ...numeric.fixed import FixedFormat, bits_needed
 from ..fixed.spec import Spec, derive_spec, nice_125
 
 MAX_FINE_BITS = 16          # the one-input datapath's widest input
+# the top's own input may be wider (an 18- or 20-bit ADC): its grid is then coarser than the
+# code (E < 0) and c''s FR fraction bits (>= -E) carry the code's low bits into the interpolation
+MAX_INPUT_BITS = 24
 # Share of the 0.5-LSB pre-rounding budget per source (output LSBs).
 SHARE = {"orders": 0.2, "horner": 0.05, "curvature": 0.1, "fraction": 0.05, "gain": 0.05,
          "temperature": 0.05}
@@ -194,7 +198,7 @@ MAX_LSB_RAISES = 12
 def _size(model, q, slope_v, slope_t, h, vmax, lsb, tlsb, fine, input_bits, vrange):
     """Every width for output LSB q, and the order datapaths (SpecError if one cannot be built)."""
     p = model.orders
-    fr = _frac_bits_for(slope_v * h * 0.5, SHARE["fraction"] * q, lo=0)
+    fr = _frac_bits_for(slope_v * h * 0.5, SHARE["fraction"] * q, lo=max(0, -fine))
     fg = _frac_bits_for(slope_v * vmax * p, SHARE["gain"] * q)
     ft = _frac_bits_for(slope_t * 0.5, SHARE["temperature"] * q)
     k = max(_frac_bits_for(1.5 * p, SHARE["orders"], lo=0),
@@ -251,8 +255,8 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
                         temp_lsb_c: float, output_lsb_mm: float | None = None) -> ThermalSpec:
     if not isinstance(model, ThermalModel):
         raise SpecError("model must be a two-input ThermalModel")
-    if not (isinstance(input_bits, int) and 4 <= input_bits <= MAX_FINE_BITS):
-        raise SpecError(f"input_bits = {input_bits!r}: must be an integer in 4..{MAX_FINE_BITS}")
+    if not (isinstance(input_bits, int) and 4 <= input_bits <= MAX_INPUT_BITS):
+        raise SpecError(f"input_bits = {input_bits!r}: must be an integer in 4..{MAX_INPUT_BITS}")
     if not (isinstance(temp_bits, int) and 2 <= temp_bits <= 16):
         raise SpecError(f"--temp-bits {temp_bits!r}: must be an integer in 2..16")
     for name, val in (("input_lsb_v", input_lsb_v), ("--temp-lsb-c", temp_lsb_c)):
