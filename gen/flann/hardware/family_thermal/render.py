@@ -1,11 +1,12 @@
 """Render the temperature-compensated family design and read it back.
 
-Order j's datapath is the family design's rendering (:func:`flann.hardware.family.render.render`,
-its templates unchanged) with its weight memory initialised from order j of the initial
-sensor: the shared entities (normaliser, expansion, multiplier, adder, sequencer) are written
-once, the memory and the family top once per order, renamed ``flann_ft<j>_mem`` and
-``flann_ft<j>_top``.  ``flann_family_thermal_top`` (this folder's template) instantiates the
-orders and adds the temperature code and the Horner combination.  The directory holds the
+The blocks are the family design's entities (:func:`flann.hardware.family.render.render`, its
+templates unchanged): the normaliser, expansion, multiplier, adder and sequencer written
+once, the weight memory once per order (renamed ``flann_ft<j>_mem``, initialised from order
+j of the initial sensor).  ``flann_family_thermal_top`` (this folder's template) wires them as
+the family top does, with one sequencer and one expansion shared by the orders (the orders'
+memories hold one input scale and clamp) and a memory, normaliser, multiplier and adder per
+order, and adds the temperature code and the Horner combination.  The directory holds the
 VHDL, ``manifest.json``, ``init_model.json`` (the initial sensor's two-input model) and each
 member's image (every order's memory in turn).
 """
@@ -28,7 +29,8 @@ TOP = "flann_family_thermal_top"
 DATAPATH = "family_thermal"
 INIT_MODEL = "init_model.json"
 TEMPLATES = "hardware/family_thermal/templates"
-PER_ORDER = ("flann_family_mem", "flann_family_top")
+PER_ORDER = ("flann_family_mem",)
+UNUSED = ("flann_family_top",)   # the top here wires the blocks itself
 _PER_ORDER_RE = re.compile(r"\b(" + "|".join(PER_ORDER) + r")\b")
 
 
@@ -47,6 +49,8 @@ def order_files(spec: FamilyThermalSpec, init_name: str) -> dict[str, str]:
         texts = family_render.render(replace(spec.fam, spec=order_spec), f"{init_name}, order {j}")
         for name, text in texts.items():
             entity = name[:-len(".vhd")]
+            if entity in UNUSED:
+                continue
             if entity in PER_ORDER:
                 out[f"{order_name(entity, j)}.vhd"] = _rename(text, j)
             elif j == 0:
@@ -60,7 +64,10 @@ def contexts(spec: FamilyThermalSpec) -> dict:
     s, t = spec, spec.temp
     acc = s.acc_bits
     prod = acc + t.t_bits
+    top = family_render.contexts(s.fam, "")["flann_family_top"]
     return dict(
+        **{k: top[k] for k in ("phase_bits", "lin_bits", "term_bits", "product_bits", "step_bits", "pidx_bits",
+                               "param_base")},
         in_bits=s.input_bits, temp_bits=t.bits, out_bits=s.out_fmt.width, input_lsb_v=s.input_lsb_v,
         temp_lsb_c=t.lsb_c, output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, orders=s.orders,
         order_bits=s.order_bits, acc_bits=acc, prod_bits=prod, t_bits=t.t_bits, t_shift=t.shift,

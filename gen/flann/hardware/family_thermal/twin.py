@@ -1,6 +1,8 @@
 """Bit-true twin of flann_family_thermal_top: the orders' family twins, then Horner in t_n.
 
-Order j is :class:`flann.hardware.family.twin.FlannFamilyTop` with memory j's words; the top
+Order j is :class:`flann.hardware.family.twin.FlannFamilyTop` with memory j's words (the
+hardware shares one expansion, driven by order 0's normaliser: every order of an image holds
+the same input scale and clamp, checked on load); the top
 combines the order outputs (LSB q / 2^K) with the exact t_n code (``tau - mid``, S fraction
 bits) as the VHDL does: ``acc = f_{P-1}``; per step ``acc = round(acc x t, S) + f_j`` (the
 serial multiplier forms the exact product, one rounding: add 2^(S-1), shift right); the output
@@ -17,6 +19,10 @@ import numpy as np
 from ...numeric.fixed import round_shift
 from ..family.twin import FlannFamilyMem, FlannFamilyTop
 from .spec import FamilyThermalSpec, check_member
+
+
+# normaliser values every order's memory holds alike (order 0's drive the shared expansion)
+SHARED_FIELDS = ("clamp_lo", "clamp_hi", "ka", "kb")
 
 
 @dataclass(frozen=True)
@@ -46,7 +52,14 @@ class FlannFamilyThermalTop:
         d = self.spec.fam.mem_depth
         if len(words) != self.spec.image_words:
             raise ValueError(f"a memory image is {self.spec.image_words} words ({self.spec.orders} x {d})")
-        self.orders = [FlannFamilyTop(self.spec.fam, words[j * d:(j + 1) * d]) for j in range(self.spec.orders)]
+        orders = [FlannFamilyTop(self.spec.fam, words[j * d:(j + 1) * d]) for j in range(self.spec.orders)]
+        # the hardware's one expansion runs on order 0's phase: an image whose orders hold
+        # another input scale or clamp is one the design does not compute (encode_image never
+        # writes one)
+        shared = [{k: v for k, v in o.mem.decode().items() if k in SHARED_FIELDS} for o in orders]
+        if any(f != shared[0] for f in shared[1:]):
+            raise ValueError(f"an image's orders must hold one {', '.join(SHARED_FIELDS)} (the expansion is shared)")
+        self.orders = orders
 
     def process(self, in_data, in_temp) -> TopOut:
         s = self.spec
