@@ -128,7 +128,10 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    terms = DEFAULT_TERMS if terms == "auto" else int(terms)
+    if terms == "auto":
+        raise FlannError("--terms auto: not chosen per member for a family with temperature yet; give --terms N "
+                         f"(default {DEFAULT_TERMS})")
+    terms = int(terms)
     if not 2 <= terms <= 60:
         raise FlannError(f"--terms {terms}: must be 2..60")
     try:

@@ -284,8 +284,7 @@ def derive_family_thermal(models: list[ThermalModel], temp: TempNorm, *, names=(
                              output_lsb_mm=float(output_lsb_mm), out_fmt=out_fmt)
     for m in models:
         check_member(spec, m)
-    return replace(spec, analysis={"bound_lsb": (P + (P - 1) / 2) / (1 << K) + 0.5,
-                                   "estimate": {k: v * P for k, v in fam.spec.analysis["estimate"].items()}})
+    return replace(spec, analysis={"bound_lsb": (P + (P - 1) / 2) / (1 << K) + 0.5})
 
 
 __all__ = ["FamilyThermalSpec", "TempNorm", "temp_norm", "order_models", "derive_family_thermal", "check_member",
