@@ -14,7 +14,7 @@ from ..golden.thermal import load_any_model
 from ..golden.train import converter_mismatch
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
-from ..hardware.registry import FAMILY, FORMATS, datapath_for_model
+from ..hardware.registry import FORMATS, datapath_for_model, family_datapath
 from .family import add_family_arguments, check_family_args
 
 HELP = "generate VHDL-93 for a model"
@@ -36,7 +36,7 @@ def run(args) -> int:
     opts = gen_options.from_args(args)
     if args.family is not None or args.model is None:
         check_family_args(args)
-        dp, source, extra = FAMILY, args.family, {"terms": args.terms, "margin": args.margin}
+        dp, source, extra = family_datapath(args.family), args.family, {"terms": args.terms, "margin": args.margin}
     else:
         dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
         other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)

@@ -103,6 +103,9 @@ def run(args) -> int:
                   f"(1 LSB = {s['output_lsb_mm']} mm)")
         elif s["max_err_mm"] is not None:
             print(f"max |HDL - float model| {s['max_err_mm']:.6f} mm")
+        if isinstance(s.get("temperature_codes"), list):
+            print(f"temperature codes       {len(s['temperature_codes'])} x every voltage code: "
+                  f"{', '.join(map(str, s['temperature_codes']))}")
         if s.get("images"):
             print(f"weight images           {', '.join(s['images'])} (through the cfg port)")
         print(f"cycles per sample       {s['cycles_per_sample']} (latency {s['latency_cycles']})")

@@ -11,7 +11,9 @@ from pathlib import Path
 from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from .datapath import Datapath, Field, _int
+from .family_thermal.build import is_thermal_family
 from .family.datapath import DATAPATH as FAMILY
+from .family_thermal.datapath import DATAPATH as FAMILY_THERMAL
 from .fixed.datapath import DATAPATH as FIXED
 from .float18.datapath import DATAPATH as FLOAT18
 from .manifest import MANIFEST, Manifest, read_manifest
@@ -35,7 +37,7 @@ PLAIN = Datapath(
     model_field="", why_no_bench=f"{WHY_PLAIN} bench", why_no_stages=f"{WHY_PLAIN} stage model",
     why_no_eval=f"{WHY_PLAIN} twin", why_no_explore=f"{WHY_PLAIN} model",
 )
-DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, SEED, THERMAL, PLAIN)}
+DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, FAMILY_THERMAL, SEED, THERMAL, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)
 FORMATS = (FIXED.name, FLOAT18.name)
 
@@ -44,6 +46,12 @@ def datapath(name: str) -> Datapath:
     if name not in DATAPATHS:
         raise FlannError(f"datapath {name!r}: known ones are {', '.join(DATAPATHS)}")
     return DATAPATHS[name]
+
+
+def family_datapath(sources) -> Datapath:
+    """The datapath ``flann gen --family SOURCES`` builds: with temperature when a member is a
+    two-input model or a recording at several temperatures."""
+    return FAMILY_THERMAL if is_thermal_family(sources) else FAMILY
 
 
 def datapath_for_model(model, format_name: str) -> Datapath:
@@ -90,4 +98,4 @@ def read_design(directory) -> tuple[Manifest, Datapath]:
     return man, dp
 
 
-__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design"]
+__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "FAMILY_THERMAL", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design"]

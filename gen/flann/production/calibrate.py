@@ -44,14 +44,15 @@ from ..golden.metrics import raw_output_mm
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
-from ..hardware.registry import FAMILY, read_design
+from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..pool import run_batch
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
 from . import images
-from .certificate import render_certificate, render_rejection
+from .certificate import render_certificate, render_certificate_thermal, render_rejection
 from .spec import ProductionSpec
+from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
 from .verdict import FAIL, PASS, Verdict, judge, rejected, uncertainty
 
@@ -67,7 +68,9 @@ SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit"
                   # production/traceability.py)
                   "verdict", "reasons", "tolerance", "max_error_pct_fs", "diagnosis",
                   "design_sha256", "model_sha256", "calibrated_at", "station", "operator",
-                  "temperature_c")
+                  "temperature_c",
+                  # a family design with temperature: the hardware's drift (empty otherwise)
+                  "drift_ppm_fs_per_c")
 
 
 @dataclass
@@ -88,6 +91,7 @@ class Result:
     design_sha256: str = ""
     model_sha256: str = ""
     written: bool = False   # OUTDIR/<sensor>/ was written by this run (_write_sensor)
+    drift_ppm_fs_per_c: float | None = None  # a family design with temperature
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -101,7 +105,7 @@ class Result:
                 "max_error_mm": f(self.max_error_mm), "ratio_to_limit": f(self.ratio_to_limit, 4),
                 "limit_mm": f(self.limit_mm), "raw_max_error_mm": f(self.raw_max_error_mm),
                 "twin_vs_float_lsb": f(self.twin_vs_float_lsb, 4), "recording": self.recording,
-                **self.verdict_cells()}
+                **self.verdict_cells(), "drift_ppm_fs_per_c": f(self.drift_ppm_fs_per_c, 4)}
 
     def verdict_cells(self) -> dict:
         """The verdict and traceability columns (a row without a verdict was rejected before
@@ -296,6 +300,85 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
     return res
 
 
+def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_error_mm: float | None = None,
+                          diagnosis_points: int | None = DIAGNOSIS_POINTS, spec: ProductionSpec | None = None,
+                          station: Station | None = None) -> Result:
+    """One multi-temperature recording for a family design with temperature (``fam`` its
+    FamilyThermalSpec): the image, verdicts at each temperature and overall, the drift."""
+    path = Path(path)
+    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
+    if spec is None:
+        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
+    station = station or Station()
+    rec = None
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rec = read_recordings(path)
+            if rec.temperature_c is None:
+                raise FlannError(f"{path}: no temperature_c column; the design compensates temperature "
+                                 f"({fam.orders} orders): calibrate at {fam.orders} or more temperatures")
+            chk = check_sensor_thermal(rec, fam)
+        res.warnings += [str(w.message) for w in caught]
+        err, x = chk["hw_err_mm"], np.asarray(rec.displacement_mm, dtype=float)
+        res.twin_vs_float_lsb = chk["twin_err_lsb"]
+        res.max_error_mm = float(np.max(np.abs(err)))
+        res.raw_max_error_mm = float(np.max(np.abs(chk["raw_err_mm"])))
+        res.limit_mm = float(np.max(chk["limit_mm"]))
+        res.ratio_to_limit = res.max_error_mm / res.limit_mm if res.limit_mm > 0 else math.inf
+        res.drift_ppm_fs_per_c = chk["drift_ppm_fs_per_c"]
+        if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
+            raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
+                             f"the bound {chk['bound_lsb']:.3g} LSB")
+        res.trace = traceability(path, rec, station)
+        res.model_sha256 = hashlib.sha256(chk["model"].to_json().encode()).hexdigest()
+        sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
+        findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
+        res.diagnosis = diagnosis_cell(named, groups)
+        # per temperature: its uncertainty (noise of its own readings) and its verdict
+        per, worst_u = [], None
+        lsb = fam.input_lsb_v
+        for g, temp in enumerate(chk["temperatures_c"]):
+            rows = chk["labels"] == g
+            sub = rec.subset(rows)
+            lim = chk["limit_mm"][rows]
+            u = uncertainty(sub, lim / (0.5 * lsb), fam.fam.terms, fam.output_lsb_mm)
+            ratio = float(np.max(np.abs(err[rows])) / np.max(lim)) if np.max(lim) > 0 else math.inf
+            per.append((temp, judge(spec, x[rows], err[rows], ratio, named, groups, u.expanded_mm), u))
+            worst_u = u if worst_u is None or u.expanded_mm > worst_u.expanded_mm else worst_u
+        res.verdict = judge(spec, x, err, res.ratio_to_limit, named, groups, worst_u.expanded_mm)
+        extra = {"spec": spec, "verdict": res.verdict, "trace": res.trace, "uncertainty": worst_u,
+                 "confounded": groups, "per_temperature": per}
+        _write_sensor_thermal(child(out_dir, res.sensor), res, chk, fam, dhash, findings, basis, extra)
+        if res.verdict.verdict == PASS:
+            res.status, res.reason = "ok", ""
+        else:
+            res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
+    except FlannError as exc:
+        _reject(res, str(exc), path, rec, out_dir, fam, dhash, spec, station)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
+        _reject(res, f"{exc.__class__.__name__}: {exc}", path, rec, out_dir, fam, dhash, spec, station)
+    return res
+
+
+def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, findings, basis: str,
+                          extra: dict) -> None:
+    """A passed sensor: its two-input model, its image (every order's memory in turn) and the
+    certificate; a failed one: only the certificate."""
+    model_json = chk["model"].to_json()
+    mhash = hashlib.sha256(model_json.encode()).hexdigest()
+    head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
+            f"model sha256 {mhash}", f"{fam.image_words} words x {images.DATA_BITS} bits, address 0 first: "
+            f"order j's memory at j x {fam.fam.mem_depth} (cfg_addr)"]
+    html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
+    with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
+        (tmp / "certificate.html").write_text(html, newline="")
+        if res.verdict.passed:
+            (tmp / "model.json").write_text(model_json, newline="")
+            (tmp / "weights.hex").write_text(images.hex_text(chk["words"], head), newline="")
+    res.written = True
+
+
 def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec, station) -> None:
     """A sensor that could not be calibrated: FAIL with the reason, and a certificate that
     says so (when even that cannot be written, the summary row still does)."""
@@ -354,8 +437,8 @@ def _progress(done: int, total: int, failed: int, t0: float) -> None:
     sys.stderr.flush()
 
 
-def _calibrate_item(item, **kw) -> Result:
-    return calibrate_one(item[1], **kw)
+def _calibrate_item(item, one=calibrate_one, **kw) -> Result:
+    return one(item[1], **kw)
 
 
 def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
@@ -368,7 +451,7 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     running finish, the rest are ``interrupted`` rows, summary.csv is written, and then
     KeyboardInterrupt goes on up (exit 130)."""
     man, dp = read_design(design_dir)  # the manifest's own datapath, its fields checked
-    if dp is not FAMILY:
+    if dp not in (FAMILY, FAMILY_THERMAL):
         raise FlannError(f"{design_dir}: a {dp.name} design; flann calibrate writes weight images for a family "
                          "design (flann gen --family)")
     fam, _ = dp.rebuild(dp.model_path(design_dir, man), man, design_dir)
@@ -419,7 +502,8 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
 
     if jobs > 1 and len(todo) > 1:
         from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
-    fn = partial(_calibrate_item, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
+    one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
+    fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
     interrupted = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record)
     if progress:
@@ -444,5 +528,5 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["calibrate_batch", "calibrate_one", "check_sensor", "train_for_design", "physical_limit_mm",
+__all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design", "physical_limit_mm",
            "diagnosis_sample", "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES", "DIAGNOSIS_POINTS"]

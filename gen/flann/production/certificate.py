@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from .. import __version__
 from ..textgen import template
-from .plot import error_plot_svg
+from .plot import error_plot_svg, error_plot_temperatures_svg
 from .verdict import PASS
 
 TEMPLATE = "production/templates/certificate.html.j2"
@@ -102,6 +102,67 @@ def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings, ba
                    after=[hardware])
 
 
+def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, findings, basis: str, *,
+                               spec, verdict, trace, uncertainty, per_temperature, confounded=()) -> str:
+    """The certificate of a sensor calibrated at several temperatures for a family design with
+    temperature (``fam`` its FamilyThermalSpec): the results over every temperature, a table
+    by temperature (error, verdict), the drift figure and one error curve per temperature."""
+    u = uncertainty.expanded_mm
+    fs = verdict.full_scale_mm
+    pct_u = f" ± {100 * u / fs:.2g}" if fs else ""
+
+    def drift(value) -> str:
+        return "-" if value is None else f"{value:.3g} ppm FS/degC"
+
+    results = ("Results over every calibration temperature (expanded uncertainty U, k = 2)", [
+        ("compensated max error (hardware) over " + verdict.range_text,
+         f"{verdict.max_error_mm:.4g} ± {u:.2g} mm" if verdict.max_error_mm is not None else "-"),
+        ("compensated max error in % FS",
+         f"{verdict.max_error_pct_fs:.4g}{pct_u} % FS" if verdict.max_error_pct_fs is not None else "-"),
+        ("raw max error (one least-squares line)", f"{res.raw_max_error_mm:.4g} ± {u:.2g} mm"),
+        ("drift_ppm_fs_per_c (hardware)", drift(chk["drift_ppm_fs_per_c"])),
+        ("drift_ppm_fs_per_c (raw sensor)", drift(chk["raw_drift_ppm_fs_per_c"])),
+        ("drift method", "largest change of the error between two calibration temperatures at one position, "
+                         f"per degC, in ppm of the recorded span ({chk['full_scale_mm']:.4g} mm)"),
+        ("physical limit, worst over the stroke", f"{res.limit_mm:.4g} mm"),
+        ("uncertainty method", uncertainty.method + " (the largest of the temperatures')"),
+    ])
+    by_t = {round(r["temperature_c"], 6): r for r in chk["by_temperature"]}
+    rows = []
+    for temp, v, ut in per_temperature:
+        r = by_t.get(round(temp, 6), {})
+        rows.append((f"{temp:g} degC ({r.get('points', 0)} readings)",
+                     f"{v.verdict}: max {r.get('max_error_mm', float('nan')):.4g} ± {ut.expanded_mm:.2g} mm, "
+                     f"RMS {r.get('rms_error_mm', float('nan')):.3g} mm"
+                     + (f", {v.max_error_pct_fs:.3g} % FS" if v.max_error_pct_fs is not None else "")))
+    by_temperature = ("Verdict at each calibration temperature", rows)
+    s = fam.fam.spec
+    t = fam.temp
+    hardware = ("Hardware figures", [
+        ("max |twin - float model|", f"{res.twin_vs_float_lsb:.4f} LSB over every input code at temperature "
+                                     f"codes {', '.join(map(str, chk['temperature_checked_codes']))}"),
+        ("error bound of the formats", f"{chk['bound_lsb']:.4f} LSB"),
+        ("input", f"{s.input_bits}-bit code x {s.input_lsb_v} V"),
+        ("temperature input", f"{t.bits}-bit code x {t.lsb_c} degC, calibrated codes {t.lo}..{t.hi} "
+                              f"(t_n = (code - {t.mid}) / 2^{t.shift})"),
+        ("output", f"{fam.out_fmt.width}-bit code x {fam.output_lsb_mm} mm"),
+        ("latency", f"{fam.latency_cycles} cycles ({fam.cycles_per_sample} cycles/sample)"),
+        ("weight memories", f"{fam.orders} temperature orders x {fam.fam.used_words} of {fam.fam.mem_depth} "
+                            f"words x 32 bits (image {fam.image_words} words)"),
+        ("terms", f"{fam.fam.terms} per temperature order"),
+    ])
+    tables = [_identification(res, dhash, mhash, chk["rec"].sha256), _traceability(res),
+              _specification(spec, verdict), results, by_temperature]
+    diagnosis_head = ""
+    if confounded:
+        sets = " or ".join("{" + ", ".join(g) + "}" for g in confounded)
+        diagnosis_head = (f"The recordings cannot tell these explanations apart (they fit equally "
+                          f"well): {sets}. None of them is named alone.")
+    plot = error_plot_temperatures_svg(chk, trace.serial, _tolerance_mm(spec, verdict), spec.working_range_mm)
+    return _render(res, trace, verdict, tables, plot, basis, findings, diagnosis_head, shipped=True,
+                   after=[hardware], weights="model.json, weights.hex (every order's memory)")
+
+
 def render_rejection(res, fam, dhash: str, spec, rec_sha: str = "") -> str:
     """The certificate of a sensor that could not be calibrated: FAIL and why."""
     tables = [_identification(res, dhash, "", rec_sha), _traceability(res),
@@ -109,7 +170,8 @@ def render_rejection(res, fam, dhash: str, spec, rec_sha: str = "") -> str:
     return _render(res, res.trace, res.verdict, tables, "", "", [], "", shipped=False)
 
 
-def _render(res, trace, verdict, tables, plot, basis, findings, diagnosis_head, shipped, after=()) -> str:
+def _render(res, trace, verdict, tables, plot, basis, findings, diagnosis_head, shipped, after=(),
+            weights="model.json, weights.hex, weights.mem, weights.bmm") -> str:
     passed = verdict.verdict == PASS
     serial = trace.serial if trace else res.sensor
     if passed:
@@ -122,9 +184,9 @@ def _render(res, trace, verdict, tables, plot, basis, findings, diagnosis_head, 
         plot=plot, tables=tables, after_tables=list(after), diagnosis_basis=basis, diagnosis_head=diagnosis_head,
         findings=(list(findings) or ["no missing physics found"]) if basis else [],
         warnings=res.warnings,
-        shipped=("weights written: model.json, weights.hex, weights.mem, weights.bmm" if shipped and passed
+        shipped=(f"weights written: {weights}" if shipped and passed
                  else "no weights written for this sensor"),
     )
 
 
-__all__ = ["render_certificate", "render_rejection", "DECISION_RULE"]
+__all__ = ["render_certificate", "render_certificate_thermal", "render_rejection", "DECISION_RULE"]

@@ -140,4 +140,51 @@ def error_plot_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
     )
 
 
-__all__ = ["error_plot_svg", "nice_ticks"]
+# one colour per calibration temperature, cold to hot
+TEMPERATURE_COLOURS = ("#1f5fa8", "#17becf", "#2ca02c", "#bcbd22", "#ff7f0e", "#d62728", "#8c564b")
+
+
+def temperature_colour(k: int, n: int) -> str:
+    """Cold blue to hot red over n temperatures."""
+    if n <= 1:
+        return TEMPERATURE_COLOURS[0]
+    return TEMPERATURE_COLOURS[round(k * (len(TEMPERATURE_COLOURS) - 1) / (n - 1))]
+
+
+def error_plot_temperatures_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
+                                working_range_mm: tuple[float, float] | None = None) -> str:
+    """Raw and compensated error vs displacement, one curve per calibration temperature (the
+    legend names them), the tolerance band given one, as an <svg>."""
+    x_all = np.asarray(chk["rec"].displacement_mm, dtype=float)
+    labels, temps = chk["labels"], chk["temperatures_c"]
+    xt = nice_ticks(float(np.min(x_all)), float(np.max(x_all)), 8)
+    sx = _scale(xt[0], xt[-1], LEFT, WIDTH - RIGHT)
+    raw_lines, hw_lines, legend = [], [], []
+    for g, temp in enumerate(temps):
+        rows = np.flatnonzero(labels == g)
+        o = rows[np.argsort(x_all[rows], kind="stable")]
+        colour = temperature_colour(g, len(temps))
+        raw_lines.append((x_all[o], chk["raw_err_mm"][o], colour, "", 1.0))
+        hw_lines.append((x_all[o], chk["hw_err_mm"][o], colour, "", 1.2))
+        legend.append((f"{temp:g} degC", colour, ""))
+    bands = ()
+    if tolerance_mm is not None:
+        lo, hi = working_range_mm or (float(np.min(x_all)), float(np.max(x_all)))
+        bands = ((max(lo, xt[0]), min(hi, xt[-1]), -tolerance_mm, tolerance_mm, COLOURS["tolerance"]),)
+        ends = np.array([max(lo, xt[0]), min(hi, xt[-1])])
+        tol = np.full(2, float(tolerance_mm))
+        hw_lines += [(ends, tol, COLOURS["tolerance"], "8,3", 1.4), (ends, -tol, COLOURS["tolerance"], "8,3", 1.4)]
+        legend.append((f"tolerance +-{tolerance_mm:.3g} mm ({lo:g}..{hi:g} mm)", COLOURS["tolerance"], "8,3"))
+    raw = _panel(TOP, f"{sensor}: raw sensor at each temperature (error from one least-squares line)",
+                 "raw error (mm)", raw_lines, sx)
+    hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design at each temperature (bit-true twin)",
+                "compensated error (mm)", hw_lines, sx, bands)
+    xstep = xt[1] - xt[0] if len(xt) > 1 else 1.0
+    return template(TEMPLATE).render(
+        width=WIDTH, height=TOP + 2 * PANEL_H + GAP + BOTTOM, left=LEFT, right=WIDTH - RIGHT, panels=(raw, hw),
+        xticks=[Tick(float(sx(t)), _label(t, xstep)) for t in xt], xlabel="displacement (mm)",
+        legend=legend, legend_y=TOP + PANEL_H + GAP + 14,
+    )
+
+
+__all__ = ["error_plot_svg", "error_plot_temperatures_svg", "nice_ticks", "temperature_colour"]

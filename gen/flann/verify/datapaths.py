@@ -24,6 +24,9 @@ from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simu
 # both ends of the calibrated range, evenly spaced codes between)
 THERMAL_MAX_SAMPLES = 2_000_000
 THERMAL_TEMPS = 17
+# the family design with temperature: every voltage code at both ends of the temperature code range
+# and this many codes evenly spaced over the calibrated range (its ends included)
+FAMILY_THERMAL_TEMPS = 7
 
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
@@ -116,7 +119,75 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     return {"summary": s, "curve": None, "spec": spec}
 
 
-BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "family": _family}
+def family_thermal_temperature_codes(spec) -> list[int]:
+    """The temperature codes the family-with-temperature sweep runs: both ends of the code range
+    (clamped), FAMILY_THERMAL_TEMPS evenly spaced codes over the calibrated range (its ends included)."""
+    inner = np.linspace(spec.temp_lo, spec.temp_hi, FAMILY_THERMAL_TEMPS).round().astype(int).tolist()
+    return sorted({spec.temp_code_min, spec.temp_code_max, *inner})
+
+
+def _read_image(path) -> list[int]:
+    try:
+        text = Path(path).read_text()
+    except OSError as exc:
+        raise FlannError(f"{path}: cannot read the image ({exc.strerror})") from None
+    words = []
+    for n, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
+        if line and not line.startswith("#"):
+            try:
+                words.append(int(line, 16))
+            except ValueError:
+                raise FlannError(f"{path}:{n}: {line!r} is not a hex word") from None
+    return words
+
+
+def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
+    """One sensor's image (the last --image, else the design's last member: not the memories'
+    initial sensor, so the cfg port is what loads it) at every voltage code and the stated
+    temperature codes."""
+    spec, man = design.spec, design.manifest
+    images = list(images or [{"name": im["name"], "hex": str(design.directory / im["hex"])}
+                             for im in man.get("images", [])])
+    if not images:
+        raise FlannError(f"{design.directory}: no weight image to load (pass --image A.hex, written by flann calibrate)")
+    image = images[-1]
+    words = _read_image(image["hex"])
+    if len(words) != spec.image_words:
+        raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
+    temps = family_thermal_temperature_codes(spec)
+    build_dir = Path(build_dir).resolve()
+    samples = len(temps) * (spec.code_max - spec.code_min + 1)
+    backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
+    build_dir.mkdir(parents=True, exist_ok=True)
+    temps_file, out_file = build_dir / "family_thermal_temps.txt", build_dir / "family_thermal_sweep.txt"
+    image_file = build_dir / "family_thermal_image.txt"
+    temps_file.write_text("".join(f"{t}\n" for t in temps))
+    image_file.write_text("".join(f"{a} {w >> 16} {w & 0xFFFF}\n" for a, w in enumerate(words)))
+    sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps,
+             "words": words}
+    params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
+              "addr_bits_g": spec.cfg_addr_bits, "code_lo_g": spec.code_min, "code_hi_g": spec.code_max,
+              "image_file_g": str(image_file), "temps_file_g": str(temps_file), "out_file_g": str(out_file)}
+    res = run_cocotb([*design.files, BENCH_DIR / "flann_family_thermal_sweep.vhd"], "flann_family_thermal_sweep",
+                     "test_family_thermal_sweep", build_dir / "family_thermal_sweep",
+                     {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
+                     name="family_thermal_sweep", parameters=params, seed=seed, backend=backend)
+    rec = res.records.get("family_thermal_sweep", {})
+    benches = {"family_thermal_sweep": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
+                                        "seconds": round(res.seconds, 1)}}
+    s = _summary(design, rec.get("samples", 0), rec.get("mismatches"), None, benches, res.ok and bool(rec),
+                 spec.output_lsb_mm)
+    s["images"] = [image["name"]]
+    s["temperature_codes"] = temps
+    s["temperature_codes_tested"] = len(temps)
+    s["voltage_codes_tested"] = spec.code_max - spec.code_min + 1
+    s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
+    return {"summary": s, "curve": None, "spec": spec}
+
+
+BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "family": _family,
+           "family_thermal": _family_thermal}
 
 
 def simulate(design: Design, build_dir, **kw) -> dict:

@@ -1,0 +1,1 @@
+"""A sensor family with temperature compensation: per-sensor temperature coefficients in weight memories."""

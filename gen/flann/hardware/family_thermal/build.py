@@ -1,0 +1,166 @@
+"""``flann gen --family`` on recordings at several temperatures (or two-input models).
+
+A recordings CSV whose ``temperature_c`` column holds 2 or more temperatures makes the family
+a temperature-compensated one (:func:`is_thermal_family`); each is trained here with the
+design's temperature normalisation (:func:`fit_sensor`, also used by ``flann calibrate``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import FlannError, SpecError
+from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups, thermal_design
+from ...golden.train import normalisation, solve_lstsq
+from ...recordings import prepare_for_fit, read_recordings
+from ..family.build import DEFAULT_TERMS, NORMALISATION, RIDGE
+from ..family.spec import DEFAULT_MARGIN
+from .render import write
+from .spec import DEFAULT_ORDERS, FamilyThermalSpec, TempNorm, derive_family_thermal, temp_norm
+
+MIN_ROWS = 4   # readings per temperature for it to count as a calibration temperature
+
+
+def calibration_temperatures(rec) -> np.ndarray:
+    """The temperatures (degC) a recording holds at least MIN_ROWS readings at."""
+    if rec.temperature_c is None:
+        return np.zeros(0)
+    levels, labels = temperature_groups(rec.temperature_c)
+    return np.asarray([t for g, t in enumerate(levels) if np.count_nonzero(labels == g) >= MIN_ROWS])
+
+
+def is_thermal_family(sources) -> bool:
+    """A member is a two-input model or a recording at 2 or more temperatures."""
+    for p in sources:
+        p = Path(p)
+        try:
+            if p.suffix.lower() == ".json" and isinstance(load_any_model(p), ThermalModel):
+                return True
+            if p.suffix.lower() == ".csv" and calibration_temperatures(read_recordings(p)).size >= 2:
+                return True
+        except FlannError:
+            continue  # reported when the members are loaded
+    return False
+
+
+def _prepared(rec):
+    """(v, T, x): the fit's checks (span, duplicates, fold-back) at each temperature on its own."""
+    levels, labels = temperature_groups(rec.temperature_c)
+    parts = [prepare_for_fit(rec.subset(labels == g)) for g in range(levels.size)
+             if np.count_nonzero(labels == g) >= MIN_ROWS]
+    cat = np.concatenate
+    return (cat([p.voltage_v for p in parts]), cat([p.temperature_c for p in parts]),
+            cat([p.displacement_mm for p in parts]))
+
+
+def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDGE) -> ThermalModel:
+    """x = sum_j t_n^j f_j(v) by least squares on every reading, t_n the design's."""
+    temps = calibration_temperatures(rec)
+    if temps.size < orders:
+        raise FlannError(f"{rec.source}: recordings at {temps.size} temperature(s) "
+                         f"({', '.join(f'{t:g}' for t in temps) or 'no temperature_c column'}); the design's "
+                         f"{orders} temperature orders need {orders} or more (4 or more readings each)")
+    v, t, x = _prepared(rec)
+    offset, scale = normalisation(v, NORMALISATION)
+    v_n, t_n = (v - offset) / scale, (t - temp.offset_c) / temp.scale_c
+    coef = solve_lstsq(thermal_design(v_n, t_n, (terms,) * orders), x, ridge)
+    k = terms + 1
+    model = ThermalModel(
+        weights=tuple(tuple(float(c) for c in coef[j * k + 1:(j + 1) * k]) for j in range(orders)),
+        bias=tuple(float(coef[j * k]) for j in range(orders)),
+        input_offset_v=float(offset), input_scale_v=float(scale),
+        temperature_offset_c=temp.offset_c, temperature_scale_c=temp.scale_c,
+        voltage_range_v=(float(v.min()), float(v.max())), temperature_range_c=(float(t.min()), float(t.max())),
+        displacement_range_mm=(float(x.min()), float(x.max())),
+        training={"method": "lstsq", "ridge": ridge, "normalisation": NORMALISATION, "points": int(v.size),
+                  "form": "x = sum_j t_n^j f_j(v) (flann gen --family, temperature)",
+                  "temperatures_c": [float(round(a, 6)) for a in temps], "data_file": Path(rec.source).name,
+                  "data_sha256": rec.sha256})
+    resid = x - model.predict(v, t)
+    return ThermalModel(**{**vars(model), "training": {**model.training,
+                                                        "train_rms_error_mm": float(np.sqrt(np.mean(resid ** 2)))}})
+
+
+def _range_of(sources) -> tuple[float, float]:
+    """The calibrated temperature range: every member's temperatures."""
+    lo, hi = np.inf, -np.inf
+    for p in sources:
+        p = Path(p)
+        try:
+            if p.suffix.lower() == ".csv":
+                t = calibration_temperatures(read_recordings(p))
+            elif p.suffix.lower() == ".json":
+                m = load_any_model(p)
+                t = np.asarray(m.temperature_range_c if isinstance(m, ThermalModel) else [])
+            else:
+                continue
+        except FlannError:
+            continue
+        if t.size:
+            lo, hi = min(lo, float(t.min())), max(hi, float(t.max()))
+    if not lo < hi:
+        raise FlannError("--family with temperature: the members hold no two calibration temperatures")
+    return lo, hi
+
+
+def load_member(path, temp: TempNorm, terms: int, orders: int) -> tuple[ThermalModel, str]:
+    """(model, model file text): a two-input model.json as it is, or a recordings CSV trained."""
+    path = Path(path)
+    if path.suffix.lower() == ".json":
+        m = load_any_model(path)
+        if not isinstance(m, ThermalModel):
+            raise FlannError(f"{path}: a one-input model; a family with temperature takes two-input models "
+                             f"({FORMAT}) or recordings at several temperatures")
+        return m, path.read_bytes().decode("utf-8")
+    if path.suffix.lower() == ".csv":
+        m = fit_sensor(read_recordings(path), temp, terms, orders)
+        return m, m.to_json()
+    raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
+
+
+def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
+                            orders: int = DEFAULT_ORDERS, temp_bits: int = 12, temp_lsb_c: float = 0.0625,
+                            **options) -> dict:
+    """Size one design for every source and write it (nothing written if any step fails)."""
+    if not sources:
+        raise FlannError("--family needs at least one recordings CSV or model.json")
+    if terms == "auto":
+        raise FlannError("--terms auto: not chosen per member for a family with temperature yet; give --terms N "
+                         f"(default {DEFAULT_TERMS})")
+    terms = int(terms)
+    if not 2 <= terms <= 60:
+        raise FlannError(f"--terms {terms}: must be 2..60")
+    try:
+        temp = temp_norm(_range_of(sources), temp_bits, temp_lsb_c)
+    except SpecError as exc:
+        raise FlannError(str(exc)) from None
+    loaded, bad = [], []
+    for p in sources:
+        try:
+            loaded.append(load_member(p, temp, terms, orders))
+        except FlannError as exc:
+            bad.append(str(exc))
+    if bad:
+        raise FlannError(f"{len(bad)} of {len(sources)} family members cannot be used (nothing written): "
+                         + "; ".join(bad))
+    names = [Path(p).stem for p in sources]
+    models = [m for m, _ in loaded]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            spec = derive_family_thermal(models, temp, names=names, margin=margin, **options)
+        except SpecError as exc:
+            raise FlannError(f"--family: {exc}") from None
+    unique = dict(zip(names, models))
+    if len(unique) < len(names):
+        unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
+    init_text = loaded[0][1]
+    sha = hashlib.sha256(init_text.encode()).hexdigest()
+    return write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
+
+
+__all__ = ["generate_family_thermal", "fit_sensor", "is_thermal_family", "calibration_temperatures", "MIN_ROWS"]

@@ -1,0 +1,134 @@
+"""Render the temperature-compensated family design and read it back.
+
+The blocks are the family design's entities (:func:`flann.hardware.family.render.render`, its
+templates unchanged): the normaliser, expansion, multiplier, adder and sequencer written
+once, the weight memory once per order (renamed ``flann_ft<j>_mem``, initialised from order
+j of the initial sensor).  ``flann_family_thermal_top`` (this folder's template) wires them as
+the family top does, with one sequencer and one expansion shared by the orders (the orders'
+memories hold one input scale and clamp) and a memory, normaliser, multiplier and adder per
+order, and adds the temperature code and the Horner combination.  The directory holds the
+VHDL, ``manifest.json``, ``init_model.json`` (the initial sensor's two-input model) and each
+member's image (every order's memory in turn).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from ...numeric.fixed import bits_literal
+from ...textgen import template
+from ..family import render as family_render
+from ..family.spec import DATA_BITS
+from ..header import header
+from ..manifest import write_design
+from .spec import FamilyThermalSpec, check_member
+from .twin import encode_image
+
+TOP = "flann_family_thermal_top"
+DATAPATH = "family_thermal"
+INIT_MODEL = "init_model.json"
+TEMPLATES = "hardware/family_thermal/templates"
+PER_ORDER = ("flann_family_mem",)
+UNUSED = ("flann_family_top",)   # the top here wires the blocks itself
+_PER_ORDER_RE = re.compile(r"\b(" + "|".join(PER_ORDER) + r")\b")
+
+
+def order_name(entity: str, j: int) -> str:
+    return f"flann_ft{j}_" + entity[len("flann_family_"):]
+
+
+def _rename(text: str, j: int) -> str:
+    return _PER_ORDER_RE.sub(lambda mt: order_name(mt.group(1), j), text)
+
+
+def order_files(spec: FamilyThermalSpec, init_name: str) -> dict[str, str]:
+    """The shared family entities once, every order's memory and family top renamed."""
+    out = {}
+    for j, order_spec in enumerate(check_member(spec, spec.model)):
+        texts = family_render.render(replace(spec.fam, spec=order_spec), f"{init_name}, order {j}")
+        for name, text in texts.items():
+            entity = name[:-len(".vhd")]
+            if entity in UNUSED:
+                continue
+            if entity in PER_ORDER:
+                out[f"{order_name(entity, j)}.vhd"] = _rename(text, j)
+            elif j == 0:
+                out[name] = text
+    # compile order: shared entities, then each order's memory and top
+    shared = [n for n in out if not n.startswith("flann_ft")]
+    return {n: out[n] for n in shared + [n for n in out if n.startswith("flann_ft")]}
+
+
+def contexts(spec: FamilyThermalSpec) -> dict:
+    s, t = spec, spec.temp
+    acc = s.acc_bits
+    prod = acc + t.t_bits
+    top = family_render.contexts(s.fam, "")["flann_family_top"]
+    return dict(
+        **{k: top[k] for k in ("phase_bits", "lin_bits", "term_bits", "product_bits", "step_bits", "pidx_bits",
+                               "param_base")},
+        in_bits=s.input_bits, temp_bits=t.bits, out_bits=s.out_fmt.width, input_lsb_v=s.input_lsb_v,
+        temp_lsb_c=t.lsb_c, output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, orders=s.orders,
+        order_bits=s.order_bits, acc_bits=acc, prod_bits=prod, t_bits=t.t_bits, t_shift=t.shift,
+        inner_bits=s.inner_bits, sel_bits=s.sel_bits, addr_bits=s.fam.addr_bits, cfg_addr_bits=s.cfg_addr_bits,
+        data_bits=DATA_BITS, temp_mid=t.mid, temp_lo_int=t.lo, temp_hi_int=t.hi,
+        temp_lo=bits_literal(t.lo, t.bits), temp_hi=bits_literal(t.hi, t.bits),
+        temp_mid_lit=bits_literal(t.mid, t.bits + 1),
+        half_t=bits_literal(1 << (t.shift - 1), prod), half_k=bits_literal(1 << (s.inner_bits - 1), acc + 1),
+        out_max=bits_literal(s.out_fmt.max_int, acc + 1), out_min=bits_literal(s.out_fmt.min_int, acc + 1),
+        cnt_bits=max(1, t.t_bits.bit_length()), idx_bits=max(1, (s.orders - 1).bit_length()),
+        last_idx=max(0, s.orders - 2), after_run="s_mul" if s.orders > 1 else "s_out",
+    )
+
+
+def header_spec(spec: FamilyThermalSpec) -> dict:
+    d = spec.to_dict()
+    t = d.pop("temperature")
+    return {**d, **{f"temperature_{k}": v for k, v in t.items()}}
+
+
+def render(spec: FamilyThermalSpec, sha: str = "", init_name: str = "") -> dict[str, str]:
+    out = order_files(spec, init_name or "(first member)")
+    h = header(f"{TOP}.vhd", "FLANN LVDT compensator for a sensor family with temperature, top level",
+               "flann gen --family", header_spec(spec), sha)
+    out[f"{TOP}.vhd"] = template(f"{TEMPLATES}/{TOP}.vhd.j2").render(h=h, **contexts(spec))
+    return out
+
+
+def manifest(spec: FamilyThermalSpec, files: list[str], sha: str) -> dict:
+    s = spec
+    return {
+        "top": TOP, "datapath": DATAPATH, "files": list(files), "model": INIT_MODEL, "init_model": INIT_MODEL,
+        "model_sha256": sha,
+        "input_bits": s.input_bits, "input_lsb_v": s.input_lsb_v, "adc_bits": s.input_bits, "adc_lsb_v": s.input_lsb_v,
+        "temp_bits": s.temp_bits, "temp_lsb_c": s.temp.lsb_c,
+        "output_bits": s.out_fmt.width, "output_lsb_mm": s.output_lsb_mm,
+        "latency_cycles": s.latency_cycles, "cycles_per_sample": s.cycles_per_sample,
+        "generator_version": s.fam.spec.generator_version,
+        "spec": s.to_dict(), "family": s.fam.to_dict(), "analysis": dict(s.analysis),
+        "cfg_port": {
+            "ports": {"in_temp": f"in std_logic_vector({s.temp_bits - 1} downto 0)", "cfg_we": "in std_logic",
+                      "cfg_addr": f"in std_logic_vector({s.cfg_addr_bits - 1} downto 0)",
+                      "cfg_data": f"in std_logic_vector({DATA_BITS - 1} downto 0)"},
+            "timing": "cfg_data is written at cfg_addr on every rising clk edge with cfg_we = 1; cfg_addr's top "
+                      f"{s.sel_bits} bit(s) name the temperature order's memory, the low {s.fam.addr_bits} the word",
+            "image": f"a sensor's image is {s.image_words} words: order j's memory at j x {s.fam.mem_depth}",
+            "in_flight": "a write cancels the sample in flight (no out_valid for it); in_ready is 0 while cfg_we = 1",
+            "reset": "rst clears the sequencers and valid flags, not the memories",
+        },
+    }
+
+
+def write(spec: FamilyThermalSpec, out_dir, init_text: str, sha: str, init_name: str = "",
+          members: dict | None = None) -> dict:
+    """The VHDL, manifest.json, the initial model and each member's image ({name: ThermalModel})."""
+    texts = render(spec, sha, init_name)
+    man = manifest(spec, list(texts), sha)
+    images = {f"image_{name}.hex": family_render.image_text(encode_image(spec, m))
+              for name, m in (members or {}).items()}
+    man["images"] = [{"name": n[len("image_"):-len(".hex")], "hex": n} for n in images]
+    return write_design({**texts, INIT_MODEL: init_text, **images}, man, out_dir)
+
+
+__all__ = ["render", "manifest", "write", "contexts", "order_files", "TOP", "DATAPATH", "INIT_MODEL"]

@@ -1,0 +1,107 @@
+"""The family design with temperature (hardware/family_thermal): sizing, twin, refusals.
+Sensors from a closed-form S-curve whose gain and null move with temperature (not the physics
+simulator); no HDL simulation here (tests/production/test_family_thermal_line.py runs it)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from flann.cli import main
+from flann.hardware.family_thermal.spec import inner_bits, temp_norm
+from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
+from flann.production.images import parse_hex
+from flann.recordings import Recordings, write_recordings
+from flann.verify.design import from_directory
+
+LSB_V = 2 * 3.6 / 2 ** 14
+
+
+def recording(temps, amp=3.0, gain_tc=-2e-4, null_tc=30e-6, steps=60, seed=0):
+    x = np.linspace(-10, 10, steps)
+    xs = np.concatenate([np.concatenate([x, x[::-1]]) for _ in temps])
+    ts = np.repeat(np.asarray(temps, dtype=float), 2 * steps)
+    u = xs / 7.0
+    v = amp * (1 + gain_tc * (ts - 25)) * u / (1 + np.abs(u) ** 2.5) ** 0.4 + null_tc * (ts - 25)
+    v = np.round((v + np.random.default_rng(seed).normal(0, 2e-4, v.size)) / LSB_V) * LSB_V
+    return Recordings(displacement_mm=xs, voltage_v=v, temperature_c=ts)
+
+
+@pytest.fixture(scope="module")
+def design(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ft")
+    paths = []
+    for k, amp in enumerate((3.0, 3.1)):
+        paths.append(d / f"s{k}.csv")
+        write_recordings(paths[-1], recording((-20, 25, 80), amp=amp, seed=k))
+    assert main(["gen", "--family", *map(str, paths), "-o", str(d / "design"), "--input-bits", "8",
+                 "--temp-bits", "8", "--temp-lsb-c", "1"]) == 0
+    return d
+
+
+def test_temperature_normalisation_is_exact_and_covers_the_range():
+    t = temp_norm((-20.0, 80.0), 8, 1.0)
+    assert (t.lo, t.hi, t.mid) == (-20, 80, 30)
+    assert 2 ** (t.shift - 1) < 50 <= 2 ** t.shift       # smallest power of two >= half the span
+    assert abs(t.t_code(t.lo)) <= 2 ** t.shift and abs(t.t_code(t.hi)) <= 2 ** t.shift
+    assert t.t_code(500) == t.t_code(t.hi)               # clamped
+
+
+def test_inner_bits_budget():
+    for p in (1, 2, 3, 4):
+        k = inner_bits(p)
+        assert (p + (p - 1) / 2) / 2 ** k <= 0.5
+
+
+def test_twin_at_mid_temperature_is_order_0_rounded(design):
+    """t_n = 0 at the middle code: the output is order 0's rounded by K, whatever the others."""
+    dz = from_directory(design / "design")
+    s = dz.spec
+    words = parse_hex((design / "design" / "image_s1.hex").read_text())
+    codes = np.arange(s.code_min, s.code_max + 1)
+    out = FlannFamilyThermalTop(s, words).process(codes, s.temp.mid)
+    f0, _ = FlannFamilyThermalTop(s, words).orders[0].process(codes)
+    want = np.clip(np.floor((np.asarray(f0) + 2 ** (s.inner_bits - 1)) / 2 ** s.inner_bits),
+                   s.out_fmt.min_int, s.out_fmt.max_int)
+    assert np.array_equal(out.out_data, want.astype(np.int64))
+
+
+def test_twin_within_one_lsb_of_float_at_every_calibrated_temperature_code(design):
+    dz = from_directory(design / "design")
+    s = dz.spec
+    assert dz.twin().error_vs_float(temp_codes=range(s.temp.lo, s.temp.hi + 1))["max_err_lsb"] <= 1.0
+
+
+def test_outside_calibrated_temperatures_clamps_and_flags(design):
+    s = from_directory(design / "design").spec
+    twin = FlannFamilyThermalTop(s)
+    codes = np.arange(-20, 21)
+    hot, top = twin.process(codes, s.temp.code_max), twin.process(codes, s.temp.hi)
+    assert np.array_equal(hot.out_data, top.out_data) and hot.out_sat.all()
+
+
+def test_image_whose_orders_disagree_on_the_input_scale_is_refused(design):
+    s = from_directory(design / "design").spec
+    words = parse_hex((design / "design" / "image_s0.hex").read_text())
+    ka = next(f for f in s.fam.fields if f.name == "ka")
+    d = s.fam.mem_depth
+    words[d + ka.addr + ka.words - 1] ^= 1   # order 1's ka, lowest bit
+    with pytest.raises(ValueError, match="expansion is shared"):
+        FlannFamilyThermalTop(s, words)
+
+
+def test_refusals_are_one_line(tmp_path, capsys):
+    multi, single = tmp_path / "m.csv", tmp_path / "one.csv"
+    write_recordings(multi, recording((-20, 25, 80)))
+    write_recordings(single, recording((25,)))
+    out = tmp_path / "d"
+    cases = [
+        (["--family", str(multi), str(single)], "temperature"),            # a member at one temperature
+        (["--family", str(multi), "--temp-bits", "6"], "--temp-bits"),   # codes do not cover -20..80 degC
+        (["--family", str(multi), "--terms", "auto"], "--terms auto"),
+    ]
+    for args, word in cases:
+        assert main(["gen", *args, "-o", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("error:") and word in err[0], err
+        assert not out.exists()
