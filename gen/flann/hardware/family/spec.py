@@ -14,7 +14,9 @@ Sizing (``derive_family``):
   fixed datapath gives a member whose weights are ``(1 + margin)`` times larger than any
   member's, so a sensor like them still meets the 1-LSB bound;
 * integer widths (weights, linear constants, products, accumulator) hold ``(1 + margin)``
-  times the family's largest value.
+  times the family's largest value: the first member's blocks derived again
+  (:func:`flann.hardware.fixed.spec.derive_multiplier`, ``derive_normaliser``,
+  ``derive_adder``, ``derive_sequencer``) with these bounds.
 
 ``member_spec`` derives one sensor's values under these formats (a fixed :class:`Spec`
 with the family's widths and the sensor's constants) and says why a sensor does not fit.

@@ -4,6 +4,10 @@ Layer 1 of the generator: ``derive_spec(model, **options) -> Spec`` validates th
 chooses every width (or checks a width the user forced) and computes every constant the
 hardware holds (normalisation constants, sin/slope table, weight ROMs).  The bit-true twin
 (:mod:`flann.hardware.fixed.twin`) and the templates (:mod:`flann.hardware.fixed.render`) only read a :class:`Spec`.
+It composes one short, checked derive function per block (``derive_input``, ``derive_output``,
+``derive_phase_bits``, ``derive_expansion``, ``derive_multiplier``, ``derive_normaliser``,
+``derive_adder``, ``derive_sequencer``: ``derive_blocks``); the float18 front end and the
+family envelope call the same functions with their own constraints.
 
 Datapath (see docs/hardware.md)::
 
