@@ -19,13 +19,16 @@ for the model's own error there.  Each sensor goes through the tool as a user ru
     flann train CAL.csv --temperature -o model.json
     flann eval model.json HELD.csv --json         (drift_ppm_fs_per_c, by_temperature)
 
-Rows: the raw sensor's drift (its own least-squares line; ppm of full scale per degC), the
-float model's drift, the hardware's (the two-input datapath's bit-true twin,
-:mod:`flann.hardware.thermal`, on the held-out ADC codes and a 12-bit x 0.0625 degC
-temperature code; ``flann gen`` does not build that datapath yet, so it is called here as a
-library) and its largest |hardware - float|, its max error at each held-out temperature over its max error at the
-calibration temperatures, and the structure chosen.  Targets (issue): drift median <= 5 and
-worst <= 10 ppm FS/degC; held-out max error within 1.5x of the calibration-temperature error.
+Rows: the raw sensor's drift (its own least-squares line; ppm of full scale per degC); the
+drift of a perfect compensator (this family's own inverse at each temperature) on the same
+readings, which is what the ADC's steps alone give the figure; the float model's drift; the
+hardware's (the two-input datapath's bit-true twin, :mod:`flann.hardware.thermal`, called as a
+library on every bit of the held-out ADC codes and a 12-bit x 0.0625 degC temperature code, at
+an output LSB of 25 ppm FS raised on the 1-2-5 series until the order datapaths build) and its
+largest |hardware - float|; the float model's and the hardware's max error at the held-out
+temperatures over the float model's max error at the calibration temperatures; the structure
+chosen.  Targets (issue, for the hardware): drift median <= 5 and worst <= 10 ppm FS/degC;
+held-out max error within 1.5x of the calibration-temperature error.
 
     .venv/bin/python bench/thermal_family.py [--n 20] [--seed 2027] [--analog]
 """
@@ -46,7 +49,7 @@ import numpy as np
 from flann.cli import main as flann
 from flann.golden.thermal import load_any_model
 from flann.errors import SpecError
-from flann.golden.thermal_metrics import drift_ppm_fs_per_c
+from flann.golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
 from flann.hardware.fixed.spec import nice_125
 from flann.hardware.thermal.spec import derive_thermal_spec
 from flann.hardware.thermal.twin import ThermalTop
@@ -148,7 +151,7 @@ def one(p, rng, work: Path, analog=False) -> dict:
             "cal_max_ppm": cal_max / h["full_scale_mm"] * 1e6,
             "held_max_ppm": max(r["max_error_mm"] for r in h["compensated"]["by_temperature"])
             / h["full_scale_mm"] * 1e6,
-            "worst_ratio": max(ratios), "terms": m["terms"], **hw}
+            "worst_ratio": max(ratios), "hw_ratio": hw["hw_held_max_mm"] / cal_max, "terms": m["terms"], **hw}
 
 
 def ideal_drift(p, held_csv, fs_mm) -> float:
@@ -189,6 +192,7 @@ def hardware_drift(p, model_path, held_csv, fs_mm) -> dict:
     out = ThermalTop(spec).process(codes, tcodes).out_data * spec.output_lsb_mm
     ref = spec.float_reference(codes, tcodes)
     return {"hw_drift": drift_ppm_fs_per_c(out - x, x, temp, fs_mm),
+            "hw_held_max_mm": max(r["max_error_mm"] for r in by_temperature(out - x, temp)),
             "hw_minus_float_lsb": float(np.max(np.abs(out - ref)) / spec.output_lsb_mm),
             "output_lsb_ppm_fs": spec.output_lsb_mm / fs_mm * 1e6}
 
@@ -206,7 +210,7 @@ def main() -> int:
     t0 = time.time()
     print(f"{'#':>3} {'stroke':>6} {'bits':>4} {'span %/C':>9} {'null ppm/C':>10} {'raw ppm/C':>9} "
           f"{'ideal ppm/C':>11} {'flann ppm/C':>11} {'hw ppm/C':>8} {'LSB ppm':>7} {'hw-fl LSB':>9} {'cal max ppm':>11} {'held max ppm':>12} "
-          f"{'held/cal':>8}  terms")
+          f"{'held/cal':>8} {'hw/cal':>6}  terms")
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(args.n):
             p = draw(rng)
@@ -218,7 +222,7 @@ def main() -> int:
             print(f"{i:3d} {p['stroke_mm']:6g} {p['bits']:4d} {p['a'] * 100:9.4f} {p['n'] * 1e6:10.2f} "
                   f"{r['raw_drift']:9.1f} {r['ideal_drift']:11.2f} {r['drift']:11.2f} {r['hw_drift']:8.2f} {r['output_lsb_ppm_fs']:7.0f} "
                   f"{r['hw_minus_float_lsb']:9.2f} {r['cal_max_ppm']:11.1f} "
-                  f"{r['held_max_ppm']:12.1f} {r['worst_ratio']:8.2f}  {r['terms']}")
+                  f"{r['held_max_ppm']:12.1f} {r['worst_ratio']:8.2f} {r['hw_ratio']:6.2f}  {r['terms']}")
     ok = [r for r in rows if "error" not in r]
     if not ok:
         return 1
@@ -237,9 +241,12 @@ def main() -> int:
     print(f"hardware (bit-true twin, {TEMP_BITS}-bit temperature code x {TEMP_LSB_C:g} degC) drift "
           f"ppm FS/degC: median {np.median(hw):.2f}, worst {hw.max():.2f}; |hardware - float| <= "
           f"{max(r['hw_minus_float_lsb'] for r in ok):.2f} output LSB")
-    print(f"held-out max error / calibration-temperature max error: median {np.median(ratio):.2f}, "
+    print(f"float: held-out max error / calibration-temperature max error: median {np.median(ratio):.2f}, "
           f"worst {ratio.max():.2f} (target <= 1.5)")
-    met = (len(ok) == len(rows) and np.median(hw) <= 5 and hw.max() <= 10 and ratio.max() <= 1.5)
+    hw_ratio = np.array([r["hw_ratio"] for r in ok])
+    print(f"hardware max error at the held-out temperatures / float model's max error at the calibration "
+          f"temperatures: median {np.median(hw_ratio):.2f}, worst {hw_ratio.max():.2f} (target <= 1.5)")
+    met = (len(ok) == len(rows) and np.median(hw) <= 5 and hw.max() <= 10 and hw_ratio.max() <= 1.5)
     print("targets met" if met else "targets NOT met")
     return 0 if met else 1
 

@@ -106,6 +106,11 @@ class FixedFormat:
         return d
 
 
+def signed_range(bits: int) -> tuple[int, int]:
+    """(lowest, highest) code of a signed ``bits``-bit word: an ADC's or a temperature sensor's."""
+    return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
+
+
 def bits_needed(lo: int, hi: int, signed: bool = True) -> int:
     """Smallest width holding every integer in [lo, hi]."""
     lo, hi = int(lo), int(hi)

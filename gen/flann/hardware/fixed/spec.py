@@ -34,7 +34,7 @@ from .. import adc
 from .. import target as spartan2
 from .latency import ADDER_EDGES, EXPANSION_ADVANCES, MULTIPLIER_ADVANCES, SEQ_START_EDGES, norm_latency
 from ...errors import SpecError
-from ...numeric.fixed import FixedFormat, bits_needed
+from ...numeric.fixed import FixedFormat, bits_needed, signed_range
 from ...golden.model import FlannModel, term_kind
 from ..options import MULT_STYLES, GenOptions
 
@@ -137,11 +137,11 @@ class Spec:
 
     @property
     def code_min(self) -> int:
-        return -(1 << (self.input_bits - 1))
+        return signed_range(self.input_bits)[0]
 
     @property
     def code_max(self) -> int:
-        return (1 << (self.input_bits - 1)) - 1
+        return signed_range(self.input_bits)[1]
 
     @property
     def output_bits(self) -> int:
@@ -380,7 +380,7 @@ def derive_input(model: FlannModel, input_bits, input_lsb_v, clamp) -> InputStag
         warnings.warn(note)
     B, input_lsb_v = _check_int("input_bits", plan.input_bits, 4, 16), plan.input_lsb_v
     vlo, vhi = sorted(model.voltage_range_v)
-    cmin, cmax = -(1 << (B - 1)), (1 << (B - 1)) - 1
+    cmin, cmax = signed_range(B)
     if input_lsb_v is None:
         # cover the trained range with 10 % margin, 3 significant digits (rounded up)
         input_lsb_v = round_sig(max(abs(vlo), abs(vhi), 1e-12) * 1.10 / (1 << (B - 1)))

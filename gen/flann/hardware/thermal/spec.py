@@ -50,7 +50,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel, corrected_voltage
-from ...numeric.fixed import FixedFormat, bits_needed
+from ...numeric.fixed import FixedFormat, bits_needed, signed_range
 from ..fixed.spec import Spec, derive_spec, nice_125
 
 MAX_FINE_BITS = 16          # the one-input datapath's widest input
@@ -90,19 +90,19 @@ class ThermalSpec:
 
     @property
     def code_min(self) -> int:
-        return -(1 << (self.input_bits - 1))
+        return signed_range(self.input_bits)[0]
 
     @property
     def code_max(self) -> int:
-        return (1 << (self.input_bits - 1)) - 1
+        return signed_range(self.input_bits)[1]
 
     @property
     def temp_code_min(self) -> int:
-        return -(1 << (self.temp_bits - 1))
+        return signed_range(self.temp_bits)[0]
 
     @property
     def temp_code_max(self) -> int:
-        return (1 << (self.temp_bits - 1)) - 1
+        return signed_range(self.temp_bits)[1]
 
     @property
     def horner_degree(self) -> int:
@@ -265,9 +265,9 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
     lsb, tlsb = float(input_lsb_v), float(temp_lsb_c)
     vlo, vhi = sorted(model.voltage_range_v)
     tlo_c, thi_c = sorted(model.temperature_range_c)
-    cmin, cmax = -(1 << (input_bits - 1)), (1 << (input_bits - 1)) - 1
+    cmin, cmax = signed_range(input_bits)
     clo, chi = max(cmin, math.ceil(vlo / lsb - 1e-9)), min(cmax, math.floor(vhi / lsb + 1e-9))
-    tmin, tmax = -(1 << (temp_bits - 1)), (1 << (temp_bits - 1)) - 1
+    tmin, tmax = signed_range(temp_bits)
     tlo, thi = math.ceil(tlo_c / tlsb - 1e-9), math.floor(thi_c / tlsb + 1e-9)
     if not (tmin <= tlo <= thi <= tmax):
         raise SpecError(f"--temp-bits {temp_bits} x --temp-lsb-c {tlsb:g} degC cover "
