@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from ...recordings import prepare_for_fit, read_recordings
 from ..family.build import DEFAULT_TERMS, NORMALISATION, RIDGE
 from ..family.spec import DEFAULT_MARGIN
 from .render import write
-from .spec import DEFAULT_ORDERS, FamilyThermalSpec, TempNorm, derive_family_thermal, temp_norm
+from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
 
 MIN_ROWS = 4   # readings per temperature for it to count as a calibration temperature
 
@@ -81,8 +82,7 @@ def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDG
                   "temperatures_c": [float(round(a, 6)) for a in temps], "data_file": Path(rec.source).name,
                   "data_sha256": rec.sha256})
     resid = x - model.predict(v, t)
-    return ThermalModel(**{**vars(model), "training": {**model.training,
-                                                        "train_rms_error_mm": float(np.sqrt(np.mean(resid ** 2)))}})
+    return replace(model, training={**model.training, "train_rms_error_mm": float(np.sqrt(np.mean(resid ** 2)))})
 
 
 def _range_of(sources) -> tuple[float, float]:

@@ -137,11 +137,11 @@ def inner_bits(orders: int) -> int:
 class FamilyThermalSpec:
     fam: FamilySpec               # every order's datapath: one set of formats, output LSB q / 2^K
     model: ThermalModel = field(repr=False, compare=False)   # the memories' initial sensor
-    orders: int = DEFAULT_ORDERS
-    temp: TempNorm = None
-    inner_bits: int = 1
-    output_lsb_mm: float = 1.0
-    out_fmt: FixedFormat = None
+    orders: int                   # P: temperature orders
+    temp: TempNorm
+    inner_bits: int               # K: the orders' outputs are in q / 2^K
+    output_lsb_mm: float          # q
+    out_fmt: FixedFormat
     analysis: dict = field(default_factory=dict, compare=False)
 
     # -- codes --------------------------------------------------------------------------
