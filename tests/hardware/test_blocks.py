@@ -1,5 +1,5 @@
 """The fixed datapath's blocks, each derived by one checked function, composed by derive_spec,
-by the float18 front end (once) and by the family envelope (with its bounds)."""
+by the float18 datapath (its front end only, once) and by the family envelope (with its bounds)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,10 @@ from flann.errors import SpecError
 from flann.golden.model import load_model
 from flann.hardware.family.spec import derive_family, family_from_dict
 from flann.hardware.fixed import spec as fixed_spec
-from flann.hardware.fixed.spec import derive_blocks, derive_multiplier, derive_normaliser, derive_spec, sfix
+from flann.hardware.fixed.render import render, render_front
+from flann.hardware.fixed.spec import (FrontEnd, derive_blocks, derive_front, derive_multiplier, derive_normaliser,
+                                      derive_spec, front_end, sfix)
+from flann.hardware.fixed.twin import FlannExpansion, FlannNorm
 from flann.hardware.float18 import spec as f18_spec
 from flann.hardware.options import GenOptions
 
@@ -50,9 +53,9 @@ def test_float18_derives_its_front_end_once(model, monkeypatch):
 
     def counting(*args, **kw):
         calls.append(kw)
-        return derive_blocks(*args, **kw)
+        return derive_front(*args, **kw)
 
-    monkeypatch.setattr(f18_spec, "derive_blocks", counting)
+    monkeypatch.setattr(f18_spec, "derive_front", counting)
     # 12-bit input, trig weights small beside the line's: the budget's terms are narrower than
     # the code, so they widen
     small = replace(model, weights=(model.weights[0], *(w * 1e-3 for w in model.weights[1:])))
@@ -61,9 +64,35 @@ def test_float18_derives_its_front_end_once(model, monkeypatch):
         f = f18_spec.derive_f18_spec(small, input_bits=12)
         own = derive_spec(small, mult_style="lut", input_bits=12, check_device=False)
     assert len(calls) == 1 and calls[0] == {"terms_hold_code": True}
+    # the float18 spec holds the front end only: no fixed multiplier or adder
+    assert isinstance(f.front, FrontEnd) and not hasattr(f.front, "weight_fmt") and not hasattr(f, "base")
     # widened to the code's width, against the fixed budget's narrower terms
-    assert f.base.term_fmt.width == 12 > own.term_fmt.width
+    assert f.front.term_fmt.width == 12 > own.term_fmt.width
     assert f.term_frac_bits - own.term_fmt.frac_bits == 12 - own.term_fmt.width
+
+
+@pytest.mark.parametrize("options", [dict(input_bits=8), dict(input_bits=8, interp=False, lanes=3, mult_style="lut"),
+                                     dict(input_bits=10, lanes=2)])
+def test_front_end_record_and_fixed_spec_give_the_same_front_blocks(model, options):
+    """flann_norm and flann_expansion read a FrontEndView: the fixed Spec and the FrontEnd of the
+    same blocks render the same VHDL (below the header) and their twins give the same values."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        spec = derive_spec(model, check_device=False, **options)
+        o = GenOptions.of(None, **options)
+        fe = front_end(derive_front(model, o), model_sha256="", device=o.device, lanes=spec.lanes,
+                       adv_period=spec.adv_period, serial_interp=spec.serial_interp)
+    fixed, front = render(spec), render_front(fe, "flann gen", {})
+    assert list(front) == ["flann_norm.vhd", "flann_expansion.vhd"]
+    for name, text in front.items():
+        body = [ln for ln in text.splitlines() if not ln.startswith("--")]
+        assert body == [ln for ln in fixed[name].splitlines() if not ln.startswith("--")], name
+    codes = np.arange(spec.code_min, spec.code_max + 1)
+    n_s, n_f = FlannNorm(spec).process(codes), FlannNorm(fe).process(codes)
+    for port in ("out_sat", "out_theta", "out_lin"):
+        assert np.array_equal(n_s[port], n_f[port])
+    assert np.array_equal(FlannExpansion(spec).process(n_s.out_theta).out_terms,
+                          FlannExpansion(fe).process(n_f.out_theta).out_terms)
 
 
 def test_family_envelope_holds_every_member_and_its_manifest_rebuilds_it(model):

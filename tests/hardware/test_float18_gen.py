@@ -144,7 +144,7 @@ def test_float18_builds_a_straight_line_model():
     spec = derive_f18_spec(line)
     top = F18Top(spec)
     codes = top.all_codes()
-    v = np.clip(codes, spec.base.clamp_lo, spec.base.clamp_hi) * spec.base.input_lsb_v
+    v = np.clip(codes, spec.front.clamp_lo, spec.front.clamp_hi) * spec.front.input_lsb_v
     by_hand = 0.75 - 12.5 * (v - 0.1) / 2.0
     # float18 keeps 11 fraction bits: a few units of 2^-11 relative on a +-16 mm output
     assert np.max(np.abs(top.out_mm(codes) - by_hand)) < 16.0 * 2.0 ** -11 * 4

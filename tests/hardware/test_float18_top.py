@@ -14,7 +14,7 @@ from flann.hardware.float18.spec import F18Top, derive_f18_spec
 from flann.golden.model import load_model
 from flann.recordings import read_recordings
 from flann.golden.train import fit_lstsq
-from flann.hardware.fixed.twin import FlannTop
+from flann.hardware.fixed.twin import FlannExpansion, FlannNorm
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -28,10 +28,11 @@ def paper_model():
 
 def test_twin_equals_scalar_exact_chain(paper_model):
     spec = derive_f18_spec(paper_model)
-    base = spec.base
+    base = spec.front
     codes = np.array([base.clamp_lo, -1000, -1, 0, 1, 777, base.clamp_hi, base.code_max])
     out, sat = F18Top(spec).process(codes)
-    fixed = FlannTop(base).trace(codes)
+    theta = FlannNorm(base).process(codes).out_theta
+    trig = FlannExpansion(base).process(theta).out_terms.reshape(codes.size, -1)
     Tf = base.term_fmt.frac_bits
     m = paper_model
     a = Fraction(base.input_lsb_v) / Fraction(m.input_scale_v)
@@ -40,7 +41,7 @@ def test_twin_equals_scalar_exact_chain(paper_model):
         # weights written from the model file, not from the spec's ROM
         w = [F.encode(Fraction(m.weights[0]) * a * 2 ** Tf)] + [F.encode(Fraction(x)) for x in m.weights[1:]]
         acc = F.encode(Fraction(m.bias) - Fraction(m.weights[0]) * Fraction(m.input_offset_v) / Fraction(m.input_scale_v))
-        terms = [cc] + [int(x) for x in fixed.by_term("terms")[n]]
+        terms = [cc] + [int(x) for x in trig[n, : m.terms - 1]]
         for t, wc in zip(terms, w):
             acc = F.add(acc, F.mul(F.encode(Fraction(t, 2 ** Tf)), wc))
         assert out[n] == acc, (c, hex(out[n]), hex(acc))
@@ -50,9 +51,9 @@ def test_twin_equals_scalar_exact_chain(paper_model):
 def test_float18_error_is_small_relative_to_output(paper_model):
     spec = derive_f18_spec(paper_model)
     top = F18Top(spec)
-    c = np.arange(spec.base.clamp_lo, spec.base.clamp_hi + 1)
+    c = np.arange(spec.front.clamp_lo, spec.front.clamp_hi + 1)
     y = top.out_mm(c)
-    ref = paper_model.predict(c * spec.base.input_lsb_v)
+    ref = paper_model.predict(c * spec.front.input_lsb_v)
     # 51 additions, each off by at most half an ulp (2^-12 relative) of a sum of size ~|y|:
     # a loose physical bound is 51 * 2^-12 * max|partial sums| + table error
     assert np.max(np.abs(y - ref)) < 51 * 2.0 ** -12 * np.max(np.abs(ref)) * 1.5

@@ -142,7 +142,7 @@ def stages_float18(fspec, codes=None) -> Stages:
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     t = top.trace(codes)
     fmt = fspec.fmt
-    base = fspec.base
+    base = fspec.front
     m = fspec.model
     N = m.terms
     Tf = fspec.term_frac_bits

@@ -21,7 +21,7 @@ from ..header import header
 from ..datapath import rebuild_matching
 from ..manifest import MANIFEST, read_manifest, write_design
 from ..options import NAMES as OPTION_NAMES, GenOptions
-from .spec import Spec, derive_spec
+from .spec import FrontEndView, Spec, derive_spec
 
 TOP = "flann_top"
 DATAPATH = "fixed"
@@ -52,7 +52,7 @@ def seq_context(steps: int, n_advs: int, adv_period: int) -> dict:
                 adv_cnt_bits=_ubits(n_advs))
 
 
-def _lsb_first_norm(s: Spec) -> dict:
+def _lsb_first_norm(s: FrontEndView) -> dict:
     """flann_norm's LSB-first form: the code offset binary (u = c + 2^(B-1)), the offsets with
     -2^(B-1) x the constant folded in as the accumulators' start values, each cycle one add and
     a halving (the bits shifted out are final: floor of floors), so after B cycles the
@@ -75,30 +75,29 @@ def _lsb_first_norm(s: Spec) -> dict:
     )
 
 
-def contexts(spec: Spec) -> dict[str, dict]:
-    """Template context of every entity."""
-    s = spec
-    B, P, L = s.input_bits, s.phase_bits, s.lanes
-    A = s.table_addr_bits
-    T, W = s.term_fmt.width, s.weight_fmt.width
-    Wp = s.product_fmt.width
-    lin_bits = s.lin_fmt.width
-    NV = P + s.norm_guard
-
-    common = dict(lanes=L, phase_bits=P, term_bits=T, product_bits=Wp, lin_bits=lin_bits,
-                  term_type=s.term_fmt.vhdl_type)
-    norm = dict(
-        code_bits=B, phase_bits=P, lin_bits=lin_bits, lin_type=s.lin_fmt.vhdl_type, acc_v_bits=NV, acc_l_bits=s.lin_width,
-        guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B), cnt_init=bits_literal(B, _ubits(B), False),
+def norm_context(s: FrontEndView) -> dict:
+    """flann_norm: the clamp and the two serial code x constant products."""
+    B, NV = s.input_bits, s.phase_bits + s.norm_guard
+    return dict(
+        code_bits=B, phase_bits=s.phase_bits, lin_bits=s.lin_fmt.width, lin_type=s.lin_fmt.vhdl_type,
+        acc_v_bits=NV, acc_l_bits=s.lin_width, guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B),
+        cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
         ka=bits_literal(s.ka, NV, False), **_lsb_first_norm(s),
     )
+
+
+def expansion_context(s: FrontEndView) -> dict:
+    """flann_expansion: phase accumulators, the quarter-wave table and its interpolation, the
+    variants as fragments chosen here."""
+    L, P, A = s.lanes, s.phase_bits, s.table_addr_bits
     de, do = s.delta_steps
     starts = [s.lane_start(l) for l in range(L)]
     slope_bits, kx, slope_reg = s.slope_rom_bits, s.interp_digit, s.slope_reg_bits
     icnt_bits = _ubits(slope_reg // kx + 1)
-    expansion = dict(
-        common, delta_even=de, delta_odd=do,
+    return dict(
+        lanes=L, phase_bits=P, term_bits=s.term_fmt.width, term_type=s.term_fmt.vhdl_type,
+        delta_even=de, delta_odd=do,
         fragments=f"{TEMPLATES}/expansion/interp/{s.interp_style}",
         parity=f"{TEMPLATES}/expansion/parity/{'alternate' if s.lane_kind_alternates else 'fixed'}.vhd.j2",
         slope_round=f"{TEMPLATES}/expansion/slope_round/{'half_up' if s.slope_guard > 0 else 'exact'}.vhd.j2",
@@ -120,6 +119,35 @@ def contexts(spec: Spec) -> dict[str, dict]:
         value_words=[s.value_fmt.literal(v) for v in s.value_rom],
         slope_words=[s.slope_fmt.literal(v) for v in s.slope_rom] if s.interp and not s.shared_table else [],
     )
+
+
+# the shared front end: entity -> its context; every datapath that uses it renders it here
+FRONT_END = {"flann_norm": norm_context, "flann_expansion": expansion_context}
+
+
+def render_front(fe: FrontEndView, command: str, spec_dict: dict) -> dict[str, str]:
+    """{file: text} of flann_norm and flann_expansion (compile order), their headers stamped with
+    ``command`` and the design's ``spec_dict``."""
+    out = {}
+    for name, title in ENTITIES:
+        if name in FRONT_END:
+            h = header(f"{name}.vhd", title, command, spec_dict, fe.model_sha256)
+            out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **FRONT_END[name](fe))
+    return out
+
+
+def contexts(spec: Spec) -> dict[str, dict]:
+    """Template context of every entity."""
+    s = spec
+    B, L = s.input_bits, s.lanes
+    T, W = s.term_fmt.width, s.weight_fmt.width
+    Wp = s.product_fmt.width
+    lin_bits = s.lin_fmt.width
+
+    common = dict(lanes=L, phase_bits=s.phase_bits, term_bits=T, product_bits=Wp, lin_bits=lin_bits,
+                  term_type=s.term_fmt.vhdl_type)
+    norm = norm_context(s)
+    expansion = expansion_context(s)
     step_bits = _ubits(max(1, s.steps - 1))
     depth = 1 << step_bits
     words = [[s.weight_fmt.literal(w) for w in lane] + [s.weight_fmt.literal(0)] * (depth - len(lane))
@@ -265,7 +293,7 @@ def rebuild_spec(model_path, man: dict, where, check_device: bool = True) -> tup
     return rebuild_matching(man, where, lambda o: load(model_path, check_device=check_device, **o),
                             lambda clamp: manifest_options(man, clamp))
 
-__all__ = ["seq_context", "generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
+__all__ = ["seq_context", "norm_context", "expansion_context", "render_front", "FRONT_END", "generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
            "rebuild_spec", "TOP",
            "ENTITIES", "MANIFEST", "write_design"]
 

@@ -5,9 +5,11 @@ chooses every width (or checks a width the user forced) and computes every const
 hardware holds (normalisation constants, sin/slope table, weight ROMs).  The bit-true twin
 (:mod:`flann.hardware.fixed.twin`) and the templates (:mod:`flann.hardware.fixed.render`) only read a :class:`Spec`.
 It composes one short, checked derive function per block (``derive_input``, ``derive_output``,
-``derive_phase_bits``, ``derive_expansion``, ``derive_multiplier``, ``derive_normaliser``,
-``derive_adder``, ``derive_sequencer``: ``derive_blocks``); the float18 front end and the
-family envelope call the same functions with their own constraints.
+``derive_phase_bits``, ``derive_expansion``, ``derive_normaliser``: ``derive_front``; then
+``derive_multiplier``, ``derive_adder``, ``derive_sequencer``: ``derive_blocks``).  The float18
+datapath takes the front end alone (``derive_front`` -> :class:`FrontEnd`); the family envelope
+calls the same functions with its own constraints.  flann_norm and flann_expansion (templates
+and twins) read a :class:`FrontEndView`: the fixed :class:`Spec` and a :class:`FrontEnd` both are one.
 
 Datapath (see docs/hardware.md)::
 
@@ -71,8 +73,108 @@ def round_sig(x: float, sig: int = 3, up: bool = True) -> float:
     return float(f"{f(x / 10.0 ** e) * 10.0 ** e:.12g}")
 
 
+class FrontEndView:
+    """What flann_norm and flann_expansion (templates and twins) read, derived from the fields
+    both the fixed :class:`Spec` and a :class:`FrontEnd` hold: the input stage (model,
+    input_bits, input_lsb_v, clamp), the normaliser's constants, the expansion's tables, lanes,
+    steps, and ``serial_interp`` / ``adv_period`` (the pace the expansion's interpolation runs at)."""
+
+    @property
+    def n_trig(self) -> int:
+        return self.model.terms - 1
+
+    @property
+    def code_min(self) -> int:
+        return signed_range(self.input_bits)[0]
+
+    @property
+    def code_max(self) -> int:
+        return signed_range(self.input_bits)[1]
+
+    @property
+    def phase_frac_bits(self) -> int:
+        return self.phase_bits - 1
+
+    # -- term order: hardware trig term j is model term j + 1 (golden.model.term_kind) ---
+    @staticmethod
+    def trig_term(j: int) -> tuple[str, int]:
+        """('sin'|'cos', harmonic m) of hardware trig term j (lane j % lanes, step j // lanes)."""
+        return term_kind(j + 1)
+
+    @property
+    def delta_steps(self) -> tuple[int, int]:
+        """Harmonic increase of one lane per step when its term index j is (even, odd)."""
+        L = self.lanes
+        return tuple(self.trig_term(j + L)[1] - self.trig_term(j)[1] for j in (0, 1))
+
+    def lane_start(self, lane: int) -> int:
+        """Harmonic of lane ``lane``'s first term (j = lane)."""
+        return self.trig_term(lane)[1]
+
+    @property
+    def lane_kind_alternates(self) -> bool:
+        """Whether a lane's next term is of the other kind (sin <-> cos) than its current one."""
+        return self.trig_term(self.lanes)[0] != self.trig_term(0)[0]
+
+    # -- expansion architecture ---------------------------------------------------------
+    @property
+    def offset_bits(self) -> int:
+        """D: phase bits below the table address (offset inside a table bin)."""
+        return _offset_bits(self.phase_bits, self.table_addr_bits)
+
+    @property
+    def slope_rom_bits(self) -> int:
+        """Width of the slope the correction multiplies: the slope ROM's word, or (shared table)
+        the low bits of the difference of two neighbouring samples."""
+        return self.slope_fmt.width if self.interp else 1
+
+    @property
+    def shared_table(self) -> bool:
+        return self.interp and self.table_style == "shared"
+
+    @property
+    def interp_style(self) -> str:
+        """The expansion's table interpolation: 'plain' (none), 'array' (an offset x slope
+        array multiplier) or 'serial' (the same product formed serially between advances)."""
+        if not self.interp:
+            return "plain"
+        return ("serial" if self.serial_interp else "array") + ("_shared" if self.shared_table else "")
+
+    @property
+    def interp_digit(self) -> int:
+        """Slope bits per cycle of the serial offset x slope product."""
+        return -(-self.slope_rom_bits // (self.adv_period - 2)) if self.serial_interp else 1
+
+    @property
+    def slope_reg_bits(self) -> int:
+        """Slope register, padded to whole digits of the serial product."""
+        kx = self.interp_digit
+        return -(-self.slope_rom_bits // kx) * kx if self.serial_interp else self.slope_rom_bits
+
+    @property
+    def interp_prod_bits(self) -> int:
+        if self.serial_interp:
+            return self.dq_bits + 1 + self.slope_reg_bits
+        # shared: an unsigned offset ('0' & dq) times the unsigned difference ('0' & delta)
+        return self.dq_bits + self.slope_rom_bits + (2 if self.shared_table else 1)
+
+    # -- constants with the rounding half-LSB folded in (the VHDL adds them, then shifts) --
+    @property
+    def kb_rounded(self) -> int:
+        return (self.kb + (1 << (self.norm_guard - 1))) % (1 << (self.phase_bits + self.norm_guard))
+
+    @property
+    def k0_rounded(self) -> int:
+        return self.k0 + (1 << (self.lin_guard - 1))
+
+    def float_reference(self, codes) -> np.ndarray:
+        """Golden float64 model (mm) at the clamped input codes."""
+        c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
+        return self.model.predict(c * self.input_lsb_v)
+
+
 @dataclass(frozen=True)
-class Spec:
+class Spec(FrontEndView):
     """Everything the twin and the templates need; nothing is recomputed downstream."""
 
     # provenance
@@ -132,102 +234,14 @@ class Spec:
 
     # -- derived ------------------------------------------------------------------------
     @property
-    def n_trig(self) -> int:
-        return self.model.terms - 1
-
-    @property
-    def code_min(self) -> int:
-        return signed_range(self.input_bits)[0]
-
-    @property
-    def code_max(self) -> int:
-        return signed_range(self.input_bits)[1]
-
-    @property
     def output_bits(self) -> int:
         return self.out_fmt.width
-
-    @property
-    def phase_frac_bits(self) -> int:
-        return self.phase_bits - 1
-
-    # -- term order: hardware trig term j is model term j + 1 (golden.model.term_kind) ---
-    @staticmethod
-    def trig_term(j: int) -> tuple[str, int]:
-        """('sin'|'cos', harmonic m) of hardware trig term j (lane j % lanes, step j // lanes)."""
-        return term_kind(j + 1)
-
-    @property
-    def delta_steps(self) -> tuple[int, int]:
-        """Harmonic increase of one lane per step when its term index j is (even, odd)."""
-        L = self.lanes
-        return tuple(self.trig_term(j + L)[1] - self.trig_term(j)[1] for j in (0, 1))
-
-    def lane_start(self, lane: int) -> int:
-        """Harmonic of lane ``lane``'s first term (j = lane)."""
-        return self.trig_term(lane)[1]
-
-    @property
-    def lane_kind_alternates(self) -> bool:
-        """Whether a lane's next term is of the other kind (sin <-> cos) than its current one."""
-        return self.trig_term(self.lanes)[0] != self.trig_term(0)[0]
-
-    # -- expansion architecture ---------------------------------------------------------
-    @property
-    def offset_bits(self) -> int:
-        """D: phase bits below the table address (offset inside a table bin)."""
-        return _offset_bits(self.phase_bits, self.table_addr_bits)
-
-    @property
-    def slope_rom_bits(self) -> int:
-        """Width of the slope the correction multiplies: the slope ROM's word, or (shared table)
-        the low bits of the difference of two neighbouring samples."""
-        return self.slope_fmt.width if self.interp else 1
-
-    @property
-    def shared_table(self) -> bool:
-        return self.interp and self.table_style == "shared"
 
     @property
     def serial_interp(self) -> bool:
         """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope
         product is formed serially then (one cycle copies the slope, the rest iterate)."""
         return self.interp and self.mult_style == "shiftadd" and self.adv_period >= 3
-
-    @property
-    def interp_style(self) -> str:
-        """The expansion's table interpolation: 'plain' (none), 'array' (an offset x slope
-        array multiplier) or 'serial' (the same product formed serially between advances)."""
-        if not self.interp:
-            return "plain"
-        return ("serial" if self.serial_interp else "array") + ("_shared" if self.shared_table else "")
-
-    @property
-    def interp_digit(self) -> int:
-        """Slope bits per cycle of the serial offset x slope product."""
-        return -(-self.slope_rom_bits // (self.adv_period - 2)) if self.serial_interp else 1
-
-    @property
-    def slope_reg_bits(self) -> int:
-        """Slope register, padded to whole digits of the serial product."""
-        kx = self.interp_digit
-        return -(-self.slope_rom_bits // kx) * kx if self.serial_interp else self.slope_rom_bits
-
-    @property
-    def interp_prod_bits(self) -> int:
-        if self.serial_interp:
-            return self.dq_bits + 1 + self.slope_reg_bits
-        # shared: an unsigned offset ('0' & dq) times the unsigned difference ('0' & delta)
-        return self.dq_bits + self.slope_rom_bits + (2 if self.shared_table else 1)
-
-    # -- constants with the rounding half-LSB folded in (the VHDL adds them, then shifts) --
-    @property
-    def kb_rounded(self) -> int:
-        return (self.kb + (1 << (self.norm_guard - 1))) % (1 << (self.phase_bits + self.norm_guard))
-
-    @property
-    def k0_rounded(self) -> int:
-        return self.k0 + (1 << (self.lin_guard - 1))
 
     # -- multiplier architecture ----------------------------------------------------------
     @property
@@ -261,11 +275,6 @@ class Spec:
     @property
     def samples_per_s_at_50mhz(self) -> float:
         return CLOCK_HZ / self.cycles_per_sample
-
-    def float_reference(self, codes) -> np.ndarray:
-        """Golden float64 model (mm) at the clamped input codes."""
-        c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
-        return self.model.predict(c * self.input_lsb_v)
 
     def to_dict(self) -> dict:
         """The spec as stamped in headers and manifest.json (ROM contents excluded)."""
@@ -340,9 +349,10 @@ def table_brams(A: int, widths) -> int:
 # -- the blocks, each derived by one short, checked function ----------------------------------
 # derive_spec composes them in the order the error budget needs them: the input stage (the
 # normaliser's clamp), the output stage (the adder's rounding), the budget shares, the
-# normaliser's phase width, the expansion, the multiplier, the normaliser's constants (its linear
-# part is in the accumulator's units), the adder, the sequencer.  The float18 front end and the
-# family envelope call the same functions with their own constraints.
+# normaliser's phase width, the expansion, the normaliser's constants (its linear part is in the
+# accumulator's units) -- the front end, derive_front -- then the multiplier, the adder, the
+# sequencer.  The float18 datapath takes the front end alone; the family envelope calls the
+# same functions with its own constraints.
 def sfix(bound: int, frac_bits: int) -> FixedFormat:
     """The signed format that holds -bound..bound (integer units) with ``frac_bits`` fraction bits."""
     width = bits_needed(-bound, bound)
@@ -594,7 +604,7 @@ def derive_multiplier(budget: Budget, exp: Expansion, weight_frac_bits, Pf: int,
         pmax = (term_max * wmax + (1 << (shift - 1))) >> shift
     else:
         pmax = _at_least("products", product_bound, (term_max * own + (1 << (shift - 1))) >> shift)
-    S = math.ceil(N / lanes)
+    S = steps_for(N, lanes)
     rom = np.zeros(S * lanes, dtype=np.int64)
     rom[:N] = w_int
     return Multiplier(sfix(wmax, Wf), sfix(pmax, Pf), shift, lanes, S,
@@ -691,6 +701,118 @@ def derive_sequencer(mult_style: str, mult_digit_bits, weight_bits: int) -> Sequ
 
 
 @dataclass(frozen=True)
+class Front:
+    """The blocks before the multiplier: the input and output stages, the budget, the
+    normaliser (its linear part is in the accumulator's units, so the products' fraction bits
+    are chosen here) and the expansion.  Every datapath that uses flann_norm and
+    flann_expansion derives them here, with its own constraints."""
+
+    input: InputStage
+    output: OutputStage
+    budget: Budget
+    normaliser: Normaliser
+    expansion: Expansion
+    product_frac_bits: int
+
+
+def derive_front(model: FlannModel, o: GenOptions, *, terms_hold_code: bool = False) -> Front:
+    """The front end's blocks for ``model`` under the options ``o``.  ``terms_hold_code``: the
+    terms share a converter with the input code (the float18 datapath), so they are at least as
+    wide as the code."""
+    parse_device(o.device)
+    inp = derive_input(model, o.input_bits, o.input_lsb_v, o.clamp)
+    out = derive_output(inp, o.output_bits, o.output_lsb_mm)
+    given = {k for k in ("phase_bits", "term_frac_bits", "weight_frac_bits") if getattr(o, k) is not None}
+    budget = error_budget(inp.model, out.output_lsb_mm, given)
+    P = derive_phase_bits(budget, o.phase_bits)
+    exp = derive_expansion(budget, P, o.term_frac_bits, o.table_addr_bits, o.interp,
+                           min_term_bits=inp.input_bits if terms_hold_code else 0)
+    Pf = product_frac_bits_for(budget, o.product_frac_bits)
+    norm = derive_normaliser(inp, P, out.output_lsb_mm, Pf)
+    _check_62((("lin accumulator", norm.lin_width), ("normaliser", norm.phase_bits + norm.norm_guard)), budget)
+    return Front(inp, out, budget, norm, exp, Pf)
+
+
+def steps_for(n_trig: int, lanes: int) -> int:
+    """Advances that issue every trig term, ``lanes`` per advance."""
+    return math.ceil(n_trig / lanes)
+
+
+@dataclass(frozen=True)
+class FrontEnd(FrontEndView):
+    """The shared front end (flann_norm, flann_expansion) as one record: what a datapath with
+    its own multiplier and adder (float18) renders those two entities and builds their twins
+    from.  The fixed :class:`Spec` holds the same fields (both are a :class:`FrontEndView`)."""
+
+    model: FlannModel = field(repr=False, compare=False)
+    model_sha256: str
+    device: str
+    lanes: int
+    steps: int
+    adv_period: int        # cycles between the expansion's advances
+    serial_interp: bool    # the interpolation product formed serially between advances
+    input_bits: int
+    input_lsb_v: float
+    clamp_lo: int
+    clamp_hi: int
+    phase_bits: int
+    norm_guard: int
+    ka: int
+    kb: int
+    lin_guard: int
+    k1: int
+    k0: int
+    lin_width: int
+    lin_fmt: FixedFormat
+    interp: bool
+    table_addr_bits: int
+    table_style: str
+    value_fmt: FixedFormat
+    slope_fmt: FixedFormat
+    dq_bits: int
+    slope_guard: int
+    term_fmt: FixedFormat
+    value_rom: tuple = field(repr=False)
+    slope_rom: tuple = field(repr=False)
+
+    def to_dict(self) -> dict:
+        """The front end's fields as stamped in headers and manifest.json (the fixed Spec's
+        names and order)."""
+        return {
+            "device": self.device,
+            "terms": self.model.terms,
+            "input_bits": self.input_bits,
+            "input_lsb_v": self.input_lsb_v,
+            "clamp_codes": [self.clamp_lo, self.clamp_hi],
+            "phase_bits": self.phase_bits,
+            "table_addr_bits": self.table_addr_bits,
+            "interp": self.interp,
+            "dq_bits": self.dq_bits,
+            "slope_guard": self.slope_guard,
+            "norm_guard": self.norm_guard,
+            "value": self.value_fmt.describe(),
+            "slope": self.slope_fmt.describe(),
+            "term": self.term_fmt.describe(),
+            "steps": self.steps,
+        }
+
+
+def front_end(f: Front, *, model_sha256: str, device: str, lanes: int, adv_period: int,
+              serial_interp: bool = False) -> FrontEnd:
+    """The :class:`FrontEnd` record of derived front blocks, advanced every ``adv_period`` cycles."""
+    i, n, e = f.input, f.normaliser, f.expansion
+    return FrontEnd(
+        model=i.model, model_sha256=model_sha256, device=device.lower(), lanes=lanes,
+        steps=steps_for(f.budget.N, lanes), adv_period=adv_period, serial_interp=serial_interp,
+        input_bits=i.input_bits, input_lsb_v=i.input_lsb_v, clamp_lo=i.clamp_lo, clamp_hi=i.clamp_hi,
+        phase_bits=n.phase_bits, norm_guard=n.norm_guard, ka=n.ka, kb=n.kb, lin_guard=n.lin_guard, k1=n.k1,
+        k0=n.k0, lin_width=n.lin_width, lin_fmt=n.lin_fmt, interp=e.interp, table_addr_bits=e.table_addr_bits,
+        table_style=e.table_style, value_fmt=e.value_fmt, slope_fmt=e.slope_fmt, dq_bits=e.dq_bits,
+        slope_guard=e.slope_guard, term_fmt=e.term_fmt, value_rom=e.value_rom, slope_rom=e.slope_rom,
+    )
+
+
+@dataclass(frozen=True)
 class Blocks:
     """A fixed datapath's blocks, before they are stamped into one :class:`Spec`."""
 
@@ -704,36 +826,31 @@ class Blocks:
     sequencer: Sequencer
 
 
-def derive_blocks(model: FlannModel, o: GenOptions, *, terms_hold_code: bool = False) -> Blocks:
-    """Every block of the fixed datapath for ``model`` under the options ``o``, composed.
-    ``terms_hold_code``: the terms share a converter with the input code (the float18 front
-    end), so they are at least as wide as the code."""
+def derive_blocks(model: FlannModel, o: GenOptions) -> Blocks:
+    """Every block of the fixed datapath for ``model`` under the options ``o``: the front end,
+    then the multiplier, the adder and the sequencer."""
     parse_device(o.device)
     # the lanes and the multiplier style are checked before the widths they shape
     L = _check_int("lanes", o.lanes, 1, max(1, model.terms - 1))
     check_mult_style(o.mult_style)
-    inp = derive_input(model, o.input_bits, o.input_lsb_v, o.clamp)
-    out = derive_output(inp, o.output_bits, o.output_lsb_mm)
-    given = {k for k in ("phase_bits", "term_frac_bits", "weight_frac_bits") if getattr(o, k) is not None}
-    budget = error_budget(inp.model, out.output_lsb_mm, given)
-    P = derive_phase_bits(budget, o.phase_bits)
-    exp = derive_expansion(budget, P, o.term_frac_bits, o.table_addr_bits, o.interp,
-                           min_term_bits=inp.input_bits if terms_hold_code else 0)
-    Pf = product_frac_bits_for(budget, o.product_frac_bits)
-    mult = derive_multiplier(budget, exp, o.weight_frac_bits, Pf, L)
-    norm = derive_normaliser(inp, P, out.output_lsb_mm, Pf)
-    acc_fmt = derive_adder(norm, exp, mult)
-    check_widths(norm, exp, mult, acc_fmt, budget)
-    return Blocks(inp, out, budget, norm, exp, mult, acc_fmt, derive_sequencer(o.mult_style, o.mult_digit_bits,
-                                                                                mult.weight_fmt.width))
+    f = derive_front(model, o)
+    mult = derive_multiplier(f.budget, f.expansion, o.weight_frac_bits, f.product_frac_bits, L)
+    acc_fmt = derive_adder(f.normaliser, f.expansion, mult)
+    check_widths(f.normaliser, f.expansion, mult, acc_fmt, f.budget)
+    return Blocks(f.input, f.output, f.budget, f.normaliser, f.expansion, mult, acc_fmt,
+                  derive_sequencer(o.mult_style, o.mult_digit_bits, mult.weight_fmt.width))
 
 
-def check_widths(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_fmt: FixedFormat, budget: Budget) -> None:
-    for name, width in (("lin accumulator", norm.lin_width), ("normaliser", norm.phase_bits + norm.norm_guard),
-                        ("accumulator", acc_fmt.width), ("product", exp.term_fmt.width + mult.weight_fmt.width)):
+def _check_62(widths, budget: Budget) -> None:
+    for name, width in widths:
         if width > 62:
             raise SpecError(f"{name} would need {width} bits (> 62): "
                             + ("reduce the requested widths" if budget.given else budget.hint))
+
+
+def check_widths(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_fmt: FixedFormat, budget: Budget) -> None:
+    _check_62((("lin accumulator", norm.lin_width), ("normaliser", norm.phase_bits + norm.norm_guard),
+               ("accumulator", acc_fmt.width), ("product", exp.term_fmt.width + mult.weight_fmt.width)), budget)
 
 
 def compose(b: Blocks, *, model_sha256: str, device: str, number_format: str) -> Spec:
@@ -889,7 +1006,7 @@ def check_fits(spec: Spec, part: str) -> None:
     )
 
 
-__all__ = ["Spec", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["Spec", "FrontEndView", "Front", "derive_front", "FrontEnd", "front_end", "steps_for", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ", "Blocks", "derive_blocks", "compose", "assemble", "sfix",
            "InputStage", "derive_input", "OutputStage", "derive_output", "Budget", "error_budget",
            "derive_phase_bits", "Expansion", "derive_expansion", "Multiplier", "product_frac_bits_for",

@@ -16,7 +16,7 @@ from ...textgen import template
 from ..header import header
 from ..manifest import write_design
 from ...golden.model import FlannModel, load_model, model_sha256
-from ..fixed.render import MODEL_FILE, TEMPLATES as FIXED_TEMPLATES, model_text, render as render_fixed, seq_context
+from ..fixed.render import MODEL_FILE, TEMPLATES as FIXED_TEMPLATES, model_text, render_front, seq_context
 from .spec import CVT, TOP, derive_f18_spec
 
 DATAPATH = "float18"
@@ -94,7 +94,7 @@ def cvt_context(fmt: FloatFormat, in_bits: int, in_frac: int) -> dict:
 
 def top_context(fspec) -> dict:
     """flann_f18_top: sequencer, weight ROM, start value, instances."""
-    b = fspec.base
+    b = fspec.front
     fmt = fspec.fmt
     n_terms = fspec.terms
     n_advs = fspec.n_advs
@@ -118,11 +118,10 @@ def top_context(fspec) -> dict:
 def render_design(fspec) -> dict[str, str]:
     """{file: text} in compile order: shared front end, float18 blocks, top."""
     fmt = fspec.fmt
-    fixed = render_fixed(fspec.base)
+    b = fspec.front
     # the shared front end, as the fixed datapath renders it, and the shared sequencer with this
     # datapath's advances (one term per adder latency)
-    out = {f: fixed[f] for f in ("flann_norm.vhd", "flann_expansion.vhd")}
-    b = fspec.base
+    out = render_front(b, COMMAND, fspec.to_dict())
     h = header(f"{SEQ}.vhd", "sequencer of one sample (shared by every top level)", COMMAND, fspec.to_dict(),
                b.model_sha256)
     out[f"{SEQ}.vhd"] = template(f"{FIXED_TEMPLATES}/{SEQ}.vhd.j2").render(
@@ -139,7 +138,7 @@ def render_design(fspec) -> dict[str, str]:
 
 
 def manifest(fspec, files: list[str]) -> dict:
-    b = fspec.base
+    b = fspec.front
     return {
         "top": TOP,
         "datapath": DATAPATH,

@@ -1,9 +1,9 @@
 """The FLANN datapath in float18 (the seed's number format): spec and bit-true twin.
 
-The float18 design shares the fixed-point design's input stage and expansion block (the
-same :class:`~flann.hardware.fixed.spec.Spec`, the same ``flann_norm`` / ``flann_expansion`` entities and
-twins), and replaces the multiplier and the adder by the seed's 18-bit floating-point
-blocks::
+The float18 design is the shared front end (the fixed datapath's input stage, normaliser and
+expansion, derived by the same block derives into a
+:class:`~flann.hardware.fixed.spec.FrontEnd`: the same ``flann_norm`` / ``flann_expansion``
+entities and twins) plus the seed's 18-bit floating-point multiplier and adder::
 
     code --clamp--> c ------------------------------.
     code --flann_norm--> theta --flann_expansion--> terms (fixed, Tf fraction bits)
@@ -32,7 +32,7 @@ from ...errors import SpecError
 from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
 from ..fixed.latency import EXPANSION_ADVANCES, SEQ_START_EDGES, norm_latency
-from ..fixed.spec import Spec, assemble, derive_blocks
+from ..fixed.spec import FrontEnd, derive_front, front_end
 from ..options import GenOptions
 from ..twin import TopOut
 
@@ -59,9 +59,10 @@ def float18_options(options: GenOptions, fixed_too: bool = False) -> dict:
 
 @dataclass(frozen=True)
 class F18Spec:
-    """A fixed-point front end (input, expansion) plus the float18 arithmetic constants."""
+    """The shared fixed-point front end (input, normaliser, expansion) plus the float18
+    arithmetic constants."""
 
-    base: Spec = field(repr=False)
+    front: FrontEnd = field(repr=False)
     fmt: FloatFormat
     weight_codes: tuple[int, ...]   # model term order; [0] is the code term's weight
     start_code: int                 # bias + w0 * (-offset / scale)
@@ -71,28 +72,28 @@ class F18Spec:
 
     @property
     def model(self) -> FlannModel:
-        return self.base.model
+        return self.front.model
 
     @property
     def terms(self) -> int:
-        return self.base.model.terms
+        return self.front.model.terms
 
     @property
     def term_frac_bits(self) -> int:
-        return self.base.term_fmt.frac_bits
+        return self.front.term_fmt.frac_bits
 
     @property
     def code_min(self) -> int:
-        return self.base.code_min
+        return self.front.code_min
 
     @property
     def code_max(self) -> int:
-        return self.base.code_max
+        return self.front.code_max
 
     @property
     def n_advs(self) -> int:
         """Expansion advances: one per trig term, plus the expansion's own to bring the first term out."""
-        return self.base.steps + EXPANSION_ADVANCES
+        return self.front.steps + EXPANSION_ADVANCES
 
     @property
     def latency_cycles(self) -> int:
@@ -100,7 +101,7 @@ class F18Spec:
         # flann_norm, flann_seq's start, the advances (the last term is captured at advance
         # n_advs - 1), then converter + multiplier + adder, then this top's own three edges:
         # the sum register and count, done_r (flann_seq's in_done), the output register
-        return (norm_latency(self.base.input_bits) + SEQ_START_EDGES + (self.n_advs - 1) * self.adv_period
+        return (norm_latency(self.front.input_bits) + SEQ_START_EDGES + (self.n_advs - 1) * self.adv_period
                 + F18Cvt.latency + F18Mul.latency + F18Add.latency + TOP_DRAIN_EDGES)
 
     @property
@@ -111,7 +112,7 @@ class F18Spec:
         """Exact (float64) constants the float18 ROM approximates, same order and scaling."""
         m = self.model
         w = np.asarray(m.weights, dtype=float).copy()
-        w[0] = w[0] * (self.base.input_lsb_v / m.input_scale_v) * 2.0 ** self.term_frac_bits
+        w[0] = w[0] * (self.front.input_lsb_v / m.input_scale_v) * 2.0 ** self.term_frac_bits
         return w
 
     def golden_start(self) -> float:
@@ -119,21 +120,17 @@ class F18Spec:
         return m.bias + m.weights[0] * (-m.input_offset_v / m.input_scale_v)
 
     def float_reference(self, codes) -> np.ndarray:
-        return self.base.float_reference(codes)
+        return self.front.float_reference(codes)
 
     def to_dict(self) -> dict:
-        # the shared front end's fields only (the fixed datapath's are not in this design)
-        shared = ("device", "terms", "input_bits", "input_lsb_v", "clamp_codes", "phase_bits",
-                  "table_addr_bits", "interp", "dq_bits", "slope_guard", "norm_guard", "value", "slope",
-                  "term", "steps")
-        d = {k: v for k, v in self.base.to_dict().items() if k in shared}
+        d = self.front.to_dict()
         d.update(number_format="float18", float=self.fmt.to_dict(), adv_period=self.adv_period,
                  sum_order="start, code term, trig terms in model order (sequential)")
         return d
 
 
 def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
-    """Float18 spec: the fixed spec's input stage and expansion, float18 constants."""
+    """Float18 spec: the shared front end, float18 constants."""
     options = {k: v for k, v in options.items() if v is not None and k != "number_format"}
     for k in options:
         if k not in FRONT_END_OPTIONS:
@@ -144,31 +141,30 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
                         f"{options['lanes']}")
     options.pop("lanes", None)
     options.pop("number_format", None)
-    # The front end must take an advance every adder latency (3 cycles): derive it as for
-    # the array-multiplier design, whose expansion forms the slope correction in one step
-    # (a shift-add spec forms it serially between its own, slower advances).  The fixed
-    # design's device estimate (multiplier, accumulator) does not apply: `flann synth`
+    # The fixed design's device estimate (multiplier, accumulator) does not apply: `flann synth`
     # measures the float18 design itself.
     options.pop("check_device", None)
     sha = options.pop("model_sha256", "")
-    o = GenOptions.of(None, mult_style="lut", **options)
+    o = GenOptions.of(None, **options)
     if not isinstance(model, FlannModel):
         raise SpecError("model must be a FlannModel (load it with flann.golden.model.load_model)")
     # small trig weights need only narrow terms, but the code shares the term converter: the
-    # expansion widens the terms to the code's width (more precision than the budget asks)
-    base = assemble(derive_blocks(model, o, terms_hold_code=True), model_sha256=sha, device=o.device,
-                    check_device=False)
+    # expansion widens the terms to the code's width (more precision than the budget asks).
+    # The front end takes an advance every adder latency and forms the slope correction in one
+    # step (the array form: only a shift-add multiplier's idle cycles make the serial one pay).
+    front = front_end(derive_front(model, o, terms_hold_code=True), model_sha256=sha, device=o.device, lanes=1,
+                      adv_period=F18Add.latency)
     fmt = FLOAT18
-    Tf = base.term_fmt.frac_bits
-    if base.input_bits > fmt.sig_bits:
-        raise SpecError(f"input_bits = {base.input_bits}: float18 holds input codes exactly only up to "
+    Tf = front.term_fmt.frac_bits
+    if front.input_bits > fmt.sig_bits:
+        raise SpecError(f"input_bits = {front.input_bits}: float18 holds input codes exactly only up to "
                         f"{fmt.sig_bits} bits")
-    if base.term_fmt.width < base.input_bits:
-        raise SpecError(f"term width {base.term_fmt.width} < input_bits {base.input_bits}: the code "
+    if front.term_fmt.width < front.input_bits:
+        raise SpecError(f"term width {front.term_fmt.width} < input_bits {front.input_bits}: the code "
                         "cannot share the term converter")
     if Tf > fmt.bias - 1:
         raise SpecError(f"term_frac_bits = {Tf}: float18 cannot hold 2^-{Tf} (min normal 2^{1 - fmt.bias})")
-    spec = F18Spec(base=base, fmt=fmt, weight_codes=(), start_code=0, adv_period=F18Add.latency)
+    spec = F18Spec(front=front, fmt=fmt, weight_codes=(), start_code=0, adv_period=F18Add.latency)
     w = spec.golden_weights()
     for i, x in enumerate(w):
         if abs(x) > float(fmt.max_value):
@@ -176,7 +172,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     start = spec.golden_start()
     if not math.isfinite(start) or abs(start) > float(fmt.max_value):
         raise SpecError(f"bias {start:.4g} exceeds float18's range")
-    return F18Spec(base=base, fmt=fmt, weight_codes=tuple(int(c) for c in fmt.encode_array(w)),
+    return F18Spec(front=front, fmt=fmt, weight_codes=tuple(int(c) for c in fmt.encode_array(w)),
                    start_code=int(fmt.encode_array([start])[0]), adv_period=F18Add.latency)
 
 
@@ -226,8 +222,8 @@ class F18Top:
     def __init__(self, spec: F18Spec):
         self.spec = spec
         self.latency = spec.latency_cycles
-        self.norm = FlannNorm(spec.base)
-        self.expansion = FlannExpansion(spec.base)
+        self.norm = FlannNorm(spec.front)
+        self.expansion = FlannExpansion(spec.front)
         self.cvt = F18Cvt(spec.term_frac_bits, spec.fmt)
         self.fmt = spec.fmt
 
