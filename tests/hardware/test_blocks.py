@@ -65,7 +65,7 @@ def test_float18_derives_its_front_end_once(model, monkeypatch):
         own = derive_spec(small, mult_style="lut", input_bits=12, check_device=False)
     assert len(calls) == 1 and calls[0] == {"terms_hold_code": True}
     # the float18 spec holds the front end only: no fixed multiplier or adder
-    assert isinstance(f.front, FrontEnd) and not hasattr(f.front, "weight_fmt") and not hasattr(f, "base")
+    assert type(f.front) is FrontEnd and not hasattr(f.front, "weight_fmt") and not hasattr(f, "base")
     # widened to the code's width, against the fixed budget's narrower terms
     assert f.front.term_fmt.width == 12 > own.term_fmt.width
     assert f.term_frac_bits - own.term_fmt.frac_bits == 12 - own.term_fmt.width
@@ -74,8 +74,9 @@ def test_float18_derives_its_front_end_once(model, monkeypatch):
 @pytest.mark.parametrize("options", [dict(input_bits=8), dict(input_bits=8, interp=False, lanes=3, mult_style="lut"),
                                      dict(input_bits=10, lanes=2)])
 def test_front_end_record_and_fixed_spec_give_the_same_front_blocks(model, options):
-    """flann_norm and flann_expansion read a FrontEndView: the fixed Spec and the FrontEnd of the
-    same blocks render the same VHDL (below the header) and their twins give the same values."""
+    """flann_norm and flann_expansion read a FrontEnd: the fixed Spec (a FrontEnd and more) and
+    the bare FrontEnd of the same blocks render the same VHDL (below the header) and their twins
+    give the same values."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         spec = derive_spec(model, check_device=False, **options)

@@ -21,7 +21,7 @@ from ..header import header
 from ..datapath import rebuild_matching
 from ..manifest import MANIFEST, read_manifest, write_design
 from ..options import NAMES as OPTION_NAMES, GenOptions
-from .spec import FrontEndView, Spec, derive_spec
+from .spec import FrontEnd, Spec, derive_spec
 
 TOP = "flann_top"
 DATAPATH = "fixed"
@@ -52,7 +52,7 @@ def seq_context(steps: int, n_advs: int, adv_period: int) -> dict:
                 adv_cnt_bits=_ubits(n_advs))
 
 
-def _lsb_first_norm(s: FrontEndView) -> dict:
+def _lsb_first_norm(s: FrontEnd) -> dict:
     """flann_norm's LSB-first form: the code offset binary (u = c + 2^(B-1)), the offsets with
     -2^(B-1) x the constant folded in as the accumulators' start values, each cycle one add and
     a halving (the bits shifted out are final: floor of floors), so after B cycles the
@@ -75,7 +75,7 @@ def _lsb_first_norm(s: FrontEndView) -> dict:
     )
 
 
-def norm_context(s: FrontEndView) -> dict:
+def norm_context(s: FrontEnd) -> dict:
     """flann_norm: the clamp and the two serial code x constant products."""
     B, NV = s.input_bits, s.phase_bits + s.norm_guard
     return dict(
@@ -87,7 +87,7 @@ def norm_context(s: FrontEndView) -> dict:
     )
 
 
-def expansion_context(s: FrontEndView) -> dict:
+def expansion_context(s: FrontEnd) -> dict:
     """flann_expansion: phase accumulators, the quarter-wave table and its interpolation, the
     variants as fragments chosen here."""
     L, P, A = s.lanes, s.phase_bits, s.table_addr_bits
@@ -125,7 +125,7 @@ def expansion_context(s: FrontEndView) -> dict:
 FRONT_END = {"flann_norm": norm_context, "flann_expansion": expansion_context}
 
 
-def render_front(fe: FrontEndView, command: str, spec_dict: dict) -> dict[str, str]:
+def render_front(fe: FrontEnd, command: str, spec_dict: dict) -> dict[str, str]:
     """{file: text} of flann_norm and flann_expansion (compile order), their headers stamped with
     ``command`` and the design's ``spec_dict``."""
     out = {}

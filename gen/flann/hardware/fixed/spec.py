@@ -9,7 +9,7 @@ It composes one short, checked derive function per block (``derive_input``, ``de
 ``derive_multiplier``, ``derive_adder``, ``derive_sequencer``: ``derive_blocks``).  The float18
 datapath takes the front end alone (``derive_front`` -> :class:`FrontEnd`); the family envelope
 calls the same functions with its own constraints.  flann_norm and flann_expansion (templates
-and twins) read a :class:`FrontEndView`: the fixed :class:`Spec` and a :class:`FrontEnd` both are one.
+and twins) read a :class:`FrontEnd`; the fixed :class:`Spec` is one (a subclass).
 
 Datapath (see docs/hardware.md)::
 
@@ -73,11 +73,51 @@ def round_sig(x: float, sig: int = 3, up: bool = True) -> float:
     return float(f"{f(x / 10.0 ** e) * 10.0 ** e:.12g}")
 
 
-class FrontEndView:
-    """What flann_norm and flann_expansion (templates and twins) read, derived from the fields
-    both the fixed :class:`Spec` and a :class:`FrontEnd` hold: the input stage (model,
-    input_bits, input_lsb_v, clamp), the normaliser's constants, the expansion's tables, lanes,
-    steps, and ``serial_interp`` / ``adv_period`` (the pace the expansion's interpolation runs at)."""
+@dataclass(frozen=True)
+class FrontEnd:
+    """The shared front end (flann_norm, flann_expansion) as one record: the input stage, the
+    normaliser's constants, the expansion's tables and the pace of its advances.  The templates
+    and twins of flann_norm and flann_expansion read it; the float18 datapath is this plus its
+    float blocks, and the fixed :class:`Spec` is this plus the multiplier, adder and sequencer."""
+
+    model: FlannModel = field(repr=False, compare=False)
+    model_sha256: str
+    device: str
+    lanes: int
+    interp: bool
+    # input
+    input_bits: int
+    input_lsb_v: float
+    clamp_lo: int
+    clamp_hi: int
+    # normaliser: theta = round((ka*c + kb) / 2^norm_guard) mod 2^phase_bits
+    phase_bits: int  # P: phase of v_n in units of pi, mod 2  (v_n has P-1 fraction bits)
+    norm_guard: int
+    ka: int
+    kb: int
+    # linear term + bias in accumulator units: lin = round((k1*c + k0) / 2^lin_guard)
+    lin_guard: int
+    k1: int
+    k0: int
+    lin_width: int  # serial accumulator width (exact, no wrap)
+    lin_fmt: FixedFormat
+    # sin/cos table (quarter wave, midpoint samples)
+    table_addr_bits: int
+    value_fmt: FixedFormat  # unsigned ROM value, frac bits = term frac bits
+    slope_fmt: FixedFormat  # unsigned ROM slope
+    dq_bits: int  # signed phase offset bits fed to the slope multiplier
+    slope_guard: int
+    term_fmt: FixedFormat
+    # 'separate': sin at bin centres + a slope table; 'shared': sin at bin edges, the slope is the
+    # difference of neighbouring samples read through the same table's second port (no slope ROM)
+    table_style: str
+    # schedule: steps advances issue the trig terms, one every adv_period cycles
+    steps: int
+    adv_period: int
+    serial_interp: bool  # the offset x slope product formed serially between advances
+    # ROM contents
+    value_rom: tuple = field(repr=False)
+    slope_rom: tuple = field(repr=False)
 
     @property
     def n_trig(self) -> int:
@@ -172,45 +212,45 @@ class FrontEndView:
         c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
         return self.model.predict(c * self.input_lsb_v)
 
+    def to_dict(self) -> dict:
+        """The front end's fields as stamped in headers and manifest.json (the fixed Spec's
+        names and order)."""
+        return {
+            "device": self.device,
+            "terms": self.model.terms,
+            "input_bits": self.input_bits,
+            "input_lsb_v": self.input_lsb_v,
+            "clamp_codes": [self.clamp_lo, self.clamp_hi],
+            "phase_bits": self.phase_bits,
+            "table_addr_bits": self.table_addr_bits,
+            "interp": self.interp,
+            "dq_bits": self.dq_bits,
+            "slope_guard": self.slope_guard,
+            "norm_guard": self.norm_guard,
+            "value": self.value_fmt.describe(),
+            "slope": self.slope_fmt.describe(),
+            "term": self.term_fmt.describe(),
+            "steps": self.steps,
+        }
+
+
+def serial_interp_for(interp: bool, mult_style: str, adv_period: int) -> bool:
+    """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope product is
+    formed serially then (one cycle copies the slope, the rest iterate)."""
+    return interp and mult_style == "shiftadd" and adv_period >= 3
+
 
 @dataclass(frozen=True)
-class Spec(FrontEndView):
-    """Everything the twin and the templates need; nothing is recomputed downstream."""
+class Spec(FrontEnd):
+    """Everything the twin and the templates need; nothing is recomputed downstream: the
+    :class:`FrontEnd`'s fields, then the multiplier's, the adder's and the sequencer's."""
 
     # provenance
-    model: FlannModel = field(repr=False, compare=False)
-    model_sha256: str
     generator_version: str
-    device: str
     number_format: str  # "fixed" (room for "float18", issue 7)
     # architecture
-    lanes: int
     mult_style: str
     mult_digit_bits: int  # shift-add: weight bits per cycle
-    interp: bool
-    # input
-    input_bits: int
-    input_lsb_v: float
-    clamp_lo: int
-    clamp_hi: int
-    # normaliser: theta = round((ka*c + kb) / 2^norm_guard) mod 2^phase_bits
-    phase_bits: int  # P: phase of v_n in units of pi, mod 2  (v_n has P-1 fraction bits)
-    norm_guard: int
-    ka: int
-    kb: int
-    # linear term + bias in accumulator units: lin = round((k1*c + k0) / 2^lin_guard)
-    lin_guard: int
-    k1: int
-    k0: int
-    lin_width: int  # serial accumulator width (exact, no wrap)
-    lin_fmt: FixedFormat
-    # sin/cos table (quarter wave, midpoint samples)
-    table_addr_bits: int
-    value_fmt: FixedFormat  # unsigned ROM value, frac bits = term frac bits
-    slope_fmt: FixedFormat  # unsigned ROM slope
-    dq_bits: int  # signed phase offset bits fed to the slope multiplier
-    slope_guard: int
-    term_fmt: FixedFormat
     # multiplier
     weight_fmt: FixedFormat
     product_fmt: FixedFormat
@@ -219,29 +259,14 @@ class Spec(FrontEndView):
     acc_fmt: FixedFormat
     out_fmt: FixedFormat
     output_lsb_mm: float
-    # schedule
-    steps: int
-    adv_period: int
-    # ROM contents
-    value_rom: tuple = field(repr=False)
-    slope_rom: tuple = field(repr=False)
     weight_rom: tuple = field(repr=False)  # [lane][step]
     analysis: dict = field(repr=False, compare=False, default_factory=dict)
     term_bound: int = 0  # largest |term| the expansion can produce (sizes products and acc)
-    # 'separate': sin at bin centres + a slope table; 'shared': sin at bin edges, the slope is the
-    # difference of neighbouring samples read through the same table's second port (no slope ROM)
-    table_style: str = "separate"
 
     # -- derived ------------------------------------------------------------------------
     @property
     def output_bits(self) -> int:
         return self.out_fmt.width
-
-    @property
-    def serial_interp(self) -> bool:
-        """Shift-add designs have adv_period - 1 idle cycles per step: the offset x slope
-        product is formed serially then (one cycle copies the slope, the rest iterate)."""
-        return self.interp and self.mult_style == "shiftadd" and self.adv_period >= 3
 
     # -- multiplier architecture ----------------------------------------------------------
     @property
@@ -738,77 +763,24 @@ def steps_for(n_trig: int, lanes: int) -> int:
     return math.ceil(n_trig / lanes)
 
 
-@dataclass(frozen=True)
-class FrontEnd(FrontEndView):
-    """The shared front end (flann_norm, flann_expansion) as one record: what a datapath with
-    its own multiplier and adder (float18) renders those two entities and builds their twins
-    from.  The fixed :class:`Spec` holds the same fields (both are a :class:`FrontEndView`)."""
-
-    model: FlannModel = field(repr=False, compare=False)
-    model_sha256: str
-    device: str
-    lanes: int
-    steps: int
-    adv_period: int        # cycles between the expansion's advances
-    serial_interp: bool    # the interpolation product formed serially between advances
-    input_bits: int
-    input_lsb_v: float
-    clamp_lo: int
-    clamp_hi: int
-    phase_bits: int
-    norm_guard: int
-    ka: int
-    kb: int
-    lin_guard: int
-    k1: int
-    k0: int
-    lin_width: int
-    lin_fmt: FixedFormat
-    interp: bool
-    table_addr_bits: int
-    table_style: str
-    value_fmt: FixedFormat
-    slope_fmt: FixedFormat
-    dq_bits: int
-    slope_guard: int
-    term_fmt: FixedFormat
-    value_rom: tuple = field(repr=False)
-    slope_rom: tuple = field(repr=False)
-
-    def to_dict(self) -> dict:
-        """The front end's fields as stamped in headers and manifest.json (the fixed Spec's
-        names and order)."""
-        return {
-            "device": self.device,
-            "terms": self.model.terms,
-            "input_bits": self.input_bits,
-            "input_lsb_v": self.input_lsb_v,
-            "clamp_codes": [self.clamp_lo, self.clamp_hi],
-            "phase_bits": self.phase_bits,
-            "table_addr_bits": self.table_addr_bits,
-            "interp": self.interp,
-            "dq_bits": self.dq_bits,
-            "slope_guard": self.slope_guard,
-            "norm_guard": self.norm_guard,
-            "value": self.value_fmt.describe(),
-            "slope": self.slope_fmt.describe(),
-            "term": self.term_fmt.describe(),
-            "steps": self.steps,
-        }
-
-
 def front_end(f: Front, *, model_sha256: str, device: str, lanes: int, adv_period: int,
               serial_interp: bool = False) -> FrontEnd:
     """The :class:`FrontEnd` record of derived front blocks, advanced every ``adv_period`` cycles."""
+    return FrontEnd(**_front_fields(f, model_sha256=model_sha256, device=device, lanes=lanes,
+                                    adv_period=adv_period, serial_interp=serial_interp))
+
+
+def _front_fields(f: Front, *, model_sha256: str, device: str, lanes: int, adv_period: int,
+                  serial_interp: bool) -> dict:
     i, n, e = f.input, f.normaliser, f.expansion
-    return FrontEnd(
-        model=i.model, model_sha256=model_sha256, device=device.lower(), lanes=lanes,
-        steps=steps_for(f.budget.N, lanes), adv_period=adv_period, serial_interp=serial_interp,
+    return dict(
+        model=i.model, model_sha256=model_sha256, device=device.lower(), lanes=lanes, interp=e.interp,
         input_bits=i.input_bits, input_lsb_v=i.input_lsb_v, clamp_lo=i.clamp_lo, clamp_hi=i.clamp_hi,
         phase_bits=n.phase_bits, norm_guard=n.norm_guard, ka=n.ka, kb=n.kb, lin_guard=n.lin_guard, k1=n.k1,
-        k0=n.k0, lin_width=n.lin_width, lin_fmt=n.lin_fmt, interp=e.interp, table_addr_bits=e.table_addr_bits,
-        table_style=e.table_style, value_fmt=e.value_fmt, slope_fmt=e.slope_fmt, dq_bits=e.dq_bits,
-        slope_guard=e.slope_guard, term_fmt=e.term_fmt, value_rom=e.value_rom, slope_rom=e.slope_rom,
+        k0=n.k0, lin_width=n.lin_width, lin_fmt=n.lin_fmt, table_addr_bits=e.table_addr_bits,
+        value_fmt=e.value_fmt, slope_fmt=e.slope_fmt, dq_bits=e.dq_bits, slope_guard=e.slope_guard,
+        term_fmt=e.term_fmt, table_style=e.table_style, steps=steps_for(f.budget.N, lanes), adv_period=adv_period,
+        serial_interp=serial_interp, value_rom=e.value_rom, slope_rom=e.slope_rom,
     )
 
 
@@ -855,19 +827,15 @@ def check_widths(norm: Normaliser, exp: Expansion, mult: Multiplier, acc_fmt: Fi
 
 def compose(b: Blocks, *, model_sha256: str, device: str, number_format: str) -> Spec:
     """The :class:`Spec` the twin and the templates read: every block's fields, stamped."""
-    n, e, m, s = b.normaliser, b.expansion, b.multiplier, b.sequencer
+    e, m, s = b.expansion, b.multiplier, b.sequencer
+    front = Front(b.input, b.output, b.budget, b.normaliser, e, m.product_fmt.frac_bits)
     return Spec(
-        model=b.input.model, model_sha256=model_sha256, generator_version=__version__, device=device.lower(),
-        number_format=number_format, lanes=m.lanes, mult_style=s.mult_style, mult_digit_bits=s.mult_digit_bits,
-        interp=e.interp, input_bits=b.input.input_bits, input_lsb_v=b.input.input_lsb_v,
-        clamp_lo=b.input.clamp_lo, clamp_hi=b.input.clamp_hi,
-        phase_bits=n.phase_bits, norm_guard=n.norm_guard, ka=n.ka, kb=n.kb, lin_guard=n.lin_guard, k1=n.k1,
-        k0=n.k0, lin_width=n.lin_width, lin_fmt=n.lin_fmt, table_addr_bits=e.table_addr_bits,
-        value_fmt=e.value_fmt, slope_fmt=e.slope_fmt, dq_bits=e.dq_bits, slope_guard=e.slope_guard,
-        term_fmt=e.term_fmt, weight_fmt=m.weight_fmt, product_fmt=m.product_fmt, product_shift=m.product_shift,
-        acc_fmt=b.acc_fmt, out_fmt=b.output.out_fmt, output_lsb_mm=b.output.output_lsb_mm, steps=m.steps,
-        adv_period=s.adv_period, value_rom=e.value_rom, slope_rom=e.slope_rom, weight_rom=m.weight_rom,
-        term_bound=int(e.term_max), table_style=e.table_style,
+        **_front_fields(front, model_sha256=model_sha256, device=device, lanes=m.lanes, adv_period=s.adv_period,
+                        serial_interp=serial_interp_for(e.interp, s.mult_style, s.adv_period)),
+        generator_version=__version__, number_format=number_format, mult_style=s.mult_style,
+        mult_digit_bits=s.mult_digit_bits, weight_fmt=m.weight_fmt, product_fmt=m.product_fmt,
+        product_shift=m.product_shift, acc_fmt=b.acc_fmt, out_fmt=b.output.out_fmt,
+        output_lsb_mm=b.output.output_lsb_mm, weight_rom=m.weight_rom, term_bound=int(e.term_max),
     )
 
 
@@ -1006,7 +974,7 @@ def check_fits(spec: Spec, part: str) -> None:
     )
 
 
-__all__ = ["Spec", "FrontEndView", "Front", "derive_front", "FrontEnd", "front_end", "steps_for", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["Spec", "serial_interp_for", "Front", "derive_front", "FrontEnd", "front_end", "steps_for", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ", "Blocks", "derive_blocks", "compose", "assemble", "sfix",
            "InputStage", "derive_input", "OutputStage", "derive_output", "Budget", "error_budget",
            "derive_phase_bits", "Expansion", "derive_expansion", "Multiplier", "product_frac_bits_for",

@@ -3,8 +3,8 @@
 Every twin names its entity and latency; ``process`` is vectorised over samples (numpy
 int64) and returns a record whose fields are the entity's output ports (plus its internal
 stages), so a test bench (or ``flann trace``) can compare hardware and twin at any block
-boundary.  Widths are those of the :class:`Spec` (flann_norm's and flann_expansion's: of any
-:class:`FrontEndView`, the float18 datapath's :class:`FrontEnd` too);
+boundary.  Widths are those of the :class:`Spec` (flann_norm's and flann_expansion's: of its
+:class:`FrontEnd`, which is all the float18 datapath gives them);
 the few places where arithmetic is modular on purpose (phase = m v_n mod 2) are marked.
 
 Term order inside the hardware: trig term ``j = 0 .. N-2`` is model term ``i = j + 1``
@@ -22,7 +22,7 @@ import numpy as np
 from ...numeric.fixed import round_shift
 from ..twin import Record, TopOut
 from .latency import ADDER_EDGES, EXPANSION_ADVANCES, MULTIPLIER_ADVANCES, norm_latency
-from .spec import FrontEndView, Spec
+from .spec import FrontEnd, Spec
 
 
 def _i64(x) -> np.ndarray:
@@ -72,7 +72,7 @@ class FlannNorm:
 
     entity = "flann_norm"
 
-    def __init__(self, spec: FrontEndView):
+    def __init__(self, spec: FrontEnd):
         self.spec = spec
         self.latency = norm_latency(spec.input_bits)
 
@@ -96,7 +96,7 @@ class FlannExpansion:
     entity = "flann_expansion"
     latency = EXPANSION_ADVANCES  # advances from theta to the first term
 
-    def __init__(self, spec: FrontEndView):
+    def __init__(self, spec: FrontEnd):
         self.spec = spec
         self.value_rom = _i64(spec.value_rom)
         self.slope_rom = _i64(spec.slope_rom)
