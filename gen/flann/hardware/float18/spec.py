@@ -66,13 +66,17 @@ class F18Spec:
     fmt: FloatFormat
     weight_codes: tuple[int, ...]   # model term order; [0] is the code term's weight
     start_code: int                 # bias + w0 * (-offset / scale)
-    adv_period: int                 # cycles per term: the adder's latency (result forwarded)
 
     number_format = "float18"
 
     @property
     def model(self) -> FlannModel:
         return self.front.model
+
+    @property
+    def adv_period(self) -> int:
+        """Cycles per term: the adder's latency (its result forwarded), the front end's pace."""
+        return self.front.adv_period
 
     @property
     def terms(self) -> int:
@@ -164,7 +168,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
                         "cannot share the term converter")
     if Tf > fmt.bias - 1:
         raise SpecError(f"term_frac_bits = {Tf}: float18 cannot hold 2^-{Tf} (min normal 2^{1 - fmt.bias})")
-    spec = F18Spec(front=front, fmt=fmt, weight_codes=(), start_code=0, adv_period=F18Add.latency)
+    spec = F18Spec(front=front, fmt=fmt, weight_codes=(), start_code=0)
     w = spec.golden_weights()
     for i, x in enumerate(w):
         if abs(x) > float(fmt.max_value):
@@ -173,7 +177,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     if not math.isfinite(start) or abs(start) > float(fmt.max_value):
         raise SpecError(f"bias {start:.4g} exceeds float18's range")
     return F18Spec(front=front, fmt=fmt, weight_codes=tuple(int(c) for c in fmt.encode_array(w)),
-                   start_code=int(fmt.encode_array([start])[0]), adv_period=F18Add.latency)
+                   start_code=int(fmt.encode_array([start])[0]))
 
 
 # -- twins ---------------------------------------------------------------------------------
