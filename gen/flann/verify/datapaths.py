@@ -102,7 +102,8 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
               "code_lo_g": code_lo, "code_hi_g": code_hi, "temps_file_g": str(temps_file),
               "out_file_g": str(out_file)}
-    res = run_cocotb([*design.files, BENCH_DIR / "flann_thermal_sweep.vhd"], "flann_thermal_sweep",
+    # the one sweep harness, with a temperature loop for a two-input design
+    res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
                      "test_thermal_sweep", work, {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
                      name="thermal_sweep", parameters=params, seed=seed, backend=backend)
     rec = res.records.get("thermal_sweep", {})

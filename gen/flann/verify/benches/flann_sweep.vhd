@@ -1,8 +1,11 @@
 -- Simulation-only harness: every input code from code_lo_g to code_hi_g (or, when codes_file_g
--- names a file, the codes listed there, one per line) through flann_top, back to back, one text
--- line per sample ("code data sat latency") in out_file_g.  Stimulus,
--- clock and response stay in VHDL: the cocotb bench (test_sweep.py) is woken once, at done,
--- and checks the whole file against the twin.  Widths and range come in as generics.
+-- names a file, the codes listed there, one per line) through the design's top, back to back,
+-- one text line per sample in out_file_g.  A one-input design (temp_bits_g = 0) is flann_top and
+-- the lines are "code data sat latency"; a two-input design (temp_bits_g > 0) is
+-- flann_thermal_top, the codes run at each temperature code listed in temps_file_g (one per
+-- line) and the lines are "code temp data sat latency".  Stimulus, clock and response stay in
+-- VHDL: the cocotb bench (test_sweep.py, test_thermal_sweep.py) is woken once, at done, and
+-- checks the whole file against the twin.  Widths and ranges come in as generics.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -15,6 +18,8 @@ entity flann_sweep is
     code_lo_g    : integer  := -2048;
     code_hi_g    : integer  := 2047;
     codes_file_g : string   := "";
+    temp_bits_g  : natural  := 0;
+    temps_file_g : string   := "";
     out_file_g   : string   := "sweep.txt";
     half_ns_g    : positive := 5
   );
@@ -24,12 +29,50 @@ entity flann_sweep is
 end entity flann_sweep;
 
 architecture sim of flann_sweep is
+  -- a one-input design has no in_temp: one bit that stays 0 keeps the signal declared
+  function at_least_one (n : natural) return positive is
+  begin
+    if n > 0 then
+      return n;
+    end if;
+    return 1;
+  end function at_least_one;
+
+  -- components, not entity instantiation: only the generated branch's top must exist
+  component flann_top is
+    port (
+      clk       : in  std_logic;
+      rst       : in  std_logic;
+      in_valid  : in  std_logic;
+      in_ready  : out std_logic;
+      in_data   : in  std_logic_vector(in_bits_g - 1 downto 0);
+      out_valid : out std_logic;
+      out_data  : out std_logic_vector(out_bits_g - 1 downto 0);
+      out_sat   : out std_logic
+    );
+  end component flann_top;
+
+  component flann_thermal_top is
+    port (
+      clk       : in  std_logic;
+      rst       : in  std_logic;
+      in_valid  : in  std_logic;
+      in_ready  : out std_logic;
+      in_data   : in  std_logic_vector(in_bits_g - 1 downto 0);
+      in_temp   : in  std_logic_vector(at_least_one(temp_bits_g) - 1 downto 0);
+      out_valid : out std_logic;
+      out_data  : out std_logic_vector(out_bits_g - 1 downto 0);
+      out_sat   : out std_logic
+    );
+  end component flann_thermal_top;
+
   signal clk       : std_logic := '0';
   signal running   : boolean   := true;
   signal rst       : std_logic := '1';
   signal in_valid  : std_logic := '0';
   signal in_ready  : std_logic;
   signal in_data   : std_logic_vector(in_bits_g - 1 downto 0) := (others => '0');
+  signal in_temp   : std_logic_vector(at_least_one(temp_bits_g) - 1 downto 0) := (others => '0');
   signal out_valid : std_logic;
   signal out_data  : std_logic_vector(out_bits_g - 1 downto 0);
   signal out_sat   : std_logic;
@@ -38,17 +81,34 @@ begin
   -- the clock stops after the last sample, so the simulation ends by itself
   clk <= not clk after half_ns_g * 1 ns when running else clk;
 
-  i_dut : entity work.flann_top
-    port map (
-      clk       => clk,
-      rst       => rst,
-      in_valid  => in_valid,
-      in_ready  => in_ready,
-      in_data   => in_data,
-      out_valid => out_valid,
-      out_data  => out_data,
-      out_sat   => out_sat
-    );
+  g_one_input : if temp_bits_g = 0 generate
+    i_dut : component flann_top
+      port map (
+        clk       => clk,
+        rst       => rst,
+        in_valid  => in_valid,
+        in_ready  => in_ready,
+        in_data   => in_data,
+        out_valid => out_valid,
+        out_data  => out_data,
+        out_sat   => out_sat
+      );
+  end generate g_one_input;
+
+  g_two_inputs : if temp_bits_g > 0 generate
+    i_dut : component flann_thermal_top
+      port map (
+        clk       => clk,
+        rst       => rst,
+        in_valid  => in_valid,
+        in_ready  => in_ready,
+        in_data   => in_data,
+        in_temp   => in_temp,
+        out_valid => out_valid,
+        out_data  => out_data,
+        out_sat   => out_sat
+      );
+  end generate g_two_inputs;
 
   p_cycle : process (clk)
   begin
@@ -57,59 +117,86 @@ begin
     end if;
   end process p_cycle;
 
-  -- offer each code until an edge with in_ready high takes it, wait for its result, write it
+  -- offer each code (at each temperature) until an edge with in_ready high takes it, wait for
+  -- its result, write it
   p_run : process
     file f       : text open write_mode is out_file_g;
     file cf      : text;
+    file tf      : text;
     variable st  : file_open_status;
     variable l   : line;
     variable cl  : line;
+    variable tl  : line;
     variable c   : integer;
+    variable t   : integer := 0;
     variable t0  : natural;
     variable ok  : boolean;
     variable lst : boolean := codes_file_g'length > 0;
+    variable two : boolean := temp_bits_g > 0;
   begin
     done <= '0';
-    if lst then
-      file_open(st, cf, codes_file_g, read_mode);
-      assert st = open_ok report "cannot open " & codes_file_g severity failure;
+    if two then
+      file_open(st, tf, temps_file_g, read_mode);
+      assert st = open_ok report "cannot open " & temps_file_g severity failure;
     end if;
     wait until rising_edge(clk);
     wait until rising_edge(clk);
     rst <= '0';
-    c := code_lo_g;
+    -- one pass over the codes per temperature code (a one-input design: one pass)
     loop
-      if lst then
-        exit when endfile(cf);
-        readline(cf, cl);
-        read(cl, c, ok);
+      if two then
+        exit when endfile(tf);
+        readline(tf, tl);
+        read(tl, t, ok);
         next when not ok;
-      else
-        exit when c > code_hi_g;
+        in_temp <= std_logic_vector(to_signed(t, at_least_one(temp_bits_g)));
       end if;
-      in_data  <= std_logic_vector(to_signed(c, in_bits_g));
-      in_valid <= '1';
+      if lst then
+        file_open(st, cf, codes_file_g, read_mode);
+        assert st = open_ok report "cannot open " & codes_file_g severity failure;
+      end if;
+      c := code_lo_g;
       loop
-        wait until rising_edge(clk);
-        exit when in_ready = '1';
+        if lst then
+          exit when endfile(cf);
+          readline(cf, cl);
+          read(cl, c, ok);
+          next when not ok;
+        else
+          exit when c > code_hi_g;
+        end if;
+        in_data  <= std_logic_vector(to_signed(c, in_bits_g));
+        in_valid <= '1';
+        loop
+          wait until rising_edge(clk);
+          exit when in_ready = '1';
+        end loop;
+        t0       := cycle;
+        in_valid <= '0';
+        wait until rising_edge(clk) and out_valid = '1';
+        write(l, c);
+        write(l, ' ');
+        if two then
+          write(l, t);
+          write(l, ' ');
+        end if;
+        write(l, to_integer(signed(out_data)));
+        write(l, ' ');
+        if out_sat = '1' then
+          write(l, 1);
+        else
+          write(l, 0);
+        end if;
+        write(l, ' ');
+        -- out_valid rose after the previous edge: that edge is the one the latency counts
+        write(l, cycle - t0 - 1);
+        writeline(f, l);
+        c := c + 1;
       end loop;
-      t0       := cycle;
-      in_valid <= '0';
-      wait until rising_edge(clk) and out_valid = '1';
-      write(l, c);
-      write(l, ' ');
-      write(l, to_integer(signed(out_data)));
-      write(l, ' ');
-      if out_sat = '1' then
-        write(l, 1);
-      else
-        write(l, 0);
+      if lst then
+        file_close(cf);
       end if;
-      write(l, ' ');
-      -- out_valid rose after the previous edge: that edge is the one the latency counts
-      write(l, cycle - t0 - 1);
-      writeline(f, l);
-      c := c + 1;
+      exit when not two;
     end loop;
     file_close(f);  -- flushed before the bench reads it
     running <= false;

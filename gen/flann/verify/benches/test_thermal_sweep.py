@@ -1,4 +1,4 @@
-"""Two-input sweep: the VHDL harness flann_thermal_sweep.vhd drives every voltage code at each
+"""Two-input sweep: the VHDL harness flann_sweep.vhd (temp_bits_g > 0) drives every voltage code at each
 listed temperature code and writes one line per sample; this bench wakes once, at done, and
 checks the whole file against the twin (hardware/thermal/twin.py)."""
 
