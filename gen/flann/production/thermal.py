@@ -9,8 +9,9 @@ calibration temperature (no HDL simulation: the design's twin stands for it).
    the recording's own temperatures;
 3. the recording through the hardware: each row's voltage code and temperature code into
    the twin; the error, by temperature, and the drift figure ``drift_ppm_fs_per_c`` (the
-   largest change of the error between two calibration temperatures per degC, in ppm of the
-   recorded span: :func:`flann.golden.thermal_metrics.drift_ppm_fs_per_c`), for the hardware
+   largest change of the error between two calibration temperatures per degC, in ppm of full
+   scale, half the recorded span, as ``flann eval --json`` reports it:
+   :func:`flann.golden.thermal_metrics.drift_ppm_fs_per_c`), for the hardware
    and the raw sensor (its one least-squares line over every temperature).
 """
 
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..golden.metrics import raw_output_mm
+from ..golden.metrics import full_scale_mm, raw_output_mm
 from ..golden.thermal import temperature_groups
 from ..golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
 from ..hardware.family.spec import FitError
@@ -63,7 +64,7 @@ def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
     raw_err = raw_output_mm(v, x) - x
     dxdv = (model.predict(v + lsb / 2, t) - model.predict(v - lsb / 2, t)) / lsb
     limit = 0.5 * lsb * np.abs(dxdv)
-    fs = float(np.ptp(x)) or 1.0
+    fs = full_scale_mm(x)   # flann eval's full scale (half the span): one drift figure
     return {"model": model, "words": words, "twin_err_lsb": twin_err, "bound_lsb": float(spec.analysis["bound_lsb"]),
             "hw_err_mm": err, "raw_err_mm": raw_err, "limit_mm": limit, "rec": rec, "temperature_c": t,
             "temperatures_c": [float(a) for a in levels], "labels": labels, "full_scale_mm": fs,
