@@ -27,13 +27,10 @@ from ..hardware.family_thermal.build import fit_sensor
 from ..hardware.family_thermal.spec import FamilyThermalSpec
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop, encode_image
 
-RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)
-
-
-def train_for_design(rec, spec: FamilyThermalSpec):
-    """(model, image words): the least ridge whose every order fits the design's formats."""
+def train_for_design(rec, spec: FamilyThermalSpec, ridges):
+    """(model, image words): the least of ``ridges`` whose every order fits the design's formats."""
     last = None
-    for ridge in RIDGES:
+    for ridge in ridges:
         model = fit_sensor(rec, spec.temp, spec.fam.terms, spec.orders, ridge)
         try:
             return model, encode_image(spec, model)
@@ -47,9 +44,10 @@ def temperature_codes(spec: FamilyThermalSpec, temperature_c) -> np.ndarray:
     return np.clip(t, spec.temp.code_min, spec.temp.code_max)
 
 
-def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
-    """Train, quantise and check one sensor's multi-temperature recordings (see the module doc)."""
-    model, words = train_for_design(rec, spec)
+def check_sensor_thermal(rec, spec: FamilyThermalSpec, ridges) -> dict:
+    """Train (``ridges`` tried in order), quantise and check one sensor's multi-temperature
+    recordings (see the module doc)."""
+    model, words = train_for_design(rec, spec, ridges)
     twin = FlannFamilyThermalTop(spec, words)
     levels, labels = temperature_groups(rec.temperature_c)
     tcodes = temperature_codes(spec, rec.temperature_c)
@@ -74,4 +72,4 @@ def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
             "temperature_checked_codes": check_codes}
 
 
-__all__ = ["check_sensor_thermal", "train_for_design", "temperature_codes", "RIDGES"]
+__all__ = ["check_sensor_thermal", "train_for_design", "temperature_codes"]
