@@ -23,7 +23,8 @@ def add_family_arguments(parser) -> None:
     g = parser.add_argument_group("one design for a family of sensors (docs/production.md)")
     g.add_argument("--family", nargs="+", metavar="REC_OR_MODEL", default=None,
                    help="size one design for these sensors (recordings .csv or model .json); per-sensor "
-                        "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data")
+                        "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data; recordings "
+                        "at several temperatures add in_temp and one memory per temperature order")
     g.add_argument("--terms", type=_terms, default=DEFAULT_TERMS,
                    help="--family: expansion terms when training recordings (default %(default)s), or "
                         "'auto': chosen like flann train --terms auto at the design's converter, for the "

@@ -16,6 +16,10 @@ the bit-true twin of the family design stands for it):
 5. write ``OUTDIR/<sensor>/``: model.json, weights.hex, weights.mem, weights.bmm and
    certificate.html, all or nothing.
 
+A family design with temperature (``hardware/family_thermal``) takes multi-temperature
+recordings instead (:func:`calibrate_one_thermal`, :mod:`.thermal`): the same steps with the
+two-input model, a verdict at each temperature and the drift figure.
+
 :func:`calibrate_batch` runs recordings over a process pool; a bad recording becomes a
 ``failed`` row with its reason and the batch goes on; ``summary.csv`` is written last.
 """
@@ -318,7 +322,7 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
             if rec.temperature_c is None:
                 raise FlannError(f"{path}: no temperature_c column; the design compensates temperature "
                                  f"({fam.orders} orders): calibrate at {fam.orders} or more temperatures")
-            chk = check_sensor_thermal(rec, fam)
+            chk = check_sensor_thermal(rec, fam, RIDGES)
         res.warnings += [str(w.message) for w in caught]
         err, x = chk["hw_err_mm"], np.asarray(rec.displacement_mm, dtype=float)
         res.twin_vs_float_lsb = chk["twin_err_lsb"]

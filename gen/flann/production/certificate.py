@@ -123,7 +123,8 @@ def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, find
         ("drift_ppm_fs_per_c (hardware)", drift(chk["drift_ppm_fs_per_c"])),
         ("drift_ppm_fs_per_c (raw sensor)", drift(chk["raw_drift_ppm_fs_per_c"])),
         ("drift method", "largest change of the error between two calibration temperatures at one position, "
-                         f"per degC, in ppm of the recorded span ({chk['full_scale_mm']:.4g} mm)"),
+                         f"per degC, in ppm of full scale ({chk['full_scale_mm']:.4g} mm, half the recorded span, "
+                         "as flann eval reports it)"),
         ("physical limit, worst over the stroke", f"{res.limit_mm:.4g} mm"),
         ("uncertainty method", uncertainty.method + " (the largest of the temperatures')"),
     ])

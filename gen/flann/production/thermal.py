@@ -9,8 +9,9 @@ calibration temperature (no HDL simulation: the design's twin stands for it).
    the recording's own temperatures;
 3. the recording through the hardware: each row's voltage code and temperature code into
    the twin; the error, by temperature, and the drift figure ``drift_ppm_fs_per_c`` (the
-   largest change of the error between two calibration temperatures per degC, in ppm of the
-   recorded span: :func:`flann.golden.thermal_metrics.drift_ppm_fs_per_c`), for the hardware
+   largest change of the error between two calibration temperatures per degC, in ppm of full
+   scale, half the recorded span, as ``flann eval --json`` reports it:
+   :func:`flann.golden.thermal_metrics.drift_ppm_fs_per_c`), for the hardware
    and the raw sensor (its one least-squares line over every temperature).
 """
 
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..golden.metrics import raw_output_mm
+from ..golden.metrics import full_scale_mm, raw_output_mm
 from ..golden.thermal import temperature_groups
 from ..golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
 from ..hardware.family.spec import FitError
@@ -26,13 +27,10 @@ from ..hardware.family_thermal.build import fit_sensor
 from ..hardware.family_thermal.spec import FamilyThermalSpec
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop, encode_image
 
-RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)
-
-
-def train_for_design(rec, spec: FamilyThermalSpec):
-    """(model, image words): the least ridge whose every order fits the design's formats."""
+def train_for_design(rec, spec: FamilyThermalSpec, ridges):
+    """(model, image words): the least of ``ridges`` whose every order fits the design's formats."""
     last = None
-    for ridge in RIDGES:
+    for ridge in ridges:
         model = fit_sensor(rec, spec.temp, spec.fam.terms, spec.orders, ridge)
         try:
             return model, encode_image(spec, model)
@@ -46,9 +44,10 @@ def temperature_codes(spec: FamilyThermalSpec, temperature_c) -> np.ndarray:
     return np.clip(t, spec.temp.code_min, spec.temp.code_max)
 
 
-def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
-    """Train, quantise and check one sensor's multi-temperature recordings (see the module doc)."""
-    model, words = train_for_design(rec, spec)
+def check_sensor_thermal(rec, spec: FamilyThermalSpec, ridges) -> dict:
+    """Train (``ridges`` tried in order), quantise and check one sensor's multi-temperature
+    recordings (see the module doc)."""
+    model, words = train_for_design(rec, spec, ridges)
     twin = FlannFamilyThermalTop(spec, words)
     levels, labels = temperature_groups(rec.temperature_c)
     tcodes = temperature_codes(spec, rec.temperature_c)
@@ -63,7 +62,7 @@ def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
     raw_err = raw_output_mm(v, x) - x
     dxdv = (model.predict(v + lsb / 2, t) - model.predict(v - lsb / 2, t)) / lsb
     limit = 0.5 * lsb * np.abs(dxdv)
-    fs = float(np.ptp(x)) or 1.0
+    fs = full_scale_mm(x)   # flann eval's full scale (half the span): one drift figure
     return {"model": model, "words": words, "twin_err_lsb": twin_err, "bound_lsb": float(spec.analysis["bound_lsb"]),
             "hw_err_mm": err, "raw_err_mm": raw_err, "limit_mm": limit, "rec": rec, "temperature_c": t,
             "temperatures_c": [float(a) for a in levels], "labels": labels, "full_scale_mm": fs,
@@ -73,4 +72,4 @@ def check_sensor_thermal(rec, spec: FamilyThermalSpec) -> dict:
             "temperature_checked_codes": check_codes}
 
 
-__all__ = ["check_sensor_thermal", "train_for_design", "temperature_codes", "RIDGES"]
+__all__ = ["check_sensor_thermal", "train_for_design", "temperature_codes"]
