@@ -92,6 +92,8 @@ def measure(hdl: Path, device: str) -> dict:
         "table_brams": rep["entities"].get("flann_expansion", {}).get("brams"),
         "fits": rep["fits"], "smallest": rep["smallest_device"],
         "fmax_mhz_estimate": (rep.get("timing") or {}).get("fmax_mhz_estimate"),
+        "estimate": man.get("analysis", {}).get("estimate"),
+        "entities": {k: v["luts"] for k, v in rep["entities"].items()},
     }
 
 

@@ -932,23 +932,27 @@ def estimate_resources(spec: Spec) -> dict:
     """Rough pre-synthesis estimate (LUT4, FF, block RAM) used to reject hopeless requests.
 
     Coefficients calibrated on `flann synth` (GHDL + yosys synth_xilinx -family xcv) of the
-    51-term default in both multiplier styles; ``flann synth`` gives the measured figures.
+    51-term default in both multiplier styles, the shift-add ones again on the 40 e2e designs of
+    bench/small_parts.py (1.03-1.13x measured); ``flann synth`` gives the measured figures.
     """
     L = spec.lanes
     T, W = spec.term_fmt.width, spec.weight_fmt.width
     P, A = spec.phase_bits, spec.table_addr_bits
     C, Dq = spec.slope_fmt.width, spec.dq_bits
     serial = spec.serial_interp
-    mult = 5.3 * T * W if spec.mult_style == "lut" else 5.5 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1)
+    # shift-add: one adder per weight digit, and the weight ROM when it stays in LUTs
+    rom = spec.steps * W / 16 if spec.steps * W <= 2048 else 0
+    mult = 5.3 * T * W if spec.mult_style == "lut" else 3.2 * (T + W) + 1.5 * T * (spec.mult_digit_bits - 1) + rom
     # slope correction: array multiplier, or serial between advances (shift-add designs)
     interp = 0 if not spec.interp else (6.3 * (Dq + C) if serial else 4.6 * Dq * (C + 1))
     if spec.shared_table:  # the difference's subtractor and the second port's address increment
         interp += C + A
-    expansion = interp + 3.4 * P
-    norm = 2 * (P + spec.norm_guard + spec.lin_width)
+    expansion = interp + 3.4 * P - T  # the quadrant's negation folded into one adder
+    norm = P + spec.norm_guard + spec.lin_width  # LSB first: one adder per product, no offset adder
     adder = 3.6 * spec.acc_fmt.width + (L - 1) * spec.acc_fmt.width
     luts = L * (mult + expansion) + norm + adder + 30
-    ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + norm + spec.acc_fmt.width + 40
+    # the normaliser's accumulators and its output registers
+    ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + 2 * norm + spec.acc_fmt.width + 40
     # each lane reads its own copy
     tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp and not spec.shared_table else [])
     brams = L * table_brams(A, tables)
