@@ -933,7 +933,7 @@ def estimate_resources(spec: Spec) -> dict:
 
     Coefficients calibrated on `flann synth` (GHDL + yosys synth_xilinx -family xcv) of the
     51-term default in both multiplier styles, the shift-add ones again on the 40 e2e designs of
-    bench/small_parts.py (1.03-1.13x measured); ``flann synth`` gives the measured figures.
+    bench/small_parts.py (1.00-1.13x measured); ``flann synth`` gives the measured figures.
     """
     L = spec.lanes
     T, W = spec.term_fmt.width, spec.weight_fmt.width
