@@ -111,33 +111,24 @@ def signed_range(bits: int) -> tuple[int, int]:
     return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
 
 
+def _code_bound(bits_field: str, end: int) -> property:
+    """The lowest (end 0) or highest (end 1) code of the signed word ``spec.<bits_field>`` bits wide."""
+    return property(lambda spec: signed_range(getattr(spec, bits_field))[end])
+
+
 class InputCodes:
     """``code_min``/``code_max``: the range of a spec's signed ``input_bits``-bit input code."""
 
-    input_bits: int
-
-    @property
-    def code_min(self) -> int:
-        return signed_range(self.input_bits)[0]
-
-    @property
-    def code_max(self) -> int:
-        return signed_range(self.input_bits)[1]
+    code_min = _code_bound("input_bits", 0)
+    code_max = _code_bound("input_bits", 1)
 
 
 class TempCodes:
     """``temp_code_min``/``temp_code_max``: the range of a spec's signed ``temp_bits``-bit
     temperature code."""
 
-    temp_bits: int
-
-    @property
-    def temp_code_min(self) -> int:
-        return signed_range(self.temp_bits)[0]
-
-    @property
-    def temp_code_max(self) -> int:
-        return signed_range(self.temp_bits)[1]
+    temp_code_min = _code_bound("temp_bits", 0)
+    temp_code_max = _code_bound("temp_bits", 1)
 
 
 def bits_needed(lo: int, hi: int, signed: bool = True) -> int:
