@@ -64,7 +64,7 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
     files = _write(tmp_path)
     entity = f"flann_f18_{kind}"
     spec = {"kind": kind, "format": FLOAT18.to_dict(), "n_random": N_RANDOM}
-    r = run_cocotb([files[f"{entity}.vhd"]], entity, f"test_f18_{kind}", tmp_path / "sim_build", spec,
+    r = run_cocotb([files[f"{entity}.vhd"]], entity, "test_f18_block", tmp_path / "sim_build", spec,
                    seed=1000 + sorted(BLOCKS).index(kind))
     assert r.ok, f"{entity}: {r.failed_tests} (see {tmp_path / 'sim_build'})"
 

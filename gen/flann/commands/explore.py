@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..argtypes import bounded
 from ..implement import explore
+from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
 from ..hardware.registry import FORMATS, datapath_for_model, read_design
 from ..hardware.target import DEFAULT_PART
@@ -41,7 +42,7 @@ def add_arguments(p):
                    help="add the float18 rows: the serial float18 design and the seed's arithmetic in float18")
     p.add_argument("--abc", choices=("fast", "full"), default="fast",
                    help="yosys LUT mapping (default fast: abc -fast; full = synth_xilinx as is, slow)")
-    p.add_argument("--input-bits", type=bounded(int, 4, 32), default=None, metavar="B",
+    p.add_argument("--input-bits", type=bounded(int, *ADC_BITS), default=None, metavar="B",
                    help="ADC width in bits, as for flann gen (default: flann gen's)")
     p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None, metavar="V",
                    help="volts per ADC code, as for flann gen (default: flann gen's)")

@@ -97,8 +97,22 @@ def evaluate(v_n, weights, bias: float = 0.0) -> np.ndarray:
     return out
 
 
+class ModelFile:
+    """A model's file, for every model kind: ``to_dict()`` as JSON (two-space indent, final
+    newline), written atomically, so every model.json is laid out alike."""
+
+    def to_dict(self) -> dict:
+        raise NotImplementedError
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    def save(self, path: str | Path) -> None:
+        atomic_write_text(path, self.to_json())
+
+
 @dataclass(frozen=True)
-class FlannModel:
+class FlannModel(ModelFile):
     weights: tuple[float, ...]
     bias: float = 0.0
     input_offset_v: float = 0.0
@@ -138,12 +152,6 @@ class FlannModel:
             "displacement_range_mm": list(self.displacement_range_mm),
             "training": self.training,
         }
-
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2) + "\n"
-
-    def save(self, path: str | Path) -> None:
-        atomic_write_text(path, self.to_json())
 
     @classmethod
     def from_dict(cls, d: dict, source: str = "<dict>") -> "FlannModel":
@@ -195,5 +203,5 @@ def model_sha256(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-__all__ = ["FORMAT", "MAX_TERMS", "FlannModel", "evaluate", "expand", "harmonics", "load_model", "model_sha256",
+__all__ = ["FORMAT", "MAX_TERMS", "FlannModel", "ModelFile", "evaluate", "expand", "harmonics", "load_model", "model_sha256",
            "term_kind", "asdict"]

@@ -28,7 +28,6 @@ per order, each result folded in by one multiply by the temperature.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,9 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelFileError
-from ..fileio import atomic_write_text
 from ..inputs import number, parse_json, read_text
-from .model import MAX_TERMS, FlannModel, evaluate, expand
+from .model import MAX_TERMS, FlannModel, ModelFile, evaluate, expand
 
 FORMAT = "flann-thermal-model/1"
 INPUTS = ("voltage_v", "temperature_c")
@@ -88,7 +86,7 @@ def corrected_voltage(voltage_v, t_n, gain_t, offset_t_v) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class ThermalModel:
+class ThermalModel(ModelFile):
     weights: tuple[tuple[float, ...], ...]   # per temperature order j
     bias: tuple[float, ...]                  # per temperature order j
     input_offset_v: float = 0.0
@@ -175,12 +173,6 @@ class ThermalModel:
             "displacement_range_mm": list(self.displacement_range_mm),
             "training": self.training,
         }
-
-    def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2) + "\n"
-
-    def save(self, path: str | Path) -> None:
-        atomic_write_text(path, self.to_json())
 
     @classmethod
     def from_dict(cls, d: dict, source: str = "<dict>") -> "ThermalModel":

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import SpecError
 from ..golden.model import FlannModel
 
+ADC_BITS = (4, 32)           # ADC widths accepted (wider ones give their top MAX_DESIGN_INPUT_BITS)
 MAX_DESIGN_INPUT_BITS = 16   # widest ADC code the datapath takes (serial normaliser, guard bits)
 MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
 SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)
@@ -62,8 +63,9 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
     * a trained range using under 1/16 of the ADC's range is said (resolution thrown away).
     """
     if isinstance(input_bits, bool) or not isinstance(input_bits, (int, np.integer)) or \
-            not 4 <= int(input_bits) <= 32:
-        raise SpecError(f"input_bits = {input_bits!r} (--input-bits): must be an integer in 4..32 (the design "
+            not ADC_BITS[0] <= int(input_bits) <= ADC_BITS[1]:
+        raise SpecError(f"input_bits = {input_bits!r} (--input-bits): must be an integer in "
+                        f"{ADC_BITS[0]}..{ADC_BITS[1]} (the design "
                         f"takes at most the top {MAX_DESIGN_INPUT_BITS})")
     bits = int(input_bits)
     lsb_given = input_lsb_v is not None
@@ -167,6 +169,6 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
             "larger --ridge, or give a coarser --output-lsb-mm")
 
 
-__all__ = ["AdcPlan", "plan_adc", "default_input_lsb", "default_output_step_mm", "max_mm_per_v",
-           "model_accuracy_mm", "pathological_hint", "weight_range_text",
+__all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "default_input_lsb", "default_output_step_mm",
+           "max_mm_per_v", "model_accuracy_mm", "pathological_hint", "weight_range_text",
            "MAX_DESIGN_INPUT_BITS"]

@@ -111,6 +111,26 @@ def signed_range(bits: int) -> tuple[int, int]:
     return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
 
 
+def _code_bound(bits_field: str, end: int) -> property:
+    """The lowest (end 0) or highest (end 1) code of the signed word ``spec.<bits_field>`` bits wide."""
+    return property(lambda spec: signed_range(getattr(spec, bits_field))[end])
+
+
+class InputCodes:
+    """``code_min``/``code_max``: the range of a spec's signed ``input_bits``-bit input code."""
+
+    code_min = _code_bound("input_bits", 0)
+    code_max = _code_bound("input_bits", 1)
+
+
+class TempCodes:
+    """``temp_code_min``/``temp_code_max``: the range of a spec's signed ``temp_bits``-bit
+    temperature code."""
+
+    temp_code_min = _code_bound("temp_bits", 0)
+    temp_code_max = _code_bound("temp_bits", 1)
+
+
 def bits_needed(lo: int, hi: int, signed: bool = True) -> int:
     """Smallest width holding every integer in [lo, hi]."""
     lo, hi = int(lo), int(hi)
@@ -161,5 +181,5 @@ def bits_literal(value: int, width: int, signed: bool = True) -> str:
     return '"' + format(value & ((1 << width) - 1), f"0{width}b") + '"'
 
 
-__all__ = ["FixedFormat", "bits_needed", "wrap", "round_shift", "saturate", "bits_literal",
-           "ROUNDING", "OVERFLOW"]
+__all__ = ["FixedFormat", "InputCodes", "TempCodes", "bits_needed", "signed_range", "wrap", "round_shift",
+           "saturate", "bits_literal", "ROUNDING", "OVERFLOW"]

@@ -36,7 +36,7 @@ from .. import adc
 from .. import target as spartan2
 from .latency import ADDER_EDGES, EXPANSION_ADVANCES, MULTIPLIER_ADVANCES, SEQ_START_EDGES, norm_latency
 from ...errors import SpecError
-from ...numeric.fixed import FixedFormat, bits_needed, signed_range
+from ...numeric.fixed import FixedFormat, InputCodes, bits_needed, signed_range
 from ...golden.model import FlannModel, term_kind
 from ..options import MULT_STYLES, GenOptions
 
@@ -74,7 +74,7 @@ def round_sig(x: float, sig: int = 3, up: bool = True) -> float:
 
 
 @dataclass(frozen=True)
-class FrontEnd:
+class FrontEnd(InputCodes):
     """The shared front end (flann_norm, flann_expansion) as one record: the input stage, the
     normaliser's constants, the expansion's tables and the pace of its advances.  The templates
     and twins of flann_norm and flann_expansion read it; the float18 datapath is this plus its
@@ -122,14 +122,6 @@ class FrontEnd:
     @property
     def n_trig(self) -> int:
         return self.model.terms - 1
-
-    @property
-    def code_min(self) -> int:
-        return signed_range(self.input_bits)[0]
-
-    @property
-    def code_max(self) -> int:
-        return signed_range(self.input_bits)[1]
 
     @property
     def phase_frac_bits(self) -> int:

@@ -57,6 +57,11 @@ def float18_options(options: GenOptions, fixed_too: bool = False) -> dict:
             if k in FRONT_END_OPTIONS or (k in changed and not fixed_too)}
 
 
+def _front_value(name: str) -> property:
+    """A read-only attribute of the spec's front end (``spec.front.<name>``)."""
+    return property(lambda spec: getattr(spec.front, name))
+
+
 @dataclass(frozen=True)
 class F18Spec:
     """The shared fixed-point front end (input, normaliser, expansion) plus the float18
@@ -69,14 +74,12 @@ class F18Spec:
 
     number_format = "float18"
 
-    @property
-    def model(self) -> FlannModel:
-        return self.front.model
-
-    @property
-    def adv_period(self) -> int:
-        """Cycles per term: the adder's latency (its result forwarded), the front end's pace."""
-        return self.front.adv_period
+    # the shared front end's own values, under the same names
+    model = _front_value("model")
+    # cycles per term: the adder's latency (its result forwarded), the front end's pace
+    adv_period = _front_value("adv_period")
+    code_min = _front_value("code_min")
+    code_max = _front_value("code_max")
 
     @property
     def terms(self) -> int:
@@ -85,14 +88,6 @@ class F18Spec:
     @property
     def term_frac_bits(self) -> int:
         return self.front.term_fmt.frac_bits
-
-    @property
-    def code_min(self) -> int:
-        return self.front.code_min
-
-    @property
-    def code_max(self) -> int:
-        return self.front.code_max
 
     @property
     def n_advs(self) -> int:

@@ -50,7 +50,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel, corrected_voltage
-from ...numeric.fixed import FixedFormat, bits_needed, signed_range
+from ...numeric.fixed import FixedFormat, InputCodes, TempCodes, bits_needed, signed_range
 from ..fixed.spec import Spec, derive_spec, nice_125
 
 MAX_FINE_BITS = 16          # the one-input datapath's widest input
@@ -63,7 +63,7 @@ SHARE = {"orders": 0.2, "horner": 0.05, "curvature": 0.1, "fraction": 0.05, "gai
 
 
 @dataclass(frozen=True)
-class ThermalSpec:
+class ThermalSpec(InputCodes, TempCodes):
     model: ThermalModel = field(repr=False, compare=False)
     input_bits: int
     input_lsb_v: float
@@ -87,22 +87,6 @@ class ThermalSpec:
     out_fmt: FixedFormat
     orders: tuple[Spec, ...] = field(repr=False)
     analysis: dict = field(default_factory=dict, compare=False)
-
-    @property
-    def code_min(self) -> int:
-        return signed_range(self.input_bits)[0]
-
-    @property
-    def code_max(self) -> int:
-        return signed_range(self.input_bits)[1]
-
-    @property
-    def temp_code_min(self) -> int:
-        return signed_range(self.temp_bits)[0]
-
-    @property
-    def temp_code_max(self) -> int:
-        return signed_range(self.temp_bits)[1]
 
     @property
     def horner_degree(self) -> int:

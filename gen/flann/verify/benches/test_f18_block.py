@@ -1,4 +1,5 @@
-"""cocotb tests of flann_f18_mul against its twin F18Mul (bit-exact, cycle by cycle)."""
+"""cocotb tests of a float18 block (flann_f18_mul or flann_f18_add, the spec's ``kind``) against
+its twin (F18Mul, F18Add), bit-exact, cycle by cycle."""
 
 import cocotb
 from flann.verify.benches.f18_bench import Bench, stimuli
@@ -8,7 +9,7 @@ from flann.verify.benches.f18_bench import Bench, stimuli
 async def corners_and_random(dut):
     tb = Bench(dut)
     await tb.start()
-    items = stimuli("mul", tb.fmt, tb.rng, int(tb.spec["n_random"]))
+    items = stimuli(tb.spec["kind"], tb.fmt, tb.rng, int(tb.spec["n_random"]))
     await tb.run(items)
     tb.finish(min_checked=len(items))
 
@@ -17,6 +18,6 @@ async def corners_and_random(dut):
 async def reset_drops_inflight(dut):
     tb = Bench(dut)
     await tb.start()
-    items = stimuli("mul", tb.fmt, tb.rng, 40)[-60:]
+    items = stimuli(tb.spec["kind"], tb.fmt, tb.rng, 40)[-60:]
     await tb.run(items, reset_at=20)
     tb.finish(min_checked=len(items) - 2 * tb.twin.latency)
