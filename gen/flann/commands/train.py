@@ -181,8 +181,7 @@ def run(args) -> int:
         # the noise is in v: near the flat ends the readings go onto the forward curve first
         ends = settle_ends(rec.displacement_mm, rec.voltage_v)
         provenance["ends_settled"] = {"windows": list(ends.windows), "degrees": list(ends.degrees)}
-        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
-                                 fit_voltage_v=ends.voltage_v,
+        model, choice = fit_auto(ends.voltage_v, rec.displacement_mm, training=provenance,
                                  cost=lambda m: fixed_point_cost(m, adc))
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "

@@ -420,15 +420,13 @@ def _key(r: CvResult) -> dict:
 
 def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NORMS,
              ridges=AUTO_RIDGES, training: dict | None = None,
-             cost=None, fit_voltage_v=None) -> tuple[FlannModel, CvResult]:
+             cost=None) -> tuple[FlannModel, CvResult]:
     """Choose (terms, norm, ridge) by cross-validation, then fit on all points.
 
     ``cost(model) -> {"buildable": bool, "cost": float, "why": str, ...}`` (lower is
     cheaper): with it, the cheapest buildable model as good as the best buildable one
     (:func:`as_good`); when none builds, the best-scoring candidate (the record says why).
     Without it, :func:`pick` (fewest terms within 2 % of the best RMS).
-    ``fit_voltage_v``: the readings the chosen candidate is fitted to (default: the ones it
-    was chosen on; they are what the held-out error is judged against).
     """
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
@@ -453,8 +451,7 @@ def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NO
     info.update({"cv_heldout_rms_error_mm": choice.rms_mm,
                  "cv_heldout_max_error_mm": choice.max_mm})
     info.update(training or {})
-    vf = v if fit_voltage_v is None else np.asarray(fit_voltage_v, dtype=float)
-    model = fit_lstsq(vf, x, choice.terms, norm=choice.norm, ridge=choice.ridge, training=info)
+    model = fit_lstsq(v, x, choice.terms, norm=choice.norm, ridge=choice.ridge, training=info)
     return model, choice
 
 
