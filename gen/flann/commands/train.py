@@ -12,7 +12,7 @@ import numpy as np
 from ..argtypes import bounded
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
-from ..golden.forward import (MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers,
+from ..golden.forward import (END_WINDOW, MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers,
                               settle_ends)
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
@@ -180,7 +180,7 @@ def run(args) -> int:
         adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
         # the noise is in v: near the flat ends the readings go onto the forward curve first
         ends = settle_ends(rec.displacement_mm, rec.voltage_v)
-        provenance["ends_settled"] = {"windows": list(ends.windows), "degrees": list(ends.degrees)}
+        provenance["ends_settled"] = {"window": END_WINDOW, "degrees": list(ends.degrees)}
         model, choice = fit_auto(ends.voltage_v, rec.displacement_mm, training=provenance,
                                  cost=lambda m: fixed_point_cost(m, adc))
         t = model.training

@@ -310,17 +310,12 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
 # Where the sensor's slope is low (a saturating curve's ends) a reading's noise costs the most
 # displacement, and a least-squares fit of x(v) is pulled toward the interior there: the
 # noise is in v, the regressor (measured on the e2e sensor family: the held-out max error sat
-# at the first or last 1 % of the stroke, biased inward, for 9 of 10 sensors).  Within a
-# share of the stroke from each end (one of these, by held-out error) the readings are moved
-# toward a polynomial v(x), the curve's own smooth shape there, fading linearly to the
-# readings as read at the window's inner edge.  Up to 0.3: of 0.2-0.5 the best held-out max
-# error on tuning sensors; 0.1 for a curve that rolls over at the end (the paper's LVDT).
-END_WINDOWS = (0.1, 0.2, 0.3)
+# at the first or last 1 % of the stroke, biased inward, for 9 of 10 sensors).  Within this
+# share of the stroke from each end the readings are moved onto a polynomial v(x), the
+# curve's own smooth shape there, blended linearly into the readings as read by the window's
+# inner edge.  0.3: of 0.2-0.5 the best held-out max error on tuning sensors.
+END_WINDOW = 0.3
 END_MAX_DEGREE = 6
-# the share of the move made at the very end: half (the settled and the read end weigh
-# alike); measured on tuning sensors, 0.5 and 0.7 both lowered the median and the worst
-# held-out max error where a full move (1.0) raised the worst
-END_BLEND = 0.5
 END_MIN_SPARE = 4   # positions beyond the polynomial's coefficients before a degree is tried
 
 
@@ -330,14 +325,12 @@ class Ends:
 
     voltage_v: np.ndarray
     degrees: tuple[int, int]
-    windows: tuple[float, float]
 
 
-def _end_polynomial(t, v, w, judge) -> tuple[float, int, np.ndarray] | None:
-    """(score, degree, fitted v) of the polynomial in t (0 at the end, 1 at the window's
-    edge) with the smallest leave-one-out error in displacement units (the residual over the
-    fit's slope: an error in v costs most where the curve is flat) on the positions
-    ``judge``; None with too few positions."""
+def _end_polynomial(t, v, w) -> tuple[int, np.ndarray] | None:
+    """(degree, fitted v) of the polynomial in t (0 at the end, 1 at the window's edge) with
+    the smallest leave-one-out error in displacement units (the residual over the fit's
+    slope: an error in v costs most where the curve is flat); None with too few positions."""
     best = None
     sw = np.sqrt(w)
     for deg in range(1, END_MAX_DEGREE + 1):
@@ -352,47 +345,38 @@ def _end_polynomial(t, v, w, judge) -> tuple[float, int, np.ndarray] | None:
         slope = np.abs(np.polynomial.polynomial.polyval(t, np.polynomial.polynomial.polyder(coef)))
         if not np.all(slope > 0):
             continue   # flat or turning inside the window: no inverse from this one
-        score = float(np.mean((w * (loo / slope) ** 2)[judge]))
+        score = float(np.mean(w * (loo / slope) ** 2))
         if best is None or score < best[0]:
             best = (score, deg, fit)
-    return best
+    return None if best is None else (best[1], best[2])
 
 
-def settle_ends(x, v, windows=END_WINDOWS) -> Ends:
+def settle_ends(x, v, window: float = END_WINDOW) -> Ends:
     """Readings near each end of the stroke moved onto a polynomial v(x) fitted there.
 
-    Per end, the window (a share of the stroke) and the degree with the smallest held-out
-    error on the positions of the smallest window (a curve that rolls over at the end needs
-    a short window).  The readings of one position move together (their mean onto the
-    polynomial, their scatter kept); the move is full at the end and fades linearly to none
-    at the window's inner edge.  A window with too few positions for a line and
-    ``END_MIN_SPARE`` more is left as read.
+    The readings of one position move together (their mean onto the polynomial, their
+    scatter kept); the move is full at the end and fades linearly to none at ``window`` of
+    the stroke from it.  A window with too few positions for a line and ``END_MIN_SPARE``
+    more is left as read.
     """
     x = np.asarray(x, float)
     v = np.asarray(v, float)
     pos = aggregate(x, v)
     lo, hi = float(pos.x[0]), float(pos.x[-1])
     moved = pos.v.copy()
-    degrees, used = [], []
+    degrees = []
     for dist in (pos.x - lo, hi - pos.x):
-        best = None
-        for win in (windows if hi > lo else ()):
-            sel = dist <= win * (hi - lo)
-            t = dist[sel] / (win * (hi - lo))
-            judge = dist[sel] <= min(windows) * (hi - lo)
-            got = _end_polynomial(t, pos.v[sel], pos.w[sel], judge)
-            if got is not None and (best is None or got[0] < best[0]):
-                best = (got[0], got[1], got[2], sel, t, win)
-        if best is None:
+        sel = dist <= window * (hi - lo)
+        t = dist[sel] / (window * (hi - lo)) if hi > lo else dist[sel]
+        got = _end_polynomial(t, pos.v[sel], pos.w[sel]) if hi > lo else None
+        if got is None:
             degrees.append(0)
-            used.append(0.0)
             continue
-        _score, deg, fit, sel, t, win = best
-        blend = END_BLEND * (1.0 - t)
+        deg, fit = got
+        blend = 1.0 - t
         moved[sel] = blend * fit + (1.0 - blend) * pos.v[sel]
         degrees.append(deg)
-        used.append(win)
-    return Ends(v + (moved - pos.v)[pos.index], (degrees[0], degrees[1]), (used[0], used[1]))
+    return Ends(v + (moved - pos.v)[pos.index], (degrees[0], degrees[1]))
 
 
 class OutlierShareError(RecordingsError):
