@@ -12,8 +12,7 @@ import numpy as np
 from ..argtypes import bounded
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
-from ..golden.forward import (END_WINDOW, MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers,
-                              settle_ends)
+from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
 from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
@@ -178,10 +177,7 @@ def run(args) -> int:
         if conv is not None:
             provenance["converter"] = conv
         adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
-        # the noise is in v: near the flat ends the readings go onto the forward curve first
-        ends = settle_ends(rec.displacement_mm, rec.voltage_v)
-        provenance["ends_settled"] = {"window": END_WINDOW, "degrees": list(ends.degrees)}
-        model, choice = fit_auto(ends.voltage_v, rec.displacement_mm, training=provenance,
+        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
                                  cost=lambda m: fixed_point_cost(m, adc))
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "

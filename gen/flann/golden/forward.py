@@ -12,8 +12,6 @@ glitch, not data.  ``flann train --terms auto`` leaves such readings out
   a penalised cubic spline (P-spline, third-difference penalty lambda).  Neither knows any
   sensor's formula; cross-validation picks the family member (the simplest as good as the
   best, by paired differences).
-* :func:`settle_ends` -- the readings near the two ends of the stroke moved onto a polynomial
-  v(x) fitted there (x exact, v noisy), for the inverse fit that follows.
 * :func:`robust_forward` -- the fit with gross outliers (held-out residual > ``OUTLIER_K``
   robust noise units) left out, and the noise: from repeated readings when there are
   enough (:func:`flann.recordings.checks.repeat_noise_v`), else from the residuals.
@@ -304,79 +302,6 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
     sm, _pred, score = choose(pos, monotonic=False)
     coef = sm.solve(pos)
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
-
-
-# -- the ends of the stroke -----------------------------------------------------------------
-# Where the sensor's slope is low (a saturating curve's ends) a reading's noise costs the most
-# displacement, and a least-squares fit of x(v) is pulled toward the interior there: the
-# noise is in v, the regressor (measured on the e2e sensor family: the held-out max error sat
-# at the first or last 1 % of the stroke, biased inward, for 9 of 10 sensors).  Within this
-# share of the stroke from each end the readings are moved onto a polynomial v(x), the
-# curve's own smooth shape there, blended linearly into the readings as read by the window's
-# inner edge.  0.3: of 0.2-0.5 the best held-out max error on tuning sensors.
-END_WINDOW = 0.3
-END_MAX_DEGREE = 6
-END_MIN_SPARE = 4   # positions beyond the polynomial's coefficients before a degree is tried
-
-
-@dataclass(frozen=True)
-class Ends:
-    """The readings with the ends settled, and each end's polynomial degree (0: left as read)."""
-
-    voltage_v: np.ndarray
-    degrees: tuple[int, int]
-
-
-def _end_polynomial(t, v, w) -> tuple[int, np.ndarray] | None:
-    """(degree, fitted v) of the polynomial in t (0 at the end, 1 at the window's edge) with
-    the smallest leave-one-out error in displacement units (the residual over the fit's
-    slope: an error in v costs most where the curve is flat); None with too few positions."""
-    best = None
-    sw = np.sqrt(w)
-    for deg in range(1, END_MAX_DEGREE + 1):
-        if t.size < deg + 1 + END_MIN_SPARE:
-            break
-        X = np.vander(t, deg + 1, increasing=True)
-        q, r = np.linalg.qr(X * sw[:, None])
-        coef = np.linalg.solve(r, q.T @ (v * sw))
-        fit = X @ coef
-        lev = np.sum(q * q, axis=1)
-        loo = (v - fit) / np.maximum(1.0 - lev, 1e-12)
-        slope = np.abs(np.polynomial.polynomial.polyval(t, np.polynomial.polynomial.polyder(coef)))
-        if not np.all(slope > 0):
-            continue   # flat or turning inside the window: no inverse from this one
-        score = float(np.mean(w * (loo / slope) ** 2))
-        if best is None or score < best[0]:
-            best = (score, deg, fit)
-    return None if best is None else (best[1], best[2])
-
-
-def settle_ends(x, v, window: float = END_WINDOW) -> Ends:
-    """Readings near each end of the stroke moved onto a polynomial v(x) fitted there.
-
-    The readings of one position move together (their mean onto the polynomial, their
-    scatter kept); the move is full at the end and fades linearly to none at ``window`` of
-    the stroke from it.  A window with too few positions for a line and ``END_MIN_SPARE``
-    more is left as read.
-    """
-    x = np.asarray(x, float)
-    v = np.asarray(v, float)
-    pos = aggregate(x, v)
-    lo, hi = float(pos.x[0]), float(pos.x[-1])
-    moved = pos.v.copy()
-    degrees = []
-    for dist in (pos.x - lo, hi - pos.x):
-        sel = dist <= window * (hi - lo)
-        t = dist[sel] / (window * (hi - lo)) if hi > lo else dist[sel]
-        got = _end_polynomial(t, pos.v[sel], pos.w[sel]) if hi > lo else None
-        if got is None:
-            degrees.append(0)
-            continue
-        deg, fit = got
-        blend = 1.0 - t
-        moved[sel] = blend * fit + (1.0 - blend) * pos.v[sel]
-        degrees.append(deg)
-    return Ends(v + (moved - pos.v)[pos.index], (degrees[0], degrees[1]))
 
 
 class OutlierShareError(RecordingsError):
