@@ -12,23 +12,18 @@ order's memory in turn (``mem_depth`` words each).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from ...numeric.fixed import round_shift
 from ..family.twin import FlannFamilyMem, FlannFamilyTop
+from ..twin import TopOut
 from .spec import FamilyThermalSpec, check_member
 
 
 # normaliser values every order's memory holds alike (order 0's drive the shared expansion)
 SHARED_FIELDS = ("clamp_lo", "clamp_hi", "ka", "kb")
-
-
-@dataclass(frozen=True)
-class TopOut:
-    out_data: np.ndarray
-    out_sat: np.ndarray
 
 
 def encode_image(spec: FamilyThermalSpec, model) -> list[int]:
