@@ -100,7 +100,7 @@ COMMANDS = {
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
            ("thermal", "explore"): "two-input",
-           ("family_thermal", "explore"): "members", ("family_thermal", "trace"): "temperature order",
+           ("family_thermal", "explore"): "members",
            # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
            ("seed", "synth"): "does not fit"}
 

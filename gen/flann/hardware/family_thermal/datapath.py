@@ -110,8 +110,7 @@ DATAPATH = Datapath(
     about="a sensor family with temperature: one family datapath per temperature order, weights in memories",
     generate=generate, rebuild=rebuild, twin=FlannFamilyThermalTop, estimate=estimate, fields=FIELDS,
     bench="family_thermal", summary=summary, eval_spec=eval_spec,
-    why_no_stages="flann trace's stage model is the one-input datapath's; a family design with temperature "
-                  "has one family datapath per temperature order",
+    stages="family_thermal",
     why_no_explore="a family design is sized by its members (flann gen --family)",
 )
 
