@@ -174,6 +174,15 @@ def test_ise_refuses_a_part_too_small(designs):
     assert "does not fit" not in r.stderr
 
 
+def test_ise_refuses_a_part_the_synthesized_design_does_not_fit(designs):
+    """A datapath with no estimate before synthesis (family_thermal): the timing check's netlist decides."""
+    out = designs["dir"] / "ise_ft_small"
+    r = flann("ise", designs["dir"] / "family_thermal", "--device", "xc2s15-vq100-5", "-o", out)
+    one_line_refusal(r)
+    assert "does not fit xc2s15-vq100-5" in r.stderr and "synthesized" in r.stderr
+    assert not out.exists()
+
+
 def test_gen_says_it_replaces_a_design(designs, tmp_path):
     out = tmp_path / "d"
     assert flann("gen", designs["model"], "-o", out, "--input-bits", BITS).returncode == 0
