@@ -58,11 +58,23 @@ def designs(tmp_path_factory):
                     + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, vh, th)))
     r = flann("gen", thermal, "-o", d / "thermal", "--input-bits", BITS, "--temp-bits", 5, "--temp-lsb-c", 6)
     assert r.returncode == 0, r.stderr
+    # a family with temperature: that sensor and one 4 % more sensitive, recorded at the same temperatures
+    # (4 terms, 4-bit temperature code: 10 calibrated codes)
+    members = []
+    for k, gain in enumerate((1.0, 1.04)):
+        members.append(d / f"ft_{k}.csv")
+        members[-1].write_text("displacement_mm,voltage_v,temperature_c\n"
+                               + "".join(f"{a:.12g},{gain * b:.12g},{c:g}\n" for a, b, c in zip(x, v, t)))
+    r = flann("gen", "--family", *members, "--terms", 4, "-o", d / "family_thermal", "--input-bits", BITS,
+              "--temp-bits", 4, "--temp-lsb-c", 12)
+    assert r.returncode == 0, r.stderr
     # the seed architecture is written by flann explore only (for comparison)
     seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
     # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
     shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
-    return {"dir": d, "model": model, "rec": recs[0], "eval": {"thermal": (thermal, held)}}
+    return {"dir": d, "model": model, "rec": recs[0],
+            # the family's initial image is its first member, the sensor the held-out recording is of
+            "eval": {"thermal": (thermal, held), "family_thermal": (d / "family_thermal" / "init_model.json", held)}}
 
 
 def one_line_refusal(r) -> None:
@@ -88,13 +100,14 @@ COMMANDS = {
 REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
            ("thermal", "explore"): "two-input",
+           ("family_thermal", "explore"): "members",
            # 5 parallel constant multipliers of the seed's wide words: more LUT4 than the largest part
            ("seed", "synth"): "does not fit"}
 
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed", "thermal"])
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed", "thermal", "family_thermal"])
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_command_on_datapath(designs, datapath, command):
     r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))
@@ -127,6 +140,30 @@ def test_explore_float18_dir_explores_its_own_widths(designs):
         assert word in r.stderr
 
 
+def test_eval_family_thermal_design_by_temperature(designs):
+    """eval --design of a family design with temperature: the hardware judged at held-out
+    temperatures (10 and 65 degC, between and beside the calibration ones) like a thermal design,
+    on the design's initial image, and within one output LSB of the float model at the same codes."""
+    d = designs["dir"] / "family_thermal"
+    model, held = designs["eval"]["family_thermal"]
+    r = flann("eval", model, held, "--design", d, "--json")
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    hw, man = res["hardware"], json.loads((d / "manifest.json").read_text())
+    assert [b["temperature_c"] for b in hw["by_temperature"]] == [10.0, 65.0]
+    assert sum(b["points"] for b in hw["by_temperature"]) == res["points"] == 78
+    assert hw["max_error_mm"] == pytest.approx(max(b["max_error_mm"] for b in hw["by_temperature"]))
+    assert set(res["drift_ppm_fs_per_c"]) == {"raw", "float", "hardware"}
+    assert all(v is not None and v >= 0 for v in res["drift_ppm_fs_per_c"].values())
+    assert (hw["temp_bits"], hw["temp_lsb_c"]) == (4, 12.0)
+    assert "initial image" in hw["weight_image"] and man["images"][0]["hex"] in hw["weight_image"]
+    # the datapath's own error, at the codes the design saw: the error analysis' bound (1 LSB)
+    assert hw["max_abs_hardware_minus_float_at_codes_mm"] <= man["output_lsb_mm"] * man["analysis"]["bound_lsb"]
+    # a one-input model is not what the design computes
+    one_line_refusal(r := flann("eval", designs["model"], held, "--design", d))
+    assert "one-input model" in r.stderr
+
+
 def test_ise_refuses_a_part_too_small(designs):
     r = flann("ise", designs["dir"] / "fixed", "--device", "xc2s15-vq100-5", "-o", designs["dir"] / "ise_small")
     one_line_refusal(r)
@@ -135,6 +172,15 @@ def test_ise_refuses_a_part_too_small(designs):
     r = flann("ise", designs["dir"] / "fixed", "--device", "xc2s15-vq100-5", "--force", "-o",
               designs["dir"] / "ise_small")
     assert "does not fit" not in r.stderr
+
+
+def test_ise_refuses_a_part_the_synthesized_design_does_not_fit(designs):
+    """A datapath with no estimate before synthesis (family_thermal): the timing check's netlist decides."""
+    out = designs["dir"] / "ise_ft_small"
+    r = flann("ise", designs["dir"] / "family_thermal", "--device", "xc2s15-vq100-5", "-o", out)
+    one_line_refusal(r)
+    assert "does not fit xc2s15-vq100-5" in r.stderr and "synthesized" in r.stderr
+    assert not out.exists()
 
 
 def test_gen_says_it_replaces_a_design(designs, tmp_path):
@@ -177,6 +223,7 @@ TAMPERED = [
     ("fixed", _set("datapath", "quantum"), "datapath"),
     ("thermal", _drop("spec.temp_bits"), "spec.temp_bits"),
     ("thermal", _set("temp_lsb_c", "0.5"), "temp_lsb_c"),
+    ("family_thermal", _drop("spec.temperature"), "spec.temperature"),
 ]
 TAMPER_COMMANDS = {
     "sim": lambda d, fx: ("sim", d),
@@ -202,7 +249,7 @@ def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field):
 
 @pytest.mark.skipif(shutil.which("vsg") is None and not (Path(sys.executable).parent / "vsg").exists(),
                     reason="vsg not installed")
-@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "thermal"])
+@pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "thermal", "family_thermal"])
 def test_generated_vhdl_passes_vsg(designs, datapath):
     files = sorted((designs["dir"] / datapath).glob("*.vhd"))
     assert files and lint_vhdl(files, start=REPO) == []

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flann.analysis.trace import trace_design
 from flann.cli import main
 from flann.hardware.family_thermal.spec import inner_bits, temp_norm
 from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
@@ -105,3 +106,22 @@ def test_refusals_are_one_line(tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("error:") and word in err[0], err
         assert not out.exists()
+
+
+def test_trace_stages_add_up_to_the_twin_minus_float_within_their_bounds(design):
+    """flann trace of the design: orders + horner + output is the twin's error against the float
+    model (computed here from the twin and the model, not the trace), each stage within the error
+    analysis' share and the total within its bound."""
+    dz = from_directory(design / "design")
+    s, r = dz.spec, trace_design(dz)
+    assert set(r.stages) == {"orders", "horner", "output"} and r.identity_residual_mm < 1e-9
+    assert r.temperature_codes[0] == s.temp.lo and r.temperature_codes[-1] == s.temp.hi
+    codes = np.arange(s.code_min, s.code_max + 1)
+    worst = max(float(np.max(np.abs(FlannFamilyThermalTop(s).process(codes, tau).out_data * s.output_lsb_mm
+                                    - s.float_reference(codes, tau)))) for tau in r.temperature_codes)
+    assert r.total["max_mm"] == pytest.approx(worst, abs=1e-12)
+    assert r.total["max_mm"] <= s.analysis["bound_lsb"] * s.output_lsb_mm
+    q_k = s.output_lsb_mm / 2 ** s.inner_bits
+    assert r.stages["output"]["max_mm"] <= 0.5 * s.output_lsb_mm + 1e-12
+    assert r.stages["horner"]["max_mm"] <= (s.orders - 1) / 2 * q_k + 1e-12
+    assert r.stages["orders"]["max_mm"] <= s.orders * q_k + 1e-12

@@ -28,9 +28,11 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.thermal import corrected_voltage
+from ..hardware.family_thermal.spec import FamilyThermalSpec, order_models
+from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.thermal.spec import ThermalSpec
 from ..hardware.thermal.twin import ThermalTop
-from ..verify.datapaths import thermal_temperature_codes
+from ..verify.datapaths import family_thermal_temperature_codes, thermal_temperature_codes
 
 STAGES = ("temperature", "correction", "interpolation", "orders", "horner", "output")
 STAGE_TEXT = {
@@ -62,6 +64,7 @@ class ThermalTraceResult:
     curves: dict = field(repr=False, default_factory=dict)
     hdl: dict | None = None
     fmt: str = "thermal"
+    stage_text: dict = field(repr=False, default_factory=lambda: dict(STAGE_TEXT))
 
     def to_dict(self) -> dict:
         d = {"format": self.fmt, "points": self.n_points, "voltage_codes": self.voltage_codes,
@@ -74,18 +77,18 @@ class ThermalTraceResult:
 
     def text(self) -> str:
         t, q = self.total, self.output_lsb_mm
-        lines = [f"flann trace (thermal): {self.voltage_codes} voltage codes x {len(self.temperature_codes)} "
+        lines = [f"flann trace ({self.fmt}): {self.voltage_codes} voltage codes x {len(self.temperature_codes)} "
                  f"temperature codes, |hardware - float| max {t['max_mm']:.3g} mm ({t['max_mm'] / q:.3f} LSB; "
                  f"at {t['peak_v']:+.4g} V, {t['peak_temperature_c']:g} degC), rms {t['rms_mm']:.3g} mm",
                  "", f"{'stage':<14} {'rms mm':>10} {'max mm':>10} {'bound mm':>10} {'share':>7}  what"]
         for s, d in self.stages.items():
             bound = "" if d["bound_mm"] is None else f"{d['bound_mm']:.3g}"
             lines.append(f"{s:<14} {d['rms_mm']:>10.3g} {d['max_mm']:>10.3g} {bound:>10} {d['share']:>6.1%}  "
-                         f"{STAGE_TEXT[s]}")
-        lines += ["", "orders (each t_n^j x its datapath's error at the grid codes): " + "; ".join(
+                         f"{self.stage_text[s]}")
+        lines += ["", "orders (each t_n^j x its datapath's error): " + "; ".join(
             f"order {o['order']} rms {o['rms_mm']:.3g} mm, max {o['max_mm']:.3g} mm" for o in self.orders)]
         d = self.dominant
-        lines.append(f"dominant stage: {d['stage']} ({STAGE_TEXT[d['stage']]}, {d['share']:.0%} of the error "
+        lines.append(f"dominant stage: {d['stage']} ({self.stage_text[d['stage']]}, {d['share']:.0%} of the error "
                      f"variance)")
         if self.hdl is not None:
             h = self.hdl
@@ -164,6 +167,64 @@ def trace_thermal(spec: ThermalSpec) -> ThermalTraceResult:
                               identity_residual_mm=resid, output_lsb_mm=q, volts=v, curves=curves)
 
 
+# the family design with temperature (flann_family_thermal_top): t_n is exact (tau - mid over a
+# power of two), there is no input correction and no interpolation; so the error is
+#   out - sum_j t^j f_j(v)  =  sum_j t^j (p_j - f_j(v))   orders   each order's family datapath
+#                            + (acc - sum_j t^j p_j)      horner   the Horner roundings in t_n
+#                            + (out - acc)                output   rounding to the output LSB, saturation
+FAMILY_STAGE_TEXT = {
+    "orders": "each order's family datapath (weights from its memory), x t_n^j",
+    "horner": "Horner in t_n over the orders (roundings)",
+    "output": "output rounding/saturation",
+}
+
+
+def trace_family_thermal(spec: FamilyThermalSpec) -> ThermalTraceResult:
+    """The stages above over every voltage code at the temperature codes ``flann sim`` runs inside
+    the calibrated ones, with the memories' initial image (the design's first member)."""
+    m, q, t = spec.model, spec.output_lsb_mm, spec.temp
+    temps = [c for c in family_thermal_temperature_codes(spec) if t.lo <= c <= t.hi]
+    vc = np.arange(spec.code_min, spec.code_max + 1, dtype=np.int64)
+    c = np.tile(vc, len(temps))
+    tau = np.repeat(np.asarray(temps, dtype=np.int64), vc.size)
+    tr = FlannFamilyThermalTop(spec).trace(c, tau)
+    kq = q / 2.0 ** spec.inner_bits                       # the orders' LSB (mm)
+    lo, hi = sorted(m.voltage_range_v)                    # the float model's clamp, as float_reference's
+    clo = max(spec.code_min, int(np.floor(lo / spec.input_lsb_v + 0.5)))
+    chi = min(spec.code_max, int(np.floor(hi / spec.input_lsb_v + 0.5)))
+    v = np.clip(c, clo, chi) * spec.input_lsb_v
+    t_n = tr.t_n.astype(float) / 2.0 ** t.shift
+    f = [om.predict(v) for om in order_models(m)]
+    x0 = spec.float_reference(c, tau)
+    parts = [p.astype(float) * kq for p in tr.parts]
+    x1 = sum(p * t_n ** j for j, p in enumerate(parts))
+    acc = tr.acc.astype(float) * kq
+    out = tr.out_data.astype(float) * q
+    pieces = {"orders": x1 - x0, "horner": acc - x1, "output": out - acc}
+    err = out - x0
+    # the float model is sum_j t_n^j f_j with the design's exact t_n: what is left is rounding
+    resid = float(max(np.max(np.abs(sum(pieces.values()) - err)),
+                      np.max(np.abs(sum(fj * t_n ** j for j, fj in enumerate(f)) - x0))))
+    var = {k: _rms(p) ** 2 for k, p in pieces.items()}
+    vsum = sum(var.values()) or 1.0
+    P = spec.orders
+    bounds = {"orders": P * kq, "horner": (P - 1) / 2 * kq, "output": 0.5 * q}   # spec.py's error analysis
+    stages = {k: {"rms_mm": _rms(p), "max_mm": float(np.max(np.abs(p))), "share": var[k] / vsum,
+                  "bound_mm": bounds[k]} for k, p in pieces.items()}
+    orders = [{"order": j, "rms_mm": _rms(t_n ** j * (p - fj)), "max_mm": float(np.max(np.abs(t_n ** j * (p - fj))))}
+              for j, (p, fj) in enumerate(zip(parts, f))]
+    dom = max(stages, key=lambda k: stages[k]["rms_mm"])
+    k = int(np.argmax(np.abs(err)))
+    total = {"max_mm": float(np.abs(err).max()), "rms_mm": _rms(err), "peak_v": float(c[k] * spec.input_lsb_v),
+             "peak_temperature_c": float(tau[k] * t.lsb_c)}
+    return ThermalTraceResult(n_points=int(c.size), voltage_codes=int(vc.size), temperature_codes=temps,
+                              total=total, stages=stages, orders=orders,
+                              dominant={"stage": dom, "share": stages[dom]["share"]},
+                              identity_residual_mm=resid, output_lsb_mm=q, volts=c * spec.input_lsb_v,
+                              curves={**pieces, "total": err}, fmt="family_thermal",
+                              stage_text=dict(FAMILY_STAGE_TEXT))
+
+
 def plot_thermal_trace(result: ThermalTraceResult, path, title: str = "") -> None:
     """Error and each stage's contribution vs input voltage, every traced temperature (PNG)."""
     # matplotlib is heavy and only needed for plots: imported when one is drawn
@@ -178,9 +239,9 @@ def plot_thermal_trace(result: ThermalTraceResult, path, title: str = "") -> Non
     ax0.axhline(-result.output_lsb_mm, color="tab:red", lw=0.6, ls="--")
     ax0.set_ylabel("hardware − float (mm)")
     ax0.legend(loc="upper left", fontsize=8)
-    ax0.set_title(title or f"flann trace (thermal): {len(result.temperature_codes)} temperature codes")
+    ax0.set_title(title or f"flann trace ({result.fmt}): {len(result.temperature_codes)} temperature codes")
     ax0.grid(alpha=0.3)
-    for s in sorted(STAGES, key=lambda s: -result.stages[s]["rms_mm"]):
+    for s in sorted(result.stages, key=lambda s: -result.stages[s]["rms_mm"]):
         if result.stages[s]["max_mm"] > 0:
             ax1.plot(v, result.curves[s], ".", ms=1, label=f"{s} (rms {result.stages[s]['rms_mm']:.2g})")
     ax1.set_xlabel("input (V)")
@@ -192,4 +253,4 @@ def plot_thermal_trace(result: ThermalTraceResult, path, title: str = "") -> Non
     plt.close(fig)
 
 
-__all__ = ["ThermalTraceResult", "STAGES", "plot_thermal_trace", "trace_thermal"]
+__all__ = ["ThermalTraceResult", "STAGES", "plot_thermal_trace", "trace_thermal", "trace_family_thermal"]

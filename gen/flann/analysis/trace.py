@@ -41,9 +41,11 @@ from ..hardware.family.twin import FlannFamilyTop
 from ..verify.datapaths import simulate as simulate_design
 from ..verify.design import Design, open_design
 from ..verify.runner import sweep
-from .thermal_trace import ThermalTraceResult, plot_thermal_trace, trace_thermal
+from .thermal_trace import ThermalTraceResult, plot_thermal_trace, trace_family_thermal, trace_thermal
 
 THERMAL_STAGES = "thermal"   # a two-input design's stage model (its own result type)
+# the two-input designs' stage models (Datapath.stages), each from the design's spec
+TWO_INPUT_STAGE_MODELS = {THERMAL_STAGES: trace_thermal, "family_thermal": trace_family_thermal}
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
 STAGE_TEXT = {
@@ -538,8 +540,8 @@ def trace_design(design: Design, codes=None) -> TraceResult | ThermalTraceResult
     dp = design.datapath
     if dp.stages is None:
         raise FlannError(f"{design.directory}: {dp.why_no_stages}")
-    if dp.stages == THERMAL_STAGES:
-        return trace_thermal(design.spec)
+    if dp.stages in TWO_INPUT_STAGE_MODELS:
+        return TWO_INPUT_STAGE_MODELS[dp.stages](design.spec)
     return trace(STAGE_MODELS[dp.stages](design.spec, codes))
 
 
@@ -555,4 +557,4 @@ def check_design_hdl(result: TraceResult, design: Design, build_dir) -> dict:
 
 __all__ = ["Stages", "Source", "TraceResult", "STAGES", "attribute", "trace", "stages_fixed",
            "stages_float18", "stages_family", "plot_trace", "plot_compare", "run_trace", "check_hdl", "term_label",
-           "trace_design", "check_design_hdl", "STAGE_MODELS"]
+           "trace_design", "check_design_hdl", "STAGE_MODELS", "TWO_INPUT_STAGE_MODELS"]

@@ -128,6 +128,8 @@ def run(args) -> int:
         print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, output LSB "
               f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; "
               f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm")
+        if "weight_image" in hw:
+            print(f"hardware weight memories: {hw['weight_image']}")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
               f"max error / limit: hardware {hw['ratio_to_limit']:.2f}, float "
               f"{hw['float_ratio_to_limit']:.2f}")

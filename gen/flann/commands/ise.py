@@ -17,7 +17,8 @@ def add_arguments(p):
                         "the example pin map is for PQ208, on other packages ISE chooses the pins)")
     p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
     p.add_argument("--force", action="store_true",
-                   help="write the project even when the design's resource estimate does not fit the part")
+                   help="write the project even when the design's resource estimate (or, without one, its synthesized "
+                        "netlist) does not fit the part")
     p.add_argument("--clock-mhz", type=float, default=CLOCK_HZ / 1e6,
                    help="clock frequency for the PERIOD constraint (default %(default)g); lowered to what the "
                         "Spartan-II timing estimate meets, with a warning")
@@ -30,7 +31,7 @@ def run(args) -> int:
     ise.check_directory_fits(args.directory, args.device, force=args.force)
     clock = args.clock_mhz
     if not args.no_timing_check:
-        clock, why = ise.checked_clock(args.directory, args.device, args.clock_mhz)
+        clock, why = ise.checked_clock(args.directory, args.device, args.clock_mhz, force=args.force)
         if why:
             print(f"warning: {why}", file=sys.stderr)
     files = ise.write_ise(args.directory, args.device, args.output, clock, force=args.force)

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
-from ..analysis.trace import (THERMAL_STAGES, check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
+from ..analysis.trace import (TWO_INPUT_STAGE_MODELS, check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
                               trace_design)
 from ..hardware import options as gen_options
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
@@ -66,7 +66,7 @@ def run(args) -> int:
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:
         args.format = design.datapath.name
-        if args.at and design.datapath.stages == THERMAL_STAGES:
+        if args.at and design.datapath.stages in TWO_INPUT_STAGE_MODELS:
             raise FlannError(f"{args.model}: --at lists the error at one-input voltages; a two-input "
                              "design's error at recordings is flann eval MODEL REC --design DIR")
         results = {args.format: trace_design(design)}

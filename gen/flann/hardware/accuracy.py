@@ -22,8 +22,13 @@ from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
 from .fixed.twin import FlannTop
+from .family_thermal.spec import FamilyThermalSpec
+from .family_thermal.twin import FlannFamilyThermalTop
 from .thermal.spec import ThermalSpec
 from .thermal.twin import ThermalTop
+
+# the two-input specs and their top-level twins (process(in_data, in_temp) -> out_data, out_sat)
+TWO_INPUT_TWINS = {ThermalSpec: ThermalTop, FamilyThermalSpec: FlannFamilyThermalTop}
 
 # -- a generated design, rebuilt ---------------------------------------------------------
 def design_spec(model_path, design_dir) -> Spec:
@@ -84,7 +89,7 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
     the error they cost is in the hardware figures.  Returns the ``"hardware"`` block of
     ``flann eval --design --json`` plus per-point arrays (``_points``) for the plot.
     """
-    if isinstance(spec, ThermalSpec):
+    if type(spec) in TWO_INPUT_TWINS:
         return thermal_accuracy(spec, rec, tol=tol, band=band, fs_mm=fs_mm)
     adc_bits, adc_lsb = adc if adc is not None else (spec.input_bits, spec.input_lsb_v)
     x = rec.displacement_mm
@@ -119,7 +124,7 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
     return rep
 
 
-def thermal_accuracy(spec: ThermalSpec, rec, *, tol, band, fs_mm) -> dict:
+def thermal_accuracy(spec: ThermalSpec | FamilyThermalSpec, rec, *, tol, band, fs_mm) -> dict:
     """:func:`hardware_accuracy` of a two-input design: its twin at the recordings' voltages and
     temperatures as the design's codes (nearest code, saturated to the code range; the design
     clamps both to the calibrated codes), the float model at the recorded (clamped) values, and
@@ -134,7 +139,7 @@ def thermal_accuracy(spec: ThermalSpec, rec, *, tol, band, fs_mm) -> dict:
     # the twin once per distinct (code, temperature code)
     pairs, back = np.unique(np.stack([codes, tcodes], axis=1), axis=0, return_inverse=True)
     back = back.ravel()
-    out, sat = ThermalTop(spec).process(pairs[:, 0], pairs[:, 1])
+    out, sat = TWO_INPUT_TWINS[type(spec)](spec).process(pairs[:, 0], pairs[:, 1])
     hw_mm = out[back] * spec.output_lsb_mm
     v, t, _ = m.clamp(rec.voltage_v, rec.temperature_c)
     fl_mm = m.predict(v, t)
@@ -150,6 +155,7 @@ def thermal_accuracy(spec: ThermalSpec, rec, *, tol, band, fs_mm) -> dict:
         "input_bits": spec.input_bits, "input_lsb_v": spec.input_lsb_v,
         "adc_bits": spec.input_bits, "adc_lsb_v": spec.input_lsb_v, "dropped_low_bits": 0,
         "temp_bits": spec.temp_bits, "temp_lsb_c": spec.temp_lsb_c,
+        **({"weight_image": spec.image} if isinstance(spec, FamilyThermalSpec) else {}),
         "output_lsb_mm": spec.output_lsb_mm,
         "points_clamped": int(np.count_nonzero(sat[back])),
         "max_abs_hardware_minus_float_mm": float(np.max(np.abs(hw_mm - fl_mm))),

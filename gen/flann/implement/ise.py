@@ -37,7 +37,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
 from ..hardware.registry import read_design
-from .synth import Resources, shortfall, smallest_fit, synthesize
+from .synth import Resources, not_fit_message, shortfall, smallest_fit, synthesize
 from .timing import safe_clock_mhz
 
 CLOCK_PIN = "P77"  # GCK1
@@ -234,12 +234,17 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
     return [*texts, *sources, "src/manifest.json"]
 
 
-def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full") -> tuple[float, str | None]:
+def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full",
+                  force: bool = False) -> tuple[float, str | None]:
     """The clock for the PERIOD constraint: ``clock_mhz`` when the Spartan-II timing estimate
     (:mod:`flann.implement.timing`, on the Yosys-mapped netlist) meets it, else the highest
-    whole MHz the estimate meets with its margin.  Returns (MHz, why it was lowered or None)."""
+    whole MHz the estimate meets with its margin.  Returns (MHz, why it was lowered or None).
+    A mapped netlist that does not fit the part is refused (unless ``force``): the check for a
+    datapath with no estimate before synthesis."""
     check_clock_mhz(clock_mhz)
     report = synthesize(directory, device, abc=abc)
+    if not force and not report.fits:
+        raise FlannError(f"{not_fit_message(report)} (synthesized; --force writes the project anyway)")
     t = report.timing
     if t.meets(clock_mhz * 1e6):
         return clock_mhz, None

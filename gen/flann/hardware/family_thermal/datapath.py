@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import json
 import warnings
+from dataclasses import replace
+from pathlib import Path
 
 from ...errors import FlannError, SpecError
+from ...golden.model import model_sha256
 from ...golden.thermal import ThermalModel, load_any_model
 from ...numeric.fixed import FixedFormat
 from ..datapath import Datapath, Field, _int, _num
@@ -14,7 +17,7 @@ from ..family.spec import DEFAULT_MARGIN, family_from_dict
 from ..options import GenOptions
 from . import render
 from .build import generate_family_thermal
-from .spec import FamilyThermalSpec, TempNorm, order_models
+from .spec import FamilyThermalSpec, TempNorm, check_member, order_models
 from .twin import FlannFamilyThermalTop
 
 
@@ -51,6 +54,31 @@ def rebuild(model, man: dict, where="design") -> tuple[FamilyThermalSpec, dict]:
     return spec, {}
 
 
+def eval_spec(model, man: dict, directory) -> FamilyThermalSpec:
+    """The design computing ``model`` (a two-input model of a sensor of the family) with that
+    sensor's weight image in its memories; ``spec.image`` says which image that is: the design's
+    initial one (its first member, ``init_model.json``) or ``model``'s own, encoded as
+    ``flann calibrate`` would.  A model outside the family is refused in one line."""
+    spec, _ = rebuild(DATAPATH.model_path(directory, man), man, directory)
+    tm = load_any_model(model)
+    if not isinstance(tm, ThermalModel):
+        raise FlannError(f"{model}: a one-input model; the family design {directory} with temperature computes "
+                         f"two-input models (evaluate {Path(directory) / man['model']})")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            check_member(spec, tm)
+    except SpecError as exc:
+        raise FlannError(f"{model}: does not fit the family design {directory}: {exc}") from None
+    images = man.get("images") or []
+    if model_sha256(model) == man["model_sha256"]:
+        first = f"image {images[0]['name']} ({images[0]['hex']}), " if images and isinstance(images[0], dict) else ""
+        image = f"the design's initial image: {first}{man['model']}"
+    else:
+        image = f"{Path(model).name}'s own image (encoded from it, loadable through cfg_*)"
+    return replace(spec, model=tm, image=image)
+
+
 def estimate(man: dict) -> dict | None:
     return None  # no estimate before synthesis (the orders share blocks): flann synth measures it
 
@@ -81,11 +109,8 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP,
     about="a sensor family with temperature: one family datapath per temperature order, weights in memories",
     generate=generate, rebuild=rebuild, twin=FlannFamilyThermalTop, estimate=estimate, fields=FIELDS,
-    bench="family_thermal", summary=summary,
-    why_no_stages="flann trace's stage model is the one-input datapath's; a family design with temperature "
-                  "has one family datapath per temperature order",
-    why_no_eval="flann eval --design evaluates a one-input design; flann calibrate judges a family design "
-                "with temperature through its twin at each temperature",
+    bench="family_thermal", summary=summary, eval_spec=eval_spec,
+    stages="family_thermal",
     why_no_explore="a family design is sized by its members (flann gen --family)",
 )
 

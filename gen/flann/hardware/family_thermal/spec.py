@@ -143,6 +143,7 @@ class FamilyThermalSpec:
     output_lsb_mm: float          # q
     out_fmt: FixedFormat
     analysis: dict = field(default_factory=dict, compare=False)
+    image: str = field(default="", compare=False)   # which sensor's weight image ``model`` is (flann eval)
 
     # -- codes --------------------------------------------------------------------------
     @property
@@ -164,6 +165,10 @@ class FamilyThermalSpec:
     @property
     def temp_bits(self) -> int:
         return self.temp.bits
+
+    @property
+    def temp_lsb_c(self) -> float:
+        return self.temp.lsb_c
 
     @property
     def temp_code_min(self) -> int:

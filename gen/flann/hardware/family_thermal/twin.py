@@ -12,23 +12,28 @@ order's memory in turn (``mem_depth`` words each).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ...numeric.fixed import round_shift
 from ..family.twin import FlannFamilyMem, FlannFamilyTop
+from ..twin import TopOut
 from .spec import FamilyThermalSpec, check_member
+
+
+@dataclass(frozen=True)
+class FamilyThermalTrace(TopOut):
+    """The output ports and the internal values: each order's output (LSB q / 2^K), the t_n
+    code (tau clamped, minus mid: S fraction bits) and the Horner sum before the output rounding."""
+
+    parts: list = field(default_factory=list)
+    t_n: np.ndarray | None = None
+    acc: np.ndarray | None = None
 
 
 # normaliser values every order's memory holds alike (order 0's drive the shared expansion)
 SHARED_FIELDS = ("clamp_lo", "clamp_hi", "ka", "kb")
-
-
-@dataclass(frozen=True)
-class TopOut:
-    out_data: np.ndarray
-    out_sat: np.ndarray
 
 
 def encode_image(spec: FamilyThermalSpec, model) -> list[int]:
@@ -61,7 +66,8 @@ class FlannFamilyThermalTop:
             raise ValueError(f"an image's orders must hold one {', '.join(SHARED_FIELDS)} (the expansion is shared)")
         self.orders = orders
 
-    def process(self, in_data, in_temp) -> TopOut:
+    def trace(self, in_data, in_temp) -> FamilyThermalTrace:
+        """The top's internal values (flann trace): each order's output, t_n, the Horner sum."""
         s = self.spec
         codes, temps = np.broadcast_arrays(np.asarray(in_data, dtype=np.int64), np.asarray(in_temp, dtype=np.int64))
         distinct, back = np.unique(codes, return_inverse=True)
@@ -76,7 +82,12 @@ class FlannFamilyThermalTop:
             acc = round_shift(acc * t, s.temp.shift) + part
         out = round_shift(acc, s.inner_bits)
         clipped = (out > s.out_fmt.max_int) | (out < s.out_fmt.min_int)
-        return TopOut(np.clip(out, s.out_fmt.min_int, s.out_fmt.max_int), sat | clipped)
+        return FamilyThermalTrace(np.clip(out, s.out_fmt.min_int, s.out_fmt.max_int), sat | clipped,
+                                  parts, t, acc)
+
+    def process(self, in_data, in_temp) -> TopOut:
+        tr = self.trace(in_data, in_temp)
+        return TopOut(tr.out_data, tr.out_sat)
 
     def all_codes(self) -> np.ndarray:
         return np.arange(self.spec.code_min, self.spec.code_max + 1, dtype=np.int64)
@@ -100,4 +111,4 @@ class FlannFamilyThermalTop:
                 "temperature_codes": int(np.size(temp_codes))}
 
 
-__all__ = ["FlannFamilyThermalTop", "TopOut", "encode_image"]
+__all__ = ["FlannFamilyThermalTop", "FamilyThermalTrace", "TopOut", "encode_image"]
