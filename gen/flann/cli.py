@@ -9,6 +9,22 @@ from __future__ import annotations
 
 import sys
 
+# Ctrl-C seen by our handler, or raised inside a callback (an import lock's weakref, a
+# __del__), where it cannot propagate and Python would print it with a traceback; a library
+# that imports an optional module inside ``try/except ImportError`` can swallow it too. The
+# flag is checked again once the command's modules are in.
+_interrupted: list[int] = []
+
+
+def _unraisable(info, default=sys.unraisablehook):
+    if isinstance(info.exc_value, KeyboardInterrupt):
+        _interrupted.append(2)   # SIGINT
+    else:
+        default(info)
+
+
+sys.unraisablehook = _unraisable
+
 try:   # Ctrl-C while the interpreter imports this module: one line too, not a traceback
     import argparse
     import importlib
@@ -78,12 +94,6 @@ def _one_line_warnings() -> None:
     warnings.showwarning = show
 
 
-# Ctrl-C seen by our handler; a library that imports an optional module inside
-# ``try/except ImportError`` can swallow the KeyboardInterrupt, so the flag is checked again
-# once the command's modules are in.
-_interrupted: list[int] = []
-
-
 def main(argv: list[str] | None = None) -> int:
     interrupted = _interrupted
 
@@ -123,11 +133,12 @@ def _main(argv: list[str] | None) -> int:
         parser.print_help()
         return 2
     _one_line_warnings()
-    if _interrupted:   # swallowed while the command's modules imported
-        raise KeyboardInterrupt
     try:
+        command = _load(args.command)
+        if _interrupted:   # swallowed while the command's modules imported
+            raise KeyboardInterrupt
         with guarding_inputs():   # no output of this command overwrites one of its inputs
-            code = int(_load(args.command).run(args) or 0)
+            code = int(command.run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return code
     except BrokenPipeError:

@@ -190,3 +190,28 @@ def test_an_ignored_ctrl_c_stays_ignored(monkeypatch):
         assert seen == [signal.SIG_IGN] and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+SWALLOWED = """
+import os, sys
+import flann.cli
+
+class LockCallback:   # a KeyboardInterrupt raised where it cannot propagate (a weakref's
+    def __del__(self):   # callback, a __del__): Python only reports it as unraisable
+        raise KeyboardInterrupt
+
+LockCallback()
+sys.exit(flann.cli.main(["train", sys.argv[1], "-o", sys.argv[2]]))
+"""
+
+
+def test_ctrl_c_swallowed_by_a_callback_is_one_line(tmp_path):
+    """A Ctrl-C that Python could not raise (it arrived inside a callback) still stops the
+    command before it waits for input: one line, exit 130, no traceback. The recording is a
+    FIFO nobody writes, so a lost interrupt shows as a command that never ends."""
+    os.mkfifo(tmp_path / "rec.csv")
+    p = subprocess.run([sys.executable, "-c", SWALLOWED, str(tmp_path / "rec.csv"), str(tmp_path / "m.json")],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 130, (p.returncode, p.stderr)
+    assert p.stderr.strip().splitlines() == ["error: interrupted"], p.stderr
+    assert not (tmp_path / "m.json").exists()
