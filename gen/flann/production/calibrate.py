@@ -249,16 +249,23 @@ def sensor_name(path) -> str:
     return safe_name(Path(path).stem)
 
 
+def _start(path: Path, dhash: str, spec: ProductionSpec | None, max_error_mm: float | None,
+           station: Station | None) -> tuple[Result, ProductionSpec, Station]:
+    """A sensor's summary row, and the spec (``--max-error-mm`` alone when none is given) and
+    station it is judged and recorded with."""
+    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
+    if spec is None:
+        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
+    return res, spec, station or Station()
+
+
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
                   spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
     that fails its spec or is rejected gets a certificate saying why and no weights."""
     path = Path(path)
-    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
-    if spec is None:
-        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
-    station = station or Station()
+    res, spec, station = _start(path, dhash, spec, max_error_mm, station)
     rec = None
     try:
         with warnings.catch_warnings(record=True) as caught:
@@ -310,10 +317,7 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
     """One multi-temperature recording for a family design with temperature (``fam`` its
     FamilyThermalSpec): the image, verdicts at each temperature and overall, the drift."""
     path = Path(path)
-    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
-    if spec is None:
-        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
-    station = station or Station()
+    res, spec, station = _start(path, dhash, spec, max_error_mm, station)
     rec = None
     try:
         with warnings.catch_warnings(record=True) as caught:

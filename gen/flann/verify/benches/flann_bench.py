@@ -61,6 +61,32 @@ async def reset(dut, cycles: int = 2) -> None:
     dut.rst.value = 0
 
 
+def two_input_samples(cfg: dict):
+    """A two-input sweep's file (code, temperature code, out, sat, latency per line), checked
+    to hold every listed sample in order: (rows, voltage codes, temperature codes)."""
+    sweep = cfg["sweep"]
+    got = np.loadtxt(sweep["file"], dtype=np.int64, ndmin=2)
+    codes = np.arange(sweep["code_lo"], sweep["code_hi"] + 1, dtype=np.int64)
+    temps = np.asarray(sweep["temps"], dtype=np.int64)
+    want_c, want_t = np.tile(codes, temps.size), np.repeat(temps, codes.size)
+    assert got.shape[0] == want_c.size, f"{got.shape[0]} outputs for {want_c.size} samples"
+    assert np.array_equal(got[:, 0], want_c) and np.array_equal(got[:, 1], want_t), "samples out of order"
+    return got, want_c, want_t
+
+
+def judge_two_input(dut, cfg: dict, name: str, got, out, sat, latency: int, record: dict) -> None:
+    """Record and judge a two-input sweep against its twin's ``out``/``sat``: bit-exact, one latency."""
+    bad = (got[:, 2] != out) | (got[:, 3] != np.asarray(sat).astype(np.int64))
+    write_record(cfg, name, {"mismatches": int(np.count_nonzero(bad)), "samples": int(got.shape[0]),
+                             **record, "latency": sorted(set(got[:, 4].tolist()))})
+    for k in np.flatnonzero(bad)[:10]:
+        dut._log.error("code %d temp %d: HDL %d sat %d, twin %d sat %d", got[k, 0], got[k, 1], got[k, 2],
+                       got[k, 3], out[k], sat[k])
+    assert not bad.any(), f"{int(np.count_nonzero(bad))} mismatches vs the twin"
+    lat = set(got[:, 4].tolist())
+    assert lat == {latency}, f"latencies {sorted(lat)} (manifest {latency})"
+
+
 def cycle_now() -> int:
     return int(cocotb.utils.get_sim_time(unit="ns")) // CLK_NS
 
