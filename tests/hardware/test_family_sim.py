@@ -33,3 +33,22 @@ def test_two_sensors_through_cfg_port(tmp_path):
     assert res.tests == 3 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
     rec = res.records["family_every_code"]
     assert len(rec["codes"]) == 2 ** 8 and rec["mismatches"] == 0
+
+
+def test_two_identical_sensors_verify(tmp_path):
+    """Two sensors whose images are the same word for word (identical sensors) are a valid
+    family: every code still agrees with the twin, and the bench does not call it a failed load."""
+    recs = write_batch(tmp_path / "rec", 1, seed=11, points=400)
+    twin = recs[0].with_name("twin_" + recs[0].name)
+    shutil.copy(recs[0], twin)
+    hdl = tmp_path / "hdl"
+    generate_family([recs[0], twin], hdl, terms=5, input_bits=6)
+    fam = load_design(hdl)
+    words = hex_text(check_sensor(read_recordings(recs[0]), fam)["words"])
+    images = []
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.hex").write_text(words)
+        images.append({"name": name, "hex": str(tmp_path / f"{name}.hex")})
+    res = runner.run_family_bench(hdl, images, tmp_path / "build")
+    assert res.tests == 3 and res.ok, f"failed: {res.failed_tests}"
+    assert res.records["family_every_code"]["mismatches"] == 0

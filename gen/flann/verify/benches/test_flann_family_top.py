@@ -92,8 +92,9 @@ async def family_two_sensors_every_code(dut):
         assert bench.sb.ok, f"{name}: {bench.sb.mismatches} mismatches vs its twin"
         assert len(got) == len(bench.codes())
     assert set(bench.sb.latencies) == {lat}, f"latencies {sorted(set(bench.sb.latencies))}, manifest {lat}"
-    names = [n for n, _ in bench.images]
-    assert outs[names[0]] != outs[names[1]], "the two sensors gave identical outputs: the load had no effect"
+    (a, words_a), (b, words_b) = bench.images[:2]
+    if list(words_a) != list(words_b):   # two identical sensors' images cannot show the load
+        assert outs[a] != outs[b], "the two sensors gave identical outputs: the load had no effect"
     write_record(bench.cfg, "family_every_code", {"codes": bench.codes(), "outputs": outs,
                                                   "mismatches": bench.sb.mismatches})
 
