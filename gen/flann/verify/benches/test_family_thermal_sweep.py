@@ -1,4 +1,4 @@
-"""Family design with temperature: the VHDL harness flann_family_thermal_sweep.vhd loads one
+"""Family design with temperature: the VHDL harness flann_sweep.vhd (addr_bits_g > 0) loads one
 sensor's image through the cfg port and drives every voltage code at each listed temperature
 code; this bench wakes once, at done, and checks the whole file against the twin holding that
 image (hardware/family_thermal/twin.py)."""
