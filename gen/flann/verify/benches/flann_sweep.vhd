@@ -183,6 +183,9 @@ begin
     variable two : boolean := temp_bits_g > 0;
   begin
     done <= '0';
+    assert addr_bits_g = 0 or two
+      report "a weight memory (addr_bits_g > 0) is a two-input design's (temp_bits_g > 0)"
+      severity failure;
     if two then
       file_open(st, tf, temps_file_g, read_mode);
       assert st = open_ok report "cannot open " & temps_file_g severity failure;
