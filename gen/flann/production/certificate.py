@@ -61,17 +61,24 @@ def _tolerance_mm(spec, verdict) -> float | None:
     return None
 
 
-def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings, basis: str, *,
-                       spec, verdict, trace, uncertainty, confounded=()) -> str:
-    s, mspec = fam.spec, chk["spec"]
-    u = uncertainty.expanded_mm
+def _verdict_rows(verdict, u: float) -> list:
+    """The verdict's compensated max error, in mm and in % FS, each with the expanded uncertainty U."""
     fs = verdict.full_scale_mm
     pct_u = f" ± {100 * u / fs:.2g}" if fs else ""
-    results = ("Results (expanded uncertainty U, k = 2)", [
+    return [
         ("compensated max error (hardware) over " + verdict.range_text,
          f"{verdict.max_error_mm:.4g} ± {u:.2g} mm" if verdict.max_error_mm is not None else "-"),
         ("compensated max error in % FS",
          f"{verdict.max_error_pct_fs:.4g}{pct_u} % FS" if verdict.max_error_pct_fs is not None else "-"),
+    ]
+
+
+def render_certificate(res, chk: dict, fam, dhash: str, mhash: str, findings, basis: str, *,
+                       spec, verdict, trace, uncertainty, confounded=()) -> str:
+    s, mspec = fam.spec, chk["spec"]
+    u = uncertainty.expanded_mm
+    results = ("Results (expanded uncertainty U, k = 2)", [
+        *_verdict_rows(verdict, u),
         ("compensated max error, whole recording", f"{res.max_error_mm:.4g} ± {u:.2g} mm"),
         ("raw max error (least-squares line)", f"{res.raw_max_error_mm:.4g} ± {u:.2g} mm"),
         ("physical limit, worst over the stroke", f"{res.limit_mm:.4g} mm"),
@@ -108,17 +115,12 @@ def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, find
     temperature (``fam`` its FamilyThermalSpec): the results over every temperature, a table
     by temperature (error, verdict), the drift figure and one error curve per temperature."""
     u = uncertainty.expanded_mm
-    fs = verdict.full_scale_mm
-    pct_u = f" ± {100 * u / fs:.2g}" if fs else ""
 
     def drift(value) -> str:
         return "-" if value is None else f"{value:.3g} ppm FS/degC"
 
     results = ("Results over every calibration temperature (expanded uncertainty U, k = 2)", [
-        ("compensated max error (hardware) over " + verdict.range_text,
-         f"{verdict.max_error_mm:.4g} ± {u:.2g} mm" if verdict.max_error_mm is not None else "-"),
-        ("compensated max error in % FS",
-         f"{verdict.max_error_pct_fs:.4g}{pct_u} % FS" if verdict.max_error_pct_fs is not None else "-"),
+        *_verdict_rows(verdict, u),
         ("raw max error (one least-squares line)", f"{res.raw_max_error_mm:.4g} ± {u:.2g} mm"),
         ("drift_ppm_fs_per_c (hardware)", drift(chk["drift_ppm_fs_per_c"])),
         ("drift_ppm_fs_per_c (raw sensor)", drift(chk["raw_drift_ppm_fs_per_c"])),

@@ -170,7 +170,8 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
               "addr_bits_g": spec.cfg_addr_bits, "code_lo_g": spec.code_min, "code_hi_g": spec.code_max,
               "image_file_g": str(image_file), "temps_file_g": str(temps_file), "out_file_g": str(out_file)}
-    res = run_cocotb([*design.files, BENCH_DIR / "flann_family_thermal_sweep.vhd"], "flann_family_thermal_sweep",
+    # the one sweep harness, its image loaded through the cfg port first
+    res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
                      "test_family_thermal_sweep", build_dir / "family_thermal_sweep",
                      {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
                      name="family_thermal_sweep", parameters=params, seed=seed, backend=backend)

@@ -36,6 +36,7 @@ from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel
 from ...numeric.fixed import FixedFormat, bits_needed
+from ..delegate import delegated
 from ..family.spec import DEFAULT_MARGIN, FamilySpec, derive_family, member_spec
 
 DEFAULT_ORDERS = 3          # a 3-temperature calibration determines 3 orders
@@ -145,46 +146,17 @@ class FamilyThermalSpec:
     analysis: dict = field(default_factory=dict, compare=False)
     image: str = field(default="", compare=False)   # which sensor's weight image ``model`` is (flann eval)
 
-    # -- codes --------------------------------------------------------------------------
-    @property
-    def input_bits(self) -> int:
-        return self.fam.spec.input_bits
-
-    @property
-    def input_lsb_v(self) -> float:
-        return self.fam.spec.input_lsb_v
-
-    @property
-    def code_min(self) -> int:
-        return self.fam.spec.code_min
-
-    @property
-    def code_max(self) -> int:
-        return self.fam.spec.code_max
-
-    @property
-    def temp_bits(self) -> int:
-        return self.temp.bits
-
-    @property
-    def temp_lsb_c(self) -> float:
-        return self.temp.lsb_c
-
-    @property
-    def temp_code_min(self) -> int:
-        return self.temp.code_min
-
-    @property
-    def temp_code_max(self) -> int:
-        return self.temp.code_max
-
-    @property
-    def temp_lo(self) -> int:
-        return self.temp.lo
-
-    @property
-    def temp_hi(self) -> int:
-        return self.temp.hi
+    # -- codes: the orders' datapath's and the temperature normaliser's ----------------
+    input_bits = delegated("fam.spec.input_bits")
+    input_lsb_v = delegated("fam.spec.input_lsb_v")
+    code_min = delegated("fam.spec.code_min")
+    code_max = delegated("fam.spec.code_max")
+    temp_bits = delegated("temp.bits")
+    temp_lsb_c = delegated("temp.lsb_c")
+    temp_code_min = delegated("temp.code_min")
+    temp_code_max = delegated("temp.code_max")
+    temp_lo = delegated("temp.lo")
+    temp_hi = delegated("temp.hi")
 
     # -- shape --------------------------------------------------------------------------
     @property
@@ -201,9 +173,7 @@ class FamilyThermalSpec:
         """A sensor's image: every order's memory in turn (order j from j x mem_depth)."""
         return self.orders * self.fam.mem_depth
 
-    @property
-    def order_bits(self) -> int:
-        return self.fam.spec.out_fmt.width
+    order_bits = delegated("fam.spec.out_fmt.width")
 
     @property
     def acc_bits(self) -> int:

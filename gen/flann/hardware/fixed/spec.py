@@ -294,37 +294,30 @@ class Spec(FrontEnd):
         return CLOCK_HZ / self.cycles_per_sample
 
     def to_dict(self) -> dict:
-        """The spec as stamped in headers and manifest.json (ROM contents excluded)."""
-        return {
-            "number_format": self.number_format,
-            "device": self.device,
-            "lanes": self.lanes,
-            "mult_style": self.mult_style,
-            "mult_digit_bits": self.mult_digit_bits,
-            "terms": self.model.terms,
-            "input_bits": self.input_bits,
-            "input_lsb_v": self.input_lsb_v,
-            "clamp_codes": [self.clamp_lo, self.clamp_hi],
-            "phase_bits": self.phase_bits,
-            "table_addr_bits": self.table_addr_bits,
-            "interp": self.interp,
-            "table_style": self.table_style,
-            "dq_bits": self.dq_bits,
-            "slope_guard": self.slope_guard,
-            "norm_guard": self.norm_guard,
-            "lin_guard": self.lin_guard,
-            "value": self.value_fmt.describe(),
-            "slope": self.slope_fmt.describe(),
-            "term": self.term_fmt.describe(),
-            "weight": self.weight_fmt.describe(),
-            "product": self.product_fmt.describe(),
-            "linear": self.lin_fmt.describe(),
-            "acc": self.acc_fmt.describe(),
-            "output": self.out_fmt.describe(),
-            "output_lsb_mm": self.output_lsb_mm,
-            "steps": self.steps,
-            "adv_period": self.adv_period,
-        }
+        """The spec as stamped in headers and manifest.json (ROM contents excluded): the front
+        end's fields with the multiplier's, adder's and sequencer's placed among them."""
+        return _placed(super().to_dict(), {
+            None: {"number_format": self.number_format},
+            "device": {"lanes": self.lanes, "mult_style": self.mult_style, "mult_digit_bits": self.mult_digit_bits},
+            "interp": {"table_style": self.table_style},
+            "norm_guard": {"lin_guard": self.lin_guard},
+            "term": {"weight": self.weight_fmt.describe(), "product": self.product_fmt.describe(),
+                     "linear": self.lin_fmt.describe(), "acc": self.acc_fmt.describe(),
+                     "output": self.out_fmt.describe(), "output_lsb_mm": self.output_lsb_mm},
+            "steps": {"adv_period": self.adv_period},
+        })
+
+
+def _placed(d: dict, after: dict) -> dict:
+    """``d`` with each group of ``after`` placed after its key (``None``: first); the order is
+    what the headers and manifest.json show, so it is kept."""
+    if not set(after) - {None} <= set(d):
+        raise KeyError(f"no field {sorted(set(after) - {None} - set(d))} to place after")
+    out = dict(after.get(None, {}))
+    for k, v in d.items():
+        out[k] = v
+        out.update(after.get(k, {}))
+    return out
 
 
 # ------------------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
 from ..fixed.latency import EXPANSION_ADVANCES, SEQ_START_EDGES, norm_latency
 from ..fixed.spec import FrontEnd, derive_front, front_end
+from ..delegate import delegated
 from ..options import GenOptions
 from ..twin import TopOut
 
@@ -57,11 +58,6 @@ def float18_options(options: GenOptions, fixed_too: bool = False) -> dict:
             if k in FRONT_END_OPTIONS or (k in changed and not fixed_too)}
 
 
-def _front_value(name: str) -> property:
-    """A read-only attribute of the spec's front end (``spec.front.<name>``)."""
-    return property(lambda spec: getattr(spec.front, name))
-
-
 @dataclass(frozen=True)
 class F18Spec:
     """The shared fixed-point front end (input, normaliser, expansion) plus the float18
@@ -75,19 +71,13 @@ class F18Spec:
     number_format = "float18"
 
     # the shared front end's own values, under the same names
-    model = _front_value("model")
+    model = delegated("front.model")
     # cycles per term: the adder's latency (its result forwarded), the front end's pace
-    adv_period = _front_value("adv_period")
-    code_min = _front_value("code_min")
-    code_max = _front_value("code_max")
-
-    @property
-    def terms(self) -> int:
-        return self.front.model.terms
-
-    @property
-    def term_frac_bits(self) -> int:
-        return self.front.term_fmt.frac_bits
+    adv_period = delegated("front.adv_period")
+    code_min = delegated("front.code_min")
+    code_max = delegated("front.code_max")
+    terms = delegated("front.model.terms")
+    term_frac_bits = delegated("front.term_fmt.frac_bits")
 
     @property
     def n_advs(self) -> int:

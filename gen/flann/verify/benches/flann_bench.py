@@ -61,6 +61,15 @@ async def reset(dut, cycles: int = 2) -> None:
     dut.rst.value = 0
 
 
+async def two_input_sweep(dut, rebuild, what: str):
+    """Wait for a two-input sweep's done, rebuild its spec (``rebuild(model, manifest, what)``)
+    and read its file: (config, spec, rows, voltage codes, temperature codes)."""
+    cfg = config()
+    await RisingEdge(dut.done)
+    spec, _ = rebuild(cfg["model"], cfg["manifest"], what)
+    return (cfg, spec, *two_input_samples(cfg))
+
+
 def two_input_samples(cfg: dict):
     """A two-input sweep's file (code, temperature code, out, sat, latency per line), checked
     to hold every listed sample in order: (rows, voltage codes, temperature codes)."""

@@ -6,21 +6,16 @@ from __future__ import annotations
 
 import cocotb
 import numpy as np
-from cocotb.triggers import RisingEdge
 
 from flann.hardware.thermal.render import rebuild
 from flann.hardware.thermal.twin import ThermalTop
-from flann.verify.benches import config
-from flann.verify.benches.flann_bench import judge_two_input, two_input_samples
+from flann.verify.benches.flann_bench import judge_two_input, two_input_sweep
 
 
 @cocotb.test()
 async def thermal_sweep_vs_twin(dut):
     """Every (voltage code, temperature code) of the sweep, bit-exact vs the twin, fixed latency."""
-    cfg = config()
-    await RisingEdge(dut.done)
-    spec, _ = rebuild(cfg["model"], cfg["manifest"], "thermal sweep")
-    got, want_c, want_t = two_input_samples(cfg)
+    cfg, spec, got, want_c, want_t = await two_input_sweep(dut, rebuild, "thermal sweep")
     out, sat = ThermalTop(spec).process(want_c, want_t)
     ref = spec.float_reference(want_c, want_t) / spec.output_lsb_mm
     ok = ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
