@@ -59,7 +59,8 @@ def bram_image(words) -> list[int]:
 DEFAULT_MARGIN = 0.5
 # a later sensor may lie beyond the members' envelope by this many times the members' own
 # spread: the offset constant k0 (bias + linear term at code 0) follows the sensor's null
-# asymmetry, which three members sample poorly (a near-family sensor's is often 2-3x theirs)
+# asymmetry, which a few members sample poorly (tests/hardware/test_family_headroom.py: three
+# members within +-3 % asymmetry, later sensors within +-6 %)
 SPREAD = 2.0
 # the forced generator options every member is derived with (stored in the manifest)
 FORCED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "phase_bits", "table_addr_bits",
