@@ -4,6 +4,8 @@ simulator); no HDL simulation here (tests/production/test_family_thermal_line.py
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -125,3 +127,9 @@ def test_trace_stages_add_up_to_the_twin_minus_float_within_their_bounds(design)
     assert r.stages["output"]["max_mm"] <= 0.5 * s.output_lsb_mm + 1e-12
     assert r.stages["horner"]["max_mm"] <= (s.orders - 1) / 2 * q_k + 1e-12
     assert r.stages["orders"]["max_mm"] <= s.orders * q_k + 1e-12
+
+
+def test_without_terms_a_family_with_temperature_takes_its_fixed_default(design):
+    """A plain family's default is --terms auto; with temperature the terms stay fixed (15)."""
+    man = json.loads((design / "design" / "manifest.json").read_text())
+    assert man["family"]["terms"] == 15

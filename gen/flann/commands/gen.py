@@ -36,7 +36,9 @@ def run(args) -> int:
     opts = gen_options.from_args(args)
     if args.family is not None or args.model is None:
         check_family_args(args)
-        dp, source, extra = family_datapath(args.family), args.family, {"terms": args.terms, "margin": args.margin}
+        dp, source, extra = family_datapath(args.family), args.family, {"margin": args.margin}
+        if args.terms is not None:  # else the datapath's own default (auto; fixed with temperature)
+            extra["terms"] = args.terms
     else:
         dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
         other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)

@@ -17,12 +17,13 @@ from ...recordings import prepare_for_fit, read_recordings
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
 
-DEFAULT_TERMS = 15
+DEFAULT_TERMS = "auto"  # chosen for the worst member, like train --terms auto (FIXED_TERMS: no recordings)
+FIXED_TERMS = 15  # a CSV's terms when --terms auto has no recordings to choose from, and calibrate's fallback
 NORMALISATION = "half"  # v_n in [-0.5, 0.5]: the periodic terms need not join the two ends
 RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in accuracy
 
 
-def train_model(rec, terms: int = DEFAULT_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
+def train_model(rec, terms: int = FIXED_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
     """Least-squares FLANN of ``terms`` terms on validated recordings."""
     rec = prepare_for_fit(rec)
     info = {"data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})}
@@ -49,7 +50,7 @@ def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN):
                         cost=lambda m: fixed_point_cost(m, adc))
 
 
-def load_member(path, terms: int = DEFAULT_TERMS) -> FlannModel:
+def load_member(path, terms: int = FIXED_TERMS) -> FlannModel:
     """A model.json as it is, or a recordings CSV trained with ``terms`` terms."""
     path = Path(path)
     if path.suffix.lower() == ".json":
@@ -59,7 +60,7 @@ def load_member(path, terms: int = DEFAULT_TERMS) -> FlannModel:
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
 
-def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
+def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
                     **options) -> dict:
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
@@ -67,7 +68,7 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
     choices = []
     if terms == "auto":
         terms, choices = auto_terms(sources, options, margin)
-        terms = DEFAULT_TERMS if terms is None else max(2, terms)
+        terms = FIXED_TERMS if terms is None else max(2, terms)
     if not 2 <= int(terms) <= 200:
         raise FlannError(f"--terms {terms}: must be 2..200")
     models, bad = [], []
@@ -90,4 +91,4 @@ def generate_family(sources, out_dir, *, terms: int = DEFAULT_TERMS, margin: flo
     return man
 
 
-__all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "NORMALISATION"]
+__all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]

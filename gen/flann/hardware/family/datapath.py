@@ -15,7 +15,7 @@ from .spec import DEFAULT_MARGIN, family_from_dict, member_spec
 from .twin import FlannFamilyTop
 
 
-def generate(sources, out_dir, options: GenOptions | None = None, *, terms: int = DEFAULT_TERMS,
+def generate(sources, out_dir, options: GenOptions | None = None, *, terms: int | str = DEFAULT_TERMS,
              margin: float = DEFAULT_MARGIN) -> dict:
     return generate_family(sources, out_dir, terms=terms, margin=margin, **(options or GenOptions()).to_kwargs())
 

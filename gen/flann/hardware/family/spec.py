@@ -13,8 +13,11 @@ Sizing (``derive_family``):
 * fraction bits (phase, table, terms, weights, products) are those the error budget of the
   fixed datapath gives a member whose weights are ``(1 + margin)`` times larger than any
   member's, so a sensor like them still meets the 1-LSB bound;
-* integer widths (weights, linear constants, products, accumulator) hold ``(1 + margin)``
-  times the family's largest value: the first member's blocks derived again
+* integer widths (weights, linear constants, products, accumulator) hold sensors of the same
+  kind that were not in the gen set (``flann calibrate`` runs them later): each bound is the
+  members' envelope widened by ``SPREAD`` times their spread (largest minus smallest, signed
+  for the linear constants k1 and k0), then ``(1 + margin)`` times that envelope's largest
+  magnitude (:func:`headroom`); the first member's blocks derived again
   (:func:`flann.hardware.fixed.spec.derive_multiplier`, ``derive_normaliser``,
   ``derive_adder``, ``derive_sequencer``) with these bounds.
 
@@ -36,7 +39,7 @@ from ...numeric.fixed import bits_needed
 from ..fixed.latency import norm_latency
 from ..fixed.spec import (BRAM_BITS, Blocks, Spec, acc_bound_for, assemble, check_fits, compose, derive_adder,
                           derive_blocks, derive_multiplier, derive_normaliser, derive_sequencer, derive_spec,
-                          estimate_resources, lin_acc_width, nice_125, round_sig)
+                          estimate_resources, lin_acc_reach, lin_acc_width, nice_125, round_sig)
 from ..options import GenOptions
 from ..target import DEFAULT_PART
 
@@ -54,6 +57,11 @@ def bram_image(words) -> list[int]:
     mask = (1 << HALF_BITS) - 1
     return [h for w in words for h in (int(w) & mask, (int(w) >> HALF_BITS) & mask)]
 DEFAULT_MARGIN = 0.5
+# a later sensor may lie beyond the members' envelope by this many times the members' own
+# spread: the offset constant k0 (bias + linear term at code 0) follows the sensor's null
+# asymmetry, which a few members sample poorly (tests/hardware/test_family_headroom.py: three
+# members within +-3 % asymmetry, later sensors within +-6 %)
+SPREAD = 2.0
 # the forced generator options every member is derived with (stored in the manifest)
 FORCED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "phase_bits", "table_addr_bits",
           "term_frac_bits", "weight_frac_bits", "product_frac_bits", "interp", "mult_style",
@@ -208,6 +216,15 @@ def _padded(model: FlannModel, terms: int) -> FlannModel:
     return replace(model, weights=tuple(model.weights) + (0.0,) * (terms - model.terms))
 
 
+def headroom(values, margin: float) -> int:
+    """The magnitude a design holds for a value whose members' values are ``values``: their
+    envelope widened by ``SPREAD`` x (largest - smallest) each way, its largest magnitude
+    x (1 + margin) (one member: (1 + margin) x its magnitude)."""
+    lo, hi = min(values), max(values)
+    wide = SPREAD * (hi - lo)
+    return int(math.ceil(max(abs(lo - wide), abs(hi + wide)) * (1 + margin)))
+
+
 def _scaled(model: FlannModel, k: float) -> FlannModel:
     return replace(model, weights=tuple(w * k for w in model.weights))
 
@@ -269,16 +286,13 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
     blocks = [derive_blocks(m, GenOptions.of(None, **options)) for m in models]
     specs = [assemble(b, device=device, check_device=False) for b in blocks]
 
-    def grow(n: int) -> int:  # (1 + margin) x the family's largest magnitude
-        return int(math.ceil(n * (1 + mu)))
-
     b0 = blocks[0]
-    wmax = grow(max(max(abs(w) for lane in s.weight_rom for w in lane) for s in specs))
-    kmax = grow(max(max(abs(s.k1), abs(s.k0) + (1 << (s.lin_guard - 1))) for s in specs))
-    lin_bound = grow(max(s.lin_fmt.max_int for s in specs))
+    wmax = headroom([max(abs(w) for lane in s.weight_rom for w in lane) for s in specs], mu)
+    k1max, k0max = headroom([s.k1 for s in specs], mu), headroom([s.k0 for s in specs], mu)
+    lin_bound = headroom([s.lin_fmt.max_int for s in specs], mu)
     shift = specs[0].product_shift
-    pmax = (b0.expansion.term_max * wmax + (1 << (shift - 1))) >> shift
-    fam = FamilySpec(spec=_envelope(b0, specs[0], weight_bound=wmax, lin_width=lin_acc_width(kmax, kmax, input_bits),
+    fam = FamilySpec(spec=_envelope(b0, specs[0], weight_bound=wmax,
+                                    lin_width=lin_acc_width(k1max, k0max, input_bits),
                                     lin_bound=lin_bound,
                                     acc_bound=acc_bound_for(lin_bound, [wmax] * specs[0].steps,
                                                             b0.expansion.term_max, shift)),
@@ -363,8 +377,7 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
     words = [w for lane in s.weight_rom for w in lane]
     checks = (
         ("weights", max(abs(w) for w in words), f.weight_fmt.max_int),
-        ("linear constants", max(abs(s.k1), abs(s.k0) + (1 << (s.lin_guard - 1))) * ((1 << (f.input_bits - 1)) + 1),
-         (1 << (f.lin_width - 2)) - 1),
+        ("linear constants", lin_acc_reach(s.k1, s.k0, f.input_bits), (1 << (f.lin_width - 2)) - 1),
         ("linear part", s.lin_fmt.max_int, f.lin_fmt.max_int),
         ("products", s.product_fmt.max_int, f.product_fmt.max_int),
         ("accumulator", s.acc_fmt.max_int, f.acc_fmt.max_int),
@@ -383,4 +396,4 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
 
 
 __all__ = ["FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
-           "bram_image", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED"]
+           "bram_image", "headroom", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED", "SPREAD"]

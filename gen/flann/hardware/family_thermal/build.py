@@ -18,11 +18,14 @@ from ...errors import FlannError, SpecError
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups, thermal_design
 from ...golden.train import normalisation, solve_lstsq
 from ...recordings import prepare_for_fit, read_recordings
-from ..family.build import DEFAULT_TERMS, NORMALISATION, RIDGE
+from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE
 from ..family.spec import DEFAULT_MARGIN
 from .render import write
 from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
 
+# terms per temperature order: fixed (auto is not chosen per member with temperature); a
+# plain family's default is --terms auto
+DEFAULT_TERMS = FIXED_TERMS
 MIN_ROWS = 4   # readings per temperature for it to count as a calibration temperature
 
 

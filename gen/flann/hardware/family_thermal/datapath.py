@@ -12,11 +12,10 @@ from ...golden.model import model_sha256
 from ...golden.thermal import ThermalModel, load_any_model
 from ...numeric.fixed import FixedFormat
 from ..datapath import Datapath, Field, _int, _num
-from ..family.build import DEFAULT_TERMS
 from ..family.spec import DEFAULT_MARGIN, family_from_dict
 from ..options import GenOptions
 from . import render
-from .build import generate_family_thermal
+from .build import DEFAULT_TERMS, generate_family_thermal
 from .spec import FamilyThermalSpec, TempNorm, check_member, order_models
 from .twin import FlannFamilyThermalTop
 

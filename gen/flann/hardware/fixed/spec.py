@@ -642,8 +642,13 @@ def lin_acc_width(k1_bound: int, k0_bound: int, input_bits: int) -> int:
     """The serial k1 x code + k0 accumulator, exact for every code (one guard bit). It holds
     k1's partial products (|k1 c| <= |k1| 2^(B-1)) and then k1 c + k0 + 2^(Gl-1) (k0 with its
     rounding half, Gl = B + 3): a tiny linear weight makes the half the largest of them."""
-    reach = (k1_bound << (input_bits - 1)) + k0_bound + (1 << (input_bits + 2))
+    reach = lin_acc_reach(k1_bound, k0_bound, input_bits)
     return bits_needed(-reach, reach) + 1
+
+
+def lin_acc_reach(k1: int, k0: int, input_bits: int) -> int:
+    """The largest magnitude the serial k1 x code + k0 accumulator holds (see :func:`lin_acc_width`)."""
+    return (abs(int(k1)) << (input_bits - 1)) + abs(int(k0)) + (1 << (input_bits + 2))
 
 
 def derive_normaliser(inp: InputStage, P: int, q: float, Pf: int, lin_width: int | None = None,
