@@ -34,6 +34,7 @@ import os
 import sys
 import time
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache, partial
 from pathlib import Path
@@ -259,6 +260,25 @@ def _start(path: Path, dhash: str, spec: ProductionSpec | None, max_error_mm: fl
     return res, spec, station or Station()
 
 
+@contextmanager
+def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, spec: ProductionSpec,
+               station: Station):
+    """Around one sensor's calibration: its verdict becomes the row's status; bad input or the
+    numerics of a pathological file reject it (``seen["rec"]``: the recording, once read)."""
+    try:
+        yield
+    except FlannError as exc:
+        _reject(res, str(exc), path, seen.get("rec"), out_dir, fam, dhash, spec, station)
+        return
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        _reject(res, f"{exc.__class__.__name__}: {exc}", path, seen.get("rec"), out_dir, fam, dhash, spec, station)
+        return
+    if res.verdict.verdict == PASS:
+        res.status, res.reason = "ok", ""
+    else:
+        res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
+
+
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
                   spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
@@ -266,11 +286,11 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
     that fails its spec or is rejected gets a certificate saying why and no weights."""
     path = Path(path)
     res, spec, station = _start(path, dhash, spec, max_error_mm, station)
-    rec = None
-    try:
+    seen: dict = {}
+    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            rec = read_recordings(path)
+            rec = seen["rec"] = read_recordings(path)
             chk = check_sensor(rec, fam)
         res.warnings += [str(w.message) for w in caught]
         res.twin_vs_float_lsb = chk["twin_err_lsb"]
@@ -300,14 +320,6 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         extra = {"spec": spec, "verdict": res.verdict, "trace": res.trace, "uncertainty": unc,
                  "confounded": groups}
         _write_sensor(child(out_dir, res.sensor), res, chk, fam, dhash, findings, basis, extra)
-        if res.verdict.verdict == PASS:
-            res.status, res.reason = "ok", ""
-        else:
-            res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
-    except FlannError as exc:
-        _reject(res, str(exc), path, rec, out_dir, fam, dhash, spec, station)
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
-        _reject(res, f"{exc.__class__.__name__}: {exc}", path, rec, out_dir, fam, dhash, spec, station)
     return res
 
 
@@ -318,11 +330,11 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
     FamilyThermalSpec): the image, verdicts at each temperature and overall, the drift."""
     path = Path(path)
     res, spec, station = _start(path, dhash, spec, max_error_mm, station)
-    rec = None
-    try:
+    seen: dict = {}
+    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            rec = read_recordings(path)
+            rec = seen["rec"] = read_recordings(path)
             if rec.temperature_c is None:
                 raise FlannError(f"{path}: no temperature_c column; the design compensates temperature "
                                  f"({fam.orders} orders): calibrate at {fam.orders} or more temperatures")
@@ -358,14 +370,6 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
         extra = {"spec": spec, "verdict": res.verdict, "trace": res.trace, "uncertainty": worst_u,
                  "confounded": groups, "per_temperature": per}
         _write_sensor_thermal(child(out_dir, res.sensor), res, chk, fam, dhash, findings, basis, extra)
-        if res.verdict.verdict == PASS:
-            res.status, res.reason = "ok", ""
-        else:
-            res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
-    except FlannError as exc:
-        _reject(res, str(exc), path, rec, out_dir, fam, dhash, spec, station)
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:  # numerics of a pathological file
-        _reject(res, f"{exc.__class__.__name__}: {exc}", path, rec, out_dir, fam, dhash, spec, station)
     return res
 
 
