@@ -20,19 +20,13 @@ from flann.hardware.thermal.twin import ThermalTop
 from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
 from flann.verify.design import from_directory
 
+from test_thermal_twin import sensor_v
+
 FLANN = [sys.executable, "-m", "flann.cli"]
 
 
 def flann(*args):
     return subprocess.run([*FLANN, *map(str, args)], capture_output=True, text=True)
-
-
-def sensor_v(x, temp):
-    """An S-curve sensor (+-10 mm) whose gain falls 0.025 %/degC, null and roll-off move."""
-    dt = np.asarray(temp, dtype=float) - 25.0
-    k = 2.5 * (1 + 1e-4 * dt)
-    u = x / 8.0
-    return 1.5 * (1 - 2.5e-4 * dt) * u / (1 + np.abs(u) ** k) ** (1 / k) + 1.5 * 4e-6 * dt
 
 
 @pytest.fixture(scope="module")

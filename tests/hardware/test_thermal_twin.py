@@ -11,7 +11,7 @@ from flann.hardware.thermal.twin import ThermalTop
 
 
 def sensor_v(x, temp):
-    """An S-curve sensor (+-10 mm) whose gain falls 0.025 %/degC and whose roll-off moves."""
+    """An S-curve sensor (+-10 mm) whose gain falls 0.025 %/degC and whose null and roll-off move."""
     dt = np.asarray(temp, dtype=float) - 25.0
     k = 2.5 * (1 + 1e-4 * dt)
     u = x / 8.0
