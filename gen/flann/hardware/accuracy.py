@@ -18,6 +18,7 @@ from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
 from ..golden.model import FlannModel
+from ..numeric.fixed import signed_range
 from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
@@ -66,7 +67,7 @@ def adc_codes(spec: Spec, voltage_v, adc: tuple[int, float] | None = None) -> np
     if drop < 0:
         raise FlannError(f"ADC of {bits} bits is narrower than the design's {spec.input_bits}-bit input")
     c = np.floor(np.asarray(voltage_v, dtype=float) / lsb + 0.5)
-    c = np.clip(c, -(1 << (bits - 1)), (1 << (bits - 1)) - 1).astype(np.int64) >> drop
+    c = np.clip(c, *signed_range(bits)).astype(np.int64) >> drop
     return np.clip(c, spec.code_min, spec.code_max)
 
 

@@ -35,7 +35,7 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel
-from ...numeric.fixed import FixedFormat, bits_needed
+from ...numeric.fixed import FixedFormat, bits_needed, signed_range
 from ..delegate import delegated
 from ..family.spec import DEFAULT_MARGIN, FamilySpec, derive_family, member_spec
 
@@ -64,11 +64,11 @@ class TempNorm:
 
     @property
     def code_min(self) -> int:
-        return -(1 << (self.bits - 1))
+        return signed_range(self.bits)[0]
 
     @property
     def code_max(self) -> int:
-        return (1 << (self.bits - 1)) - 1
+        return signed_range(self.bits)[1]
 
     @property
     def t_bits(self) -> int:
@@ -100,7 +100,7 @@ def temp_norm(temperature_range_c, bits: int, lsb_c: float) -> TempNorm:
         raise SpecError(f"--temp-lsb-c {lsb_c!r}: must be a number > 0")
     t_lo, t_hi = sorted(float(t) for t in temperature_range_c)
     lo, hi = math.floor(t_lo / lsb_c + 0.5), math.floor(t_hi / lsb_c + 0.5)
-    cmin, cmax = -(1 << (bits - 1)), (1 << (bits - 1)) - 1
+    cmin, cmax = signed_range(bits)
     if lo < cmin or hi > cmax:
         raise SpecError(f"calibrated temperatures {t_lo:g}..{t_hi:g} degC are codes {lo}..{hi}, outside the "
                         f"{bits}-bit temperature code ({cmin}..{cmax} x {lsb_c:g} degC): raise --temp-bits or "
