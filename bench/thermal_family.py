@@ -24,7 +24,7 @@ drift of a perfect compensator (this family's own inverse at each temperature) o
 readings, which is what the ADC's steps alone give the figure; the float model's drift; the
 hardware's (the two-input datapath's bit-true twin, :mod:`flann.hardware.thermal`, called as a
 library on every bit of the held-out ADC codes and a 12-bit x 0.0625 degC temperature code, at
-an output LSB of ``DRIFT_LSB_FS`` raised on the 1-2-5 series until the order datapaths build) and its
+an output LSB of ``DRIFT_LSB_FS`` raised in steps of ``LSB_STEP`` until the order datapaths build) and its
 largest |hardware - float|; the float model's and the hardware's max error at the held-out
 temperatures over the float model's max error at the calibration temperatures; the structure
 chosen.  Targets (issue, for the hardware): drift median <= 5 and worst <= 10 ppm FS/degC;
@@ -50,15 +50,17 @@ from flann.cli import main as flann
 from flann.golden.thermal import load_any_model
 from flann.errors import SpecError
 from flann.golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
-from flann.hardware.fixed.spec import nice_125
 from flann.hardware.thermal.spec import derive_thermal_spec
 from flann.hardware.thermal.twin import ThermalTop
 
 TEMP_BITS, TEMP_LSB_C = 12, 0.0625     # a digital temperature sensor's code
 # output LSB asked of the datapath: its rounding adds up to one LSB to the change of the error
-# between two temperatures, over the closest pair's 20 degC: 10 ppm FS keeps that <= 0.5 ppm
-# FS/degC (25 ppm FS: 1.25); raised on the 1-2-5 series where the order datapaths do not build
+# across the temperatures, over their 75 degC: 10 ppm FS keeps that <= 0.14 ppm FS/degC;
+# raised where the order datapaths do not build
 DRIFT_LSB_FS = 10e-6
+# finer than the 1-2-5 series (whose 2 -> 5 step can more than double the rounding): any
+# output LSB is a `flann gen --output-lsb-mm` a user can ask for
+LSB_STEP = 1.25
 
 CALIBRATION_C = (-20.0, 25.0, 80.0)
 HELD_OUT_C = (-10.0, 10.0, 40.0, 65.0)
@@ -177,15 +179,15 @@ def hardware_drift(p, model_path, held_csv, fs_mm) -> dict:
     datapath takes up to 24-bit codes), its drift and its largest |hardware - float| in output LSBs."""
     model = load_any_model(model_path)
     bits, lsb = p["bits"], lsb_v(p)
-    want = nice_125(DRIFT_LSB_FS * fs_mm, up=False)
-    # raised on the 1-2-5 series while the order datapaths do not build it (large weights)
-    for _ in range(12):
+    want = DRIFT_LSB_FS * fs_mm
+    # raised while the order datapaths do not build it (large weights)
+    for _ in range(40):
         try:
             spec = derive_thermal_spec(model, input_bits=bits, input_lsb_v=lsb, temp_bits=TEMP_BITS,
                                        temp_lsb_c=TEMP_LSB_C, output_lsb_mm=want)
             break
         except SpecError:
-            want = nice_125(want * 1.5, up=True)
+            want *= LSB_STEP
     data = np.loadtxt(held_csv, delimiter=",", skiprows=1)
     x, v, temp = data[:, 0], data[:, 1], data[:, 2]
     codes = np.clip(np.floor(v / lsb + 0.5), spec.code_min, spec.code_max).astype(np.int64)

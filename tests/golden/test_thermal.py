@@ -103,6 +103,16 @@ def test_drift_is_the_largest_change_of_error_per_degc_in_ppm_of_full_scale():
     assert drift_ppm_fs_per_c(err[:21], x[:21], temp[:21], 10.0) is None
 
 
+def test_drift_is_the_box_method_over_the_whole_temperature_range():
+    # a position read 0.01 mm high at 10 degC only (a converter step, say): the change across
+    # the recorded temperatures (0..50 degC) is 0.01 mm, per degC of that range -- not per the
+    # closest pair's 10 degC, which would make it 5x larger
+    x = np.tile(np.linspace(-10, 10, 21), 3)
+    temp = np.repeat([0.0, 10.0, 50.0], 21)
+    err = np.where((temp == 10.0) & (x == 0.0), 0.01, 0.0)
+    assert drift_ppm_fs_per_c(err, x, temp, 10.0) == pytest.approx(0.01 / 50 / 10 * 1e6)
+
+
 def test_drift_interpolates_positions_one_temperature_lacks():
     xa, xb = np.linspace(-10, 10, 21), np.linspace(-10, 10, 8)
     x = np.concatenate([xa, xb])

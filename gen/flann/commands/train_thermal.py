@@ -49,9 +49,9 @@ def run_thermal(args, rec) -> int:
     model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
     model.save(args.output)
     tr = model.training
-    full = tr["full_structure"]
     print(f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "
-          f"coefficients; every order in full: {full['coefficients']}), normalisation {choice.norm}, "
+          f"coefficients; the smallest weights of {tr['as_good_candidates']} as good), "
+          f"normalisation {choice.norm}, "
           f"ridge {choice.ridge:g}; held-out error (cross-validation over "
           f"{tr['cv_position_folds']} position folds and {tr['cv_temperature_folds']} held-out "
           f"temperatures): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)

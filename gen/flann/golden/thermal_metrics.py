@@ -2,18 +2,20 @@
 
 * **by temperature**: rows grouped by temperature (:func:`.thermal.temperature_groups`);
   for each, ``max |e|`` and ``sqrt(mean e^2)`` with ``e = output - displacement`` (mm).
-* **drift** (ppm of full scale per degC): the largest change of the error between two
-  recorded temperatures, per degC of their difference, over every pair of temperatures and
-  every position both hold::
+* **drift** (ppm of full scale per degC), the data-sheet box method applied at every
+  position: the largest change of the error across the recorded temperatures, per degC of
+  the temperatures' range::
 
-      drift = max_{a, b} max_x |e_a(x) - e_b(x)| / |T_a - T_b| / FS * 1e6
+      drift = max_x (max_T e_T(x) - min_T e_T(x)) / (T_max - T_min) / FS * 1e6
 
   where ``e_T(x)`` is the error at temperature T at position x (forward and reverse
   readings of one position averaged; positions one temperature lacks are interpolated
-  linearly in its error curve, within its span).  A constant offset common to all
-  temperatures does not count: only what moves with temperature.  Noise in the readings
-  adds to it (twice the noise over the closest pair's temperature difference): judge it on
-  quiet or dense sweeps.  ``None`` when fewer than 2 temperatures have 2 positions each.
+  linearly in its error curve, within its span; T_min and T_max are those of the
+  temperatures holding x).  A constant offset common to all temperatures does not count:
+  only what moves with temperature.  A linear drift gives its slope; the converter's steps
+  and the readings' noise add at most their spread over the whole range (not over the
+  closest pair of temperatures, which made a perfect compensator behind a 16-bit converter
+  read 5-15 ppm FS/degC).  ``None`` when fewer than 2 temperatures have 2 positions each.
 """
 
 from __future__ import annotations
@@ -54,16 +56,22 @@ def by_temperature(error_mm, temperature_c) -> list[dict]:
 def drift_ppm_fs_per_c(error_mm, displacement_mm, temperature_c, fs_mm: float) -> float | None:
     curves = [c for c in error_curves(error_mm, displacement_mm, temperature_c)
               if c[1].size >= MIN_POSITIONS_PER_TEMPERATURE]
-    worst = None
-    for i, (ta, xa, ea) in enumerate(curves):
-        for tb, xb, eb in curves[i + 1:]:
-            inside = (xa >= xb[0]) & (xa <= xb[-1])
-            if not inside.any():
-                continue
-            change = np.max(np.abs(ea[inside] - np.interp(xa[inside], xb, eb)))
-            rate = float(change / abs(tb - ta) / fs_mm * 1e6)
-            worst = rate if worst is None else max(worst, rate)
-    return worst
+    if len(curves) < 2:
+        return None
+    at = np.unique(np.concatenate([pos for _, pos, _ in curves]))
+    errors = np.full((len(curves), at.size), np.nan)
+    temps = np.full((len(curves), at.size), np.nan)
+    for k, (temp, pos, err) in enumerate(curves):
+        inside = (at >= pos[0]) & (at <= pos[-1])
+        errors[k, inside] = np.interp(at[inside], pos, err)
+        temps[k, inside] = temp
+    held = np.sum(np.isfinite(errors), axis=0) >= 2
+    if not held.any():
+        return None
+    errors, temps = errors[:, held], temps[:, held]
+    change = np.nanmax(errors, axis=0) - np.nanmin(errors, axis=0)
+    span = np.nanmax(temps, axis=0) - np.nanmin(temps, axis=0)
+    return float(np.max(change / span) / fs_mm * 1e6)
 
 
 def temperature_report(errors: dict, displacement_mm, temperature_c, fs_mm: float) -> dict:

@@ -8,12 +8,17 @@
   fold fits the orders its remaining temperatures determine, so with 3 temperatures the
   quadratic order is judged on positions only).  Every candidate is judged on the same
   held-out points, so two candidates are compared point by point (the paired standard
-  error of :mod:`.train`).  Stage 1 picks normalisation, ridge and the expansion size with
-  every order using the whole expansion; stage 2 takes, of every narrower structure (fewer
-  cross terms per order, orders dropped) whose held-out mean squared error is within
-  ``AUTO_PAIRED_Z`` paired standard errors of the best, the one with the fewest
-  coefficients (the weight memory and the serial multiplier's cycles).  Candidates whose
-  coefficients exceed ``WEIGHT_LIMIT`` times the largest displacement are not taken.
+  error of :mod:`.train`).  Every order uses the whole expansion: dropping cross terms
+  that the held-out mean square cannot tell from noise cost accuracy and drift between the
+  calibration temperatures, at the flat ends of the stroke, where the mean square does not
+  look.  Of the candidates (normalisation, ridge, expansion size) whose held-out mean
+  squared error is within ``AUTO_PAIRED_Z`` paired standard errors of the best, the one
+  with the smallest sum of |coefficients| (the fixed-point terms' width, so the finest
+  output LSB the hardware builds).  Candidates whose coefficients exceed ``WEIGHT_LIMIT``
+  times the largest displacement, or sum to more than ``WEIGHT_SUM_LIMIT`` times, are not
+  taken.  Position folds are ``POSITION_FOLDS``:
+  with fewer, each fold's fit misses a larger share of the positions and the held-out
+  error favours stiffer models than the full fit needs.
 
 The temperature order is at most 2 (and at most the number of temperatures - 1): the
 copper law makes the gain a ratio of functions linear in T, whose series in T is dominated
@@ -36,9 +41,13 @@ AUTO_TERMS = (0, 1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41)
 # taken: nearly collinear terms cancelling each other, which fixed point cannot carry (the
 # one-input selection asks the fixed-point design itself; its weights stay within ~3x).
 WEIGHT_LIMIT = 16.0
+# ... nor one whose |coefficients| sum to more than this many times: the sum sets the width of
+# the order datapaths' terms, and past it the finest output LSB that builds is coarser than the
+# model's own error (a 2 mm sensor at 122x built at nothing finer than 180 ppm FS)
+WEIGHT_SUM_LIMIT = 64.0
 AUTO_NORMS = ("range", "half")
 AUTO_RIDGES = (0.0, 1e-12, 1e-10, 1e-8, 1e-6)
-POSITION_FOLDS = 5
+POSITION_FOLDS = 10
 MIN_TEMPERATURES = 2
 MIN_POSITIONS = 4
 AUTO_MAX_CV_POINTS = 20000
@@ -132,6 +141,7 @@ class ThermalCv:
     ridge: float
     sq_errors: np.ndarray       # held-out squared error of every judged point, fixed order
     max_coefficient: float      # largest |coefficient| fitted on all the judged points
+    weight_sum: float           # sum of |coefficient| fitted on all the judged points
 
     @property
     def mse(self) -> float:
@@ -206,30 +216,13 @@ def _cv(x, folds: _Folds, inputs: _Inputs, terms, norm, ridge) -> ThermalCv:
         coef = solve_lstsq(part[train], x[train], ridge)
         errs.append((part[held] @ coef - x[held]) ** 2)
     coef = solve_lstsq(full, x, ridge)
-    return ThermalCv(tuple(terms), norm, ridge, np.concatenate(errs), float(np.max(np.abs(coef))))
+    return ThermalCv(tuple(terms), norm, ridge, np.concatenate(errs), float(np.max(np.abs(coef))),
+                     float(np.sum(np.abs(coef))))
 
 
 def _paired_se(r: ThermalCv, ref: ThermalCv) -> float:
     d = r.sq_errors - ref.sq_errors
     return float(np.std(d, ddof=1) / np.sqrt(d.size)) if d.size > 1 else 0.0
-
-
-def _narrower(full_terms: int, orders: int):
-    """Every structure with n_0 <= full_terms and n_0 >= n_1 >= ... (orders dropped too)."""
-    sizes = [n for n in AUTO_TERMS if n <= full_terms]
-    out = []
-
-    def rec(prefix, cap):
-        if prefix:
-            out.append(tuple(prefix))
-        if len(prefix) == orders:
-            return
-        for n in sizes:
-            if n <= cap and (prefix or n >= 1):
-                rec(prefix + [n], n)
-
-    rec([], full_terms)
-    return out
 
 
 def cv_subset(n: int, limit: int = AUTO_MAX_CV_POINTS) -> np.ndarray:
@@ -266,28 +259,25 @@ def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dic
                 results.append(_cv(xs, folds, inputs[norm], (n,) * orders, norm, ridge))
     if not results:
         raise RecordingsError(f"{source}: {v.size} points are too few for a two-input model")
-    limit = WEIGHT_LIMIT * float(np.max(np.abs(x)))
-    buildable = [r for r in results if r.max_coefficient <= limit] or results
-    full = min(buildable, key=lambda r: r.mse)
-    narrow = [_cv(xs, folds, inputs[full.norm], terms, full.norm, full.ridge)
-              for terms in _narrower(full.terms[0], orders) if terms != full.terms]
-    everything = [full] + [r for r in narrow if r.max_coefficient <= limit]
-    best = min(everything, key=lambda r: r.mse)
-    good = [r for r in everything
+    scale = float(np.max(np.abs(x)))
+    limit, sum_limit = WEIGHT_LIMIT * scale, WEIGHT_SUM_LIMIT * scale
+    buildable = [r for r in results if r.max_coefficient <= limit and r.weight_sum <= sum_limit] or results
+    best = min(buildable, key=lambda r: r.mse)
+    good = [r for r in buildable
             if r is best or r.mse - best.mse <= AUTO_PAIRED_Z * _paired_se(r, best)]
-    choice = min(good, key=lambda r: (r.coefficients, r.mse))
+    choice = min(good, key=lambda r: (r.weight_sum, r.mse))
     info = {
-        "selected_by": "cross-validation over held-out positions and temperatures; of the "
-                       f"structures within {AUTO_PAIRED_Z:g} paired standard errors of the best "
-                       "held-out error, the fewest coefficients",
+        "selected_by": "cross-validation over held-out positions and temperatures; every "
+                       "order with the whole expansion; of the candidates within "
+                       f"{AUTO_PAIRED_Z:g} paired standard errors of the best held-out error, "
+                       "the smallest sum of |coefficients|",
         "cv_position_folds": len(folds.position),
         "cv_temperature_folds": len(folds.temperature),
         "cv_points": int(sub.size),
         "cv_rms_error_mm": choice.rms_mm,
         "cv_max_error_mm": choice.max_mm,
         "calibration_temperatures_c": [float(round(x_, 3)) for x_ in levels],
-        "full_structure": {"terms": list(full.terms), "cv_rms_error_mm": full.rms_mm,
-                           "coefficients": full.coefficients},
+        "as_good_candidates": len(good),
         "best_structure": {"terms": list(best.terms), "cv_rms_error_mm": best.rms_mm,
                            "coefficients": best.coefficients},
     }
