@@ -116,6 +116,7 @@ def test_calibrate_certificates_per_temperature(line):
         assert float(r["max_error_mm"]) < float(r["raw_max_error_mm"]) / 5
         html = (out / name / "certificate.html").read_text()
         assert "drift_ppm_fs_per_c (hardware)" in html
+        assert "box method" in html and "{" not in html.split("<body")[1].split("<svg")[0]
         assert "Verdict at each calibration temperature" in html
         for t in ("-20 degC", "25 degC", "80 degC"):  # the legend: one curve per temperature
             assert f">{t}</text>" in html

@@ -124,8 +124,9 @@ def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, find
         ("raw max error (one least-squares line)", f"{res.raw_max_error_mm:.4g} ± {u:.2g} mm"),
         ("drift_ppm_fs_per_c (hardware)", drift(chk["drift_ppm_fs_per_c"])),
         ("drift_ppm_fs_per_c (raw sensor)", drift(chk["raw_drift_ppm_fs_per_c"])),
-        ("drift method", "largest change of the error between two calibration temperatures at one position, "
-                         f"per degC, in ppm of full scale ({chk['full_scale_mm']:.4g} mm, half the recorded span, "
+        ("drift method", "box method at every position: the largest change of the error across the "
+                         "calibration temperatures, per degC of their range, in ppm of full scale "
+                         f"({chk['full_scale_mm']:.4g} mm, half the recorded span, "
                          "as flann eval reports it)"),
         ("physical limit, worst over the stroke", f"{res.limit_mm:.4g} mm"),
         ("uncertainty method", uncertainty.method + " (the largest of the temperatures')"),

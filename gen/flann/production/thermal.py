@@ -9,8 +9,8 @@ calibration temperature (no HDL simulation: the design's twin stands for it).
    the recording's own temperatures;
 3. the recording through the hardware: each row's voltage code and temperature code into
    the twin; the error, by temperature, and the drift figure ``drift_ppm_fs_per_c`` (the
-   largest change of the error between two calibration temperatures per degC, in ppm of full
-   scale, half the recorded span, as ``flann eval --json`` reports it:
+   box method at every position: the largest change of the error across the calibration
+   temperatures per degC of their range, in ppm of full scale, half the recorded span, as ``flann eval --json`` reports it:
    :func:`flann.golden.thermal_metrics.drift_ppm_fs_per_c`), for the hardware
    and the raw sensor (its one least-squares line over every temperature).
 """
