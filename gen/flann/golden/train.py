@@ -557,10 +557,9 @@ BOOT_TIE = 0.02
 @dataclass(frozen=True)
 class Readings:
     """What the recordings say about their readings: the noise (V, total, quantisation
-    included; None: from the cross-validated choice's held-out errors) and the converter
-    step (V, 0: none)."""
+    included: the outlier screen's robust estimate) and the converter step (V, 0: none)."""
 
-    noise_v: float | None = None
+    noise_v: float
     step_v: float = 0.0
 
 
@@ -585,20 +584,8 @@ def inverse_curve(model: FlannModel):
     return lambda x: np.interp(x, xo, vo)
 
 
-def heldout_noise_v(voltage_v, displacement_mm, r: CvResult, curve) -> float:
-    """Robust noise (V) of the readings from a candidate's held-out errors (mm) times the
-    curve's slope dv/dx there (1.4826 MAD)."""
-    v = np.asarray(voltage_v, float)
-    x = np.asarray(displacement_mm, float)
-    held = np.sort(np.concatenate(cv_folds(v, groups=x)))
-    h = 1e-4 * (float(x.max()) - float(x.min()))
-    slope = (curve(x[held] + h) - curve(x[held] - h)) / (2 * h)
-    ev = r.errors * slope
-    return float(1.4826 * np.median(np.abs(ev - np.median(ev))))
-
-
 def bootstrap_max_errors(voltage_v, displacement_mm, cands: list[CvResult], proxy: Proxy,
-                         draws: int = BOOT_DRAWS, seed: int = BOOT_SEED) -> np.ndarray:
+                         draws: int = BOOT_DRAWS, seed: int = BOOT_SEED, curves: bool = False):
     """(len(cands), draws): each candidate's max |x_hat(g(x)) - x| over a dense x grid across
     the stroke, refitted to synthetic recordings g(x_i) + noise (quantised) at the same
     positions; the voltage is clamped to each synthetic recording's range, as the hardware
@@ -611,6 +598,7 @@ def bootstrap_max_errors(voltage_v, displacement_mm, cands: list[CvResult], prox
     rng = np.random.default_rng(seed)
     tmax = max(c.terms for c in cands)
     out = np.empty((len(cands), draws))
+    mean_err = np.zeros((len(cands), grid.size))
     for b in range(draws):
         vb = g_pos + proxy.noise_v * rng.standard_normal(x.size)
         if proxy.step_v > 0:
@@ -629,7 +617,8 @@ def bootstrap_max_errors(voltage_v, displacement_mm, cands: list[CvResult], prox
                 coef = solve_lstsq(R[:, : c.terms + 1], z, c.ridge, samples=x.size)
                 e = G[:, : c.terms + 1] @ coef - grid
                 out[i, b] = float(np.max(np.abs(e))) if np.all(np.isfinite(e)) else math.inf
-    return out
+                mean_err[i] += e / draws
+    return (out, grid, mean_err) if curves else out
 
 
 def shortlist(results: list[CvResult], also=(), ok=None) -> list[CvResult]:
@@ -662,13 +651,19 @@ def _bootstrap_choice(v, x, results, cost, cv_choice: CvResult,
     anchor = cands[0]
     curve = inverse_curve(fit_lstsq(v, x, anchor.terms, norm=anchor.norm, ridge=anchor.ridge))
     step = max(float(readings.step_v), 0.0)
-    noise = readings.noise_v
-    source = "the recording's noise"
-    if noise is None:
-        noise, source = heldout_noise_v(v, x, anchor, curve), "held-out errors of the proxy's candidate"
-    noise = max(float(noise), step / math.sqrt(12.0))
+    noise = max(float(readings.noise_v), step / math.sqrt(12.0))
     gauss = math.sqrt(max(noise ** 2 - step ** 2 / 12.0, 0.0))
-    S = bootstrap_max_errors(v, x, cands, Proxy(curve, gauss, step))
+    # first round: the best buildable candidate's inverse as the truth; its pick's own bias
+    # (the mean error over the draws, the ends pulled inward) is then taken off its inverse,
+    # and that curve is the truth of the second round, which chooses
+    first = bootstrap_max_errors(v, x, cands, Proxy(curve, gauss, step)).mean(axis=1)
+    j = cands[int(np.argmin(first))]
+    curve = inverse_curve(fit_lstsq(v, x, j.terms, norm=j.norm, ridge=j.ridge))
+    _S, grid, bias = bootstrap_max_errors(v, x, [j], Proxy(curve, gauss, step), curves=True)
+    xc, vc = grid - bias[0], curve(grid)
+    o = np.argsort(xc, kind="stable")
+    S = bootstrap_max_errors(v, x, cands, Proxy(lambda q: np.interp(q, xc[o], vc[o]), gauss, step),
+                             seed=BOOT_SEED + 1)
     mean = S.mean(axis=1)
     best = min(mean[i] for i in range(len(cands)) if costed(cands[i])["buildable"])
     pool = [i for i in range(len(cands)) if mean[i] <= (1.0 + BOOT_TIE) * best and costed(cands[i])["buildable"]]
@@ -683,7 +678,7 @@ def _bootstrap_choice(v, x, results, cost, cv_choice: CvResult,
                             "candidates); of those "
                             f"within {100 * BOOT_TIE:g} % of the smallest, cheapest in fixed point"),
             "bootstrap": {"draws": int(S.shape[1]), "candidates": len(cands), "seed": BOOT_SEED,
-                          "noise_v": float(f"{noise:.4g}"), "noise_from": source,
+                          "noise_v": float(f"{noise:.4g}"),
                           "step_v": float(f"{step:.6g}"),
                           "proxy": _key(anchor),
                           "est_max_error_mm": float(f"{mean[k]:.4g}"),
