@@ -182,7 +182,7 @@ def run(args) -> int:
         readings = (Readings(record["noise_v"], converter_step(rec.voltage_v))
                     if "noise_v" in record else None)
         model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
-                                 cost=lambda m: fixed_point_cost(m, adc), bootstrap=None if __import__("os").environ.get("A22_CV") else readings)
+                                 cost=lambda m: fixed_point_cost(m, adc), bootstrap=readings)
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
                     f"held-out error (cross-validation, {t['cv_folds']} folds"
