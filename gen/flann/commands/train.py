@@ -13,8 +13,8 @@ from ..argtypes import bounded
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
-from ..golden.train import (NORMALISATIONS, PAPER_TERMS, Readings, check_fit_input, cross_validate,
-                            fit_auto, fit_lms, fit_lstsq)
+from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+                            fit_lms, fit_lstsq)
 from ..errors import SpecError
 from ..golden.model import MAX_TERMS
 from ..hardware.fixed.cost import fixed_point_cost
@@ -177,12 +177,8 @@ def run(args) -> int:
         if conv is not None:
             provenance["converter"] = conv
         adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
-        # the selection's bootstrap draws readings as noisy and as quantised as these; without
-        # the screen's noise (under 20 or over 5,000 positions) the cross-validated choice stands
-        readings = (Readings(record["noise_v"], converter_step(rec.voltage_v))
-                    if "noise_v" in record else None)
         model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
-                                 cost=lambda m: fixed_point_cost(m, adc), bootstrap=readings)
+                                 cost=lambda m: fixed_point_cost(m, adc))
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
                     f"held-out error (cross-validation, {t['cv_folds']} folds"

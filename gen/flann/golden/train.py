@@ -420,16 +420,13 @@ def _key(r: CvResult) -> dict:
 
 def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NORMS,
              ridges=AUTO_RIDGES, training: dict | None = None,
-             cost=None, bootstrap: Readings | None = None) -> tuple[FlannModel, CvResult]:
+             cost=None) -> tuple[FlannModel, CvResult]:
     """Choose (terms, norm, ridge) by cross-validation, then fit on all points.
 
     ``cost(model) -> {"buildable": bool, "cost": float, "why": str, ...}`` (lower is
     cheaper): with it, the cheapest buildable model as good as the best buildable one
     (:func:`as_good`); when none builds, the best-scoring candidate (the record says why).
     Without it, :func:`pick` (fewest terms within 2 % of the best RMS).
-    ``bootstrap`` (with ``cost``): the choice is then made among the best candidates by their
-    max error in a parametric bootstrap (:func:`_bootstrap_choice`), the cross-validated one
-    being the proxy of the truth.
     """
     v = np.asarray(voltage_v, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
@@ -451,9 +448,6 @@ def fit_auto(voltage_v, displacement_mm, *, terms_list=AUTO_TERMS, norms=AUTO_NO
     else:
         choice, _model, info_hw = _cheapest(vs, xs, results, cost)
         info.update(info_hw)
-        if bootstrap is not None and "chosen" in info_hw:
-            choice, info_bs = _bootstrap_choice(vs, xs, results, cost, choice, bootstrap)
-            info.update(info_bs)
     info.update({"cv_heldout_rms_error_mm": choice.rms_mm,
                  "cv_heldout_max_error_mm": choice.max_mm})
     info.update(training or {})
@@ -533,159 +527,3 @@ def converter_mismatch(model: FlannModel, input_bits: int, input_lsb_v: float | 
             f"this design is for {given}: retrain with flann train --input-bits {input_bits}"
             + (f" --input-lsb-v {input_lsb_v:.6g}" if input_lsb_v is not None else "")
             + " for a model judged at this converter")
-
-
-
-# -- auto: selection by parametric bootstrap of the max error ------------------------------
-# The held-out MSE is set by the interior of the stroke, the max error by its ends (low slope,
-# few points, the fit's boundary variance and its errors-in-variables bias): the cross-
-# validated choice is more flexible than the one with the smallest max error.  A parametric
-# bootstrap asks each of the best buildable candidates what max error it makes when refitted
-# to synthetic recordings of a known curve -- the best buildable candidate's inverse -- read at
-# the same positions with the recording's noise and converter.
-BOOT_DRAWS = 32
-BOOT_SHORTLIST = 20
-BOOT_GRID = 1001
-BOOT_SEED = 0
-BOOT_INVERSE_POINTS = 20001
-# candidates whose mean bootstrap max error is within this share of the smallest tie: the
-# cheapest of them in fixed point is taken (a paired 0.5 standard error over the draws, as
-# the cross-validation uses, gave a fifth of the gain back for a cheaper datapath)
-BOOT_TIE = 0.02
-
-
-@dataclass(frozen=True)
-class Readings:
-    """What the recordings say about their readings: the noise (V, total, quantisation
-    included: the outlier screen's robust estimate) and the converter step (V, 0: none)."""
-
-    noise_v: float
-    step_v: float = 0.0
-
-
-@dataclass(frozen=True)
-class Proxy:
-    """A stand-in for the sensor's true forward curve v(x) (x exact), the Gaussian part of
-    the reading noise (V) and the converter step (V, 0: none) readings are quantised to."""
-
-    curve: object
-    noise_v: float
-    step_v: float = 0.0
-
-
-def inverse_curve(model: FlannModel):
-    """v(x) of a model x(v): tabulated densely over its trained voltage range and inverted
-    (sorted by x, so a model not monotonic within the noise still gives a curve)."""
-    lo, hi = model.voltage_range_v
-    vv = np.linspace(lo, hi, BOOT_INVERSE_POINTS)
-    xx = model.predict(vv)
-    o = np.argsort(xx, kind="stable")
-    xo, vo = xx[o], vv[o]
-    return lambda x: np.interp(x, xo, vo)
-
-
-def bootstrap_max_errors(voltage_v, displacement_mm, cands: list[CvResult], proxy: Proxy,
-                         draws: int = BOOT_DRAWS, seed: int = BOOT_SEED, curves: bool = False):
-    """(len(cands), draws): each candidate's max |x_hat(g(x)) - x| over a dense x grid across
-    the stroke, refitted to synthetic recordings g(x_i) + noise (quantised) at the same
-    positions; the voltage is clamped to each synthetic recording's range, as the hardware
-    does.  One QR per draw and normalisation serves every candidate (nested columns)."""
-    v = np.asarray(voltage_v, float)
-    x = np.asarray(displacement_mm, float)
-    g_pos = np.asarray(proxy.curve(x), float)
-    grid = np.linspace(float(x.min()), float(x.max()), BOOT_GRID)
-    g_grid = np.asarray(proxy.curve(grid), float)
-    rng = np.random.default_rng(seed)
-    tmax = max(c.terms for c in cands)
-    out = np.empty((len(cands), draws))
-    mean_err = np.zeros((len(cands), grid.size))
-    for b in range(draws):
-        vb = g_pos + proxy.noise_v * rng.standard_normal(x.size)
-        if proxy.step_v > 0:
-            vb = np.round(vb / proxy.step_v) * proxy.step_v
-        if not float(vb.max()) > float(vb.min()):
-            vb = v   # a draw that reads one code everywhere: the recording itself
-        vg = np.clip(g_grid, vb.min(), vb.max())
-        for norm in sorted({c.norm for c in cands}):
-            offset, scale = normalisation(vb, norm)
-            Q, R = np.linalg.qr(design_matrix((vb - offset) / scale, tmax))
-            z = Q.T @ x
-            G = design_matrix((vg - offset) / scale, tmax)
-            for i, c in enumerate(cands):
-                if c.norm != norm:
-                    continue
-                coef = solve_lstsq(R[:, : c.terms + 1], z, c.ridge, samples=x.size)
-                e = G[:, : c.terms + 1] @ coef - grid
-                out[i, b] = float(np.max(np.abs(e))) if np.all(np.isfinite(e)) else math.inf
-                mean_err[i] += e / draws
-    return (out, grid, mean_err) if curves else out
-
-
-def shortlist(results: list[CvResult], also=(), ok=None) -> list[CvResult]:
-    """The candidates the bootstrap scores: the best ``BOOT_SHORTLIST`` by held-out MSE of
-    those ``ok`` accepts (buildable), and ``also``."""
-    out = []
-    for r in sorted((r for r in results if math.isfinite(r.rms_mm)), key=lambda r: (r.mse, r.terms)):
-        if len(out) >= BOOT_SHORTLIST:
-            break
-        if ok is None or ok(r):
-            out.append(r)
-    out += [r for r in also if r not in out]
-    return out
-
-
-def _bootstrap_choice(v, x, results, cost, cv_choice: CvResult,
-                      readings: Readings) -> tuple[CvResult, dict]:
-    """The buildable candidate of the shortlist with the smallest mean bootstrap max error;
-    of those within ``BOOT_TIE`` of it, the cheapest in fixed point (ties: the smaller mean)."""
-    costs: dict[CvResult, dict] = {}
-
-    def costed(r):
-        if r not in costs:
-            costs[r] = cost(fit_lstsq(v, x, r.terms, norm=r.norm, ridge=r.ridge,
-                                      training={"cv_heldout_rms_error_mm": r.rms_mm}))
-        return costs[r]
-
-    cands = shortlist(results, (cv_choice,), ok=lambda r: costed(r)["buildable"])
-    # the proxy truth: the best buildable candidate by held-out MSE (the first listed), inverted
-    anchor = cands[0]
-    curve = inverse_curve(fit_lstsq(v, x, anchor.terms, norm=anchor.norm, ridge=anchor.ridge))
-    step = max(float(readings.step_v), 0.0)
-    noise = max(float(readings.noise_v), step / math.sqrt(12.0))
-    gauss = math.sqrt(max(noise ** 2 - step ** 2 / 12.0, 0.0))
-    # first round: the best buildable candidate's inverse as the truth; its pick's own bias
-    # (the mean error over the draws, the ends pulled inward) is then taken off its inverse,
-    # and that curve is the truth of the second round, which chooses
-    first = bootstrap_max_errors(v, x, cands, Proxy(curve, gauss, step)).mean(axis=1)
-    j = cands[int(np.argmin(first))]
-    curve = inverse_curve(fit_lstsq(v, x, j.terms, norm=j.norm, ridge=j.ridge))
-    _S, grid, bias = bootstrap_max_errors(v, x, [j], Proxy(curve, gauss, step), curves=True)
-    xc, vc = grid - bias[0], curve(grid)
-    o = np.argsort(xc, kind="stable")
-    S = bootstrap_max_errors(v, x, cands, Proxy(lambda q: np.interp(q, xc[o], vc[o]), gauss, step),
-                             seed=BOOT_SEED + 1)
-    mean = S.mean(axis=1)
-    best = min(mean[i] for i in range(len(cands)) if costed(cands[i])["buildable"])
-    pool = [i for i in range(len(cands)) if mean[i] <= (1.0 + BOOT_TIE) * best and costed(cands[i])["buildable"]]
-    k = min(pool, key=lambda i: (costs[cands[i]]["cost"], mean[i]))
-    choice, c = cands[k], costs[cands[k]]
-    ci = cands.index(cv_choice)
-    traded = (f"estimated max error {mean[k]:.4g} mm (cross-validated choice, {cv_choice.terms} terms "
-              f"{cv_choice.norm}: {mean[ci]:.4g} mm) for {c['cost']:.0f} LUT4-equivalents, "
-              f"{choice.terms} terms, {c['weight_bits']}-bit weights")
-    info = {"selected_by": (f"parametric bootstrap of the max error ({S.shape[1]} synthetic recordings of "
-                            f"the best buildable cross-validated candidate's inverse, {len(cands)} "
-                            "candidates); of those "
-                            f"within {100 * BOOT_TIE:g} % of the smallest, cheapest in fixed point"),
-            "bootstrap": {"draws": int(S.shape[1]), "candidates": len(cands), "seed": BOOT_SEED,
-                          "noise_v": float(f"{noise:.4g}"),
-                          "step_v": float(f"{step:.6g}"),
-                          "proxy": _key(anchor),
-                          "est_max_error_mm": float(f"{mean[k]:.4g}"),
-                          "cross_validated": {**_key(cv_choice),
-                                              "est_max_error_mm": float(f"{mean[ci]:.4g}")}},
-            "chosen": _key(choice),
-            "traded": traded,
-            "fixed_point": {kk: c[kk] for kk in ("cost", "luts", "brams", "weight_bits", "term_bits",
-                                                 "phase_bits", "output_lsb_mm")}}
-    return choice, info
