@@ -17,6 +17,7 @@ from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
 from ..golden.model import MAX_TERMS
+from ..golden.sparse import sparse_fit
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .train_thermal import compensation_hint, run_thermal
@@ -138,6 +139,54 @@ def _check_generatable(model) -> None:
                          "use fewer --terms, a --ridge, or --terms auto (the default)") from None
 
 
+def _train_auto(args, rec, provenance: dict) -> tuple:
+    """(model, lines to print) of --terms auto: the direct fit's cross-validated choice,
+    or with few positions the fit to the inverse of the forward spline when it predicts
+    left-out positions better (:mod:`flann.golden.sparse`)."""
+    said = []
+    check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
+    positions = int(np.unique(rec.displacement_mm).size)
+    if positions < 4:
+        raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
+                         "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
+    conv = converter(args, rec)
+    rec, record, outlier_text = _screen(rec)
+    if outlier_text:
+        warnings.warn(outlier_text)
+    provenance.update(record)
+    if conv is not None:
+        provenance["converter"] = conv
+    adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
+
+    def cost(m):
+        return fixed_point_cost(m, adc)
+
+    model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
+    sparse = sparse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, provenance)
+    if sparse is None:
+        t = model.training
+        said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
+                    f"held-out error (cross-validation, {t['cv_folds']} folds"
+                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
+                    + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
+    else:
+        model, t = sparse, sparse.training
+        loo = t["leave_one_out"]
+        said.append(f"auto: {t['selected_by']}: left-out positions RMS {loo['rms_error_mm']:.4g} mm "
+                    f"(direct fit {loo['direct_rms_error_mm']:.4g} mm); {model.terms} terms, "
+                    f"normalisation {t['normalisation']}, ridge {t['ridge']:g}, within "
+                    f"{t['teacher_max_deviation_mm']:.3g} mm of the spline's inverse")
+    if conv is not None:
+        said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
+                    + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")
+                    + f" converter ({conv['from']}); positions used {t.get('positions_used')}")
+    if "traded" in t:
+        said.append(f"auto: {t['selected_by']}: {t['traded']}")
+    elif "hardware_why" in t:
+        said.append(f"auto: no candidate builds in fixed point ({t['hardware_why']})")
+    return model, said
+
+
 def run(args) -> int:
     rec = read_recordings(args.recordings)
     if args.temperature:
@@ -164,34 +213,7 @@ def run(args) -> int:
         if args.method != "lstsq" or explicit is not None or args.normalise or args.ridge:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
-        check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
-        positions = int(np.unique(rec.displacement_mm).size)
-        if positions < 4:
-            raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
-                             "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
-        conv = converter(args, rec)
-        rec, record, outlier_text = _screen(rec)
-        if outlier_text:
-            warnings.warn(outlier_text)
-        provenance.update(record)
-        if conv is not None:
-            provenance["converter"] = conv
-        adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])
-        model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance,
-                                 cost=lambda m: fixed_point_cost(m, adc))
-        t = model.training
-        said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-                    f"held-out error (cross-validation, {t['cv_folds']} folds"
-                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
-                    + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
-        if conv is not None:
-            said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
-                        + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")
-                        + f" converter ({conv['from']}); positions used {t.get('positions_used')}")
-        if "traded" in t:
-            said.append(f"auto: {t['selected_by']}: {t['traded']}")
-        elif "hardware_why" in t:
-            said.append(f"auto: no candidate builds in fixed point ({t['hardware_why']})")
+        model, said = _train_auto(args, rec, provenance)
     else:
         if args.input_bits is not None or args.input_lsb_v is not None:
             raise FlannError("--input-bits/--input-lsb-v choose among --terms auto's candidates; "
