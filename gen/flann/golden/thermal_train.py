@@ -331,5 +331,5 @@ def compensable(temperature_c, min_rows: int = MIN_POSITIONS) -> tuple[float, ..
     return tuple(float(t) for t, c in zip(levels, counts) if c >= min_rows)
 
 
-__all__ = ["AUTO_TERMS", "MAX_ORDER", "ThermalCv", "ThermalCvRun", "compensable", "cross_validate_thermal", "fit_thermal",
-           "fit_thermal_auto", "select_thermal"]
+__all__ = ["AUTO_TERMS", "MAX_ORDER", "ThermalCv", "ThermalCvRun", "compensable", "cross_validate_thermal",
+           "fit_thermal", "fit_thermal_auto", "select_thermal"]

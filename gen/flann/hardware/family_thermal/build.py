@@ -120,7 +120,8 @@ def _range_of(sources) -> tuple[float, float]:
     return lo, hi
 
 
-def load_member(path, temp: TempNorm, terms: int, orders: int, training: dict | None = None) -> tuple[ThermalModel, str]:
+def load_member(path, temp: TempNorm, terms: int, orders: int,
+                training: dict | None = None) -> tuple[ThermalModel, str]:
     """(model, model file text): a two-input model.json as it is, or a recordings CSV trained."""
     path = Path(path)
     if path.suffix.lower() == ".json":
@@ -183,4 +184,5 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     return man
 
 
-__all__ = ["generate_family_thermal", "fit_sensor", "auto_terms", "DEFAULT_TERMS", "is_thermal_family", "calibration_temperatures", "MIN_ROWS"]
+__all__ = ["generate_family_thermal", "fit_sensor", "auto_terms", "DEFAULT_TERMS", "is_thermal_family",
+           "calibration_temperatures", "MIN_ROWS"]
