@@ -78,24 +78,25 @@ def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDG
 
 
 def auto_terms(sources, temp: TempNorm, orders: int, margin: float):
-    """(terms, per-member choices) for the recordings among ``sources``
+    """(terms, [(index in ``sources``, its choice)]) for the recordings among ``sources``
     (:func:`flann.golden.family.family_thermal_terms`); (None, []) when none is one."""
-    members = []
-    for p in sources:
-        p = Path(p)
-        if p.suffix.lower() != ".csv":
+    members, where = [], []
+    for k, p in enumerate(sources):
+        if Path(p).suffix.lower() != ".csv":
             continue
         try:
             rec = read_recordings(p)
             if calibration_temperatures(rec).size < orders:
                 continue   # reported with every other bad member when the members are loaded
-            members.append((p.stem, *_prepared(rec)))
+            members.append((Path(p).stem, *_prepared(rec)))
+            where.append(k)
         except FlannError:
             continue
     if not members:
         return None, []
-    return family_thermal_terms(members, orders=orders, temperature_norm=(temp.offset_c, temp.scale_c),
-                                norm=NORMALISATION, ridge=RIDGE, margin=margin)
+    terms, choices = family_thermal_terms(members, orders=orders, temperature_norm=(temp.offset_c, temp.scale_c),
+                                          norm=NORMALISATION, ridge=RIDGE, margin=margin)
+    return terms, list(zip(where, choices))
 
 
 def _range_of(sources) -> tuple[float, float]:
@@ -153,13 +154,14 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
         terms, choices = auto_terms(sources, temp, orders, margin)
         terms = FIXED_TERMS if terms is None else terms
     terms = int(terms)
-    chosen = {c.name: {"terms_chosen_by": "flann gen --family --terms auto", "own_terms": c.own_terms,
-                       "own_cv_rms_error_mm": c.own_rms_mm, "family_terms": terms,
-                       "family_cv_rms_error_mm": c.family_rms_mm} for c in choices}
+    # each trained member's model records what sharing the count costs it
+    chosen = {k: {"terms_chosen_by": "flann gen --family --terms auto", "own_terms": c.own_terms,
+                  "own_cv_rms_error_mm": c.own_rms_mm, "family_terms": terms,
+                  "family_cv_rms_error_mm": c.family_rms_mm} for k, c in choices}
     loaded, bad = [], []
-    for p in sources:
+    for k, p in enumerate(sources):
         try:
-            loaded.append(load_member(p, temp, terms, orders, chosen.get(Path(p).stem)))
+            loaded.append(load_member(p, temp, terms, orders, chosen.get(k)))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
@@ -180,7 +182,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     sha = hashlib.sha256(init_text.encode()).hexdigest()
     man = write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
     if choices:
-        man = {**man, "terms_chosen": [vars(c) for c in choices]}
+        man = {**man, "terms_chosen": [vars(c) for _p, c in choices]}
     return man
 
 
