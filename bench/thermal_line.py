@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 """The production line with temperature on sensors the project did not make, end to end.
 
-    .venv/bin/python bench/thermal_line.py [--out build/thermal_line] [--input-bits 12] [--no-sim] [--no-synth]
+    .venv/bin/python bench/thermal_line.py [--out build/thermal_line] [--input-bits 12] [--terms auto|N]
+                                           [--no-sim] [--no-synth]
 
 Writes 3 recordings of a closed-form S-curve family (not the physics simulator; the same
 formula as tests/production/test_family_thermal_line.py) whose gain (-1.2e-4 .. -2.6e-4 /degC)
 and null (-25 .. +40 uV/degC) move with temperature, each calibrated at -20, 25 and 80 degC
 (forward and reverse sweeps of 100 points, 0.2 mV noise, a 14-bit +-3.6 V ADC), then runs::
 
-    flann gen --family a.csv b.csv c.csv -o OUT/design --input-bits B
+    flann gen --family a.csv b.csv c.csv -o OUT/design --input-bits B --terms auto
     flann sim OUT/design                      (every voltage code at 9 temperature codes)
     flann synth OUT/design                    (VSG lint, GHDL + Yosys)
     flann calibrate a.csv b.csv c.csv --design OUT/design -o OUT/calibrated
@@ -62,6 +63,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="build/thermal_line")
     ap.add_argument("--input-bits", type=int, default=12)
+    ap.add_argument("--terms", default="auto", help="gen --family --terms (auto: the default; 15: the former fixed count)")
     ap.add_argument("--no-sim", action="store_true")
     ap.add_argument("--no-synth", action="store_true")
     args = ap.parse_args()
@@ -71,7 +73,8 @@ def main() -> int:
     for k, (name, params) in enumerate(SENSORS.items()):
         paths.append(out / f"{name}.csv")
         write_recordings(paths[-1], recording(params, seed=k))
-    ok = flann("gen", "--family", *paths, "-o", out / "design", "--input-bits", args.input_bits) == 0
+    ok = flann("gen", "--family", *paths, "-o", out / "design", "--input-bits", args.input_bits,
+               "--terms", args.terms) == 0
     if ok and not args.no_sim:
         ok = flann("sim", out / "design", "--summary-json", out / "sim.json") == 0
         s = json.loads((out / "sim.json").read_text())

@@ -11,10 +11,13 @@ import pytest
 
 from flann.analysis.trace import trace_design
 from flann.cli import main
+from flann.golden.family import FAMILY_SHARE, REACH_FACTOR
+from flann.hardware.family_thermal.build import fit_sensor
 from flann.hardware.family_thermal.spec import inner_bits, temp_norm
 from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
 from flann.production.images import parse_hex
-from flann.recordings import Recordings, write_recordings
+from flann.production.thermal import temperature_codes
+from flann.recordings import Recordings, read_recordings, write_recordings
 from flann.verify.design import from_directory
 
 LSB_V = 2 * 3.6 / 2 ** 14
@@ -38,7 +41,7 @@ def design(tmp_path_factory):
         paths.append(d / f"s{k}.csv")
         write_recordings(paths[-1], recording((-20, 25, 80), amp=amp, seed=k))
     assert main(["gen", "--family", *map(str, paths), "-o", str(d / "design"), "--input-bits", "8",
-                 "--temp-bits", "8", "--temp-lsb-c", "1"]) == 0
+                 "--temp-bits", "8", "--temp-lsb-c", "1", "--terms", "15"]) == 0
     return d
 
 
@@ -101,7 +104,7 @@ def test_refusals_are_one_line(tmp_path, capsys):
     cases = [
         (["--family", str(multi), str(single)], "temperature"),            # a member at one temperature
         (["--family", str(multi), "--temp-bits", "6"], "--temp-bits"),   # codes do not cover -20..80 degC
-        (["--family", str(multi), "--terms", "auto"], "--terms auto"),
+        (["--family", str(multi), "--terms", "1"], "--terms"),
     ]
     for args, word in cases:
         assert main(["gen", *args, "-o", str(out)]) == 2
@@ -129,7 +132,48 @@ def test_trace_stages_add_up_to_the_twin_minus_float_within_their_bounds(design)
     assert r.stages["orders"]["max_mm"] <= s.orders * q_k + 1e-12
 
 
-def test_without_terms_a_family_with_temperature_takes_its_fixed_default(design):
-    """A plain family's default is --terms auto; with temperature the terms stay fixed (15)."""
-    man = json.loads((design / "design" / "manifest.json").read_text())
-    assert man["family"]["terms"] == 15
+def hardware_error_mm(design_dir, name, rec) -> np.ndarray:
+    """A member's image (written by gen) through the twin on its own recording's codes."""
+    spec = from_directory(design_dir).spec
+    twin = FlannFamilyThermalTop(spec, parse_hex((design_dir / f"image_{name}.hex").read_text()))
+    s = spec.fam.spec
+    codes = np.clip(np.floor(rec.voltage_v / s.input_lsb_v + 0.5).astype(np.int64), s.code_min, s.code_max)
+    return twin.process(codes, temperature_codes(spec, rec.temperature_c)).out_data * spec.output_lsb_mm \
+        - rec.displacement_mm
+
+
+def test_terms_auto_is_the_default_and_keeps_every_member_within_its_own_reach(tmp_path, capsys):
+    """Without --terms the count per temperature order is chosen for the worst member: it is in
+    the manifest and the initial model, every member's held-out RMS at it is within FAMILY_SHARE
+    of its own choice's, and every member's hardware (its image through the twin, on its own
+    recording) is within REACH_FACTOR of what its own count reaches as a float model on the same
+    points.  A fixed small count (5) is not: the check tells a poor count from a good one."""
+    params = [(3.0, -2.0e-4, 40e-6), (3.1, -1.2e-4, -25e-6), (2.9, -2.6e-4, 10e-6)]
+    paths = []
+    for k, (amp, gain_tc, null_tc) in enumerate(params):
+        paths.append(tmp_path / f"m{k}.csv")
+        write_recordings(paths[-1], recording((-20, 25, 80), amp=amp, gain_tc=gain_tc, null_tc=null_tc, seed=k))
+    common = ["--input-bits", "14", "--temp-bits", "8", "--temp-lsb-c", "1"]
+    capsys.readouterr()
+    assert main(["gen", "--family", *map(str, paths), "-o", str(tmp_path / "auto"), "--json", *common]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert main(["gen", "--family", *map(str, paths), "-o", str(tmp_path / "five"), "--terms", "5", *common]) == 0
+    man = json.loads((tmp_path / "auto" / "manifest.json").read_text())
+    terms = man["family"]["terms"]
+    init = json.loads((tmp_path / "auto" / "init_model.json").read_text())
+    assert all(len(w) == terms for w in init["weights"]) and len(init["weights"]) == man["spec"]["orders"]
+    assert init["training"]["family_terms"] == terms
+    chosen = printed["terms_chosen"]
+    assert [c["name"] for c in chosen] == ["m0", "m1", "m2"]
+    assert terms <= max(c["own_terms"] for c in chosen)
+    spec = from_directory(tmp_path / "auto").spec
+    within, five_within = [], []
+    for c, p in zip(chosen, paths):
+        assert c["family_rms_mm"] <= FAMILY_SHARE * c["own_rms_mm"]
+        rec = read_recordings(p)
+        own = fit_sensor(rec, spec.temp, c["own_terms"], spec.orders)
+        reach = float(np.max(np.abs(own.predict(rec.voltage_v, rec.temperature_c) - rec.displacement_mm)))
+        within.append(float(np.max(np.abs(hardware_error_mm(tmp_path / "auto", c["name"], rec)))) / reach)
+        five_within.append(float(np.max(np.abs(hardware_error_mm(tmp_path / "five", c["name"], rec)))) / reach)
+    assert max(within) <= REACH_FACTOR, within
+    assert max(five_within) > REACH_FACTOR, five_within

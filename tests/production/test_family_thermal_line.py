@@ -54,7 +54,7 @@ def line(tmp_path_factory):
     design = d / "design"
     # a small converter keeps the simulation short (every code at 9 temperature codes)
     assert main(["gen", "--family", *map(str, paths), "-o", str(design), "--input-bits", "8",
-                 "--temp-bits", "8", "--temp-lsb-c", "1"]) == 0
+                 "--temp-bits", "8", "--temp-lsb-c", "1", "--terms", "15"]) == 0
     return {"dir": d, "paths": paths, "design": design}
 
 

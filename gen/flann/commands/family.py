@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from ..errors import FlannError
-from ..hardware.family_thermal.build import DEFAULT_TERMS as THERMAL_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN
 from ..hardware.registry import FAMILY
 
@@ -26,10 +25,9 @@ def add_family_arguments(parser) -> None:
                         "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data; recordings "
                         "at several temperatures add in_temp and one memory per temperature order")
     g.add_argument("--terms", type=_terms, default=None,
-                   help="--family: expansion terms when training recordings, or 'auto' (default): chosen "
-                        "like flann train --terms auto at the design's converter, for the member that needs "
-                        "the most (docs/production.md); recordings at several temperatures: N only "
-                        f"(default {THERMAL_TERMS})")
+                   help="--family: expansion terms (per temperature order with temperature) when training "
+                        "recordings, or 'auto' (default): chosen like flann train --terms auto (--temperature "
+                        "with temperature) for the member that needs the most (docs/production.md)")
     g.add_argument("--margin", type=float, default=DEFAULT_MARGIN,
                    help="--family: headroom for sensors like these, 0.5 = 50 %% larger weights and "
                         "ranges (default %(default)s)")

@@ -8,6 +8,12 @@ takes the fewest terms at which every member's held-out RMS (at the family's rid
 (:func:`_steady`), at most the largest of the members' own term counts.  :func:`family_terms` also says what
 sharing costs each member: its own choice (terms, held-out RMS, fixed-point cost) next to
 its held-out RMS at the family's terms.
+
+:func:`family_thermal_terms` is the same rule for a family with temperature (x = sum_j t_n^j
+f_j(v), one term count shared by every order and member): each member's own choice is
+``flann train --temperature``'s selection (:mod:`.thermal_train`: held-out positions and
+temperatures) restricted to the family design's form (no input correction, the design's
+temperature normalisation, the family's voltage normalisation and ridge).
 """
 
 from __future__ import annotations
@@ -16,6 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import FlannError
+from . import thermal_train
 from .train import AUTO_RIDGES, AUTO_TERMS, cross_validate, fit_auto, fit_lstsq
 
 # the family's terms keep every member's held-out RMS within this factor of its own design's
@@ -36,11 +44,10 @@ def _steady(models, margin: float) -> bool:
     """Every member's bias, linear weight and largest sin/cos weight within (1 + margin) of
     the largest the other members have: a design sized without any one member still holds
     it, so a sensor like them fits too (high-order fits of nearly collinear terms cancel
-    huge weights, which differ from sensor to sensor)."""
+    huge weights, which differ from sensor to sensor).  ``models``: (bias, weights) pairs."""
     if len(models) < 2:
         return True
-    size = np.array([[abs(m.bias), abs(m.weights[0]), max((abs(w) for w in m.weights[1:]), default=0.0)]
-                     for m in models])
+    size = np.array([[abs(b), abs(w[0]), max((abs(c) for c in w[1:]), default=0.0)] for b, w in models])
     for i in range(len(models)):
         others = np.delete(size, i, axis=0).max(axis=0)
         if np.any(size[i] > (1 + margin) * others + 1e-12):
@@ -63,27 +70,76 @@ def family_terms(members, *, norm: str, ridge: float, margin: float = 0.5,
                                  cost=cost)
         fp = model.training.get("fixed_point") or {}
         own.append((name, v, x, choice, fp.get("cost")))
-    # the fewest terms that keep every member's held-out error within FAMILY_SHARE of its own
-    # (fewer terms: smaller, steadier weights, so sensors like the members fit the memory too)
     top = max(c.terms for _n, _v, _x, c, _c in own)
     tried = [t for t in AUTO_TERMS if t <= top]
-    table = {name: {r.terms: r.rms_mm for r in cross_validate(v, x, tried, (norm,), (ridge,))}
-             for name, v, x, _c, _cost in own}
+    table = [{r.terms: r.rms_mm for r in cross_validate(v, x, tried, (norm,), (ridge,))}
+             for _n, v, x, _c, _cost in own]
+
     def steady(t):
-        return _steady([fit_lstsq(v, x, t, norm=norm, ridge=ridge) for _n, v, x, _c, _cost in own], margin)
+        fits = [fit_lstsq(v, x, t, norm=norm, ridge=ridge) for _n, v, x, _c, _cost in own]
+        return _steady([(m.bias, m.weights) for m in fits], margin)
 
-    def accurate(t):
-        return all(table[name][t] <= FAMILY_SHARE * c.rms_mm for name, _v, _x, c, _cost in own)
-
-    terms = next((t for t in tried if accurate(t) and steady(t)), None)
-    if terms is None:   # no count is both: the most accurate steady one, else the members' largest
-        terms = next((t for t in reversed(tried) if steady(t)), top)
-    out = [MemberChoice(name, c.terms, c.ridge, c.rms_mm, own_cost, table[name][terms])
-           for name, v, x, c, own_cost in own]
+    terms = shared_terms(tried, table, [c.rms_mm for _n, _v, _x, c, _cost in own], steady)
+    out = [MemberChoice(name, c.terms, c.ridge, c.rms_mm, own_cost, rms[terms])
+           for (name, v, x, c, own_cost), rms in zip(own, table)]
     return terms, out
 
 
-__all__ = ["MemberChoice", "family_terms"]
+def shared_terms(tried, table, own_rms, steady) -> int:
+    """The family's rule: of the term counts ``tried`` (ascending, up to the members' largest
+    own count), the fewest that keep every member's held-out RMS (``table[k][terms]``, member
+    k) within ``FAMILY_SHARE`` of its own choice's (``own_rms[k]``) and whose weights are
+    ``steady(terms)`` (fewer terms: smaller, steadier weights, so sensors like the members fit
+    the memory too); if none is both, the most accurate steady one, else the largest."""
+    def accurate(t):
+        return all(held[t] <= FAMILY_SHARE * rms for held, rms in zip(table, own_rms))
+
+    terms = next((t for t in tried if accurate(t) and steady(t)), None)
+    if terms is None:
+        terms = next((t for t in reversed(tried) if steady(t)), tried[-1])
+    return terms
+
+
+# the family design's temperature orders take these expansion sizes (the design needs >= 2)
+THERMAL_TERMS = tuple(n for n in thermal_train.AUTO_TERMS if n >= 2)
+
+
+def family_thermal_terms(members, *, orders: int, temperature_norm: tuple[float, float], norm: str,
+                         ridge: float, margin: float = 0.5) -> tuple[int, list[MemberChoice]]:
+    """(terms per temperature order, per-member choices) for ``members``: (name, voltage_v,
+    temperature_c, displacement_mm) tuples, fitted as x = sum_j t_n^j f_j(v) with ``orders``
+    orders, t_n = (T - offset) / scale for ``temperature_norm`` (the design's), the voltage
+    normalisation ``norm`` and no input correction.  A member's own choice is
+    :func:`flann.golden.thermal_train.select_thermal` over the ridges >= ``ridge``; the
+    family's count is :func:`shared_terms` of the held-out RMS at ``ridge``."""
+    ridges = tuple(r for r in thermal_train.AUTO_RIDGES if r >= ridge) or (ridge,)
+    if ridge not in ridges:
+        ridges = (*ridges, ridge)
+    own, table = [], []
+    for name, v, t, x in members:
+        run = thermal_train.cross_validate_thermal(v, t, x, orders=orders, terms=THERMAL_TERMS, norms=(norm,),
+                                                   ridges=ridges, temperature_norm=temperature_norm,
+                                                   correct_input=False, source=name)
+        choice, _best, _good = thermal_train.select_thermal(run.results, x)
+        own.append((name, v, t, x, choice))
+        table.append({r.terms[0]: r.rms_mm for r in run.results if r.ridge == ridge})
+    top = max(c.terms[0] for *_m, c in own)
+    tried = [n for n in THERMAL_TERMS if n <= top and all(n in held for held in table)]
+    if not tried:
+        raise FlannError("--terms auto: the members' recordings are too few points for a common term count")
+
+    def steady(n):
+        fits = [thermal_train.fit_thermal(v, t, x, (n,) * orders, norm=norm, ridge=ridge, correct_input=False,
+                                          temperature_norm=temperature_norm) for _n, v, t, x, _c in own]
+        return all(_steady([(m.bias[j], m.weights[j]) for m in fits], margin) for j in range(orders))
+
+    terms = shared_terms(tried, table, [c.rms_mm for *_m, c in own], steady)
+    out = [MemberChoice(name, c.terms[0], c.ridge, c.rms_mm, None, held[terms])
+           for (name, _v, _t, _x, c), held in zip(own, table)]
+    return terms, out
+
+
+__all__ = ["MemberChoice", "family_terms", "family_thermal_terms", "shared_terms", "THERMAL_TERMS"]
 
 
 # a member whose error in the family design exceeds its own design's by more than this is

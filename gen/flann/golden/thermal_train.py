@@ -98,15 +98,16 @@ def input_correction(voltage_v, t_n, displacement_mm, labels, groups) -> tuple[t
 
 def fit_thermal(voltage_v, temperature_c, displacement_mm, terms: tuple[int, ...], *,
                 norm: str = "range", ridge: float = 0.0, correct_input: bool = True,
-                training: dict | None = None) -> ThermalModel:
+                temperature_norm: tuple[float, float] | None = None, training: dict | None = None) -> ThermalModel:
     """Least squares for ``terms`` (expansion terms per temperature order), after the
-    input correction (:func:`input_correction`) unless ``correct_input`` is False."""
+    input correction (:func:`input_correction`) unless ``correct_input`` is False;
+    ``temperature_norm`` (offset, scale) degC, default the recording's own range."""
     v = np.asarray(voltage_v, dtype=float)
     t = np.asarray(temperature_c, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     if not terms or any(n < 0 for n in terms):
         raise FlannError(f"terms per temperature order must be >= 0, got {list(terms)}")
-    t_off, t_scale = _temperature_norm(t)
+    t_off, t_scale = temperature_norm or _temperature_norm(t)
     t_n = (t - t_off) / t_scale
     gain_t, offset_t = ((), ())
     if correct_input:
@@ -186,13 +187,16 @@ class _Inputs:
     v_n_without: list[np.ndarray]
 
 
-def _inputs(v, t_n, x, labels, n_groups, folds: _Folds, norm: str) -> _Inputs:
-    gain_t, offset_t = input_correction(v, t_n, x, labels, range(n_groups))
+def _inputs(v, t_n, x, labels, n_groups, folds: _Folds, norm: str, correct_input: bool = True) -> _Inputs:
+    def correction(groups):
+        return input_correction(v, t_n, x, labels, groups) if correct_input else ((), ())
+
+    gain_t, offset_t = correction(range(n_groups))
     v_c = corrected_voltage(v, t_n, gain_t, offset_t)
     offset, scale = normalisation(v_c, norm)
     without = []
     for g in range(1, n_groups - 1):
-        gk, ok = input_correction(v, t_n, x, labels, [k for k in range(n_groups) if k != g])
+        gk, ok = correction([k for k in range(n_groups) if k != g])
         without.append((corrected_voltage(v, t_n, gk, ok) - offset) / scale)
     return _Inputs((v_c - offset) / scale, t_n, without)
 
@@ -229,9 +233,24 @@ def cv_subset(n: int, limit: int = AUTO_MAX_CV_POINTS) -> np.ndarray:
     return np.arange(n) if n <= limit else np.unique(np.linspace(0, n - 1, limit).round().astype(int))
 
 
-def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dict | None = None,
-                     source: str = "recordings") -> tuple[ThermalModel, ThermalCv]:
-    """Structure by cross-validation (module docstring); the choice fitted on every row."""
+@dataclass(frozen=True)
+class ThermalCvRun:
+    """Every candidate of one cross-validation and the folds it used."""
+    results: list[ThermalCv]
+    position_folds: int
+    temperature_folds: int
+    points: int
+    temperatures_c: tuple[float, ...]
+
+
+def cross_validate_thermal(voltage_v, temperature_c, displacement_mm, *, orders: int | None = None,
+                           terms=AUTO_TERMS[1:], norms=AUTO_NORMS, ridges=AUTO_RIDGES,
+                           temperature_norm: tuple[float, float] | None = None, correct_input: bool = True,
+                           source: str = "recordings") -> ThermalCvRun:
+    """Held-out errors (module docstring) of every candidate: ``terms`` per order (every order
+    the same), ``orders`` temperature orders (default: what the temperatures determine, at most
+    ``MAX_ORDER`` + 1), ``temperature_norm`` (offset, scale) degC (default: the recording's own
+    range) and with or without the input correction."""
     v = np.asarray(voltage_v, dtype=float)
     t = np.asarray(temperature_c, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
@@ -246,43 +265,60 @@ def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dic
     vs, ts, xs = v[sub], t[sub], x[sub]
     _, sub_labels = temperature_groups(ts)
     folds = _folds(xs, sub_labels, levels.size)
-    t_off, t_scale = _temperature_norm(t)
-    orders = min(MAX_ORDER + 1, levels.size)
-    inputs = {norm: _inputs(vs, (ts - t_off) / t_scale, xs, sub_labels, levels.size, folds, norm)
-              for norm in AUTO_NORMS}
+    t_off, t_scale = temperature_norm or _temperature_norm(t)
+    if orders is None:
+        orders = min(MAX_ORDER + 1, levels.size)
+    inputs = {norm: _inputs(vs, (ts - t_off) / t_scale, xs, sub_labels, levels.size, folds, norm, correct_input)
+              for norm in norms}
     results: list[ThermalCv] = []
-    for norm in AUTO_NORMS:
-        for ridge in AUTO_RIDGES:
-            for n in AUTO_TERMS[1:]:
+    for norm in norms:
+        for ridge in ridges:
+            for n in terms:
                 if (n + 1) * orders >= xs.size:
                     continue
                 results.append(_cv(xs, folds, inputs[norm], (n,) * orders, norm, ridge))
     if not results:
         raise RecordingsError(f"{source}: {v.size} points are too few for a two-input model")
-    scale = float(np.max(np.abs(x)))
+    return ThermalCvRun(results, len(folds.position), len(folds.temperature), int(sub.size),
+                        tuple(float(round(a, 3)) for a in levels))
+
+
+def select_thermal(results: list[ThermalCv], displacement_mm) -> tuple[ThermalCv, ThermalCv, int]:
+    """(choice, best, how many as good): of the buildable candidates (``WEIGHT_LIMIT``,
+    ``WEIGHT_SUM_LIMIT``) within ``AUTO_PAIRED_Z`` paired standard errors of the best held-out
+    error, the smallest sum of |coefficients|."""
+    scale = float(np.max(np.abs(displacement_mm)))
     limit, sum_limit = WEIGHT_LIMIT * scale, WEIGHT_SUM_LIMIT * scale
     buildable = [r for r in results if r.max_coefficient <= limit and r.weight_sum <= sum_limit] or results
     best = min(buildable, key=lambda r: r.mse)
     good = [r for r in buildable
             if r is best or r.mse - best.mse <= AUTO_PAIRED_Z * _paired_se(r, best)]
-    choice = min(good, key=lambda r: (r.weight_sum, r.mse))
+    return min(good, key=lambda r: (r.weight_sum, r.mse)), best, len(good)
+
+
+def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dict | None = None,
+                     source: str = "recordings") -> tuple[ThermalModel, ThermalCv]:
+    """Structure by cross-validation (module docstring); the choice fitted on every row."""
+    run = cross_validate_thermal(voltage_v, temperature_c, displacement_mm, source=source)
+    choice, best, n_good = select_thermal(run.results, displacement_mm)
     info = {
         "selected_by": "cross-validation over held-out positions and temperatures; every "
                        "order with the whole expansion; of the candidates within "
                        f"{AUTO_PAIRED_Z:g} paired standard errors of the best held-out error, "
                        "the smallest sum of |coefficients|",
-        "cv_position_folds": len(folds.position),
-        "cv_temperature_folds": len(folds.temperature),
-        "cv_points": int(sub.size),
+        "cv_position_folds": run.position_folds,
+        "cv_temperature_folds": run.temperature_folds,
+        "cv_points": run.points,
         "cv_rms_error_mm": choice.rms_mm,
         "cv_max_error_mm": choice.max_mm,
-        "calibration_temperatures_c": [float(round(x_, 3)) for x_ in levels],
-        "as_good_candidates": len(good),
+        "calibration_temperatures_c": list(run.temperatures_c),
+        "as_good_candidates": n_good,
         "best_structure": {"terms": list(best.terms), "cv_rms_error_mm": best.rms_mm,
                            "coefficients": best.coefficients},
     }
     info.update(training or {})
-    model = fit_thermal(v, t, x, choice.terms, norm=choice.norm, ridge=choice.ridge, training=info)
+    model = fit_thermal(voltage_v, temperature_c, displacement_mm, choice.terms, norm=choice.norm,
+                        ridge=choice.ridge, training=info)
     return model, choice
 
 
@@ -295,4 +331,5 @@ def compensable(temperature_c, min_rows: int = MIN_POSITIONS) -> tuple[float, ..
     return tuple(float(t) for t, c in zip(levels, counts) if c >= min_rows)
 
 
-__all__ = ["AUTO_TERMS", "MAX_ORDER", "ThermalCv", "compensable", "fit_thermal", "fit_thermal_auto"]
+__all__ = ["AUTO_TERMS", "MAX_ORDER", "ThermalCv", "ThermalCvRun", "compensable", "cross_validate_thermal",
+           "fit_thermal", "fit_thermal_auto", "select_thermal"]

@@ -54,10 +54,16 @@ def summary(man: dict) -> list[str]:
             f"{man['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample",
             f"  weight memory {mem['used_words']} of {mem['depth']} x {mem['data_bits']}-bit words "
             f"(cfg_addr {mem['addr_bits']} bits); estimate {man['analysis']['estimate']}",
-            *(f"  {c['name']}: own design {c['own_terms']} terms (held-out RMS {c['own_rms_mm']:.4g} mm"
-              + (f", {c['own_cost']:.0f} LUT4-eq." if c["own_cost"] is not None else "")
-              + f"); in the family {fam['terms']} terms, held-out RMS {c['family_rms_mm']:.4g} mm "
-              f"({c['family_rms_mm'] / c['own_rms_mm']:.2f}x its own)" for c in man.get("terms_chosen", []))]
+            *choice_lines(man)]
+
+
+def choice_lines(man: dict) -> list[str]:
+    """One line per member of ``--terms auto``: its own design against its share of the family's."""
+    terms = man["family"]["terms"]
+    return [f"  {c['name']}: own design {c['own_terms']} terms (held-out RMS {c['own_rms_mm']:.4g} mm"
+            + (f", {c['own_cost']:.0f} LUT4-eq." if c["own_cost"] is not None else "")
+            + f"); in the family {terms} terms, held-out RMS {c['family_rms_mm']:.4g} mm "
+            f"({c['family_rms_mm'] / c['own_rms_mm']:.2f}x its own)" for c in man.get("terms_chosen", [])]
 
 
 FIELDS = (

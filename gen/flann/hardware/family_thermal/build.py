@@ -9,23 +9,23 @@ from __future__ import annotations
 
 import hashlib
 import warnings
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import FlannError, SpecError
-from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups, thermal_design
-from ...golden.train import normalisation, solve_lstsq
+from ...golden.family import family_thermal_terms
+from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
+from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
 from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE
 from ..family.spec import DEFAULT_MARGIN
 from .render import write
 from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
 
-# terms per temperature order: fixed (auto is not chosen per member with temperature); a
-# plain family's default is --terms auto
-DEFAULT_TERMS = FIXED_TERMS
+# terms per temperature order: chosen for the worst member like a plain family's
+# (golden/family.family_thermal_terms); FIXED_TERMS when no member is a recording
+DEFAULT_TERMS = "auto"
 MIN_ROWS = 4   # readings per temperature for it to count as a calibration temperature
 
 
@@ -61,7 +61,8 @@ def _prepared(rec):
             cat([p.displacement_mm for p in parts]))
 
 
-def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDGE) -> ThermalModel:
+def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDGE,
+               training: dict | None = None) -> ThermalModel:
     """x = sum_j t_n^j f_j(v) by least squares on every reading, t_n the design's."""
     temps = calibration_temperatures(rec)
     if temps.size < orders:
@@ -69,23 +70,33 @@ def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDG
                          f"({', '.join(f'{t:g}' for t in temps) or 'no temperature_c column'}); the design's "
                          f"{orders} temperature orders need {orders} or more (4 or more readings each)")
     v, t, x = _prepared(rec)
-    offset, scale = normalisation(v, NORMALISATION)
-    v_n, t_n = (v - offset) / scale, (t - temp.offset_c) / temp.scale_c
-    coef = solve_lstsq(thermal_design(v_n, t_n, (terms,) * orders), x, ridge)
-    k = terms + 1
-    model = ThermalModel(
-        weights=tuple(tuple(float(c) for c in coef[j * k + 1:(j + 1) * k]) for j in range(orders)),
-        bias=tuple(float(coef[j * k]) for j in range(orders)),
-        input_offset_v=float(offset), input_scale_v=float(scale),
-        temperature_offset_c=temp.offset_c, temperature_scale_c=temp.scale_c,
-        voltage_range_v=(float(v.min()), float(v.max())), temperature_range_c=(float(t.min()), float(t.max())),
-        displacement_range_mm=(float(x.min()), float(x.max())),
-        training={"method": "lstsq", "ridge": ridge, "normalisation": NORMALISATION, "points": int(v.size),
-                  "form": "x = sum_j t_n^j f_j(v) (flann gen --family, temperature)",
-                  "temperatures_c": [float(round(a, 6)) for a in temps], "data_file": Path(rec.source).name,
-                  "data_sha256": rec.sha256})
-    resid = x - model.predict(v, t)
-    return replace(model, training={**model.training, "train_rms_error_mm": float(np.sqrt(np.mean(resid ** 2)))})
+    return fit_thermal(v, t, x, (terms,) * orders, norm=NORMALISATION, ridge=ridge, correct_input=False,
+                       temperature_norm=(temp.offset_c, temp.scale_c),
+                       training={"form": "x = sum_j t_n^j f_j(v) (flann gen --family, temperature)",
+                                 "temperatures_c": [float(round(a, 6)) for a in temps],
+                                 "data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})})
+
+
+def auto_terms(sources, temp: TempNorm, orders: int, margin: float):
+    """(terms, [(index in ``sources``, its choice)]) for the recordings among ``sources``
+    (:func:`flann.golden.family.family_thermal_terms`); (None, []) when none is one."""
+    members, where = [], []
+    for k, p in enumerate(sources):
+        if Path(p).suffix.lower() != ".csv":
+            continue
+        try:
+            rec = read_recordings(p)
+            if calibration_temperatures(rec).size < orders:
+                continue   # reported with every other bad member when the members are loaded
+            members.append((Path(p).stem, *_prepared(rec)))
+            where.append(k)
+        except FlannError:
+            continue
+    if not members:
+        return None, []
+    terms, choices = family_thermal_terms(members, orders=orders, temperature_norm=(temp.offset_c, temp.scale_c),
+                                          norm=NORMALISATION, ridge=RIDGE, margin=margin)
+    return terms, list(zip(where, choices))
 
 
 def _range_of(sources) -> tuple[float, float]:
@@ -110,7 +121,8 @@ def _range_of(sources) -> tuple[float, float]:
     return lo, hi
 
 
-def load_member(path, temp: TempNorm, terms: int, orders: int) -> tuple[ThermalModel, str]:
+def load_member(path, temp: TempNorm, terms: int, orders: int,
+                training: dict | None = None) -> tuple[ThermalModel, str]:
     """(model, model file text): a two-input model.json as it is, or a recordings CSV trained."""
     path = Path(path)
     if path.suffix.lower() == ".json":
@@ -120,7 +132,7 @@ def load_member(path, temp: TempNorm, terms: int, orders: int) -> tuple[ThermalM
                              f"({FORMAT}) or recordings at several temperatures")
         return m, path.read_bytes().decode("utf-8")
     if path.suffix.lower() == ".csv":
-        m = fit_sensor(read_recordings(path), temp, terms, orders)
+        m = fit_sensor(read_recordings(path), temp, terms, orders, training=training)
         return m, m.to_json()
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
@@ -131,20 +143,25 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    if terms == "auto":
-        raise FlannError("--terms auto: not chosen per member for a family with temperature yet; give --terms N "
-                         f"(default {DEFAULT_TERMS})")
-    terms = int(terms)
-    if not 2 <= terms <= 60:
+    if terms != "auto" and not 2 <= int(terms) <= 60:
         raise FlannError(f"--terms {terms}: must be 2..60")
     try:
         temp = temp_norm(_range_of(sources), temp_bits, temp_lsb_c)
     except SpecError as exc:
         raise FlannError(str(exc)) from None
+    choices = []
+    if terms == "auto":
+        terms, choices = auto_terms(sources, temp, orders, margin)
+        terms = FIXED_TERMS if terms is None else terms
+    terms = int(terms)
+    # each trained member's model records what sharing the count costs it
+    chosen = {k: {"terms_chosen_by": "flann gen --family --terms auto", "own_terms": c.own_terms,
+                  "own_cv_rms_error_mm": c.own_rms_mm, "family_terms": terms,
+                  "family_cv_rms_error_mm": c.family_rms_mm} for k, c in choices}
     loaded, bad = [], []
-    for p in sources:
+    for k, p in enumerate(sources):
         try:
-            loaded.append(load_member(p, temp, terms, orders))
+            loaded.append(load_member(p, temp, terms, orders, chosen.get(k)))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
@@ -163,7 +180,11 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
         unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
     init_text = loaded[0][1]
     sha = hashlib.sha256(init_text.encode()).hexdigest()
-    return write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
+    man = write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
+    if choices:
+        man = {**man, "terms_chosen": [vars(c) for _p, c in choices]}
+    return man
 
 
-__all__ = ["generate_family_thermal", "fit_sensor", "is_thermal_family", "calibration_temperatures", "MIN_ROWS"]
+__all__ = ["generate_family_thermal", "fit_sensor", "auto_terms", "DEFAULT_TERMS", "is_thermal_family",
+           "calibration_temperatures", "MIN_ROWS"]

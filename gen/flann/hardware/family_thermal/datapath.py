@@ -12,6 +12,7 @@ from ...golden.model import model_sha256
 from ...golden.thermal import ThermalModel, load_any_model
 from ...numeric.fixed import FixedFormat
 from ..datapath import Datapath, Field, _int, _num
+from ..family.datapath import choice_lines
 from ..family.spec import DEFAULT_MARGIN, family_from_dict
 from ..options import GenOptions
 from . import render
@@ -92,7 +93,7 @@ def summary(man: dict) -> list[str]:
             f"x {s['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample",
             f"  weight memories {s['orders']} x {fam['memory']['depth']} x {fam['memory']['data_bits']}-bit words "
             f"(image {s['image_words']} words, cfg_addr {s['cfg_addr_bits']} bits); error bound "
-            f"{man['analysis']['bound_lsb']:.3f} LSB"]
+            f"{man['analysis']['bound_lsb']:.3f} LSB", *choice_lines(man)]
 
 
 FIELDS = (
