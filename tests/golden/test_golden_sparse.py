@@ -8,7 +8,7 @@ import pytest
 
 from flann.cli import main as flann
 from flann.golden.model import load_model
-from flann.golden.sparse import SPARSE_POSITIONS, forward_curve
+from flann.golden.sparse import SPARSE_POSITIONS, forward_curve, sparse_fit
 from flann.golden.train import fit_auto
 
 
@@ -81,3 +81,15 @@ def test_no_monotone_curve_through_the_positions_is_no_spline():
     assert forward_curve(x, v) is None
     assert forward_curve(x[:4], sensor(x[:4])) is None      # too few positions
     assert forward_curve(x, sensor(x)) is not None
+
+
+def test_no_candidate_that_builds_falls_back_to_the_direct_fit():
+    x = np.linspace(-20, 20, 13)
+    v = sensor(x)
+    _, choice = fit_auto(v, x)
+    never = sparse_fit(x, v, choice, lambda m: {"buildable": False, "why": "test", "cost": np.inf}, {})
+    assert never is None
+    built = sparse_fit(x, v, choice, lambda m: {"buildable": True, "why": "", "cost": float(m.terms),
+                                                "luts": 0, "brams": 0, "weight_bits": 16,
+                                                "term_bits": 16, "output_lsb_mm": 1e-3}, {})
+    assert built is not None and built.training["forward_spline"] == "cubic"

@@ -8,9 +8,10 @@ when that one is not monotone) is inverted densely over the recorded stroke, and
 candidates are fitted to that noise-free inverse.
 
 :func:`sparse_fit` is used by ``flann train --terms auto`` instead of the direct fit when the
-recording holds fewer than :data:`SPARSE_POSITIONS` distinct positions *and* the whole
-procedure predicts the left-out interior positions better than the direct fit's candidate
-does (leave one position out, both procedures refitted without it; judged in mm).
+recording holds fewer than :data:`SPARSE_POSITIONS` distinct positions.  The error of each
+procedure at interior positions left out in turn is recorded, not used to choose: it is
+pessimistic (a left-out position doubles the spacing there) and blind to a direct fit that
+swings *between* the positions, which is where the direct fit of few points fails.
 """
 
 from __future__ import annotations
@@ -108,10 +109,10 @@ def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(e))))
 
 
-def fit_to_forward(fw: Forward, cost, training: dict) -> tuple[FlannModel, dict]:
+def fit_to_forward(fw: Forward, cost, training: dict) -> tuple[FlannModel, dict] | None:
     """The FLANN candidate with the fewest terms (then the cheapest) whose largest deviation
     from the inverted spline, between the points it was fitted to, is within
-    ``TEACHER_TOL`` of the best buildable candidate's."""
+    ``TEACHER_TOL`` of the best buildable candidate's; None when none builds."""
     v, x = fw.inverse()
     v_mid, x_mid = fw.inverse(2 * DENSE - 1)
     v_mid, x_mid = v_mid[1::2], x_mid[1::2]     # between the fitted points
@@ -131,9 +132,7 @@ def fit_to_forward(fw: Forward, cost, training: dict) -> tuple[FlannModel, dict]
 
     best = next((s for s in scored if costed(s)["buildable"]), None)
     if best is None:
-        s = scored[0]
-        return s[4], {"teacher_max_deviation_mm": s[0],
-                      "hardware_why": costed(s)["why"]}
+        return None
     near = sorted((s for s in scored if s[0] <= TEACHER_TOL * best[0]), key=lambda s: (s[1], s[0]))
     choice = next(s for s in near if costed(s)["buildable"])
     c = costed(choice)
@@ -145,9 +144,10 @@ def fit_to_forward(fw: Forward, cost, training: dict) -> tuple[FlannModel, dict]
 
 def sparse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> FlannModel | None:
     """The model fitted to the inverted forward spline, or None when the recording has
-    :data:`SPARSE_POSITIONS` or more positions, no monotone spline, or when the direct fit's
-    candidate ``direct`` (a :class:`~flann.golden.train.CvResult`) predicts the left-out
-    interior positions as well (RMS, mm)."""
+    :data:`SPARSE_POSITIONS` or more positions, no monotone spline through them, or no
+    candidate that builds.  The record gives the left-out error of the procedure and of the
+    direct fit's candidate ``direct`` (a :class:`~flann.golden.train.CvResult`), each
+    interior position left out in turn (mm)."""
     x = np.asarray(displacement_mm, dtype=float)
     if np.unique(x).size >= SPARSE_POSITIONS:
         return None
@@ -169,7 +169,10 @@ def sparse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Flan
                           "direct": {"terms": direct.terms, "normalisation": direct.norm,
                                      "ridge": direct.ridge}},
     })
-    model, info = fit_to_forward(fw, cost, record)
+    fitted = fit_to_forward(fw, cost, record)
+    if fitted is None:      # no candidate builds at this converter: the direct fit says why
+        return None
+    model, info = fitted
     model.training.update(info)
     return model
 
