@@ -140,9 +140,8 @@ def _check_generatable(model) -> None:
 
 
 def _train_auto(args, rec, provenance: dict) -> tuple:
-    """(model, lines to print) of --terms auto: the direct fit's cross-validated choice,
-    or with few positions the fit to the inverse of the forward spline when it predicts
-    left-out positions better (:mod:`flann.golden.sparse`)."""
+    """(model, lines to print) of --terms auto: the direct fit's cross-validated choice, or
+    with few positions the fit to the inverse of the forward spline (:mod:`flann.golden.sparse`)."""
     said = []
     check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
     positions = int(np.unique(rec.displacement_mm).size)

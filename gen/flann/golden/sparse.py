@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
+from .forward import aggregate
 from .model import FlannModel
 from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, fit_lstsq
 
@@ -56,17 +57,12 @@ def _monotone(v: np.ndarray) -> bool:
 def forward_curve(displacement_mm, voltage_v) -> Forward | None:
     """The spline v(x) through the position means, or None (too few positions, or no
     monotone curve through them: the readings fold back or sit within noise of each other)."""
-    x = np.asarray(displacement_mm, dtype=float)
-    v = np.asarray(voltage_v, dtype=float)
-    pos, inv = np.unique(x, return_inverse=True)
-    if pos.size < MIN_POSITIONS:
+    pos = aggregate(displacement_mm, voltage_v)
+    if pos.x.size < MIN_POSITIONS or not _monotone(pos.v):
         return None
-    mean_v = np.bincount(inv, weights=v) / np.bincount(inv)
-    if not _monotone(mean_v):
-        return None
-    fine = np.linspace(pos[0], pos[-1], 8 * DENSE)
+    fine = np.linspace(pos.x[0], pos.x[-1], 8 * DENSE)
     for kind in ("cubic", "pchip"):
-        fw = Forward(pos, mean_v, kind)
+        fw = Forward(pos.x, pos.v, kind)
         if _monotone(fw.curve()(fine)):
             return fw
     return None
@@ -152,7 +148,7 @@ def sparse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Flan
     if np.unique(x).size >= SPARSE_POSITIONS:
         return None
     fw = forward_curve(x, voltage_v)
-    if fw is None or fw.positions.size < 3:
+    if fw is None:
         return None
     mine = leave_one_out_mm(fw)
     theirs = direct_leave_one_out_mm(fw, x, voltage_v, direct.terms, direct.norm, direct.ridge)
