@@ -30,19 +30,31 @@ def train_model(rec, terms: int = FIXED_TERMS, ridge: float = RIDGE, training: d
     return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
 
 
-def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN):
-    """(terms, per-member choices) for the recordings among ``sources``, chosen like ``flann
-    train --terms auto`` at the design's converter (:func:`flann.golden.family.family_terms`);
-    (None, []) when every member is a model.json (their terms are used as they are)."""
-    members = []
-    for p in sources:
-        p = Path(p)
-        if p.suffix.lower() == ".csv":
+def read_csvs(sources) -> dict:
+    """{place in ``sources``: Recordings} of every recordings CSV that reads, each read once
+    (one that does not is read again, and reported, when the members are loaded)."""
+    out = {}
+    for k, p in enumerate(sources):
+        if Path(p).suffix.lower() == ".csv":
             try:
-                rec = prepare_for_fit(read_recordings(p))
+                out[k] = read_recordings(p)
             except FlannError:
-                continue   # reported with every other bad member when the members are loaded
-            members.append((p.stem, rec.voltage_v, rec.displacement_mm))
+                continue
+    return out
+
+
+def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, read: dict | None = None):
+    """(terms, per-member choices) for the recordings among ``sources`` (``read``: their
+    :func:`read_csvs`), chosen like ``flann train --terms auto`` at the design's converter
+    (:func:`flann.golden.family.family_terms`); (None, []) when every member is a model.json
+    (their terms are used as they are)."""
+    members = []
+    for k, raw in (read_csvs(sources) if read is None else read).items():
+        try:
+            rec = prepare_for_fit(raw)
+        except FlannError:
+            continue   # reported with every other bad member when the members are loaded
+        members.append((Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm))
     if not members:
         return None, []
     adc = (options.get("input_bits", 12), options.get("input_lsb_v"))
@@ -50,13 +62,14 @@ def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN):
                         cost=lambda m: fixed_point_cost(m, adc))
 
 
-def load_member(path, terms: int = FIXED_TERMS) -> FlannModel:
-    """A model.json as it is, or a recordings CSV trained with ``terms`` terms."""
+def load_member(path, terms: int = FIXED_TERMS, rec=None) -> FlannModel:
+    """A model.json as it is, or a recordings CSV (``rec``: already read) trained with
+    ``terms`` terms."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         return load_model(path)
     if path.suffix.lower() == ".csv":
-        return train_model(read_recordings(path), terms)
+        return train_model(read_recordings(path) if rec is None else rec, terms)
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
 
@@ -65,16 +78,16 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    choices = []
+    choices, read = [], read_csvs(sources)
     if terms == "auto":
-        terms, choices = auto_terms(sources, options, margin)
+        terms, choices = auto_terms(sources, options, margin, read)
         terms = FIXED_TERMS if terms is None else max(2, terms)
     if not 2 <= int(terms) <= 200:
         raise FlannError(f"--terms {terms}: must be 2..200")
     models, bad = [], []
-    for p in sources:   # every member is tried: the user learns of all bad files at once
+    for k, p in enumerate(sources):   # every member is tried: the user learns of all bad files at once
         try:
-            models.append(load_member(p, terms))
+            models.append(load_member(p, terms, read.get(k)))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
@@ -91,4 +104,4 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     return man
 
 
-__all__ = ["generate_family", "train_model", "load_member", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]
+__all__ = ["generate_family", "train_model", "load_member", "read_csvs", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]

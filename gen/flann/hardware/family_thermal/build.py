@@ -18,7 +18,7 @@ from ...golden.family import family_thermal_terms
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
 from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
-from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE
+from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, read_csvs
 from ..family.spec import DEFAULT_MARGIN
 from .render import write
 from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
@@ -77,18 +77,16 @@ def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDG
                                  "data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})})
 
 
-def auto_terms(sources, temp: TempNorm, orders: int, margin: float):
+def auto_terms(sources, temp: TempNorm, orders: int, margin: float, read: dict | None = None):
     """(terms, [(index in ``sources``, its choice)]) for the recordings among ``sources``
-    (:func:`flann.golden.family.family_thermal_terms`); (None, []) when none is one."""
+    (``read``: their :func:`~flann.hardware.family.build.read_csvs`;
+    :func:`flann.golden.family.family_thermal_terms`); (None, []) when none is one."""
     members, where = [], []
-    for k, p in enumerate(sources):
-        if Path(p).suffix.lower() != ".csv":
-            continue
+    for k, rec in (read_csvs(sources) if read is None else read).items():
         try:
-            rec = read_recordings(p)
             if calibration_temperatures(rec).size < orders:
                 continue   # reported with every other bad member when the members are loaded
-            members.append((Path(p).stem, *_prepared(rec)))
+            members.append((Path(sources[k]).stem, *_prepared(rec)))
             where.append(k)
         except FlannError:
             continue
@@ -99,14 +97,16 @@ def auto_terms(sources, temp: TempNorm, orders: int, margin: float):
     return terms, list(zip(where, choices))
 
 
-def _range_of(sources) -> tuple[float, float]:
-    """The calibrated temperature range: every member's temperatures."""
+def _range_of(sources, read: dict) -> tuple[float, float]:
+    """The calibrated temperature range: every member's temperatures (``read``: the CSVs')."""
     lo, hi = np.inf, -np.inf
-    for p in sources:
+    for k, p in enumerate(sources):
         p = Path(p)
         try:
             if p.suffix.lower() == ".csv":
-                t = calibration_temperatures(read_recordings(p))
+                if k not in read:
+                    continue   # does not read: reported when the members are loaded
+                t = calibration_temperatures(read[k])
             elif p.suffix.lower() == ".json":
                 m = load_any_model(p)
                 t = np.asarray(m.temperature_range_c if isinstance(m, ThermalModel) else [])
@@ -122,8 +122,9 @@ def _range_of(sources) -> tuple[float, float]:
 
 
 def load_member(path, temp: TempNorm, terms: int, orders: int,
-                training: dict | None = None) -> tuple[ThermalModel, str]:
-    """(model, model file text): a two-input model.json as it is, or a recordings CSV trained."""
+                training: dict | None = None, rec=None) -> tuple[ThermalModel, str]:
+    """(model, model file text): a two-input model.json as it is, or a recordings CSV
+    (``rec``: already read) trained."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         m = load_any_model(path)
@@ -132,7 +133,7 @@ def load_member(path, temp: TempNorm, terms: int, orders: int,
                              f"({FORMAT}) or recordings at several temperatures")
         return m, path.read_bytes().decode("utf-8")
     if path.suffix.lower() == ".csv":
-        m = fit_sensor(read_recordings(path), temp, terms, orders, training=training)
+        m = fit_sensor(read_recordings(path) if rec is None else rec, temp, terms, orders, training=training)
         return m, m.to_json()
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
@@ -145,13 +146,14 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
         raise FlannError("--family needs at least one recordings CSV or model.json")
     if terms != "auto" and not 2 <= int(terms) <= 60:
         raise FlannError(f"--terms {terms}: must be 2..60")
+    read = read_csvs(sources)
     try:
-        temp = temp_norm(_range_of(sources), temp_bits, temp_lsb_c)
+        temp = temp_norm(_range_of(sources, read), temp_bits, temp_lsb_c)
     except SpecError as exc:
         raise FlannError(str(exc)) from None
     choices = []
     if terms == "auto":
-        terms, choices = auto_terms(sources, temp, orders, margin)
+        terms, choices = auto_terms(sources, temp, orders, margin, read)
         terms = FIXED_TERMS if terms is None else terms
     terms = int(terms)
     # each trained member's model records what sharing the count costs it
@@ -161,7 +163,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     loaded, bad = [], []
     for k, p in enumerate(sources):
         try:
-            loaded.append(load_member(p, temp, terms, orders, chosen.get(k)))
+            loaded.append(load_member(p, temp, terms, orders, chosen.get(k), read.get(k)))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
