@@ -17,7 +17,7 @@ from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_
                             fit_lms, fit_lstsq)
 from ..errors import SpecError
 from ..golden.model import MAX_TERMS
-from ..golden.sparse import sparse_fit
+from ..golden.inverse import inverse_fit
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .train_thermal import compensation_hint, run_thermal
@@ -140,8 +140,8 @@ def _check_generatable(model) -> None:
 
 
 def _train_auto(args, rec, provenance: dict) -> tuple:
-    """(model, lines to print) of --terms auto: the direct fit's cross-validated choice, or
-    with few positions the fit to the inverse of the forward spline (:mod:`flann.golden.sparse`)."""
+    """(model, lines to print) of --terms auto: the FLANN fitted to the inverse of the forward
+    curve (:mod:`flann.golden.inverse`), or the direct fit's cross-validated choice."""
     said = []
     check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
     positions = int(np.unique(rec.displacement_mm).size)
@@ -161,20 +161,22 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         return fixed_point_cost(m, adc)
 
     model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
-    sparse = sparse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, provenance)
-    if sparse is None:
+    inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training)
+    if inverse is None:
         t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
                     f"held-out error (cross-validation, {t['cv_folds']} folds"
                     + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
                     + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
     else:
-        model, t = sparse, sparse.training
-        loo = t["leave_one_out"]
-        said.append(f"auto: {t['selected_by']}: left-out positions RMS {loo['rms_error_mm']:.4g} mm "
-                    f"(direct fit {loo['direct_rms_error_mm']:.4g} mm); {model.terms} terms, "
+        model, t = inverse, inverse.training
+        loo = t.get("leave_one_out")
+        heldout = (f"left-out positions RMS {loo['rms_error_mm']:.4g} mm (direct fit "
+                   f"{loo['direct_rms_error_mm']:.4g} mm)" if loo else
+                   f"the direct fit's held-out max {choice.max_mm:.4g} mm")
+        said.append(f"auto: {t['selected_by']}: {heldout}; {model.terms} terms, "
                     f"normalisation {t['normalisation']}, ridge {t['ridge']:g}, within "
-                    f"{t['teacher_max_deviation_mm']:.3g} mm of the spline's inverse")
+                    f"{t['teacher_max_deviation_mm']:.3g} mm of the curve's inverse")
     if conv is not None:
         said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
                     + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")

@@ -1,0 +1,228 @@
+"""The FLANN fitted to the inverse of a forward curve v(x), the noise where it is.
+
+A calibration steps the actuator to exact positions and reads a noisy voltage.  Fitting
+x(v) directly puts the noise in the regressor: least squares then pulls the fit flat where
+the sensor's slope is low (the ends of the stroke, where the max error sits), and with a
+handful of positions x(v) swings between them.  So ``flann train --terms auto`` fits the
+forward curve v(x), inverts it densely, and fits the FLANN candidates to that noise-free
+inverse (:func:`fit_to_forward`):
+
+* the forward curve is a small sum of tanh units averaged over their number
+  (:mod:`flann.golden.sigmoids`); with fewer than :data:`SPARSE_POSITIONS` positions and
+  no monotone such curve, a cubic spline through the position means (not-a-knot; monotone
+  piecewise cubic when that one is not monotone);
+* with :data:`SPARSE_POSITIONS` or more positions the direct fit's cross-validated choice
+  is kept when the FLANN cannot follow the forward curve's inverse more closely than that
+  choice's own held-out max error (a knee too sharp for any buildable candidate);
+* with fewer, the error of the procedure at interior positions left out in turn is
+  recorded, not used to choose: it is pessimistic (a left-out position doubles the spacing
+  there) and blind to a direct fit that swings *between* the positions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import CubicSpline, PchipInterpolator
+
+from .forward import aggregate
+from .model import FlannModel
+from .sigmoids import SigmoidForward, fit_forward
+from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, fit_lstsq
+
+SPARSE_POSITIONS = 20      # the outlier screen's lower limit: below it, no smooth fit judges noise
+MIN_POSITIONS = 5          # a cubic through fewer is no better than the direct fit's candidates
+DENSE = 2001               # points of the inverse the FLANN is fitted to (uniform in x)
+TEACHER_TOL = 1.25         # candidates within this factor of the best buildable max deviation
+
+
+@dataclass(frozen=True)
+class Forward:
+    """The interpolated forward curve: position means and the spline through them."""
+    positions: np.ndarray
+    mean_v: np.ndarray
+    kind: str                 # "cubic" or "pchip"
+
+    def curve(self, positions=None, mean_v=None):
+        p = self.positions if positions is None else positions
+        m = self.mean_v if mean_v is None else mean_v
+        return (CubicSpline(p, m) if self.kind == "cubic" else PchipInterpolator(p, m))
+
+    def __call__(self, x) -> np.ndarray:
+        return self.curve()(x)
+
+    @property
+    def stroke(self) -> tuple[float, float]:
+        return float(self.positions[0]), float(self.positions[-1])
+
+    def inverse(self, n: int = DENSE) -> tuple[np.ndarray, np.ndarray]:
+        """(v, x) on n points uniform in x over the recorded stroke."""
+        x = np.linspace(*self.stroke, n)
+        return self(x), x
+
+    def describe(self) -> dict:
+        return {"kind": "cubic spline" if self.kind == "cubic" else "monotone cubic"}
+
+
+def _monotone(v: np.ndarray) -> bool:
+    d = np.diff(v)
+    return bool(np.all(d > 0) or np.all(d < 0))
+
+
+def spline_curve(displacement_mm, voltage_v) -> Forward | None:
+    """The spline v(x) through the position means, or None (too few positions, or no
+    monotone curve through them: the readings fold back or sit within noise of each other)."""
+    pos = aggregate(displacement_mm, voltage_v)
+    if pos.x.size < MIN_POSITIONS or not _monotone(pos.v):
+        return None
+    fine = np.linspace(pos.x[0], pos.x[-1], 8 * DENSE)
+    for kind in ("cubic", "pchip"):
+        fw = Forward(pos.x, pos.v, kind)
+        if _monotone(fw.curve()(fine)):
+            return fw
+    return None
+
+
+def forward_curve(displacement_mm, voltage_v) -> SigmoidForward | Forward | None:
+    """The tanh units' average; with fewer than :data:`SPARSE_POSITIONS` positions and none
+    monotone, the spline through the position means; else None."""
+    fw = fit_forward(displacement_mm, voltage_v)
+    if fw is None and np.unique(np.asarray(displacement_mm, float)).size < SPARSE_POSITIONS:
+        return spline_curve(displacement_mm, voltage_v)
+    return fw
+
+
+def _refit(fw, displacement_mm, voltage_v):
+    """The same kind of forward curve fitted to a subset of the readings."""
+    if isinstance(fw, Forward):
+        pos = aggregate(displacement_mm, voltage_v)
+        return Forward(pos.x, pos.v, fw.kind)
+    return fit_forward(displacement_mm, voltage_v)
+
+
+def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
+    x = np.linspace(lo, hi, 8 * DENSE)
+    f = curve(x)
+    order = np.argsort(f)
+    return np.interp(v, f[order], x[order])
+
+
+def leave_one_out_mm(fw, displacement_mm, voltage_v) -> np.ndarray:
+    """Error (mm) at each interior position of the procedure refitted without it: the
+    forward curve through the other positions, inverted at the position's mean reading."""
+    x = np.asarray(displacement_mm, dtype=float)
+    v = np.asarray(voltage_v, dtype=float)
+    pos = aggregate(x, v)
+    errs = []
+    for i in range(1, pos.x.size - 1):
+        keep = x != pos.x[i]
+        curve = _refit(fw, x[keep], v[keep])
+        if curve is None:
+            continue
+        errs.append(_invert(curve, pos.x[0], pos.x[-1], pos.v[i:i + 1])[0] - pos.x[i])
+    return np.asarray(errs)
+
+
+def direct_leave_one_out_mm(displacement_mm, voltage_v, terms: int, norm: str,
+                            ridge: float) -> np.ndarray:
+    """The same interior positions left out of the direct fit of x(v) (one candidate)."""
+    x = np.asarray(displacement_mm, dtype=float)
+    v = np.asarray(voltage_v, dtype=float)
+    pos = aggregate(x, v)
+    errs = []
+    for i in range(1, pos.x.size - 1):
+        keep = x != pos.x[i]
+        m = fit_lstsq(v[keep], x[keep], terms, norm=norm, ridge=ridge)
+        lo, hi = sorted(m.voltage_range_v)
+        errs.append(float(m.predict(np.clip([pos.v[i]], lo, hi))[0]) - pos.x[i])
+    return np.asarray(errs)
+
+
+def _rms(e: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
+
+
+def fit_to_forward(fw, cost, training: dict) -> tuple[FlannModel, dict] | None:
+    """The FLANN candidate with the fewest terms (then the cheapest) whose largest deviation
+    from the inverted forward curve, between the points it was fitted to, is within
+    ``TEACHER_TOL`` of the best buildable candidate's; None when none builds."""
+    v, x = fw.inverse()
+    v_mid, x_mid = fw.inverse(2 * DENSE - 1)
+    v_mid, x_mid = v_mid[1::2], x_mid[1::2]     # between the fitted points
+    scored = []
+    for norm in AUTO_NORMS:
+        for ridge in AUTO_RIDGES:
+            for terms in AUTO_TERMS:
+                m = fit_lstsq(v, x, terms, norm=norm, ridge=ridge, training=training)
+                scored.append((float(np.max(np.abs(m.predict(v_mid) - x_mid))), terms, norm, ridge, m))
+    scored.sort(key=lambda s: (s[0], s[1]))
+    costs = {}
+
+    def costed(s):
+        if id(s[4]) not in costs:
+            costs[id(s[4])] = cost(s[4])
+        return costs[id(s[4])]
+
+    best = next((s for s in scored if costed(s)["buildable"]), None)
+    if best is None:
+        return None
+    near = sorted((s for s in scored if s[0] <= TEACHER_TOL * best[0]), key=lambda s: (s[1], s[0]))
+    choice = next(s for s in near if costed(s)["buildable"])
+    c = costed(choice)
+    return choice[4], {"teacher_max_deviation_mm": choice[0], "terms": choice[1],
+                       "normalisation": choice[2], "ridge": choice[3],
+                       "fixed_point": {k: c[k] for k in ("cost", "luts", "brams", "weight_bits",
+                                                         "term_bits", "output_lsb_mm")}}
+
+
+def _described(fw) -> str:
+    if isinstance(fw, Forward):
+        return ("a cubic spline" if fw.kind == "cubic" else "a monotone cubic") + \
+            " through their mean readings"
+    return "an average of tanh-unit curves v(x)"
+
+
+def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> FlannModel | None:
+    """The model fitted to the inverted forward curve, or None: no forward curve, no
+    candidate that builds, or (:data:`SPARSE_POSITIONS` or more positions) none that follows
+    the curve more closely than the direct fit's held-out max error.  ``direct`` is the
+    direct fit's :class:`~flann.golden.train.CvResult`; ``training`` the record to extend
+    (with many positions, the direct fit's own, whose held-out figures it keeps)."""
+    x = np.asarray(displacement_mm, dtype=float)
+    positions = int(np.unique(x).size)
+    fw = forward_curve(x, voltage_v)
+    if fw is None:
+        return None
+    record = {k: val for k, val in training.items()
+              if k not in ("traded", "best_heldout", "chosen", "fixed_point", "as_good_candidates",
+                           "candidates_costed", "hardware_why")}
+    record["forward_model"] = fw.describe()
+    record["selected_by"] = (f"{positions} positions: the FLANN fitted to the inverse of "
+                             f"{_described(fw)} (x exact)")
+    record["direct"] = {"terms": direct.terms, "normalisation": direct.norm, "ridge": direct.ridge,
+                        "cv_heldout_rms_error_mm": direct.rms_mm,
+                        "cv_heldout_max_error_mm": direct.max_mm}
+    if isinstance(fw, Forward):
+        record["forward_spline"] = fw.kind
+    if positions < SPARSE_POSITIONS:
+        mine = leave_one_out_mm(fw, x, voltage_v)
+        theirs = direct_leave_one_out_mm(x, voltage_v, direct.terms, direct.norm, direct.ridge)
+        record.update({
+            "cv_heldout_rms_error_mm": _rms(mine),
+            "cv_heldout_max_error_mm": float(np.max(np.abs(mine))) if mine.size else float("nan"),
+            "leave_one_out": {"positions": int(mine.size), "rms_error_mm": _rms(mine),
+                              "direct_rms_error_mm": _rms(theirs)},
+        })
+    fitted = fit_to_forward(fw, cost, record)
+    if fitted is None:      # no candidate builds at this converter: the direct fit says why
+        return None
+    model, info = fitted
+    if positions >= SPARSE_POSITIONS and info["teacher_max_deviation_mm"] > direct.max_mm:
+        return None
+    model.training.update(info)
+    return model
+
+
+__all__ = ["DENSE", "Forward", "MIN_POSITIONS", "SPARSE_POSITIONS", "direct_leave_one_out_mm",
+           "fit_to_forward", "forward_curve", "inverse_fit", "leave_one_out_mm", "spline_curve"]

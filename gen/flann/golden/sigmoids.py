@@ -1,0 +1,178 @@
+"""The forward curve v(x) as a small sum of tanh units, averaged over their number.
+
+The calibration positions are exact and the readings noisy, so the curve worth estimating is
+v(x), not x(v).  A displacement sensor's v(x) is steep near its null and flattens toward the
+ends of its stroke; a few saturating units carry that shape with few parameters, where a
+generic smoother (polynomial, spline) needs many and is loose at the ends, which is where
+the inverse's max error sits:
+
+    v(x) = c [+ d x] + sum_k a_k tanh((x - b_k) / s_k),   k = 1..K
+
+(a one-hidden-layer network in x; no sensor's formula).  The linear parameters (c, d, a_k)
+are solved exactly for every trial of the others (variable projection), the units are grown
+one at a time from the previous fit, and every K with and without the linear term is kept
+when its curve is monotone over the stroke.  Their curves are averaged with Akaike weights:
+choosing one K by a held-out score is a noisy choice (the score is set by the interior of
+the stroke, the max error by its ends), averaging is not.
+
+:func:`fit_forward` returns a :class:`SigmoidForward`, whose :meth:`~SigmoidForward.inverse`
+feeds :func:`flann.golden.inverse.fit_to_forward`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .forward import aggregate
+
+MAX_UNITS = 6
+MIN_POSITIONS = 6           # the smallest model (one unit and an offset) has 3 parameters
+LOG_WIDTH = (np.log(0.02), np.log(5.0))     # unit widths, in halves of the stroke
+CENTRE = (-1.5, 1.5)                        # unit centres, in halves of the stroke
+GRID_CENTRES = np.linspace(-1.0, 1.0, 9)
+GRID_WIDTHS = np.log([0.1, 0.4, 1.2])
+RANDOM_STARTS = 6
+REFINED = 6                 # starting points refined per K (the best by their first residual)
+CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
+DENSE = 2001
+
+
+def _basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
+    cols = [np.ones_like(x)] + ([x] if linear else [])
+    for b, ls in nl.reshape(-1, 2):
+        cols.append(np.tanh((x - b) * np.exp(-ls)))
+    return np.column_stack(cols)
+
+
+def _linear(nl, x, y, sw, linear):
+    """The linear parameters for these units (weighted least squares) and the residuals."""
+    B = _basis(nl, x, linear) * sw[:, None]
+    beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
+    return beta, B @ beta - y * sw
+
+
+def _bounds(k: int):
+    lo = np.tile([CENTRE[0], LOG_WIDTH[0]], k)
+    hi = np.tile([CENTRE[1], LOG_WIDTH[1]], k)
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class Units:
+    """One fitted member: K units (centre, log width), the linear term or not, and the
+    linear parameters, all in normalised x (stroke to [-1, 1]) and v (range to [-1, 1])."""
+
+    nl: np.ndarray
+    beta: np.ndarray
+    linear: bool
+    sse: float
+
+    @property
+    def params(self) -> int:
+        return self.nl.size + self.beta.size
+
+    def __call__(self, xn: np.ndarray) -> np.ndarray:
+        return _basis(self.nl, xn, self.linear) @ self.beta
+
+
+def _refine(nl0, x, y, sw, linear) -> Units:
+    lo, hi = _bounds(nl0.size // 2)
+    nl0 = np.clip(nl0, lo + 1e-9, hi - 1e-9)
+    r = least_squares(lambda nl: _linear(nl, x, y, sw, linear)[1], nl0, bounds=(lo, hi),
+                      method="trf", max_nfev=300)
+    beta, res = _linear(r.x, x, y, sw, linear)
+    return Units(r.x, beta, linear, float(res @ res))
+
+
+def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
+    """The best fit with 1..kmax units, each grown from the previous one."""
+    out, prev = [], np.zeros(0)
+    for k in range(1, kmax + 1):
+        starts = [np.concatenate([prev, [b, ls]]) for b in GRID_CENTRES for ls in GRID_WIDTHS]
+        starts += [np.column_stack([rng.uniform(-1, 1, k), rng.uniform(np.log(0.05), np.log(2.0), k)]).ravel()
+                   for _ in range(RANDOM_STARTS)]
+        lo, hi = _bounds(k)
+
+        def first(s):
+            r = _linear(np.clip(s, lo, hi), x, y, sw, linear)[1]
+            return float(r @ r)
+        fits = [_refine(s, x, y, sw, linear) for s in sorted(starts, key=first)[:REFINED]]
+        best = min(fits, key=lambda u: u.sse)
+        out.append(best)
+        prev = best.nl
+    return out
+
+
+def _monotone(y: np.ndarray) -> bool:
+    d = np.diff(y)
+    return bool(np.all(d > 0) or np.all(d < 0))
+
+
+@dataclass(frozen=True)
+class SigmoidForward:
+    """The Akaike-weighted average of the monotone members, in physical units."""
+
+    members: tuple[Units, ...]
+    weights: np.ndarray
+    x_lo: float
+    x_hi: float
+    v_mid: float
+    v_half: float
+
+    def _xn(self, x):
+        return (np.asarray(x, float) - 0.5 * (self.x_lo + self.x_hi)) / (0.5 * (self.x_hi - self.x_lo))
+
+    def __call__(self, x) -> np.ndarray:
+        xn = self._xn(x)
+        return self.v_mid + self.v_half * sum(w * m(xn) for w, m in zip(self.weights, self.members))
+
+    def inverse(self, n: int = DENSE) -> tuple[np.ndarray, np.ndarray]:
+        """(v, x) on n points uniform in x over the recorded stroke."""
+        x = np.linspace(self.x_lo, self.x_hi, n)
+        return self(x), x
+
+    def describe(self) -> dict:
+        top = int(np.argmax(self.weights))
+        return {"kind": "tanh units, Akaike-weighted",
+                "members": [{"units": m.nl.size // 2, "linear_term": m.linear, "weight": round(float(w), 4)}
+                            for m, w in zip(self.members, self.weights) if w >= 1e-4],
+                "heaviest_units": self.members[top].nl.size // 2}
+
+
+def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> SigmoidForward | None:
+    """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
+    no monotone member."""
+    pos = aggregate(displacement_mm, voltage_v)
+    if pos.x.size < MIN_POSITIONS:
+        return None
+    x_lo, x_hi = float(pos.x[0]), float(pos.x[-1])
+    v = np.asarray(voltage_v, float)
+    v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
+    if v_half <= 0:
+        return None
+    xn = (pos.x - 0.5 * (x_lo + x_hi)) / (0.5 * (x_hi - x_lo))
+    y = (pos.v - v_mid) / v_half
+    sw = np.sqrt(pos.w)
+    n = int(pos.w.sum())
+    # scatter about the position means: the same for every member, part of each one's SSE
+    within = float(np.sum(((v - v_mid) / v_half - y[pos.index]) ** 2))
+    kmax = max(1, min(max_units, (pos.x.size - 3) // 3))
+    rng = np.random.default_rng(0)
+    check = np.linspace(-1.0, 1.0, CHECK_POINTS)
+    members = [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)
+               if _monotone(u(check))]
+    if not members:
+        return None
+    # Akaike's criterion with the positions as the sample size: repeated readings at one
+    # position share its error (backlash, hysteresis, drift between sweeps), so the evidence
+    # about the curve's shape grows with the positions, not the readings
+    aic = np.array([pos.x.size * np.log(max(u.sse + within, 1e-300) / n) + 2 * u.params
+                    for u in members])
+    w = np.exp(-0.5 * (aic - aic.min()))
+    return SigmoidForward(tuple(members), w / w.sum(), x_lo, x_hi, v_mid, v_half)
+
+
+__all__ = ["MAX_UNITS", "MIN_POSITIONS", "SigmoidForward", "Units", "fit_forward"]

@@ -1,0 +1,149 @@
+"""`flann train --terms auto` fits the FLANN to the inverse of a forward curve v(x)
+(flann.golden.inverse, flann.golden.sigmoids), judged against sensors written here (not sums
+of tanh units) and the direct fit of x(v)."""
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from flann.cli import main as flann
+from flann.golden.inverse import SPARSE_POSITIONS, forward_curve, inverse_fit, spline_curve
+from flann.golden.model import load_model
+from flann.golden.sigmoids import fit_forward
+from flann.golden.train import fit_auto
+
+
+def sensor(x):
+    """A saturating sensor of this test's own: arctan roll-off, a slight even term; the ends of
+    +-20 mm fall to a seventeenth of the slope at the null."""
+    return 2.0 * np.arctan(x / 5.0) + 0.02 * (x / 20.0) ** 2 + 0.002
+
+
+LSB = 2 * 3.2 / 2 ** 14
+
+
+def recording(path, positions, seed, sweeps=1, noise=3e-4):
+    rng = np.random.default_rng(seed)
+    one = np.linspace(-20, 20, positions)
+    x = np.concatenate([one if k % 2 == 0 else one[::-1] for k in range(sweeps)])
+    v = np.round((sensor(x) + rng.normal(0, noise, x.size)) / LSB) * LSB
+    d = np.repeat([1 if k % 2 == 0 else -1 for k in range(sweeps)], positions) if sweeps > 1 else None
+    rows = ["displacement_mm,voltage_v" + (",direction" if d is not None else "")]
+    for i in range(x.size):
+        rows.append(f"{x[i]:.9g},{v[i]:.9g}" + (f",{d[i]:+d}" if d is not None else ""))
+    path.write_text("\n".join(rows) + "\n")
+    return x, v
+
+
+def held_out_max_mm(model):
+    xt = np.linspace(-20, 20, 2001)
+    lo, hi = sorted(model.voltage_range_v)
+    return float(np.max(np.abs(model.predict(np.clip(sensor(xt), lo, hi)) - xt)))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_thirteen_positions_fit_the_inverse_of_the_forward_curve(tmp_path, seed):
+    rec, out = tmp_path / "rec.csv", tmp_path / "m.json"
+    x, v = recording(rec, 13, seed)
+    assert flann(["train", str(rec), "-o", str(out)]) == 0
+    model = load_model(out)
+    t = model.training
+    assert t["forward_model"]["kind"].startswith("tanh units")
+    assert t["leave_one_out"]["positions"] == 11
+    assert t["cv_heldout_rms_error_mm"] == pytest.approx(t["leave_one_out"]["rms_error_mm"])
+    # against the direct fit of x(v) on the same readings (auto's own choice): the ends of
+    # the stroke, where x(v) is steep, are where the direct fit swings between 13 points
+    direct, _ = fit_auto(v, x)
+    assert held_out_max_mm(model) < 0.25 * held_out_max_mm(direct)
+    assert held_out_max_mm(model) < 0.05      # of a 40 mm stroke, noise 0.3 mV
+
+
+def test_many_positions_fit_the_inverse_of_the_forward_curve(tmp_path):
+    """Two noisy sweeps of 120 positions: the direct fit of x(v) has the noise in its
+    regressor and is pulled flat at the ends; the forward curve's inverse is not."""
+    ratios = []
+    for seed in (3, 4, 5):
+        rec, out = tmp_path / f"rec{seed}.csv", tmp_path / f"m{seed}.json"
+        x, v = recording(rec, 120, seed, sweeps=2, noise=2e-3)
+        assert flann(["train", str(rec), "-o", str(out)]) == 0
+        model = load_model(out)
+        t = model.training
+        assert t["selected_by"].startswith("120 positions: the FLANN fitted to the inverse")
+        assert t["direct"]["cv_heldout_max_error_mm"] > t["teacher_max_deviation_mm"]
+        direct, _ = fit_auto(v, x)
+        ratios.append(held_out_max_mm(model) / held_out_max_mm(direct))
+    assert max(ratios) < 0.9 and np.mean(ratios) < 0.75
+
+
+def test_repeats_at_few_positions_are_averaged_into_the_curve(tmp_path):
+    rec, out = tmp_path / "rec.csv", tmp_path / "m.json"
+    recording(rec, 13, 4, sweeps=4)
+    assert flann(["train", str(rec), "-o", str(out)]) == 0
+    model = load_model(out)
+    assert model.training["positions_used"] == 13
+    assert held_out_max_mm(model) < 0.05
+
+
+def test_the_forward_curve_follows_a_shape_outside_its_family():
+    """arctan is no finite sum of tanh units: the average follows it within the noise."""
+    rng = np.random.default_rng(7)
+    x = np.repeat(np.linspace(-20, 20, 81), 2)
+    v = sensor(x) + rng.normal(0, 1e-3, x.size)
+    fw = fit_forward(x, v)
+    assert fw is not None
+    assert fw.weights.sum() == pytest.approx(1.0)
+    fine = np.linspace(-20, 20, 4001)
+    assert np.all(np.diff(fw(fine)) > 0)
+    assert np.max(np.abs(fw(fine) - sensor(fine))) < 1.5e-3
+    again = fit_forward(x, v)                       # deterministic: same starts, same fit
+    assert np.array_equal(again(fine), fw(fine))
+
+
+def test_no_forward_curve_from_too_few_or_flat_positions():
+    x = np.linspace(-20, 20, 5)
+    assert fit_forward(x, sensor(x)) is None                   # fewer than 6 positions
+    assert fit_forward(np.linspace(-20, 20, 30), np.zeros(30)) is None
+    assert isinstance(forward_curve(x, sensor(x)).kind, str)   # the spline, with 5
+
+
+def test_no_monotone_spline_through_the_positions_is_none():
+    x = np.linspace(-20, 20, 9)
+    v = sensor(x)
+    v[-2], v[-1] = v[-1], v[-2]          # the last two positions read in the wrong order
+    assert spline_curve(x, v) is None
+    assert spline_curve(x[:4], sensor(x[:4])) is None      # too few positions
+    assert spline_curve(x, sensor(x)) is not None
+
+
+def test_no_candidate_that_builds_falls_back_to_the_direct_fit():
+    x = np.linspace(-20, 20, 13)
+    v = sensor(x)
+    _, choice = fit_auto(v, x)
+    never = inverse_fit(x, v, choice, lambda m: {"buildable": False, "why": "test", "cost": np.inf}, {})
+    assert never is None
+    built = inverse_fit(x, v, choice, lambda m: {"buildable": True, "why": "", "cost": float(m.terms),
+                                                 "luts": 0, "brams": 0, "weight_bits": 16,
+                                                 "term_bits": 16, "output_lsb_mm": 1e-3}, {})
+    assert built is not None and "forward_model" in built.training
+
+
+def test_a_curve_the_flann_cannot_follow_keeps_the_direct_fit():
+    """With many positions the direct fit stays when the FLANN's best buildable deviation
+    from the curve's inverse exceeds the direct fit's own held-out max error."""
+    x = np.repeat(np.linspace(-20, 20, SPARSE_POSITIONS + 10), 2)
+    v = sensor(x)
+    _, choice = fit_auto(v, x)
+    tight = replace(choice, max_mm=1e-9)
+    ok = {"buildable": True, "why": "", "cost": 1.0, "luts": 0, "brams": 0, "weight_bits": 16,
+          "term_bits": 16, "output_lsb_mm": 1e-3}
+    assert inverse_fit(x, v, tight, lambda m: ok, {}) is None
+    assert inverse_fit(x, v, choice, lambda m: ok, {}) is not None
+
+
+def test_the_paper_table_trains_through_the_forward_curve(tmp_path):
+    out = tmp_path / "m.json"
+    assert flann(["train", "data/paper_table1.csv", "-o", str(out)]) == 0
+    t = json.loads(out.read_text())["training"]
+    assert t["positions_used"] == 13 and "forward_model" in t
