@@ -50,7 +50,7 @@ def test_thirteen_positions_fit_the_inverse_of_the_forward_curve(tmp_path, seed)
     assert flann(["train", str(rec), "-o", str(out)]) == 0
     model = load_model(out)
     t = model.training
-    assert t["forward_model"]["kind"].startswith("tanh units")
+    assert t["forward_spline"] in ("cubic", "pchip")
     assert t["leave_one_out"]["positions"] == 11
     assert t["cv_heldout_rms_error_mm"] == pytest.approx(t["leave_one_out"]["rms_error_mm"])
     # against the direct fit of x(v) on the same readings (auto's own choice): the ends of
@@ -71,6 +71,7 @@ def test_many_positions_fit_the_inverse_of_the_forward_curve(tmp_path):
         model = load_model(out)
         t = model.training
         assert t["selected_by"].startswith("120 positions: the FLANN fitted to the inverse")
+        assert t["forward_model"]["kind"].startswith("tanh units")
         assert t["direct"]["cv_heldout_max_error_mm"] > t["teacher_max_deviation_mm"]
         direct, _ = fit_auto(v, x)
         ratios.append(held_out_max_mm(model) / held_out_max_mm(direct))
@@ -105,7 +106,9 @@ def test_no_forward_curve_from_too_few_or_flat_positions():
     x = np.linspace(-20, 20, 5)
     assert fit_forward(x, sensor(x)) is None                   # fewer than 6 positions
     assert fit_forward(np.linspace(-20, 20, 30), np.zeros(30)) is None
-    assert isinstance(forward_curve(x, sensor(x)).kind, str)   # the spline, with 5
+    assert forward_curve(x, sensor(x)).kind in ("cubic", "pchip")   # few positions: the spline
+    many = np.linspace(-20, 20, SPARSE_POSITIONS)
+    assert "tanh" in forward_curve(many, sensor(many)).describe()["kind"]
 
 
 def test_no_monotone_spline_through_the_positions_is_none():

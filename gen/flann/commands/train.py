@@ -162,21 +162,22 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
 
     model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
     inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training)
+    t = model.training
+    direct_text = (f"held-out error (cross-validation, {t['cv_folds']} folds"
+                   + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
+                   + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
     if inverse is None:
-        t = model.training
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
-                    f"held-out error (cross-validation, {t['cv_folds']} folds"
-                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
-                    + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
+                    + direct_text)
     else:
         model, t = inverse, inverse.training
         loo = t.get("leave_one_out")
         heldout = (f"left-out positions RMS {loo['rms_error_mm']:.4g} mm (direct fit "
                    f"{loo['direct_rms_error_mm']:.4g} mm)" if loo else
-                   f"the direct fit's held-out max {choice.max_mm:.4g} mm")
-        said.append(f"auto: {t['selected_by']}: {heldout}; {model.terms} terms, "
-                    f"normalisation {t['normalisation']}, ridge {t['ridge']:g}, within "
-                    f"{t['teacher_max_deviation_mm']:.3g} mm of the curve's inverse")
+                   f"the direct fit x(v)'s {direct_text}")
+        said.append(f"auto: {t['selected_by']}; {model.terms} terms, normalisation {t['normalisation']}, "
+                    f"ridge {t['ridge']:g}, within {t['teacher_max_deviation_mm']:.3g} mm of the curve's "
+                    f"inverse; {heldout}")
     if conv is not None:
         said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
                     + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")

@@ -38,6 +38,7 @@ RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 DENSE = 2001
+MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 
 
 def _basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
@@ -142,24 +143,40 @@ class SigmoidForward:
                 "heaviest_units": self.members[top].nl.size // 2}
 
 
+def _groups(x: np.ndarray, v: np.ndarray):
+    """(x, mean v, count, group of each reading, positions): the readings averaged per
+    position (exact for least squares), or per bin of x when a logger's file has more than
+    :data:`MAX_GROUPS` distinct positions (the curve is straight within a bin)."""
+    pos = aggregate(x, v)
+    if pos.x.size <= MAX_GROUPS:
+        return pos.x, pos.v, pos.w, pos.index, pos.x.size
+    edges = np.linspace(pos.x[0], pos.x[-1], MAX_GROUPS + 1)
+    index = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, MAX_GROUPS - 1)
+    _used, index = np.unique(index, return_inverse=True)
+    count = np.bincount(index).astype(float)
+    return (np.bincount(index, weights=x) / count, np.bincount(index, weights=v) / count, count,
+            index, pos.x.size)
+
+
 def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> SigmoidForward | None:
     """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
     no monotone member."""
-    pos = aggregate(displacement_mm, voltage_v)
-    if pos.x.size < MIN_POSITIONS:
-        return None
-    x_lo, x_hi = float(pos.x[0]), float(pos.x[-1])
+    x = np.asarray(displacement_mm, float)
     v = np.asarray(voltage_v, float)
+    gx, gv, count, index, positions = _groups(x, v)
+    if gx.size < MIN_POSITIONS:
+        return None
+    x_lo, x_hi = float(x.min()), float(x.max())
     v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
     if v_half <= 0:
         return None
-    xn = (pos.x - 0.5 * (x_lo + x_hi)) / (0.5 * (x_hi - x_lo))
-    y = (pos.v - v_mid) / v_half
-    sw = np.sqrt(pos.w)
-    n = int(pos.w.sum())
-    # scatter about the position means: the same for every member, part of each one's SSE
-    within = float(np.sum(((v - v_mid) / v_half - y[pos.index]) ** 2))
-    kmax = max(1, min(max_units, (pos.x.size - 3) // 3))
+    xn = (gx - 0.5 * (x_lo + x_hi)) / (0.5 * (x_hi - x_lo))
+    y = (gv - v_mid) / v_half
+    sw = np.sqrt(count)
+    n = v.size
+    # scatter about the group means: the same for every member, part of each one's SSE
+    within = float(np.sum(((v - v_mid) / v_half - y[index]) ** 2))
+    kmax = max(1, min(max_units, (gx.size - 3) // 3))
     rng = np.random.default_rng(0)
     check = np.linspace(-1.0, 1.0, CHECK_POINTS)
     members = [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)
@@ -169,7 +186,7 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     # Akaike's criterion with the positions as the sample size: repeated readings at one
     # position share its error (backlash, hysteresis, drift between sweeps), so the evidence
     # about the curve's shape grows with the positions, not the readings
-    aic = np.array([pos.x.size * np.log(max(u.sse + within, 1e-300) / n) + 2 * u.params
+    aic = np.array([min(positions, n) * np.log(max(u.sse + within, 1e-300) / n) + 2 * u.params
                     for u in members])
     w = np.exp(-0.5 * (aic - aic.min()))
     return SigmoidForward(tuple(members), w / w.sum(), x_lo, x_hi, v_mid, v_half)
