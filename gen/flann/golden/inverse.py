@@ -63,6 +63,10 @@ class Forward:
         x = np.linspace(*self.stroke, n)
         return self(x), x
 
+    @property
+    def name(self) -> str:
+        return ("a cubic spline" if self.kind == "cubic" else "a monotone cubic") + " through their mean readings"
+
     def describe(self) -> dict:
         return {"kind": "cubic spline" if self.kind == "cubic" else "monotone cubic"}
 
@@ -94,14 +98,6 @@ def forward_curve(displacement_mm, voltage_v) -> SigmoidForward | Forward | None
     return fit_forward(displacement_mm, voltage_v)
 
 
-def _refit(fw, displacement_mm, voltage_v):
-    """The same kind of forward curve fitted to a subset of the readings."""
-    if isinstance(fw, Forward):
-        pos = aggregate(displacement_mm, voltage_v)
-        return Forward(pos.x, pos.v, fw.kind)
-    return fit_forward(displacement_mm, voltage_v)
-
-
 def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
     x = np.linspace(lo, hi, 8 * DENSE)
     f = curve(x)
@@ -109,20 +105,23 @@ def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
     return np.interp(v, f[order], x[order])
 
 
-def leave_one_out_mm(fw, displacement_mm, voltage_v) -> np.ndarray:
-    """Error (mm) at each interior position of the procedure refitted without it: the
-    forward curve through the other positions, inverted at the position's mean reading."""
+def _left_out_mm(displacement_mm, voltage_v, predict) -> np.ndarray:
+    """Error (mm) at each interior position of a procedure refitted without it and asked at
+    the position's mean reading: ``predict(keep, mean_v) -> x``, ``keep`` a reading mask."""
+    x = np.asarray(displacement_mm, dtype=float)
+    pos = aggregate(x, voltage_v)
+    return np.asarray([predict(x != pos.x[i], pos.v[i]) - pos.x[i] for i in range(1, pos.x.size - 1)])
+
+
+def leave_one_out_mm(fw: Forward, displacement_mm, voltage_v) -> np.ndarray:
+    """The spline through the other positions, inverted at the left-out position's reading."""
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(voltage_v, dtype=float)
-    pos = aggregate(x, v)
-    errs = []
-    for i in range(1, pos.x.size - 1):
-        keep = x != pos.x[i]
-        curve = _refit(fw, x[keep], v[keep])
-        if curve is None:
-            continue
-        errs.append(_invert(curve, pos.x[0], pos.x[-1], pos.v[i:i + 1])[0] - pos.x[i])
-    return np.asarray(errs)
+
+    def predict(keep, mean_v):
+        pos = aggregate(x[keep], v[keep])
+        return _invert(fw.curve(pos.x, pos.v), x.min(), x.max(), np.array([mean_v]))[0]
+    return _left_out_mm(x, v, predict)
 
 
 def direct_leave_one_out_mm(displacement_mm, voltage_v, terms: int, norm: str,
@@ -130,14 +129,12 @@ def direct_leave_one_out_mm(displacement_mm, voltage_v, terms: int, norm: str,
     """The same interior positions left out of the direct fit of x(v) (one candidate)."""
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(voltage_v, dtype=float)
-    pos = aggregate(x, v)
-    errs = []
-    for i in range(1, pos.x.size - 1):
-        keep = x != pos.x[i]
+
+    def predict(keep, mean_v):
         m = fit_lstsq(v[keep], x[keep], terms, norm=norm, ridge=ridge)
         lo, hi = sorted(m.voltage_range_v)
-        errs.append(float(m.predict(np.clip([pos.v[i]], lo, hi))[0]) - pos.x[i])
-    return np.asarray(errs)
+        return float(m.predict(np.clip([mean_v], lo, hi))[0])
+    return _left_out_mm(x, v, predict)
 
 
 def _rms(e: np.ndarray) -> float:
@@ -177,13 +174,6 @@ def fit_to_forward(fw, cost, training: dict) -> tuple[FlannModel, dict] | None:
                                                          "term_bits", "output_lsb_mm")}}
 
 
-def _described(fw) -> str:
-    if isinstance(fw, Forward):
-        return ("a cubic spline" if fw.kind == "cubic" else "a monotone cubic") + \
-            " through their mean readings"
-    return "an average of tanh-unit curves v(x)"
-
-
 def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> FlannModel | None:
     """The model fitted to the inverted forward curve, or None: no forward curve, no
     candidate that builds, or (:data:`SPARSE_POSITIONS` or more positions) none that follows
@@ -199,14 +189,13 @@ def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Fla
               if k not in ("traded", "best_heldout", "chosen", "fixed_point", "as_good_candidates",
                            "candidates_costed", "hardware_why")}
     record["forward_model"] = fw.describe()
-    record["selected_by"] = (f"{positions} positions: the FLANN fitted to the inverse of "
-                             f"{_described(fw)} (x exact)")
+    record["selected_by"] = f"{positions} positions: the FLANN fitted to the inverse of {fw.name} (x exact)"
     record["direct"] = {"terms": direct.terms, "normalisation": direct.norm, "ridge": direct.ridge,
                         "cv_heldout_rms_error_mm": direct.rms_mm,
                         "cv_heldout_max_error_mm": direct.max_mm}
-    if isinstance(fw, Forward):
+    spline = isinstance(fw, Forward)    # few positions: judged by leaving each out, no fallback
+    if spline:
         record["forward_spline"] = fw.kind
-    if positions < SPARSE_POSITIONS:
         mine = leave_one_out_mm(fw, x, voltage_v)
         theirs = direct_leave_one_out_mm(x, voltage_v, direct.terms, direct.norm, direct.ridge)
         record.update({
@@ -219,7 +208,7 @@ def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Fla
     if fitted is None:      # no candidate builds at this converter: the direct fit says why
         return None
     model, info = fitted
-    if positions >= SPARSE_POSITIONS and info["teacher_max_deviation_mm"] > direct.max_mm:
+    if not spline and info["teacher_max_deviation_mm"] > direct.max_mm:
         return None
     model.training.update(info)
     return model

@@ -55,6 +55,23 @@ def _linear(nl, x, y, sw, linear):
     return beta, B @ beta - y * sw
 
 
+def _jacobian(nl, x, y, sw, linear):
+    """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
+    the projection, orthogonal to the basis, of each unit's derivative times its weight."""
+    B = _basis(nl, x, linear) * sw[:, None]
+    beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
+    q, _r = np.linalg.qr(B)
+    first = 2 if linear else 1
+    cols = []
+    for k, (b, ls) in enumerate(nl.reshape(-1, 2)):
+        inv_w = np.exp(-ls)
+        t = np.tanh((x - b) * inv_w)
+        d = -(1.0 - t * t) * inv_w * beta[first + k] * sw
+        cols += [d, d * (x - b)]
+    D = np.column_stack(cols)
+    return D - q @ (q.T @ D)
+
+
 def _bounds(k: int):
     lo = np.tile([CENTRE[0], LOG_WIDTH[0]], k)
     hi = np.tile([CENTRE[1], LOG_WIDTH[1]], k)
@@ -83,7 +100,7 @@ def _refine(nl0, x, y, sw, linear) -> Units:
     lo, hi = _bounds(nl0.size // 2)
     nl0 = np.clip(nl0, lo + 1e-9, hi - 1e-9)
     r = least_squares(lambda nl: _linear(nl, x, y, sw, linear)[1], nl0, bounds=(lo, hi),
-                      method="trf", max_nfev=300)
+                      jac=lambda nl: _jacobian(nl, x, y, sw, linear), method="trf", max_nfev=300)
     beta, res = _linear(r.x, x, y, sw, linear)
     return Units(r.x, beta, linear, float(res @ res))
 
@@ -134,6 +151,8 @@ class SigmoidForward:
         """(v, x) on n points uniform in x over the recorded stroke."""
         x = np.linspace(self.x_lo, self.x_hi, n)
         return self(x), x
+
+    name = "an average of tanh-unit curves v(x)"
 
     def describe(self) -> dict:
         top = int(np.argmax(self.weights))
