@@ -148,9 +148,11 @@ REACH_FACTOR = 1.5
 
 
 def own_reach_mm(voltage_v, displacement_mm, cost=None) -> tuple[float, int]:
-    """(max |error| on the recording itself, terms) of the sensor's own ``--terms auto`` model:
-    what its own design would reach on the same points (the float model; its hardware is
-    within an output LSB of it)."""
+    """(max |error| on the recording itself, terms) of the sensor's own direct fit of x(v)
+    (``--terms auto``'s cross-validated choice): what its own design would reach on the same
+    points (the float model; its hardware is within an output LSB of it).  The direct fit,
+    not the forward curve's inverse ``train`` now writes: on the noisy points it was fitted
+    to, it is the stricter yardstick."""
     model, choice = fit_auto(voltage_v, displacement_mm, cost=cost)
     err = np.abs(model.predict(voltage_v) - np.asarray(displacement_mm, dtype=float))
     return float(np.max(err)), choice.terms
