@@ -150,3 +150,12 @@ def test_the_paper_table_trains_through_the_forward_curve(tmp_path):
     assert flann(["train", "data/paper_table1.csv", "-o", str(out)]) == 0
     t = json.loads(out.read_text())["training"]
     assert t["positions_used"] == 13 and "forward_model" in t
+
+
+def test_a_straight_sensor_is_mostly_the_straight_line():
+    rng = np.random.default_rng(11)
+    x = np.repeat(np.linspace(0, 10, 150), 2)
+    fw = fit_forward(x, 0.2 * x + rng.normal(0, 1e-3, x.size))
+    assert fw.describe()["heaviest_units"] == 0
+    fine = np.linspace(0, 10, 1001)
+    assert np.max(np.abs(fw(fine) - 0.2 * fine)) < 1e-3

@@ -10,8 +10,8 @@ the inverse's max error sits:
 
 (a one-hidden-layer network in x; no sensor's formula).  The linear parameters (c, d, a_k)
 are solved exactly for every trial of the others (variable projection), the units are grown
-one at a time from the previous fit, and every K with and without the linear term is kept
-when its curve is monotone over the stroke.  Their curves are averaged with Akaike weights:
+one at a time from the previous fit, and every K with and without the linear term (and the
+straight line, K = 0) is kept when its curve is monotone over the stroke.  Their curves are averaged with Akaike weights:
 choosing one K by a held-out score is a noisy choice (the score is set by the interior of
 the stroke, the max error by its ends), averaging is not.
 
@@ -198,8 +198,10 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     kmax = max(1, min(max_units, (gx.size - 3) // 3))
     rng = np.random.default_rng(0)
     check = np.linspace(-1.0, 1.0, CHECK_POINTS)
-    members = [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)
-               if _monotone(u(check))]
+    line = _linear(np.zeros(0), xn, y, sw, True)          # no unit: a straight sensor
+    fitted = [Units(np.zeros(0), line[0], True, float(line[1] @ line[1]))]
+    fitted += [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)]
+    members = [u for u in fitted if _monotone(u(check))]
     if not members:
         return None
     # Akaike's criterion with the positions as the sample size: repeated readings at one
