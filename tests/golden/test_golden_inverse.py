@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main as flann
-from flann.golden.inverse import SPARSE_POSITIONS, forward_curve, inverse_fit, spline_curve
+from flann.golden.inverse import SPARSE_POSITIONS, Forward, forward_curve, inverse_fit, spline_curve
 from flann.golden.model import load_model
 from flann.golden.sigmoids import fit_forward
 from flann.golden.train import fit_auto
@@ -159,3 +159,14 @@ def test_a_straight_sensor_is_mostly_the_straight_line():
     assert fw.describe()["heaviest_units"] == 0
     fine = np.linspace(0, 10, 1001)
     assert np.max(np.abs(fw(fine) - 0.2 * fine)) < 1e-3
+
+
+def test_few_positions_take_the_spline_on_a_trend_when_it_leaves_out_better():
+    """13 noise-free positions of the arctan sensor: a cubic through what a 2-unit trend
+    leaves bends less between them than a cubic through the readings themselves."""
+    x = np.linspace(-20, 20, 13)
+    fw = spline_curve(x, sensor(x))
+    assert fw.trend is not None
+    plain = Forward(fw.positions, fw.mean_v, fw.kind)
+    fine = np.linspace(-20, 20, 4001)
+    assert np.max(np.abs(fw(fine) - sensor(fine))) < 0.5 * np.max(np.abs(plain(fine) - sensor(fine)))

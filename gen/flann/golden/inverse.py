@@ -39,17 +39,28 @@ DENSE = 2001               # points of the inverse the FLANN is fitted to (unifo
 TEACHER_TOL = 1.25         # candidates within this factor of the best buildable max deviation
 
 
+TREND_UNITS = 2             # the few-positions trend: at most this many tanh units
+
+
 @dataclass(frozen=True)
 class Forward:
-    """The interpolated forward curve: position means and the spline through them."""
+    """The interpolated forward curve: position means and the spline through them, on a
+    smooth trend when there is one (the spline then interpolates only what the trend leaves,
+    which is smaller and gentler, so it swings less between the positions)."""
     positions: np.ndarray
     mean_v: np.ndarray
     kind: str                 # "cubic" or "pchip"
+    trend: SigmoidForward | None = None
 
-    def curve(self, positions=None, mean_v=None):
+    def curve(self, positions=None, mean_v=None, trend=None):
         p = self.positions if positions is None else positions
         m = self.mean_v if mean_v is None else mean_v
-        return (CubicSpline(p, m) if self.kind == "cubic" else PchipInterpolator(p, m))
+        t = self.trend if positions is None else trend
+        base = CubicSpline if self.kind == "cubic" else PchipInterpolator
+        if t is None:
+            return base(p, m)
+        rest = base(p, m - t(p))
+        return lambda x: t(x) + rest(x)
 
     def __call__(self, x) -> np.ndarray:
         return self.curve()(x)
@@ -65,10 +76,17 @@ class Forward:
 
     @property
     def name(self) -> str:
-        return ("a cubic spline" if self.kind == "cubic" else "a monotone cubic") + " through their mean readings"
+        spline = "a cubic spline" if self.kind == "cubic" else "a monotone cubic"
+        on = " on a tanh-unit trend" if self.trend is not None else ""
+        return f"{spline}{on} through their mean readings"
 
     def describe(self) -> dict:
-        return {"kind": "cubic spline" if self.kind == "cubic" else "monotone cubic"}
+        return {"kind": "cubic spline" if self.kind == "cubic" else "monotone cubic",
+                "trend": None if self.trend is None else self.trend.describe()}
+
+
+def _rms(e: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
 
 
 def _monotone(v: np.ndarray) -> bool:
@@ -78,16 +96,28 @@ def _monotone(v: np.ndarray) -> bool:
 
 def spline_curve(displacement_mm, voltage_v) -> Forward | None:
     """The spline v(x) through the position means, or None (too few positions, or no
-    monotone curve through them: the readings fold back or sit within noise of each other)."""
+    monotone curve through them: the readings fold back or sit within noise of each other).
+
+    Two are tried, each the not-a-knot cubic or, when that is not monotone, the monotone
+    one: on a trend of at most :data:`TREND_UNITS` tanh units, and plain.  When both are
+    monotone the one with the smaller error at interior positions left out in turn is taken
+    (ties: plain).  Both interpolate the same points, so what tells them apart is how they
+    bend between them, which leaving a position out sees."""
     pos = aggregate(displacement_mm, voltage_v)
     if pos.x.size < MIN_POSITIONS or not _monotone(pos.v):
         return None
     fine = np.linspace(pos.x[0], pos.x[-1], 8 * DENSE)
-    for kind in ("cubic", "pchip"):
-        fw = Forward(pos.x, pos.v, kind)
-        if _monotone(fw.curve()(fine)):
-            return fw
-    return None
+
+    def monotone(trend):
+        return next((fw for kind in ("cubic", "pchip")
+                     if _monotone((fw := Forward(pos.x, pos.v, kind, trend))(fine))), None)
+    plain = monotone(None)
+    trend = fit_forward(displacement_mm, voltage_v, max_units=TREND_UNITS)
+    on_trend = None if trend is None else monotone(trend)
+    if plain is None or on_trend is None:
+        return on_trend or plain
+    scores = [_rms(leave_one_out_mm(fw, displacement_mm, voltage_v)) for fw in (plain, on_trend)]
+    return on_trend if scores[1] < scores[0] else plain
 
 
 def forward_curve(displacement_mm, voltage_v) -> SigmoidForward | Forward | None:
@@ -114,13 +144,15 @@ def _left_out_mm(displacement_mm, voltage_v, predict) -> np.ndarray:
 
 
 def leave_one_out_mm(fw: Forward, displacement_mm, voltage_v) -> np.ndarray:
-    """The spline through the other positions, inverted at the left-out position's reading."""
+    """The spline through the other positions (on its trend refitted without the left-out
+    position), inverted at the left-out position's reading."""
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(voltage_v, dtype=float)
 
     def predict(keep, mean_v):
         pos = aggregate(x[keep], v[keep])
-        return _invert(fw.curve(pos.x, pos.v), x.min(), x.max(), np.array([mean_v]))[0]
+        trend = None if fw.trend is None else fit_forward(x[keep], v[keep], max_units=TREND_UNITS)
+        return _invert(fw.curve(pos.x, pos.v, trend), x.min(), x.max(), np.array([mean_v]))[0]
     return _left_out_mm(x, v, predict)
 
 
@@ -135,10 +167,6 @@ def direct_leave_one_out_mm(displacement_mm, voltage_v, terms: int, norm: str,
         lo, hi = sorted(m.voltage_range_v)
         return float(m.predict(np.clip([mean_v], lo, hi))[0])
     return _left_out_mm(x, v, predict)
-
-
-def _rms(e: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
 
 
 def fit_to_forward(fw, cost, training: dict) -> tuple[FlannModel, dict] | None:
