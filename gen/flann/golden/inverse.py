@@ -36,7 +36,11 @@ from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, fit_lstsq
 SPARSE_POSITIONS = 20      # the outlier screen's lower limit: below it, no smooth fit judges noise
 MIN_POSITIONS = 5          # a cubic through fewer is no better than the direct fit's candidates
 DENSE = 2001               # points of the inverse the FLANN is fitted to (uniform in x)
-TEACHER_TOL = 1.25         # candidates within this factor of the best buildable max deviation
+# candidates within this factor of the best buildable max deviation: through few positions
+# the fewest terms near the best; on a dense curve the best buildable one (the roll-over of
+# the paper's LVDT: 0.031 mm from the curve with 41 terms, 0.025 mm with 51)
+TEACHER_TOL = 1.25
+DENSE_TEACHER_TOL = 1.0
 
 
 TREND_UNITS = 2             # the few-positions trend: at most this many tanh units
@@ -169,10 +173,10 @@ def direct_leave_one_out_mm(displacement_mm, voltage_v, terms: int, norm: str,
     return _left_out_mm(x, v, predict)
 
 
-def fit_to_forward(fw, cost, training: dict) -> tuple[FlannModel, dict] | None:
+def fit_to_forward(fw, cost, training: dict, tol: float = TEACHER_TOL) -> tuple[FlannModel, dict] | None:
     """The FLANN candidate with the fewest terms (then the cheapest) whose largest deviation
     from the inverted forward curve, between the points it was fitted to, is within
-    ``TEACHER_TOL`` of the best buildable candidate's; None when none builds."""
+    ``tol`` times the best buildable candidate's; None when none builds."""
     v, x = fw.inverse()
     v_mid, x_mid = fw.inverse(2 * DENSE - 1)
     v_mid, x_mid = v_mid[1::2], x_mid[1::2]     # between the fitted points
@@ -193,7 +197,7 @@ def fit_to_forward(fw, cost, training: dict) -> tuple[FlannModel, dict] | None:
     best = next((s for s in scored if costed(s)["buildable"]), None)
     if best is None:
         return None
-    near = sorted((s for s in scored if s[0] <= TEACHER_TOL * best[0]), key=lambda s: (s[1], s[0]))
+    near = sorted((s for s in scored if s[0] <= tol * best[0]), key=lambda s: (s[1], s[0]))
     choice = next(s for s in near if costed(s)["buildable"])
     c = costed(choice)
     return choice[4], {"teacher_max_deviation_mm": choice[0], "terms": choice[1],
@@ -232,7 +236,7 @@ def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Fla
             "leave_one_out": {"positions": int(mine.size), "rms_error_mm": _rms(mine),
                               "direct_rms_error_mm": _rms(theirs)},
         })
-    fitted = fit_to_forward(fw, cost, record)
+    fitted = fit_to_forward(fw, cost, record, TEACHER_TOL if spline else DENSE_TEACHER_TOL)
     if fitted is None:      # no candidate builds at this converter: the direct fit says why
         return None
     model, info = fitted
