@@ -41,8 +41,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...)")
     p.add_argument("-o", "--output", required=True, help="model.json to write")
     p.add_argument("--terms", type=_terms, default="auto",
-                   help="expansion terms N (paper: %s) or 'auto' (default): terms, "
-                        "normalisation and ridge chosen by cross-validation"
+                   help="expansion terms N (paper: %s) or 'auto' (default): the forward curve "
+                        "v(x) fitted where the noise is, inverted, and the FLANN (terms, "
+                        "normalisation, ridge) fitted to that inverse at the converter; the "
+                        "cross-validated direct fit of x(v) when the FLANN cannot follow it"
                         % ", ".join(map(str, PAPER_TERMS)))
     p.add_argument("--method", choices=("lstsq", "lms"), default="lstsq",
                    help="closed-form least squares (default) or the paper's LMS")
