@@ -170,3 +170,17 @@ def test_few_positions_take_the_spline_on_a_trend_when_it_leaves_out_better():
     plain = Forward(fw.positions, fw.mean_v, fw.kind)
     fine = np.linspace(-20, 20, 4001)
     assert np.max(np.abs(fw(fine) - sensor(fine))) < 0.5 * np.max(np.abs(plain(fine) - sensor(fine)))
+
+
+def test_a_straight_sensor_keeps_the_cheap_direct_fit(tmp_path):
+    """No curvature beyond the noise: the direct fit (a few terms), not 61 terms following
+    the curved members' wiggles."""
+    rng = np.random.default_rng(5)
+    x = np.linspace(0, 10, 300)
+    rec, out = tmp_path / "line.csv", tmp_path / "m.json"
+    rec.write_text("displacement_mm,voltage_v\n" + "".join(
+        f"{a:.9g},{b:.9g}\n" for a, b in zip(x, 0.2 * x + rng.normal(0, 1e-3, x.size))))
+    assert flann(["train", str(rec), "-o", str(out)]) == 0
+    model = load_model(out)
+    assert "forward_model" not in model.training and model.terms <= 3
+    assert fit_forward(x, 0.2 * x).straight and not fit_forward(x, np.arctan(x - 5)).straight

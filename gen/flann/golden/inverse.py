@@ -73,6 +73,8 @@ class Forward:
     def stroke(self) -> tuple[float, float]:
         return float(self.positions[0]), float(self.positions[-1])
 
+    straight = False           # an interpolant says nothing of curvature beyond the noise
+
     def inverse(self, n: int = DENSE) -> tuple[np.ndarray, np.ndarray]:
         """(v, x) on n points uniform in x over the recorded stroke."""
         x = np.linspace(*self.stroke, n)
@@ -207,15 +209,17 @@ def fit_to_forward(fw, cost, training: dict, tol: float = TEACHER_TOL) -> tuple[
 
 
 def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> FlannModel | None:
-    """The model fitted to the inverted forward curve, or None: no forward curve, no
-    candidate that builds, or (:data:`SPARSE_POSITIONS` or more positions) none that follows
+    """The model fitted to the inverted forward curve, or None: no forward curve, a straight
+    one (without curvature there is no flattening at the ends to undo, and the FLANN would
+    spend 61 terms following the curved members' 1e-4 mm wiggles where the direct fit takes
+    1), no candidate that builds, or (:data:`SPARSE_POSITIONS` or more positions) none that follows
     the curve more closely than the direct fit's held-out max error.  ``direct`` is the
     direct fit's :class:`~flann.golden.train.CvResult`; ``training`` the record to extend
     (with many positions, the direct fit's own, whose held-out figures it keeps)."""
     x = np.asarray(displacement_mm, dtype=float)
     positions = int(np.unique(x).size)
     fw = forward_curve(x, voltage_v)
-    if fw is None:
+    if fw is None or fw.straight:
         return None
     record = {k: val for k, val in training.items()
               if k not in ("traded", "best_heldout", "chosen", "fixed_point", "as_good_candidates",

@@ -139,6 +139,9 @@ class SigmoidForward:
     x_hi: float
     v_mid: float
     v_half: float
+    # the straight line is the best member by the Bayesian criterion: no curvature shows
+    # beyond the noise (Akaike's weights spread over units that fit noise, 5-45 % on a line)
+    straight: bool = False
 
     def _xn(self, x):
         return (np.asarray(x, float) - 0.5 * (self.x_lo + self.x_hi)) / (0.5 * (self.x_hi - self.x_lo))
@@ -153,6 +156,7 @@ class SigmoidForward:
         return self(x), x
 
     name = "an average of tanh-unit curves v(x)"
+
 
     def describe(self) -> dict:
         top = int(np.argmax(self.weights))
@@ -207,10 +211,14 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     # Akaike's criterion with the positions as the sample size: repeated readings at one
     # position share its error (backlash, hysteresis, drift between sweeps), so the evidence
     # about the curve's shape grows with the positions, not the readings
-    aic = np.array([min(positions, n) * np.log(max(u.sse + within, 1e-300) / n) + 2 * u.params
-                    for u in members])
+    m = min(positions, n)
+    # residuals below 1e-12 of the range are rounding: noise-free readings tie every member
+    fit = np.array([m * np.log(max((u.sse + within) / n, 1e-24)) for u in members])
+    params = np.array([u.params for u in members])
+    aic = fit + 2 * params
     w = np.exp(-0.5 * (aic - aic.min()))
-    return SigmoidForward(tuple(members), w / w.sum(), x_lo, x_hi, v_mid, v_half)
+    straight = members[int(np.argmin(fit + np.log(m) * params))].nl.size == 0
+    return SigmoidForward(tuple(members), w / w.sum(), x_lo, x_hi, v_mid, v_half, bool(straight))
 
 
 __all__ = ["MAX_UNITS", "MIN_POSITIONS", "SigmoidForward", "Units", "fit_forward"]
