@@ -160,7 +160,8 @@ def heldout_predictions(sm: Smoother, pos: Positions, folds) -> np.ndarray:
     return pred
 
 
-def _monotonic(y) -> bool:
+def strictly_monotone(y) -> bool:
+    """Every step of ``y`` rises, or every step falls."""
     d = np.diff(y)
     return bool(np.all(d > 0) or np.all(d < 0))
 
@@ -183,7 +184,7 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     grid = np.linspace(pos.x[0], pos.x[-1], 1025)
     scored = []
     for sm in candidates(pos):
-        if monotonic and not _monotonic(sm.predict(sm.solve(pos), grid)):
+        if monotonic and not strictly_monotone(sm.predict(sm.solve(pos), grid)):
             continue   # no inverse: not a calibration curve
         pred = heldout_predictions(sm, pos, folds)
         e2 = cw * ((pos.v[held] - pred[held]) / s[held]) ** 2 * held.size

@@ -23,12 +23,12 @@ inverse (:func:`fit_to_forward`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
-from .forward import aggregate
+from .forward import aggregate, strictly_monotone
 from .model import FlannModel
 from .sigmoids import SigmoidForward, fit_forward
 from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, fit_lstsq
@@ -41,9 +41,7 @@ DENSE = 2001               # points of the inverse the FLANN is fitted to (unifo
 # the paper's LVDT: 0.031 mm from the curve with 41 terms, 0.025 mm with 51)
 TEACHER_TOL = 1.25
 DENSE_TEACHER_TOL = 1.0
-
-
-TREND_UNITS = 2             # the few-positions trend: at most this many tanh units
+TREND_UNITS = 2            # the few-positions trend: at most this many tanh units
 
 
 @dataclass(frozen=True)
@@ -55,6 +53,9 @@ class Forward:
     mean_v: np.ndarray
     kind: str                 # "cubic" or "pchip"
     trend: SigmoidForward | None = None
+    # the procedure's error at each interior position left out in turn (mm), once judged
+    left_out_mm: np.ndarray | None = field(default=None, compare=False, repr=False)
+    straight = False           # an interpolant says nothing of curvature beyond the noise
 
     def curve(self, positions=None, mean_v=None, trend=None):
         p = self.positions if positions is None else positions
@@ -73,13 +74,6 @@ class Forward:
     def stroke(self) -> tuple[float, float]:
         return float(self.positions[0]), float(self.positions[-1])
 
-    straight = False           # an interpolant says nothing of curvature beyond the noise
-
-    def inverse(self, n: int = DENSE) -> tuple[np.ndarray, np.ndarray]:
-        """(v, x) on n points uniform in x over the recorded stroke."""
-        x = np.linspace(*self.stroke, n)
-        return self(x), x
-
     @property
     def name(self) -> str:
         spline = "a cubic spline" if self.kind == "cubic" else "a monotone cubic"
@@ -95,11 +89,6 @@ def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
 
 
-def _monotone(v: np.ndarray) -> bool:
-    d = np.diff(v)
-    return bool(np.all(d > 0) or np.all(d < 0))
-
-
 def spline_curve(displacement_mm, voltage_v) -> Forward | None:
     """The spline v(x) through the position means, or None (too few positions, or no
     monotone curve through them: the readings fold back or sit within noise of each other).
@@ -110,20 +99,21 @@ def spline_curve(displacement_mm, voltage_v) -> Forward | None:
     (ties: plain).  Both interpolate the same points, so what tells them apart is how they
     bend between them, which leaving a position out sees."""
     pos = aggregate(displacement_mm, voltage_v)
-    if pos.x.size < MIN_POSITIONS or not _monotone(pos.v):
+    if pos.x.size < MIN_POSITIONS or not strictly_monotone(pos.v):
         return None
     fine = np.linspace(pos.x[0], pos.x[-1], 8 * DENSE)
 
     def monotone(trend):
         return next((fw for kind in ("cubic", "pchip")
-                     if _monotone((fw := Forward(pos.x, pos.v, kind, trend))(fine))), None)
-    plain = monotone(None)
+                     if strictly_monotone((fw := Forward(pos.x, pos.v, kind, trend))(fine))), None)
+
+    def judged(fw):
+        return replace(fw, left_out_mm=leave_one_out_mm(fw, displacement_mm, voltage_v))
     trend = fit_forward(displacement_mm, voltage_v, max_units=TREND_UNITS)
-    on_trend = None if trend is None else monotone(trend)
-    if plain is None or on_trend is None:
-        return on_trend or plain
-    scores = [_rms(leave_one_out_mm(fw, displacement_mm, voltage_v)) for fw in (plain, on_trend)]
-    return on_trend if scores[1] < scores[0] else plain
+    found = [judged(fw) for fw in (monotone(None), None if trend is None else monotone(trend))
+             if fw is not None]
+    # plain first: it keeps a tie
+    return min(found, key=lambda fw: _rms(fw.left_out_mm), default=None)
 
 
 def forward_curve(displacement_mm, voltage_v) -> SigmoidForward | Forward | None:
@@ -139,6 +129,12 @@ def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
     f = curve(x)
     order = np.argsort(f)
     return np.interp(v, f[order], x[order])
+
+
+def _sampled(fw, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(v, x) of the forward curve on n points uniform in x over its stroke."""
+    x = np.linspace(*fw.stroke, n)
+    return fw(x), x
 
 
 def _left_out_mm(displacement_mm, voltage_v, predict) -> np.ndarray:
@@ -179,8 +175,8 @@ def fit_to_forward(fw, cost, training: dict, tol: float = TEACHER_TOL) -> tuple[
     """The FLANN candidate with the fewest terms (then the cheapest) whose largest deviation
     from the inverted forward curve, between the points it was fitted to, is within
     ``tol`` times the best buildable candidate's; None when none builds."""
-    v, x = fw.inverse()
-    v_mid, x_mid = fw.inverse(2 * DENSE - 1)
+    v, x = _sampled(fw, DENSE)
+    v_mid, x_mid = _sampled(fw, 2 * DENSE - 1)
     v_mid, x_mid = v_mid[1::2], x_mid[1::2]     # between the fitted points
     scored = []
     for norm in AUTO_NORMS:
@@ -232,7 +228,7 @@ def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> Fla
     spline = isinstance(fw, Forward)    # few positions: judged by leaving each out, no fallback
     if spline:
         record["forward_spline"] = fw.kind
-        mine = leave_one_out_mm(fw, x, voltage_v)
+        mine = fw.left_out_mm
         theirs = direct_leave_one_out_mm(x, voltage_v, direct.terms, direct.norm, direct.ridge)
         record.update({
             "cv_heldout_rms_error_mm": _rms(mine),

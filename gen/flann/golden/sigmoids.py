@@ -11,12 +11,12 @@ the inverse's max error sits:
 (a one-hidden-layer network in x; no sensor's formula).  The linear parameters (c, d, a_k)
 are solved exactly for every trial of the others (variable projection), the units are grown
 one at a time from the previous fit, and every K with and without the linear term (and the
-straight line, K = 0) is kept when its curve is monotone over the stroke.  Their curves are averaged with Akaike weights:
-choosing one K by a held-out score is a noisy choice (the score is set by the interior of
-the stroke, the max error by its ends), averaging is not.
+straight line, K = 0) is kept when its curve is monotone over the stroke.  Their curves are
+averaged with Akaike weights: choosing one K by a held-out score is a noisy choice (the
+score is set by the interior of the stroke, the max error by its ends), averaging is not.
 
-:func:`fit_forward` returns a :class:`SigmoidForward`, whose :meth:`~SigmoidForward.inverse`
-feeds :func:`flann.golden.inverse.fit_to_forward`.
+:func:`fit_forward` returns a :class:`SigmoidForward`, a curve over its stroke that
+:func:`flann.golden.inverse.fit_to_forward` inverts.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from .forward import aggregate
+from .forward import aggregate, strictly_monotone
 
 MAX_UNITS = 6
 MIN_POSITIONS = 6           # the smallest model (one unit and an offset) has 3 parameters
@@ -37,7 +37,6 @@ GRID_WIDTHS = np.log([0.1, 0.4, 1.2])
 RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
-DENSE = 2001
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 
 
@@ -49,17 +48,17 @@ def _basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
 
 
 def _linear(nl, x, y, sw, linear):
-    """The linear parameters for these units (weighted least squares) and the residuals."""
+    """(weighted basis, linear parameters, residuals) for these units: the linear parameters
+    by weighted least squares."""
     B = _basis(nl, x, linear) * sw[:, None]
     beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
-    return beta, B @ beta - y * sw
+    return B, beta, B @ beta - y * sw
 
 
-def _jacobian(nl, x, y, sw, linear):
+def _jacobian(nl, x, sw, linear, B, beta):
     """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
-    the projection, orthogonal to the basis, of each unit's derivative times its weight."""
-    B = _basis(nl, x, linear) * sw[:, None]
-    beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
+    the projection, orthogonal to the basis ``B``, of each unit's derivative times its
+    weight in ``beta``."""
     q, _r = np.linalg.qr(B)
     first = 2 if linear else 1
     cols = []
@@ -99,9 +98,19 @@ class Units:
 def _refine(nl0, x, y, sw, linear) -> Units:
     lo, hi = _bounds(nl0.size // 2)
     nl0 = np.clip(nl0, lo + 1e-9, hi - 1e-9)
-    r = least_squares(lambda nl: _linear(nl, x, y, sw, linear)[1], nl0, bounds=(lo, hi),
-                      jac=lambda nl: _jacobian(nl, x, y, sw, linear), method="trf", max_nfev=300)
-    beta, res = _linear(r.x, x, y, sw, linear)
+    last: dict = {}
+
+    def solved(nl):     # the solver asks for the Jacobian where it just took the residuals
+        key = nl.tobytes()
+        if key not in last:
+            last.clear()
+            last[key] = _linear(nl, x, y, sw, linear)
+        return last[key]
+
+    r = least_squares(lambda nl: solved(nl)[2], nl0, bounds=(lo, hi),
+                      jac=lambda nl: _jacobian(nl, x, sw, linear, *solved(nl)[:2]),
+                      method="trf", max_nfev=300)
+    _B, beta, res = solved(r.x)
     return Units(r.x, beta, linear, float(res @ res))
 
 
@@ -115,18 +124,13 @@ def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
         lo, hi = _bounds(k)
 
         def first(s):
-            r = _linear(np.clip(s, lo, hi), x, y, sw, linear)[1]
+            r = _linear(np.clip(s, lo, hi), x, y, sw, linear)[2]
             return float(r @ r)
         fits = [_refine(s, x, y, sw, linear) for s in sorted(starts, key=first)[:REFINED]]
         best = min(fits, key=lambda u: u.sse)
         out.append(best)
         prev = best.nl
     return out
-
-
-def _monotone(y: np.ndarray) -> bool:
-    d = np.diff(y)
-    return bool(np.all(d > 0) or np.all(d < 0))
 
 
 @dataclass(frozen=True)
@@ -150,13 +154,11 @@ class SigmoidForward:
         xn = self._xn(x)
         return self.v_mid + self.v_half * sum(w * m(xn) for w, m in zip(self.weights, self.members))
 
-    def inverse(self, n: int = DENSE) -> tuple[np.ndarray, np.ndarray]:
-        """(v, x) on n points uniform in x over the recorded stroke."""
-        x = np.linspace(self.x_lo, self.x_hi, n)
-        return self(x), x
+    @property
+    def stroke(self) -> tuple[float, float]:
+        return self.x_lo, self.x_hi
 
     name = "an average of tanh-unit curves v(x)"
-
 
     def describe(self) -> dict:
         top = int(np.argmax(self.weights))
@@ -175,7 +177,7 @@ def _groups(x: np.ndarray, v: np.ndarray):
         return pos.x, pos.v, pos.w, pos.index, pos.x.size
     edges = np.linspace(pos.x[0], pos.x[-1], MAX_GROUPS + 1)
     index = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, MAX_GROUPS - 1)
-    _used, index = np.unique(index, return_inverse=True)
+    index = np.unique(index, return_inverse=True)[1]
     count = np.bincount(index).astype(float)
     return (np.bincount(index, weights=x) / count, np.bincount(index, weights=v) / count, count,
             index, pos.x.size)
@@ -202,10 +204,10 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     kmax = max(1, min(max_units, (gx.size - 3) // 3))
     rng = np.random.default_rng(0)
     check = np.linspace(-1.0, 1.0, CHECK_POINTS)
-    line = _linear(np.zeros(0), xn, y, sw, True)          # no unit: a straight sensor
-    fitted = [Units(np.zeros(0), line[0], True, float(line[1] @ line[1]))]
+    _B, beta, res = _linear(np.zeros(0), xn, y, sw, True)     # no unit: a straight sensor
+    fitted = [Units(np.zeros(0), beta, True, float(res @ res))]
     fitted += [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)]
-    members = [u for u in fitted if _monotone(u(check))]
+    members = [u for u in fitted if strictly_monotone(u(check))]
     if not members:
         return None
     # Akaike's criterion with the positions as the sample size: repeated readings at one
