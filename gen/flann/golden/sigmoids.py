@@ -183,44 +183,78 @@ def _groups(x: np.ndarray, v: np.ndarray):
             index, pos.x.size)
 
 
-def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> SigmoidForward | None:
-    """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
-    no monotone member."""
-    x = np.asarray(displacement_mm, float)
-    v = np.asarray(voltage_v, float)
+@dataclass(frozen=True)
+class _Scaled:
+    """The readings averaged per position, in a curve's normalised x and v."""
+    xn: np.ndarray
+    y: np.ndarray
+    sw: np.ndarray
+    within: float       # scatter about the group means: the same for every member
+    positions: int
+    n: int
+
+
+def _scaled(x: np.ndarray, v: np.ndarray, x_lo: float, x_hi: float, v_mid: float, v_half: float) -> _Scaled:
     gx, gv, count, index, positions = _groups(x, v)
-    if gx.size < MIN_POSITIONS:
-        return None
-    x_lo, x_hi = float(x.min()), float(x.max())
-    v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
-    if v_half <= 0:
-        return None
-    xn = (gx - 0.5 * (x_lo + x_hi)) / (0.5 * (x_hi - x_lo))
     y = (gv - v_mid) / v_half
-    sw = np.sqrt(count)
-    n = v.size
-    # scatter about the group means: the same for every member, part of each one's SSE
-    within = float(np.sum(((v - v_mid) / v_half - y[index]) ** 2))
-    kmax = max(1, min(max_units, (gx.size - 3) // 3))
-    rng = np.random.default_rng(0)
+    return _Scaled((gx - 0.5 * (x_lo + x_hi)) / (0.5 * (x_hi - x_lo)), y, np.sqrt(count),
+                   float(np.sum(((v - v_mid) / v_half - y[index]) ** 2)), positions, v.size)
+
+
+def _line(d: _Scaled) -> Units:
+    _B, beta, res = _linear(np.zeros(0), d.xn, d.y, d.sw, True)
+    return Units(np.zeros(0), beta, True, float(res @ res))
+
+
+def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForward | None:
+    """The Akaike-weighted average of the monotone members, or None when none is."""
     check = np.linspace(-1.0, 1.0, CHECK_POINTS)
-    _B, beta, res = _linear(np.zeros(0), xn, y, sw, True)     # no unit: a straight sensor
-    fitted = [Units(np.zeros(0), beta, True, float(res @ res))]
-    fitted += [u for linear in (False, True) for u in _path(xn, y, sw, kmax, linear, rng)]
     members = [u for u in fitted if strictly_monotone(u(check))]
     if not members:
         return None
     # Akaike's criterion with the positions as the sample size: repeated readings at one
     # position share its error (backlash, hysteresis, drift between sweeps), so the evidence
     # about the curve's shape grows with the positions, not the readings
-    m = min(positions, n)
+    m = min(d.positions, d.n)
     # residuals below 1e-12 of the range are rounding: noise-free readings tie every member
-    fit = np.array([m * np.log(max((u.sse + within) / n, 1e-24)) for u in members])
+    fit = np.array([m * np.log(max((u.sse + d.within) / d.n, 1e-24)) for u in members])
     params = np.array([u.params for u in members])
     aic = fit + 2 * params
     w = np.exp(-0.5 * (aic - aic.min()))
     straight = members[int(np.argmin(fit + np.log(m) * params))].nl.size == 0
-    return SigmoidForward(tuple(members), w / w.sum(), x_lo, x_hi, v_mid, v_half, bool(straight))
+    return SigmoidForward(tuple(members), w / w.sum(), *geometry, bool(straight))
 
 
-__all__ = ["MAX_UNITS", "MIN_POSITIONS", "SigmoidForward", "Units", "fit_forward"]
+def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> SigmoidForward | None:
+    """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
+    no monotone member."""
+    x = np.asarray(displacement_mm, float)
+    v = np.asarray(voltage_v, float)
+    v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
+    if v_half <= 0:
+        return None
+    geometry = (float(x.min()), float(x.max()), v_mid, v_half)
+    d = _scaled(x, v, *geometry)
+    if d.xn.size < MIN_POSITIONS:
+        return None
+    kmax = max(1, min(max_units, (d.xn.size - 3) // 3))
+    rng = np.random.default_rng(0)
+    fitted = [_line(d)]     # no unit: a straight sensor
+    fitted += [u for linear in (False, True) for u in _path(d.xn, d.y, d.sw, kmax, linear, rng)]
+    return _averaged(fitted, d, geometry)
+
+
+def refit(fw: SigmoidForward, displacement_mm, voltage_v) -> SigmoidForward | None:
+    """``fw``'s members refined on other readings of the same stroke, starting from their
+    fitted units, and weighted again: the procedure for its cross-validation, without
+    growing the units from the grid again (ten times the cost)."""
+    x = np.asarray(displacement_mm, float)
+    v = np.asarray(voltage_v, float)
+    geometry = (fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+    d = _scaled(x, v, *geometry)
+    fitted = [_line(d) if u.nl.size == 0 else _refine(u.nl, d.xn, d.y, d.sw, u.linear)
+              for u in fw.members]
+    return _averaged(fitted, d, geometry)
+
+
+__all__ = ["MAX_UNITS", "MIN_POSITIONS", "SigmoidForward", "Units", "fit_forward", "refit"]
