@@ -173,13 +173,15 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
                     + direct_text)
     else:
         model, t = inverse, inverse.training
-        loo = t.get("leave_one_out")
-        own = t["forward_model"].get("heldout")
-        heldout = (f"left-out positions RMS {loo['rms_error_mm']:.4g} mm (direct fit "
-                   f"{loo['direct_rms_error_mm']:.4g} mm)" if loo else
-                   (f"the curve's held-out error (the same {own['folds']} folds): RMS "
-                    f"{own['rms_error_mm']:.4g} mm, max {own['max_error_mm']:.4g} mm; " if own else "")
-                   + f"the direct fit x(v)'s {direct_text}")
+        loo, own = t.get("leave_one_out"), t["forward_model"].get("heldout")
+        if loo:
+            heldout = (f"left-out positions RMS {loo['rms_error_mm']:.4g} mm (direct fit "
+                       f"{loo['direct_rms_error_mm']:.4g} mm)")
+        else:
+            heldout = f"the direct fit x(v)'s {direct_text}"
+            if own:
+                heldout = (f"the curve's held-out error (the same {own['folds']} folds): RMS "
+                           f"{own['rms_error_mm']:.4g} mm, max {own['max_error_mm']:.4g} mm; " + heldout)
         said.append(f"auto: {t['selected_by']}; {model.terms} terms, normalisation {t['normalisation']}, "
                     f"ridge {t['ridge']:g}, within {t['teacher_max_deviation_mm']:.3g} mm of the curve's "
                     f"inverse; {heldout}")
