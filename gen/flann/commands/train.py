@@ -185,6 +185,11 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         said.append(f"auto: {t['selected_by']}; {model.terms} terms, normalisation {t['normalisation']}, "
                     f"ridge {t['ridge']:g}, within {t['teacher_max_deviation_mm']:.3g} mm of the curve's "
                     f"inverse; {heldout}")
+        odd = t["forward_model"].get("odd_about_null")
+        if odd and odd["weight"] >= 0.5:
+            said.append(f"auto: the curve is odd about a null at {odd['null_mm']:.4g} mm, its slope "
+                        f"above the null {odd['slope_above_over_below']:.4g}x that below (weight "
+                        f"{odd['weight']:.2f} of the average)")
     if conv is not None:
         said.append(f"auto: judged buildable at a {conv['input_bits']}-bit"
                     + (f" x {conv['input_lsb_v']:.6g} V" if conv["input_lsb_v"] is not None else "")

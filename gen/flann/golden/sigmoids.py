@@ -15,6 +15,17 @@ straight line, K = 0) is kept when its curve is monotone over the stroke.  Their
 averaged with Akaike weights: choosing one K by a held-out score is a noisy choice (the
 score is set by the interior of the stroke, the max error by its ends), averaging is not.
 
+A differential sensor (an LVDT's two secondaries in opposition) is odd about its null, up
+to a gain that differs between the two halves of the stroke (its datasheet's "symmetry").
+So a second kind of member shares one centre h, the null, between its units and scales
+each half by its own gain:
+
+    v(x) = c + (1 + g sgn(x - h)) (d (x - h) + sum_k a_k tanh((x - h) / s_k))
+
+Each end of the stroke is then tied to the other half's readings, not to its own few, which
+is where the free units' variance sat.  Both kinds are averaged together: a sensor that is
+not odd about a null gives its odd members little weight.
+
 :func:`fit_forward` returns a :class:`SigmoidForward`, a curve over its stroke that
 :func:`flann.golden.inverse.fit_to_forward` inverts.
 """
@@ -32,6 +43,8 @@ MAX_UNITS = 6
 MIN_POSITIONS = 6           # the smallest model (one unit and an offset) has 3 parameters
 LOG_WIDTH = (np.log(0.02), np.log(5.0))     # unit widths, in halves of the stroke
 CENTRE = (-1.5, 1.5)                        # unit centres, in halves of the stroke
+NULL = (-0.95, 0.95)                        # an odd member's null, in halves of the stroke
+GAIN_STEP = (-0.3, 0.3)                     # an odd member's gain step between the halves
 GRID_CENTRES = np.linspace(-1.0, 1.0, 9)
 GRID_WIDTHS = np.log([0.1, 0.4, 1.2])
 RANDOM_STARTS = 6
@@ -40,63 +53,128 @@ CHECK_POINTS = 20001        # monotonicity checked on this many points over the 
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 
 
-def _basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
-    cols = [np.ones_like(x)] + ([x] if linear else [])
-    for b, ls in nl.reshape(-1, 2):
-        cols.append(np.tanh((x - b) * np.exp(-ls)))
-    return np.column_stack(cols)
+class _Free:
+    """Units with their own centres: nl = (centre, log width) per unit."""
+
+    name = "free"
+
+    @staticmethod
+    def units(nl: np.ndarray) -> int:
+        return nl.size // 2
+
+    @staticmethod
+    def basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
+        cols = [np.ones_like(x)] + ([x] if linear else [])
+        for b, ls in nl.reshape(-1, 2):
+            cols.append(np.tanh((x - b) * np.exp(-ls)))
+        return np.column_stack(cols)
+
+    @staticmethod
+    def bounds(k: int):
+        return np.tile([CENTRE[0], LOG_WIDTH[0]], k), np.tile([CENTRE[1], LOG_WIDTH[1]], k)
+
+    @staticmethod
+    def jacobian(nl, x, sw, linear, B, beta):
+        """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
+        the projection, orthogonal to the basis ``B``, of each unit's derivative times its
+        weight in ``beta``."""
+        q, _r = np.linalg.qr(B)
+        first = 2 if linear else 1
+        cols = []
+        for k, (b, ls) in enumerate(nl.reshape(-1, 2)):
+            inv_w = np.exp(-ls)
+            t = np.tanh((x - b) * inv_w)
+            d = -(1.0 - t * t) * inv_w * beta[first + k] * sw
+            cols += [d, d * (x - b)]
+        D = np.column_stack(cols)
+        return D - q @ (q.T @ D)
 
 
-def _linear(nl, x, y, sw, linear):
+class _Odd:
+    """Units sharing one centre, the null h, each half of the stroke scaled by its own gain:
+    nl = (h, gain step g, log width per unit)."""
+
+    name = "odd about a null"
+
+    @staticmethod
+    def units(nl: np.ndarray) -> int:
+        return nl.size - 2
+
+    @staticmethod
+    def basis(nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
+        z = x - nl[0]
+        gain = 1.0 + nl[1] * np.sign(z)
+        cols = [np.ones_like(x)] + ([z * gain] if linear else [])
+        for ls in nl[2:]:
+            cols.append(np.tanh(z * np.exp(-ls)) * gain)
+        return np.column_stack(cols)
+
+    @staticmethod
+    def bounds(k: int):
+        return (np.array([NULL[0], GAIN_STEP[0]] + [LOG_WIDTH[0]] * k),
+                np.array([NULL[1], GAIN_STEP[1]] + [LOG_WIDTH[1]] * k))
+
+    @staticmethod
+    def jacobian(nl, x, sw, linear, B, beta):
+        """d(residual)/d(null, gain step, log widths), Kaufman's approximation as for
+        :meth:`_Free.jacobian`: the null and the gain step move every column but the offset."""
+        q, _r = np.linalg.qr(B)
+        z = x - nl[0]
+        side = np.sign(z)
+        gain = 1.0 + nl[1] * side
+        d_null = np.zeros_like(x)
+        d_gain = np.zeros_like(x)
+        widths = []
+        first = 1
+        if linear:
+            d_null -= gain * beta[1]
+            d_gain += np.abs(z) * beta[1]
+            first = 2
+        for k, ls in enumerate(nl[2:]):
+            inv_w = np.exp(-ls)
+            t = np.tanh(z * inv_w)
+            dt = (1.0 - t * t) * inv_w * gain * beta[first + k]
+            d_null -= dt
+            d_gain += t * side * beta[first + k]
+            widths.append(-dt * z)
+        D = np.column_stack([d_null, d_gain] + widths) * sw[:, None]
+        return D - q @ (q.T @ D)
+
+
+def _linear(nl, x, y, sw, linear, shape=_Free):
     """(weighted basis, linear parameters, residuals) for these units: the linear parameters
     by weighted least squares."""
-    B = _basis(nl, x, linear) * sw[:, None]
+    B = shape.basis(nl, x, linear) * sw[:, None]
     beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
     return B, beta, B @ beta - y * sw
 
 
-def _jacobian(nl, x, sw, linear, B, beta):
-    """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
-    the projection, orthogonal to the basis ``B``, of each unit's derivative times its
-    weight in ``beta``."""
-    q, _r = np.linalg.qr(B)
-    first = 2 if linear else 1
-    cols = []
-    for k, (b, ls) in enumerate(nl.reshape(-1, 2)):
-        inv_w = np.exp(-ls)
-        t = np.tanh((x - b) * inv_w)
-        d = -(1.0 - t * t) * inv_w * beta[first + k] * sw
-        cols += [d, d * (x - b)]
-    D = np.column_stack(cols)
-    return D - q @ (q.T @ D)
-
-
-def _bounds(k: int):
-    lo = np.tile([CENTRE[0], LOG_WIDTH[0]], k)
-    hi = np.tile([CENTRE[1], LOG_WIDTH[1]], k)
-    return lo, hi
-
-
 @dataclass(frozen=True)
 class Units:
-    """One fitted member: K units (centre, log width), the linear term or not, and the
-    linear parameters, all in normalised x (stroke to [-1, 1]) and v (range to [-1, 1])."""
+    """One fitted member: K units of one shape (:class:`_Free` or :class:`_Odd`), the linear
+    term or not, and the linear parameters, all in normalised x (stroke to [-1, 1]) and v
+    (range to [-1, 1])."""
 
     nl: np.ndarray
     beta: np.ndarray
     linear: bool
     sse: float
+    shape: type = _Free
+
+    @property
+    def units(self) -> int:
+        return self.shape.units(self.nl)
 
     @property
     def params(self) -> int:
         return self.nl.size + self.beta.size
 
     def __call__(self, xn: np.ndarray) -> np.ndarray:
-        return _basis(self.nl, xn, self.linear) @ self.beta
+        return self.shape.basis(self.nl, xn, self.linear) @ self.beta
 
 
-def _refine(nl0, x, y, sw, linear) -> Units:
-    lo, hi = _bounds(nl0.size // 2)
+def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
+    lo, hi = shape.bounds(shape.units(nl0))
     nl0 = np.clip(nl0, lo + 1e-9, hi - 1e-9)
     last: dict = {}
 
@@ -104,14 +182,14 @@ def _refine(nl0, x, y, sw, linear) -> Units:
         key = nl.tobytes()
         if key not in last:
             last.clear()
-            last[key] = _linear(nl, x, y, sw, linear)
+            last[key] = _linear(nl, x, y, sw, linear, shape)
         return last[key]
 
     r = least_squares(lambda nl: solved(nl)[2], nl0, bounds=(lo, hi),
-                      jac=lambda nl: _jacobian(nl, x, sw, linear, *solved(nl)[:2]),
+                      jac=lambda nl: shape.jacobian(nl, x, sw, linear, *solved(nl)[:2]),
                       method="trf", max_nfev=300)
     _B, beta, res = solved(r.x)
-    return Units(r.x, beta, linear, float(res @ res))
+    return Units(r.x, beta, linear, float(res @ res), shape)
 
 
 def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
@@ -121,13 +199,28 @@ def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
         starts = [np.concatenate([prev, [b, ls]]) for b in GRID_CENTRES for ls in GRID_WIDTHS]
         starts += [np.column_stack([rng.uniform(-1, 1, k), rng.uniform(np.log(0.05), np.log(2.0), k)]).ravel()
                    for _ in range(RANDOM_STARTS)]
-        lo, hi = _bounds(k)
+        lo, hi = _Free.bounds(k)
 
         def first(s):
             r = _linear(np.clip(s, lo, hi), x, y, sw, linear)[2]
             return float(r @ r)
         fits = [_refine(s, x, y, sw, linear) for s in sorted(starts, key=first)[:REFINED]]
         best = min(fits, key=lambda u: u.sse)
+        out.append(best)
+        prev = best.nl
+    return out
+
+
+def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
+    """The best odd member with 1..kmax units about a null first placed at ``null``, each
+    grown from the previous one."""
+    out, prev = [], None
+    for k in range(1, kmax + 1):
+        if prev is None:
+            starts = [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
+        else:
+            starts = [np.concatenate([prev, [ls]]) for ls in GRID_WIDTHS]
+        best = min((_refine(s, x, y, sw, linear, _Odd) for s in starts), key=lambda u: u.sse)
         out.append(best)
         prev = best.nl
     return out
@@ -150,9 +243,12 @@ class SigmoidForward:
     def _xn(self, x):
         return (np.asarray(x, float) - 0.5 * (self.x_lo + self.x_hi)) / (0.5 * (self.x_hi - self.x_lo))
 
+    def normalised(self, xn) -> np.ndarray:
+        """The curve in normalised x and v (stroke and range to [-1, 1])."""
+        return sum(w * m(xn) for w, m in zip(self.weights, self.members))
+
     def __call__(self, x) -> np.ndarray:
-        xn = self._xn(x)
-        return self.v_mid + self.v_half * sum(w * m(xn) for w, m in zip(self.weights, self.members))
+        return self.v_mid + self.v_half * self.normalised(self._xn(x))
 
     @property
     def stroke(self) -> tuple[float, float]:
@@ -162,10 +258,20 @@ class SigmoidForward:
 
     def describe(self) -> dict:
         top = int(np.argmax(self.weights))
-        return {"kind": "tanh units, Akaike-weighted",
-                "members": [{"units": m.nl.size // 2, "linear_term": m.linear, "weight": round(float(w), 4)}
-                            for m, w in zip(self.members, self.weights) if w >= 1e-4],
-                "heaviest_units": self.members[top].nl.size // 2}
+        out = {"kind": "tanh units, Akaike-weighted",
+               "members": [{"units": m.units, "shape": m.shape.name, "linear_term": m.linear,
+                            "weight": round(float(w), 4)}
+                           for m, w in zip(self.members, self.weights) if w >= 1e-4],
+               "heaviest_units": self.members[top].units}
+        odd = [k for k, m in enumerate(self.members) if m.shape is _Odd]
+        if odd:
+            h, g = self.members[max(odd, key=lambda k: self.weights[k])].nl[:2]
+            # the heaviest odd member's null and the ratio of the slopes either side of it
+            out["odd_about_null"] = {
+                "weight": round(float(self.weights[odd].sum()), 4),
+                "null_mm": float(0.5 * (self.x_lo + self.x_hi) + h * 0.5 * (self.x_hi - self.x_lo)),
+                "slope_above_over_below": round(float((1 + g) / (1 - g)), 5)}
+        return out
 
 
 def _groups(x: np.ndarray, v: np.ndarray):
@@ -221,7 +327,7 @@ def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForwar
     params = np.array([u.params for u in members])
     aic = fit + 2 * params
     w = np.exp(-0.5 * (aic - aic.min()))
-    straight = members[int(np.argmin(fit + np.log(m) * params))].nl.size == 0
+    straight = members[int(np.argmin(fit + np.log(m) * params))].units == 0
     return SigmoidForward(tuple(members), w / w.sum(), *geometry, bool(straight))
 
 
@@ -241,19 +347,27 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     rng = np.random.default_rng(0)
     fitted = [_line(d)]     # no unit: a straight sensor
     fitted += [u for linear in (False, True) for u in _path(d.xn, d.y, d.sw, kmax, linear, rng)]
+    free = _averaged(fitted, d, geometry)
+    if free is None:
+        return None
+    # the odd members' null starts where the free units' curve is steepest
+    check = np.linspace(-1.0, 1.0, CHECK_POINTS)
+    null = float(np.clip(check[np.argmax(np.abs(np.gradient(free.normalised(check))))], *NULL))
+    fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, kmax, linear, null)]
     return _averaged(fitted, d, geometry)
 
 
-def refit(fw: SigmoidForward, displacement_mm, voltage_v) -> SigmoidForward | None:
+def refit(fw: SigmoidForward, displacement_mm, voltage_v, min_weight: float = 0.0) -> SigmoidForward | None:
     """``fw``'s members refined on other readings of the same stroke, starting from their
     fitted units, and weighted again: the procedure for its cross-validation, without
-    growing the units from the grid again (ten times the cost)."""
+    growing the units from the grid again (ten times the cost).  Members lighter than
+    ``min_weight`` in ``fw`` are left out."""
     x = np.asarray(displacement_mm, float)
     v = np.asarray(voltage_v, float)
     geometry = (fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
     d = _scaled(x, v, *geometry)
-    fitted = [_line(d) if u.nl.size == 0 else _refine(u.nl, d.xn, d.y, d.sw, u.linear)
-              for u in fw.members]
+    fitted = [_line(d) if u.units == 0 else _refine(u.nl, d.xn, d.y, d.sw, u.linear, u.shape)
+              for u, w in zip(fw.members, fw.weights) if w >= min_weight]
     return _averaged(fitted, d, geometry)
 
 
