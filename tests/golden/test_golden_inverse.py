@@ -13,6 +13,7 @@ from flann.golden.inverse import SPARSE_POSITIONS, Forward, forward_curve, inver
 from flann.golden.model import load_model
 from flann.golden.sigmoids import fit_forward, refit
 from flann.golden.train import fit_auto
+from flann.physics import filament
 
 
 def sensor(x):
@@ -131,7 +132,9 @@ def odd_sensor(x):
 def inverse_max_mm(fw, truth, lo, hi):
     fine = np.linspace(lo, hi, 4001)
     g = np.linspace(lo, hi, 40001)
-    return float(np.max(np.abs(np.interp(truth(fine), fw(g), g) - fine)))
+    v = fw(g)
+    order = np.argsort(v)
+    return float(np.max(np.abs(np.interp(truth(fine), v[order], g[order]) - fine)))
 
 
 @pytest.mark.parametrize("seed", [0, 1, 3])
@@ -147,6 +150,20 @@ def test_a_sensor_odd_about_its_null_is_carried_by_the_odd_members(seed):
     assert odd["null_mm"] == pytest.approx(3.0, abs=0.05)
     assert odd["slope_above_over_below"] == pytest.approx(1.03 / 0.97, abs=0.01)
     assert inverse_max_mm(fw, odd_sensor, -15, 20) < 0.015
+
+
+def test_the_filament_lvdt_is_odd_about_its_null():
+    """The independent forward model (a coil geometry, not the physics simulator's sensor
+    file): the odd members carry most of the weight, and the inverse is closer to the
+    truth than the free units alone got (0.0072 mm on this draw)."""
+    rng = np.random.default_rng(0)
+    m = filament.random_geometry(rng)
+    half = filament.monotonic_half_range(m)
+    x = np.repeat(np.linspace(-half, half, 161), 2)
+    clean = filament.output_v(m, x)
+    fw = fit_forward(x, clean + rng.normal(0, 2e-4 * np.ptp(clean), x.size))
+    assert fw.describe()["odd_about_null"]["weight"] > 0.5
+    assert inverse_max_mm(fw, lambda z: filament.output_v(m, z), -half, half) < 0.006
 
 
 def test_a_sensor_with_an_even_part_gives_the_odd_members_no_weight():

@@ -7,8 +7,8 @@ handful of positions x(v) swings between them.  So ``flann train --terms auto`` 
 forward curve v(x), inverts it densely, and fits the FLANN candidates to that noise-free
 inverse (:func:`fit_to_forward`):
 
-* the forward curve is a small sum of tanh units averaged over their number
-  (:mod:`flann.golden.sigmoids`); with fewer than :data:`SPARSE_POSITIONS` positions, a
+* the forward curve is a small sum of tanh units averaged over their number, free ones
+  and ones odd about a fitted null (:mod:`flann.golden.sigmoids`); with fewer than :data:`SPARSE_POSITIONS` positions, a
   cubic spline through the position means (not-a-knot; monotone piecewise cubic when that
   one is not monotone): on 13 positions of the e2e family the tanh units' average, whose
   larger members then nearly interpolate, swung between the points (up to 24x the oracle
