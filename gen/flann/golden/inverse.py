@@ -8,9 +8,9 @@ forward curve v(x), inverts it densely, and fits the FLANN candidates to that no
 inverse (:func:`fit_to_forward`):
 
 * the forward curve is a small sum of tanh units averaged over their number, free ones
-  and ones odd about a fitted null (:mod:`flann.golden.sigmoids`); with fewer than :data:`SPARSE_POSITIONS` positions, a
-  cubic spline through the position means (not-a-knot; monotone piecewise cubic when that
-  one is not monotone): on 13 positions of the e2e family the tanh units' average, whose
+  and ones odd about a fitted null (:mod:`flann.golden.sigmoids`); with fewer than
+  :data:`SPARSE_POSITIONS` positions, a cubic spline through the position means
+  (not-a-knot; monotone piecewise cubic when that one is not monotone): on 13 positions of the e2e family the tanh units' average, whose
   larger members then nearly interpolate, swung between the points (up to 24x the oracle
   where the spline had 6.8x);
 * with :data:`SPARSE_POSITIONS` or more positions the direct fit's cross-validated choice
@@ -164,9 +164,9 @@ def leave_one_out_mm(fw: Forward, displacement_mm, voltage_v) -> np.ndarray:
 def forward_heldout(fw: SigmoidForward, displacement_mm, voltage_v) -> dict | None:
     """The averaged curve's held-out error, on the direct fit's folds (whole positions, the
     ends never held out): per fold the members refitted without it (:func:`refit`; those
-    below :data:`REFIT_WEIGHT` left out) and inverted at each held-out reading.  Like the direct fit's, the figure includes the
-    readings' noise; on the same readings the two compare point for point.  None when a
-    fold leaves no monotone member."""
+    below :data:`REFIT_WEIGHT` left out) and inverted at each held-out reading.  Like the
+    direct fit's, the figure includes the readings' noise; on the same readings the two
+    compare point for point.  None when a fold leaves no monotone member."""
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(voltage_v, dtype=float)
     folds = cv_folds(v, groups=x)

@@ -51,6 +51,14 @@ RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
+_CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
+
+
+def _orthogonal_to(B: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """``D``'s columns projected orthogonally to the basis ``B``: Kaufman's approximation of
+    the variable-projection Jacobian from the basis' derivatives times their weights."""
+    q, _r = np.linalg.qr(B)
+    return D - q @ (q.T @ D)
 
 
 class _Free:
@@ -78,7 +86,6 @@ class _Free:
         """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
         the projection, orthogonal to the basis ``B``, of each unit's derivative times its
         weight in ``beta``."""
-        q, _r = np.linalg.qr(B)
         first = 2 if linear else 1
         cols = []
         for k, (b, ls) in enumerate(nl.reshape(-1, 2)):
@@ -86,8 +93,7 @@ class _Free:
             t = np.tanh((x - b) * inv_w)
             d = -(1.0 - t * t) * inv_w * beta[first + k] * sw
             cols += [d, d * (x - b)]
-        D = np.column_stack(cols)
-        return D - q @ (q.T @ D)
+        return _orthogonal_to(B, np.column_stack(cols))
 
 
 class _Odd:
@@ -118,7 +124,6 @@ class _Odd:
     def jacobian(nl, x, sw, linear, B, beta):
         """d(residual)/d(null, gain step, log widths), Kaufman's approximation as for
         :meth:`_Free.jacobian`: the null and the gain step move every column but the offset."""
-        q, _r = np.linalg.qr(B)
         z = x - nl[0]
         side = np.sign(z)
         gain = 1.0 + nl[1] * side
@@ -137,8 +142,7 @@ class _Odd:
             d_null -= dt
             d_gain += t * side * beta[first + k]
             widths.append(-dt * z)
-        D = np.column_stack([d_null, d_gain] + widths) * sw[:, None]
-        return D - q @ (q.T @ D)
+        return _orthogonal_to(B, np.column_stack([d_null, d_gain] + widths) * sw[:, None])
 
 
 def _linear(nl, x, y, sw, linear, shape=_Free):
@@ -314,8 +318,7 @@ def _line(d: _Scaled) -> Units:
 
 def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForward | None:
     """The Akaike-weighted average of the monotone members, or None when none is."""
-    check = np.linspace(-1.0, 1.0, CHECK_POINTS)
-    members = [u for u in fitted if strictly_monotone(u(check))]
+    members = [u for u in fitted if strictly_monotone(u(_CHECK))]
     if not members:
         return None
     # Akaike's criterion with the positions as the sample size: repeated readings at one
@@ -351,8 +354,7 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     if free is None:
         return None
     # the odd members' null starts where the free units' curve is steepest
-    check = np.linspace(-1.0, 1.0, CHECK_POINTS)
-    null = float(np.clip(check[np.argmax(np.abs(np.gradient(free.normalised(check))))], *NULL))
+    null = float(np.clip(_CHECK[np.argmax(np.abs(np.gradient(free.normalised(_CHECK))))], *NULL))
     fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, kmax, linear, null)]
     return _averaged(fitted, d, geometry)
 
