@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""The forward curve's members odd about a null: what they change, against the free units alone.
+
+Every figure is the forward curve inverted alone (no FLANN, no hardware: the whole flow gives
+the same figures, docs/golden.md), in process, with the odd members in the Akaike average
+("both") and without them ("free": the same fit's free members, weighted again, which is
+the curve `flann train` wrote before the odd members).
+
+    .venv/bin/python bench/odd_members.py filament [--n 6]
+    .venv/bin/python bench/odd_members.py off-centre [--draws 16]
+    .venv/bin/python bench/odd_members.py e2e --seeds 3,7,11 [--n 20]          # needs ../shared/checks
+    .venv/bin/python bench/odd_members.py draws --seed 7 --index 1 [--draws 16]  # needs ../shared/checks
+
+filament: random geometries of the independent forward model (`flann.physics.filament`),
+161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
+error against the noise-free curve.  off-centre: an arctan with a 2 % gain step on 0..20 mm,
+the null at 10, 6 and 3 mm, 150 positions x 2, 1 mV.  e2e: the shared check's sensors
+(`draw`, `recordings`, `oracle_reference`), held-out max error / the oracle's, median,
+geometric mean and worst per seed.  draws: one of those sensors recorded again with new noise
+draws (generator seed 99).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from flann.golden import sigmoids
+from flann.physics import filament
+
+E2E = Path(__file__).resolve().parents[2] / "shared" / "checks" / "e2e_sensors.py"
+
+
+def free_only(fw: sigmoids.SigmoidForward, x, v) -> sigmoids.SigmoidForward:
+    """The same fit's free members weighted again: the curve without the odd members (the
+    module's own averaging, reached into on purpose: no public switch is worth adding)."""
+    geometry = (fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+    free = [m for m in fw.members if m.shape is sigmoids._Free]
+    return sigmoids._averaged(free, sigmoids._scaled(np.asarray(x, float), np.asarray(v, float), *geometry),
+                              geometry)
+
+
+def inverse_max(curve, lo: float, hi: float, xt, vt) -> float:
+    g = np.linspace(lo, hi, 40001)
+    c = curve(g)
+    o = np.argsort(c)
+    return float(np.max(np.abs(np.interp(np.clip(vt, c.min(), c.max()), c[o], g[o]) - xt)))
+
+
+def both_and_free(x, v, lo, hi, xt, vt) -> tuple[float, float, float]:
+    fw = sigmoids.fit_forward(x, v)
+    return (inverse_max(fw, lo, hi, xt, vt), inverse_max(free_only(fw, x, v), lo, hi, xt, vt),
+            fw.describe()["odd_about_null"]["weight"])
+
+
+def run_filament(a) -> None:
+    for seed in range(a.n):
+        rng = np.random.default_rng(seed)
+        m = filament.random_geometry(rng)
+        half = filament.monotonic_half_range(m)
+        x = np.repeat(np.linspace(-half, half, 161), 2)
+        clean = filament.output_v(m, x)
+        v = clean + rng.normal(0, 2e-4 * np.ptp(clean), x.size)
+        xt = np.linspace(-half, half, 3001)
+        both, free, w = both_and_free(x, v, -half, half, xt, filament.output_v(m, xt))
+        print(f"geometry {seed}: half range {half:.2f} mm, odd weight {w:.2f}, inverse max error "
+              f"both {both:.4g} mm, free {free:.4g} mm", flush=True)
+
+
+def run_off_centre(a) -> None:
+    for null in (10.0, 6.0, 3.0):
+        def truth(x, null=null):
+            return (1 + 0.02 * np.sign(x - null)) * 2 * np.arctan((x - null) / 6.0)
+        r = []
+        for k in range(a.draws):
+            rng = np.random.default_rng(100 + k)
+            x = np.repeat(np.linspace(0, 20, 150), 2)
+            xt = np.linspace(0, 20, 3001)
+            r.append(both_and_free(x, truth(x) + rng.normal(0, 1e-3, x.size), 0, 20, xt, truth(xt)))
+        r = np.array(r)
+        q = r[:, 0] / r[:, 1]
+        print(f"null at {null:g} mm: geometric mean both / free {np.exp(np.mean(np.log(q))):.3f}, "
+              f"better by > 5 % {int(np.sum(q < 0.95))}, worse {int(np.sum(q > 1.05))} of {a.draws}; "
+              f"median odd weight {np.median(r[:, 2]):.2f}", flush=True)
+
+
+def e2e_module():
+    if not E2E.is_file():
+        sys.exit(f"error: {E2E} not found (the shared check sits beside the project)")
+    spec = importlib.util.spec_from_file_location("e2e_sensors", E2E)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def ratios(e2e, p, rng) -> tuple[float, float]:
+    (xs, v, _d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, 2)
+    oracle = e2e.oracle_reference(p, xs, v, xt, vt)
+    both, free, _w = both_and_free(xs, v, xs.min(), xs.max(), xt, vt)
+    return both / oracle, free / oracle
+
+
+def summary(label: str, r: np.ndarray) -> str:
+    return (f"{label}: median {np.median(r):.2f}, geometric mean {np.exp(np.mean(np.log(r))):.3f}, "
+            f"worst {r.max():.2f}")
+
+
+def run_e2e(a) -> None:
+    e2e = e2e_module()
+    for seed in (int(s) for s in a.seeds.split(",")):
+        rng = np.random.default_rng(seed)
+        r = np.array([ratios(e2e, e2e.draw(rng), rng) for _ in range(a.n)])
+        print(f"seed {seed}, {a.n} sensors, held-out max error / oracle: "
+              f"{summary('both', r[:, 0])}; {summary('free', r[:, 1])}", flush=True)
+
+
+def run_draws(a) -> None:
+    e2e = e2e_module()
+    rng = np.random.default_rng(a.seed)
+    for _ in range(a.index + 1):
+        p = e2e.draw(rng)
+        e2e.recordings(p, rng, 2)       # the check's own draws, to reach sensor `index`
+    again = np.random.default_rng(99)
+    r = np.array([ratios(e2e, p, again) for _ in range(a.draws)])
+    print(f"seed {a.seed} #{a.index}, {a.draws} new noise draws, held-out max error / oracle: "
+          f"{summary('both', r[:, 0])}; {summary('free', r[:, 1])}")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="what", required=True)
+    sub.add_parser("filament").add_argument("--n", type=int, default=6)
+    sub.add_parser("off-centre").add_argument("--draws", type=int, default=16)
+    e = sub.add_parser("e2e")
+    e.add_argument("--seeds", default="3,7,11")
+    e.add_argument("--n", type=int, default=20)
+    d = sub.add_parser("draws")
+    d.add_argument("--seed", type=int, default=7)
+    d.add_argument("--index", type=int, default=1)
+    d.add_argument("--draws", type=int, default=16)
+    a = ap.parse_args()
+    warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
+    {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws}[a.what](a)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
