@@ -122,6 +122,21 @@ def test_the_forward_curve_follows_a_shape_outside_its_family():
     assert np.array_equal(again(fine), fw(fine))
 
 
+def test_near_equal_local_optima_are_members_of_the_average():
+    """Which of near-equal optima the solver reaches turns on rounding: every one within 5 %
+    of its K's best residual is a member, none further, and no optimum twice."""
+    rng = np.random.default_rng(7)
+    x = np.repeat(np.linspace(-20, 20, 81), 2)
+    fw = fit_forward(x, sensor(x) + rng.normal(0, 1e-3, x.size))
+    groups: dict = {}
+    for m in fw.members:
+        groups.setdefault((m.shape, m.units, m.linear), []).append(m.sse)
+    assert any(len(sse) > 1 for sse in groups.values())
+    for sse in groups.values():
+        assert max(sse) <= 1.05 * min(sse)
+        assert len(set(np.round(np.array(sse) / min(sse), 9))) == len(sse)
+
+
 def odd_sensor(x):
     """A differential sensor of this test's own: arctan about a null at 3 mm, 3 % more gain
     above the null than below it (slopes 1.0619:1), a small offset."""

@@ -11,7 +11,9 @@ the inverse's max error sits:
 (a one-hidden-layer network in x; no sensor's formula).  The linear parameters (c, d, a_k)
 are solved exactly for every trial of the others (variable projection), the units are grown
 one at a time from the previous fit, and every K with and without the linear term (and the
-straight line, K = 0) is kept when its curve is monotone over the stroke.  Their curves are
+straight line, K = 0) is kept when its curve is monotone over the stroke, together with the
+other local optima within 5 % of its residual: which of near-equal optima the solver reaches
+turns on rounding, and they part at the ends.  Their curves are
 averaged with Akaike weights: choosing one K by a held-out score is a noisy choice (the
 score is set by the interior of the stroke, the max error by its ends), averaging is not.
 
@@ -49,6 +51,7 @@ GRID_CENTRES = np.linspace(-1.0, 1.0, 9)
 GRID_WIDTHS = np.log([0.1, 0.4, 1.2])
 RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
+NEAR_BEST = 0.05            # local optima within 5 % of the best residual are members too
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 _CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
@@ -196,8 +199,22 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
     return Units(r.x, beta, linear, float(res @ res), shape)
 
 
+def _near_best(fits: list[Units]) -> list[Units]:
+    """The best fit, then the other local optima within :data:`NEAR_BEST` of its residual:
+    which of several near-equal optima the solver reaches turns on rounding, and where they
+    part is at the ends, so the average keeps them all rather than one by chance."""
+    fits = sorted(fits, key=lambda u: u.sse)
+    kept = [fits[0]]
+    for u in fits[1:]:
+        near = u.sse <= fits[0].sse * (1 + NEAR_BEST)
+        if near and all(abs(u.sse - k.sse) > 1e-6 * fits[0].sse for k in kept):  # not a repeat
+            kept.append(u)
+    return kept
+
+
 def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
-    """The best fit with 1..kmax units, each grown from the previous one."""
+    """The best fits (:func:`_near_best`) with 1..kmax units, each K grown from the best
+    with one unit fewer."""
     out, prev = [], np.zeros(0)
     for k in range(1, kmax + 1):
         starts = [np.concatenate([prev, [b, ls]]) for b in GRID_CENTRES for ls in GRID_WIDTHS]
@@ -208,25 +225,25 @@ def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
         def first(s):
             r = _linear(np.clip(s, lo, hi), x, y, sw, linear)[2]
             return float(r @ r)
-        fits = [_refine(s, x, y, sw, linear) for s in sorted(starts, key=first)[:REFINED]]
-        best = min(fits, key=lambda u: u.sse)
-        out.append(best)
-        prev = best.nl
+        best_starts = sorted(starts, key=first)[:REFINED]
+        kept = _near_best([_refine(s, x, y, sw, linear) for s in best_starts])
+        out += kept
+        prev = kept[0].nl
     return out
 
 
 def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
-    """The best odd member with 1..kmax units about a null first placed at ``null``, each
-    grown from the previous one."""
+    """The best odd members (:func:`_near_best`) with 1..kmax units about a null first placed
+    at ``null``, each K grown from the best with one unit fewer."""
     out, prev = [], None
     for k in range(1, kmax + 1):
         if prev is None:
             starts = [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
         else:
             starts = [np.concatenate([prev, [ls]]) for ls in GRID_WIDTHS]
-        best = min((_refine(s, x, y, sw, linear, _Odd) for s in starts), key=lambda u: u.sse)
-        out.append(best)
-        prev = best.nl
+        kept = _near_best([_refine(s, x, y, sw, linear, _Odd) for s in starts])
+        out += kept
+        prev = kept[0].nl
     return out
 
 
