@@ -11,7 +11,7 @@ import pytest
 from flann.cli import main as flann
 from flann.golden.inverse import SPARSE_POSITIONS, Forward, forward_curve, inverse_fit, spline_curve
 from flann.golden.model import load_model
-from flann.golden.sigmoids import fit_forward, refit
+from flann.golden.sigmoids import SPREADS, Units, fit_forward, refit
 from flann.golden.train import fit_auto
 from flann.physics import filament
 
@@ -135,6 +135,45 @@ def test_near_equal_local_optima_are_members_of_the_average():
     for sse in groups.values():
         assert max(sse) <= 1.05 * min(sse)
         assert len(set(np.round(np.array(sse) / min(sse), 9))) == len(sse)
+
+
+@pytest.mark.parametrize("shape", SPREADS, ids=lambda s: f"{s.derivatives}-derivatives")
+@pytest.mark.parametrize("linear", [False, True])
+def test_an_odd_spread_members_derivative_is_its_curves(shape, linear):
+    """The analytic derivative in (null, gain step, log width) the solver's Jacobian is built
+    from, against central differences of the curve (off the null, where the gain steps)."""
+    x = np.linspace(-1, 1, 200)
+    nl = np.array([0.07, 0.05, np.log(0.6)])
+    beta = np.random.default_rng(1).normal(size=shape.basis(nl, x, linear).shape[1])
+    numeric = []
+    for k in range(nl.size):
+        step = np.zeros(3)
+        step[k] = 1e-6
+        numeric.append((Units(nl + step, beta, linear, 0.0, shape)(x)
+                        - Units(nl - step, beta, linear, 0.0, shape)(x)) / 2e-6)
+    got = shape.derivative(nl, x, linear, beta)
+    assert np.max(np.abs(got - np.column_stack(numeric))) < 1e-6 * np.max(np.abs(got))
+
+
+def langevin_sensor(x):
+    """A magnetisation-like curve of this test's own, coth(z) - 1/z, odd about 1 mm with 2 %
+    more gain above it: its tail is algebraic, no tanh's, so one width does not carry it."""
+    z = (x - 1.0) / 3.0
+    small = np.abs(z) < 1e-6
+    safe = np.where(small, 1.0, z)
+    return (1 + 0.02 * np.sign(z)) * 2.0 * np.where(small, z / 3, 1 / np.tanh(safe) - 1 / safe)
+
+
+def test_a_spread_of_widths_is_carried_by_the_spread_members():
+    rng = np.random.default_rng(0)
+    x = np.repeat(np.linspace(-15, 17, 150), 2)
+    fw = fit_forward(x, langevin_sensor(x) + rng.normal(0, 1e-3, x.size))
+    spread = sum(w for m, w in zip(fw.members, fw.weights) if m.shape in SPREADS)
+    assert spread > 0.1
+    odd = fw.describe()["odd_about_null"]
+    assert odd["weight"] > 0.9                      # the spread members count as odd ones
+    assert odd["null_mm"] == pytest.approx(1.0, abs=0.02)
+    assert inverse_max_mm(fw, langevin_sensor, -15, 17) < 0.012
 
 
 def odd_sensor(x):

@@ -25,8 +25,10 @@ each half by its own gain:
     v(x) = c + (1 + g sgn(x - h)) (d (x - h) + sum_k a_k tanh((x - h) / s_k))
 
 Each end of the stroke is then tied to the other half's readings, not to its own few, which
-is where the free units' variance sat.  Both kinds are averaged together: a sensor that is
-not odd about a null gives its odd members little weight.
+is where the free units' variance sat.  A third kind, also odd about a null, has one width s
+and the unit's derivatives in log s, (1 + g sgn z) u^j tanh^(j)(u), u = (x - h) / s,
+j = 0..J: a spread of widths at one parameter a column.  All kinds are averaged together: a
+sensor that is not odd about a null gives its odd members little weight.
 
 :func:`fit_forward` returns a :class:`SigmoidForward`, a curve over its stroke that
 :func:`flann.golden.inverse.fit_to_forward` inverts.
@@ -52,6 +54,7 @@ GRID_WIDTHS = np.log([0.1, 0.4, 1.2])
 RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
 NEAR_BEST = 0.05            # local optima within 5 % of the best residual are members too
+SPREAD_DERIVATIVES = 4      # an odd member with one width carries up to this many derivatives
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 _CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
@@ -148,6 +151,71 @@ class _Odd:
         return _orthogonal_to(B, np.column_stack([d_null, d_gain] + widths) * sw[:, None])
 
 
+def _tanh_derivatives(n: int) -> list[np.polynomial.Polynomial]:
+    """tanh and its first n derivatives as polynomials in t = tanh(u)."""
+    out = [np.polynomial.Polynomial([0.0, 1.0])]
+    for _ in range(n):
+        out.append(np.polynomial.Polynomial([1.0, 0.0, -1.0]) * out[-1].deriv())
+    return out
+
+
+class _OddSpread:
+    """Odd about a null like :class:`_Odd`, with one width s and the unit's derivatives in
+    log s: nl = (h, gain step g, log s), columns (1 + g sgn z) u^j tanh^(j)(u), u = z / s,
+    j = 0..J.  A spread of widths about s, one linear parameter per column where each width
+    of :class:`_Odd` costs two: the odd members settle on that by themselves, as widths
+    equal to three digits whose coefficients of 1e6-1e8 cancel, which is fragile."""
+
+    def __init__(self, derivatives: int):
+        self.derivatives = derivatives
+        self.name = f"odd about a null, one width and {derivatives} derivative(s) in it"
+        self._tanh = _tanh_derivatives(derivatives + 1)
+
+    def units(self, nl: np.ndarray) -> int:
+        return self.derivatives + 1
+
+    def _columns(self, nl, x):
+        """(z, gain, u, columns, their derivatives in u)"""
+        z = x - nl[0]
+        gain = 1.0 + nl[1] * np.sign(z)
+        u = z * np.exp(-nl[2])
+        t = np.tanh(u)
+        p = [f(t) for f in self._tanh]
+        cols = [u ** j * p[j] for j in range(self.derivatives + 1)]
+        d_cols = [(j * u ** (j - 1) * p[j] if j else 0.0) + u ** j * p[j + 1]
+                  for j in range(self.derivatives + 1)]
+        return z, gain, u, cols, d_cols
+
+    def basis(self, nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
+        z, gain, _u, cols, _d = self._columns(nl, x)
+        return np.column_stack([np.ones_like(x)] + ([z * gain] if linear else [])
+                               + [c * gain for c in cols])
+
+    def bounds(self, k: int):
+        return (np.array([NULL[0], GAIN_STEP[0], LOG_WIDTH[0]]),
+                np.array([NULL[1], GAIN_STEP[1], LOG_WIDTH[1]]))
+
+    def derivative(self, nl, x, linear, beta):
+        """d(curve)/d(null, gain step, log width)."""
+        z, gain, u, cols, d_cols = self._columns(nl, x)
+        side = np.sign(z)
+        first = 2 if linear else 1
+        shape = sum(b * c for b, c in zip(beta[first:], cols))
+        slope = sum(b * d for b, d in zip(beta[first:], d_cols))
+        d_null = -slope * gain * np.exp(-nl[2])
+        d_gain = shape * side
+        if linear:
+            d_null = d_null - gain * beta[1]
+            d_gain = d_gain + np.abs(z) * beta[1]
+        return np.column_stack([d_null, d_gain, -slope * gain * u])
+
+    def jacobian(self, nl, x, sw, linear, B, beta):
+        return _orthogonal_to(B, self.derivative(nl, x, linear, beta) * sw[:, None])
+
+
+SPREADS = tuple(_OddSpread(j) for j in range(1, SPREAD_DERIVATIVES + 1))
+
+
 def _linear(nl, x, y, sw, linear, shape=_Free):
     """(weighted basis, linear parameters, residuals) for these units: the linear parameters
     by weighted least squares."""
@@ -166,7 +234,7 @@ class Units:
     beta: np.ndarray
     linear: bool
     sse: float
-    shape: type = _Free
+    shape: object = _Free      # _Free, _Odd or an _OddSpread
 
     @property
     def units(self) -> int:
@@ -247,6 +315,14 @@ def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
     return out
 
 
+def _spread_members(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
+    """The best :class:`_OddSpread` members (:func:`_near_best`) with 1..kmax - 1 derivatives
+    (at most :data:`SPREAD_DERIVATIVES`), their null first placed at ``null``."""
+    starts = [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
+    return [u for shape in SPREADS[:max(0, kmax - 1)]
+            for u in _near_best([_refine(s, x, y, sw, linear, shape) for s in starts])]
+
+
 @dataclass(frozen=True)
 class SigmoidForward:
     """The Akaike-weighted average of the monotone members, in physical units."""
@@ -284,7 +360,7 @@ class SigmoidForward:
                             "weight": round(float(w), 4)}
                            for m, w in zip(self.members, self.weights) if w >= 1e-4],
                "heaviest_units": self.members[top].units}
-        odd = [k for k, m in enumerate(self.members) if m.shape is _Odd]
+        odd = [k for k, m in enumerate(self.members) if m.shape is not _Free]
         if odd:
             h, g = self.members[max(odd, key=lambda k: self.weights[k])].nl[:2]
             # the heaviest odd member's null and the ratio of the slopes either side of it
@@ -373,6 +449,7 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     # the odd members' null starts where the free units' curve is steepest
     null = float(np.clip(_CHECK[np.argmax(np.abs(np.gradient(free.normalised(_CHECK))))], *NULL))
     fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, kmax, linear, null)]
+    fitted += [u for linear in (False, True) for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
     return _averaged(fitted, d, geometry)
 
 
