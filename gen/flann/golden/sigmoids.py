@@ -300,13 +300,18 @@ def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
     return out
 
 
+def _null_starts(null: float) -> list[np.ndarray]:
+    """(null, gain step, log width) to start a member odd about a null from."""
+    return [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
+
+
 def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
     """The best odd members (:func:`_near_best`) with 1..kmax units about a null first placed
     at ``null``, each K grown from the best with one unit fewer."""
     out, prev = [], None
     for k in range(1, kmax + 1):
         if prev is None:
-            starts = [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
+            starts = _null_starts(null)
         else:
             starts = [np.concatenate([prev, [ls]]) for ls in GRID_WIDTHS]
         kept = _near_best([_refine(s, x, y, sw, linear, _Odd) for s in starts])
@@ -318,7 +323,7 @@ def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
 def _spread_members(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
     """The best :class:`_OddSpread` members (:func:`_near_best`) with 1..kmax - 1 derivatives
     (at most :data:`SPREAD_DERIVATIVES`), their null first placed at ``null``."""
-    starts = [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
+    starts = _null_starts(null)
     return [u for shape in SPREADS[:max(0, kmax - 1)]
             for u in _near_best([_refine(s, x, y, sw, linear, shape) for s in starts])]
 
@@ -449,7 +454,8 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     # the odd members' null starts where the free units' curve is steepest
     null = float(np.clip(_CHECK[np.argmax(np.abs(np.gradient(free.normalised(_CHECK))))], *NULL))
     fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, kmax, linear, null)]
-    fitted += [u for linear in (False, True) for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
+    fitted += [u for linear in (False, True)
+               for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
     return _averaged(fitted, d, geometry)
 
 
