@@ -10,9 +10,9 @@ inverse (:func:`fit_to_forward`):
 * the forward curve is a small sum of tanh units averaged over their number, free ones
   and ones odd about a fitted null (:mod:`flann.golden.sigmoids`); with fewer than
   :data:`SPARSE_POSITIONS` positions, a cubic spline through the position means
-  (not-a-knot; monotone piecewise cubic when that one is not monotone): on 13 positions of the e2e family the tanh units' average, whose
-  larger members then nearly interpolate, swung between the points (up to 24x the oracle
-  where the spline had 6.8x);
+  (not-a-knot; monotone piecewise cubic when that one is not monotone): on 13 positions of
+  the e2e family the tanh units' average, whose larger members then nearly interpolate,
+  swung between the points (up to 24x the oracle where the spline had 6.8x);
 * with :data:`SPARSE_POSITIONS` or more positions the direct fit's cross-validated choice
   is kept when the FLANN cannot follow the forward curve's inverse more closely than that
   choice's own held-out max error (a knee too sharp for any buildable candidate);

@@ -13,9 +13,9 @@ are solved exactly for every trial of the others (variable projection), the unit
 one at a time from the previous fit, and every K with and without the linear term (and the
 straight line, K = 0) is kept when its curve is monotone over the stroke, together with the
 other local optima within 5 % of its residual: which of near-equal optima the solver reaches
-turns on rounding, and they part at the ends.  Their curves are
-averaged with Akaike weights: choosing one K by a held-out score is a noisy choice (the
-score is set by the interior of the stroke, the max error by its ends), averaging is not.
+turns on rounding, and they part at the ends.  Their curves are averaged with Akaike
+weights: choosing one K by a held-out score is a noisy choice (the score is set by the
+interior of the stroke, the max error by its ends), averaging is not.
 
 A differential sensor (an LVDT's two secondaries in opposition) is odd about its null, up
 to a gain that differs between the two halves of the stroke (its datasheet's "symmetry").
