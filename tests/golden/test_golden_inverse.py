@@ -137,7 +137,7 @@ def test_near_equal_local_optima_are_members_of_the_average():
         assert len(set(np.round(np.array(sse) / min(sse), 9))) == len(sse)
 
 
-@pytest.mark.parametrize("shape", SPREADS, ids=lambda s: f"{s.derivatives}-derivatives")
+@pytest.mark.parametrize("shape", SPREADS, ids=lambda s: f"{s.unit}-{s.derivatives}-derivatives")
 @pytest.mark.parametrize("linear", [False, True])
 def test_an_odd_spread_members_derivative_is_its_curves(shape, linear):
     """The analytic derivative in (null, gain step, log width) the solver's Jacobian is built
@@ -174,6 +174,18 @@ def test_a_spread_of_widths_is_carried_by_the_spread_members():
     assert odd["weight"] > 0.9                      # the spread members count as odd ones
     assert odd["null_mm"] == pytest.approx(1.0, abs=0.02)
     assert inverse_max_mm(fw, langevin_sensor, -15, 17) < 0.012
+
+
+def test_an_algebraic_tail_is_carried_by_the_algebraic_members():
+    """coth z - 1/z falls off as 1/z: the algebraic units take most of the weight, and the
+    inverse is closer than with tanh units alone (0.0092 mm measured without them)."""
+    rng = np.random.default_rng(0)
+    x = np.repeat(np.linspace(-15, 17, 150), 2)
+    fw = fit_forward(x, langevin_sensor(x) + rng.normal(0, 1e-3, x.size))
+    algebraic = sum(w for m, w in zip(fw.members, fw.weights)
+                    if m.shape in SPREADS and m.shape.unit == "algebraic")
+    assert algebraic > 0.4
+    assert inverse_max_mm(fw, langevin_sensor, -15, 17) < 0.0085
 
 
 def odd_sensor(x):

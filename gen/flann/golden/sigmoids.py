@@ -26,9 +26,11 @@ each half by its own gain:
 
 Each end of the stroke is then tied to the other half's readings, not to its own few, which
 is where the free units' variance sat.  A third kind, also odd about a null, has one width s
-and the unit's derivatives in log s, (1 + g sgn z) u^j tanh^(j)(u), u = (x - h) / s,
-j = 0..J: a spread of widths at one parameter a column.  All kinds are averaged together: a
-sensor that is not odd about a null gives its odd members little weight.
+and the unit's derivatives in log s, (1 + g sgn z) u^j f^(j)(u), u = (x - h) / s, j = 0..J:
+a spread of widths at one parameter a column, of tanh units or of algebraic ones,
+f(u) = u / sqrt(1 + u^2), whose tail falls off as the axial field of a coil's end does, not
+exponentially.  All kinds are averaged together: a sensor that is not odd about a null gives
+its odd members little weight, one whose ends are not algebraic its algebraic ones.
 
 :func:`fit_forward` returns a :class:`SigmoidForward`, a curve over its stroke that
 :func:`flann.golden.inverse.fit_to_forward` inverts.
@@ -151,25 +153,53 @@ class _Odd:
         return _orthogonal_to(B, np.column_stack([d_null, d_gain] + widths) * sw[:, None])
 
 
-def _tanh_derivatives(n: int) -> list[np.polynomial.Polynomial]:
-    """tanh and its first n derivatives as polynomials in t = tanh(u)."""
-    out = [np.polynomial.Polynomial([0.0, 1.0])]
-    for _ in range(n):
-        out.append(np.polynomial.Polynomial([1.0, 0.0, -1.0]) * out[-1].deriv())
-    return out
+class _TanhUnit:
+    """tanh(u) and its derivatives, as polynomials in t = tanh(u): an exponential tail."""
+
+    name = "tanh"
+
+    def __init__(self, n: int):
+        self._p = [np.polynomial.Polynomial([0.0, 1.0])]
+        for _ in range(n):
+            self._p.append(np.polynomial.Polynomial([1.0, 0.0, -1.0]) * self._p[-1].deriv())
+
+    def __call__(self, u: np.ndarray) -> list[np.ndarray]:
+        """The unit and its first n derivatives at u."""
+        t = np.tanh(u)
+        return [f(t) for f in self._p]
+
+
+class _AlgebraicUnit:
+    """u / sqrt(1 + u^2) and its derivatives, P_j(u) r^(2j+1) with r = (1 + u^2)^(-1/2): an
+    algebraic tail, the axial field of a coil's end (a disc's solid angle), where tanh's
+    falls off exponentially."""
+
+    name = "algebraic"
+
+    def __init__(self, n: int):
+        u = np.polynomial.Polynomial([0.0, 1.0])
+        self._p = [u]
+        for j in range(n):      # (P r^m)' = (P' (1 + u^2) - m u P) r^(m+2)
+            self._p.append(self._p[-1].deriv() * (1 + u * u) - (2 * j + 1) * u * self._p[-1])
+
+    def __call__(self, u: np.ndarray) -> list[np.ndarray]:
+        r = 1.0 / np.sqrt(1.0 + u * u)
+        return [f(u) * r ** (2 * j + 1) for j, f in enumerate(self._p)]
 
 
 class _OddSpread:
     """Odd about a null like :class:`_Odd`, with one width s and the unit's derivatives in
-    log s: nl = (h, gain step g, log s), columns (1 + g sgn z) u^j tanh^(j)(u), u = z / s,
-    j = 0..J.  A spread of widths about s, one linear parameter per column where each width
-    of :class:`_Odd` costs two: the odd members settle on that by themselves, as widths
-    equal to three digits whose coefficients of 1e6-1e8 cancel, which is fragile."""
+    log s: nl = (h, gain step g, log s), columns (1 + g sgn z) u^j f^(j)(u), u = z / s,
+    j = 0..J, f a :class:`_TanhUnit` or an :class:`_AlgebraicUnit`.  A spread of widths
+    about s, one linear parameter per column where each width of :class:`_Odd` costs two:
+    the odd members settle on that by themselves, as widths equal to three digits whose
+    coefficients of 1e6-1e8 cancel, which is fragile."""
 
-    def __init__(self, derivatives: int):
+    def __init__(self, derivatives: int, unit=_TanhUnit):
         self.derivatives = derivatives
-        self.name = f"odd about a null, one width and {derivatives} derivative(s) in it"
-        self._tanh = _tanh_derivatives(derivatives + 1)
+        self.unit = unit.name
+        self.name = f"odd about a null, one width of {unit.name} units and {derivatives} derivative(s) in it"
+        self._unit = unit(derivatives + 1)
 
     def units(self, nl: np.ndarray) -> int:
         return self.derivatives + 1
@@ -179,8 +209,7 @@ class _OddSpread:
         z = x - nl[0]
         gain = 1.0 + nl[1] * np.sign(z)
         u = z * np.exp(-nl[2])
-        t = np.tanh(u)
-        p = [f(t) for f in self._tanh]
+        p = self._unit(u)
         cols = [u ** j * p[j] for j in range(self.derivatives + 1)]
         d_cols = [(j * u ** (j - 1) * p[j] if j else 0.0) + u ** j * p[j + 1]
                   for j in range(self.derivatives + 1)]
@@ -213,7 +242,9 @@ class _OddSpread:
         return _orthogonal_to(B, self.derivative(nl, x, linear, beta) * sw[:, None])
 
 
-SPREADS = tuple(_OddSpread(j) for j in range(1, SPREAD_DERIVATIVES + 1))
+# no derivative: one tanh unit is an _Odd member already, one algebraic unit is not
+SPREADS = (tuple(_OddSpread(j) for j in range(1, SPREAD_DERIVATIVES + 1))
+           + tuple(_OddSpread(j, _AlgebraicUnit) for j in range(SPREAD_DERIVATIVES + 1)))
 
 
 def _linear(nl, x, y, sw, linear, shape=_Free):
@@ -226,9 +257,9 @@ def _linear(nl, x, y, sw, linear, shape=_Free):
 
 @dataclass(frozen=True)
 class Units:
-    """One fitted member: K units of one shape (:class:`_Free` or :class:`_Odd`), the linear
-    term or not, and the linear parameters, all in normalised x (stroke to [-1, 1]) and v
-    (range to [-1, 1])."""
+    """One fitted member: K units of one shape (:class:`_Free`, :class:`_Odd` or an
+    :class:`_OddSpread`), the linear term or not, and the linear parameters, all in
+    normalised x (stroke to [-1, 1]) and v (range to [-1, 1])."""
 
     nl: np.ndarray
     beta: np.ndarray
@@ -321,10 +352,10 @@ def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
 
 
 def _spread_members(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
-    """The best :class:`_OddSpread` members (:func:`_near_best`) with 1..kmax - 1 derivatives
-    (at most :data:`SPREAD_DERIVATIVES`), their null first placed at ``null``."""
+    """The best :class:`_OddSpread` members (:func:`_near_best`) with at most kmax - 1
+    derivatives (and :data:`SPREAD_DERIVATIVES`), their null first placed at ``null``."""
     starts = _null_starts(null)
-    return [u for shape in SPREADS[:max(0, kmax - 1)]
+    return [u for shape in SPREADS if shape.derivatives <= kmax - 1
             for u in _near_best([_refine(s, x, y, sw, linear, shape) for s in starts])]
 
 
