@@ -31,8 +31,11 @@ venv: $(STAMP)
 tools:
 	@scripts/ensure_tools.sh
 
+# The suite's fits are single-threaded: one pytest worker per core (TEST_WORKERS=0: in one process).
+TEST_WORKERS ?= auto
+
 test: venv tools
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS)
 
 # Main job: train (unless MODEL= is given), generate VHDL, verify every input code (RTL sweep,
 # reactive benches, post-synthesis netlist), summarise.  DESIGN=dir verifies that generated
