@@ -164,10 +164,16 @@ def langevin_sensor(x):
     return (1 + 0.02 * np.sign(z)) * 2.0 * np.where(small, z / 3, 1 / np.tanh(safe) - 1 / safe)
 
 
-def test_a_spread_of_widths_is_carried_by_the_spread_members():
+@pytest.fixture(scope="module")
+def langevin_fit():
+    """The forward curve of one noisy recording of :func:`langevin_sensor`, fitted once."""
     rng = np.random.default_rng(0)
     x = np.repeat(np.linspace(-15, 17, 150), 2)
-    fw = fit_forward(x, langevin_sensor(x) + rng.normal(0, 1e-3, x.size))
+    return fit_forward(x, langevin_sensor(x) + rng.normal(0, 1e-3, x.size))
+
+
+def test_a_spread_of_widths_is_carried_by_the_spread_members(langevin_fit):
+    fw = langevin_fit
     spread = sum(w for m, w in zip(fw.members, fw.weights) if m.shape in SPREADS)
     assert spread > 0.1
     odd = fw.describe()["odd_about_null"]
@@ -176,12 +182,10 @@ def test_a_spread_of_widths_is_carried_by_the_spread_members():
     assert inverse_max_mm(fw, langevin_sensor, -15, 17) < 0.012
 
 
-def test_an_algebraic_tail_is_carried_by_the_algebraic_members():
+def test_an_algebraic_tail_is_carried_by_the_algebraic_members(langevin_fit):
     """coth z - 1/z falls off as 1/z: the algebraic units take most of the weight, and the
     inverse is closer than with tanh units alone (0.0092 mm measured without them)."""
-    rng = np.random.default_rng(0)
-    x = np.repeat(np.linspace(-15, 17, 150), 2)
-    fw = fit_forward(x, langevin_sensor(x) + rng.normal(0, 1e-3, x.size))
+    fw = langevin_fit
     algebraic = sum(w for m, w in zip(fw.members, fw.weights)
                     if m.shape in SPREADS and m.shape.unit == "algebraic")
     assert algebraic > 0.4
