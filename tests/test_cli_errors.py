@@ -14,6 +14,8 @@ from flann.cli import main
     (["--bogus"], "--bogus"),
     (["frobnicate"], "frobnicate"),
     (["paper", "--epochs", "1.5"], "--epochs"),
+    (["train", "r.csv", "-o", "m.json", "--terms", "11", "--normalise", "1.2"], "(0, 1]"),
+    (["paper", "--normalise", "full"], "(0, 1]"),
 ])
 def test_wrong_flag_or_value_is_one_line(argv, fragment, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

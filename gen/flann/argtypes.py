@@ -46,4 +46,22 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
     return parse
 
 
-__all__ = ["finite_float", "bounded"]
+def name_or_fraction(names):
+    """An argparse ``type`` for one of ``names`` or a number in (0, 1] (given back as text)."""
+    def parse(text: str) -> str:
+        if text in names:
+            return text
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not 0 < value <= 1:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: must be one of {', '.join(names)} or a number in (0, 1]")
+        return f"{value:g}"
+
+    parse.__name__ = "name or fraction"
+    return parse
+
+
+__all__ = ["bounded", "finite_float", "name_or_fraction"]

@@ -66,6 +66,15 @@ def test_train_lms_records_mse_per_epoch(tmp_path, capsys):
     assert (d["input_offset_v"], d["input_scale_v"]) == (0.0, 1.0)
 
 
+def test_train_takes_a_fraction_as_its_normalisation(tmp_path, capsys):
+    out = tmp_path / "m.json"
+    rc, _, err = run(["train", TABLE1, "--terms", 11, "--normalise", "0.85", "-o", out], capsys)
+    assert rc == 0, err
+    d = json.loads(out.read_text())
+    assert d["training"]["normalisation"] == "0.85"
+    assert d["input_scale_v"] == pytest.approx((5.276 + 5.185) / 2 / 0.85)
+
+
 def test_train_auto_reports_held_out_error(tmp_path, capsys):
     x = np.linspace(-30, 30, 61)
     data = write_csv(tmp_path / "s.csv", x, s_curve(x, 1e-3, seed=4))

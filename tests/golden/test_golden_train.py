@@ -70,6 +70,15 @@ def test_range_and_raw_normalisation():
     assert normalisation([-5.185, 5.276], "range") == pytest.approx((0.0455, 5.2305))
     assert normalisation([-5.185, 5.276], "half") == pytest.approx((0.0455, 10.461))
     assert normalisation([-5.185, 5.276], "none") == (0.0, 1.0)
+    # a fraction f maps the range to [-f, f]: the ends at -0.85 and +0.85
+    offset, scale = normalisation([-5.185, 5.276], "0.85")
+    assert ((-5.185 - offset) / scale, (5.276 - offset) / scale) == pytest.approx((-0.85, 0.85))
+
+
+@pytest.mark.parametrize("kind", ["0", "1.5", "-0.5", "nan", "wide"])
+def test_a_normalisation_neither_named_nor_in_zero_to_one_is_refused(kind):
+    with pytest.raises(FlannError, match="normalisation must be one of range, half, none"):
+        normalisation([0.0, 1.0], kind)
 
 
 def test_lms_diverges_with_a_clear_error():

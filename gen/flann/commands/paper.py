@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 
+from ..argtypes import name_or_fraction
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..golden.metrics import DEFAULT_TOL_PCT_FS
@@ -35,8 +36,9 @@ def add_arguments(p) -> None:
                    help="linearity tolerance, %% of full scale (default %(default)g)")
     p.add_argument("--data", default=None,
                    help="recordings CSV instead of the paper's Table 1 (built in)")
-    p.add_argument("--normalise", choices=NORMALISATIONS, default="none",
-                   help="input normalisation: 'none' = raw volts as the paper (default)")
+    p.add_argument("--normalise", type=name_or_fraction(NORMALISATIONS), default="none",
+                   help="input normalisation: 'none' = raw volts as the paper (default), "
+                        "'range', 'half' or a number f in (0, 1] (the data's range -> [-f, f])")
     p.add_argument("--sensitivity", action="store_true",
                    help="also print Table 2 over a grid of eta and epochs")
     p.add_argument("--dense", action="store_true",

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..argtypes import bounded
+from ..argtypes import bounded, name_or_fraction
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
@@ -52,10 +52,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--epochs", type=int, default=1000, help="LMS epochs (default 1000)")
     p.add_argument("--ridge", type=bounded(float, 0, 1e6), default=0.0,
                    help="lstsq ridge penalty on mean squared error (default 0)")
-    p.add_argument("--normalise", choices=NORMALISATIONS, default=None,
+    p.add_argument("--normalise", type=name_or_fraction(NORMALISATIONS), default=None,
                    help="input normalisation for explicit --terms: 'range' (default: the "
-                        "data's voltage range -> [-1, 1]), 'half' (-> [-0.5, 0.5]) or 'none' "
-                        "(raw volts, as the paper)")
+                        "data's voltage range -> [-1, 1]), 'half' (-> [-0.5, 0.5]), a number "
+                        "f in (0, 1] (-> [-f, f]) or 'none' (raw volts, as the paper)")
     p.add_argument("--input-offset-v", type=bounded(float, -1e6, 1e6), default=None,
                    help="explicit normalisation offset (V); needs --input-scale-v")
     p.add_argument("--input-scale-v", type=bounded(float, -1e6, 1e6, nonzero_abs=1e-9), default=None,

@@ -42,7 +42,10 @@ from ..errors import FlannError, RecordingsError
 from .model import FlannModel, expand
 
 PAPER_TERMS = (11, 25, 51, 61)
-NORMALISATIONS = ("range", "half", "none")
+# v_n's half range under each named normalisation; a number f in (0, 1] is one too (the range
+# -> [-f, f]) and 'none' is raw volts
+HALF_RANGES = {"range": 1.0, "half": 0.5}
+NORMALISATIONS = (*HALF_RANGES, "none")
 MIN_POINTS = 3  # a line and one curvature point: fewer cannot be fitted at all
 AUTO_TERMS = (1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41, 51, 61)
 # 'range' puts one full period of the fundamental over the recorded range (the linear term
@@ -67,19 +70,34 @@ AUTO_PAIRED_Z = 0.5
 
 
 # -- normalisation -----------------------------------------------------------------------
-def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
-    """(input_offset_v, input_scale_v) for ``kind`` ('range', 'half' or 'none')."""
-    v = np.asarray(voltage_v, dtype=float)
+def half_range(kind: str) -> float | None:
+    """v_n's half range under normalisation ``kind`` (None: 'none', raw volts)."""
     if kind == "none":
+        return None
+    if kind in HALF_RANGES:
+        return HALF_RANGES[kind]
+    try:
+        f = float(kind)
+    except ValueError:
+        f = math.nan
+    if not 0 < f <= 1:
+        raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)} or a number "
+                         f"in (0, 1] (the range -> [-f, f]), got {kind!r}")
+    return f
+
+
+def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
+    """(input_offset_v, input_scale_v) for ``kind`` (:func:`half_range`)."""
+    f = half_range(kind)
+    if f is None:
         return 0.0, 1.0
-    if kind in ("range", "half"):
-        lo, hi = float(v.min()), float(v.max())
-        if not hi > lo:
-            raise RecordingsError(
-                f"voltage_v spans no range (all {lo:g} V): cannot normalise or fit"
-            )
-        return (lo + hi) / 2.0, (hi - lo) / (2.0 if kind == "range" else 1.0)
-    raise FlannError(f"normalisation must be one of {', '.join(NORMALISATIONS)}, got {kind!r}")
+    v = np.asarray(voltage_v, dtype=float)
+    lo, hi = float(v.min()), float(v.max())
+    if not hi > lo:
+        raise RecordingsError(
+            f"voltage_v spans no range (all {lo:g} V): cannot normalise or fit"
+        )
+    return (lo + hi) / 2.0, (hi - lo) / (2.0 * f)
 
 
 def design_matrix(v_n: np.ndarray, terms: int) -> np.ndarray:
