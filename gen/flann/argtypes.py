@@ -11,6 +11,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from .errors import FlannError
+
 
 def finite_float(text: str) -> float:
     try:
@@ -46,22 +48,17 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
     return parse
 
 
-def name_or_fraction(names):
-    """An argparse ``type`` for one of ``names`` or a number in (0, 1] (given back as text)."""
-    def parse(text: str) -> str:
-        if text in names:
-            return text
+def checked(parse_value):
+    """An argparse ``type`` from ``parse_value(text)``, which returns the value or raises
+    :class:`~flann.errors.FlannError`: the rule stays where the value is used."""
+    def parse(text: str):
         try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not 0 < value <= 1:
-            raise argparse.ArgumentTypeError(
-                f"{text!r}: must be one of {', '.join(names)} or a number in (0, 1]")
-        return f"{value:g}"
+            return parse_value(text)
+        except FlannError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
 
-    parse.__name__ = "name or fraction"
+    parse.__name__ = parse_value.__name__
     return parse
 
 
-__all__ = ["bounded", "finite_float", "name_or_fraction"]
+__all__ = ["bounded", "checked", "finite_float"]

@@ -6,12 +6,12 @@ import json
 
 import numpy as np
 
-from ..argtypes import name_or_fraction
+from ..argtypes import checked
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..golden.train import NORMALISATIONS, fit_auto, fit_lstsq, normalisation
+from ..golden.train import fit_auto, fit_lstsq, normalisation, normalisation_kind
 from ..golden import paper
 from ..hardware.fixed.cost import fixed_point_cost
 
@@ -36,7 +36,7 @@ def add_arguments(p) -> None:
                    help="linearity tolerance, %% of full scale (default %(default)g)")
     p.add_argument("--data", default=None,
                    help="recordings CSV instead of the paper's Table 1 (built in)")
-    p.add_argument("--normalise", type=name_or_fraction(NORMALISATIONS), default="none",
+    p.add_argument("--normalise", type=checked(normalisation_kind), default="none",
                    help="input normalisation: 'none' = raw volts as the paper (default), "
                         "'range', 'half' or a number f in (0, 1] (the data's range -> [-f, f])")
     p.add_argument("--sensitivity", action="store_true",

@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..argtypes import bounded, name_or_fraction
+from ..argtypes import bounded, checked
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
-from ..golden.train import (NORMALISATIONS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
-                            fit_lms, fit_lstsq)
+from ..golden.train import (PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+                            fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
 from ..golden.model import MAX_TERMS
 from ..golden.inverse import inverse_fit
@@ -52,7 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--epochs", type=int, default=1000, help="LMS epochs (default 1000)")
     p.add_argument("--ridge", type=bounded(float, 0, 1e6), default=0.0,
                    help="lstsq ridge penalty on mean squared error (default 0)")
-    p.add_argument("--normalise", type=name_or_fraction(NORMALISATIONS), default=None,
+    p.add_argument("--normalise", type=checked(normalisation_kind), default=None,
                    help="input normalisation for explicit --terms: 'range' (default: the "
                         "data's voltage range -> [-1, 1]), 'half' (-> [-0.5, 0.5]), a number "
                         "f in (0, 1] (-> [-f, f]) or 'none' (raw volts, as the paper)")

@@ -86,6 +86,11 @@ def half_range(kind: str) -> float | None:
     return f
 
 
+def normalisation_kind(kind: str) -> str:
+    """``kind`` as the training record writes it: a name, or the fraction (``%g``)."""
+    return kind if kind in NORMALISATIONS else f"{half_range(kind):g}"
+
+
 def normalisation(voltage_v, kind: str = "range") -> tuple[float, float]:
     """(input_offset_v, input_scale_v) for ``kind`` (:func:`half_range`)."""
     f = half_range(kind)
