@@ -51,7 +51,6 @@ TREND_UNITS = 2            # the few-positions trend: at most this many tanh uni
 # v_n in [-0.85, 0.85] (a gap of 0.3 in the terms' period for the curve to turn in) is
 # better conditioned than 'half' and follows the ends far better than 'range'.
 TEACHER_NORMS = (*AUTO_NORMS, "0.85")
-TEACHER_RIDGES = AUTO_RIDGES
 
 
 @dataclass(frozen=True)
@@ -213,7 +212,7 @@ def fit_to_forward(fw, cost, training: dict, tol: float = TEACHER_TOL) -> tuple[
     v_mid, x_mid = v_mid[1::2], x_mid[1::2]     # between the fitted points
     scored = []
     for norm in TEACHER_NORMS:
-        for ridge in TEACHER_RIDGES:
+        for ridge in AUTO_RIDGES:
             for terms in AUTO_TERMS:
                 m = fit_lstsq(v, x, terms, norm=norm, ridge=ridge, training=training)
                 scored.append((float(np.max(np.abs(m.predict(v_mid) - x_mid))), terms, norm, ridge, m))

@@ -26,7 +26,8 @@ All three return a :class:`flann.golden.model.FlannModel` whose output is
 Normalisation: ``"range"`` maps the data's voltage range to [-1, 1] (offset = midpoint,
 scale = half span); ``"half"`` maps it to [-0.5, 0.5] (scale = span: the trigonometric terms,
 periodic over 2 units of v_n, then need not join the two ends of the curve, which avoids the
-Gibbs-like error near the ends); ``"none"`` uses raw volts (offset 0, scale 1) as the paper.
+Gibbs-like error near the ends); a number f in (0, 1] maps it to [-f, f] (scale = span / 2f);
+``"none"`` uses raw volts (offset 0, scale 1) as the paper.
 Everything here is deterministic: no random numbers, a fixed order of operations.
 """
 
