@@ -10,6 +10,7 @@ the curve `flann train` wrote before the odd members).
     .venv/bin/python bench/odd_members.py off-centre [--draws 16]
     .venv/bin/python bench/odd_members.py e2e --seeds 3,7,11 [--n 20]          # needs ../shared/checks
     .venv/bin/python bench/odd_members.py draws --seed 7 --index 1 [--draws 16]  # needs ../shared/checks
+    .venv/bin/python bench/odd_members.py flow --seeds 202,404 [--n 30] [--sweeps 2] [--steps M]
 
 filament: random geometries of the independent forward model (`flann.physics.filament`),
 161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
@@ -17,20 +18,30 @@ error against the noise-free curve.  off-centre: an arctan with a 2 % gain step 
 the null at 10, 6 and 3 mm, 150 positions x 2, 1 mV.  e2e: the shared check's sensors
 (`draw`, `recordings`, `oracle_reference`), held-out max error / the oracle's, median,
 geometric mean and worst per seed.  draws: one of those sensors recorded again with new noise
-draws (generator seed 99).
+draws (generator seed 99).  flow: the whole flow instead of the curve alone, in process
+(`flann train` through `flann.cli.main`, the written model on the held-out points as
+`flann eval` clamps them), on both cores: the figures `e2e_sensors.py` prints, without
+`flann gen`; against other code with PYTHONPATH=<worktree>/gen.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib.util
+import io
 import sys
+import tempfile
 import warnings
+from multiprocessing import Pool
 from pathlib import Path
 
 import numpy as np
 
+from flann.cli import main as flann
+from flann.commands.predict import predict_clamped
 from flann.golden import sigmoids
+from flann.golden.model import load_model
 from flann.physics import filament
 
 E2E = Path(__file__).resolve().parents[2] / "shared" / "checks" / "e2e_sensors.py"
@@ -131,6 +142,36 @@ def run_draws(a) -> None:
           f"{summary('both', r[:, 0])}; {summary('free', r[:, 1])}")
 
 
+def flow_ratio(job) -> float:
+    """Held-out max error / oracle of sensor ``index`` of ``seed`` through `flann train`."""
+    seed, index, sweeps, steps = job
+    e2e = e2e_module()
+    rng = np.random.default_rng(seed)
+    for _ in range(index + 1):        # the check's own draws, to reach sensor `index`
+        p = e2e.draw(rng)
+        if steps:
+            p["steps"] = steps
+        (xs, v, d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, sweeps)
+    with tempfile.TemporaryDirectory() as t:
+        rec, out = Path(t) / "rec.csv", Path(t) / "model.json"
+        e2e.write_csv(str(rec), (xs, v, d), ("displacement_mm", "voltage_v", "direction"))
+        with warnings.catch_warnings(), contextlib.redirect_stderr(io.StringIO()):
+            warnings.simplefilter("ignore")
+            if flann(["train", str(rec), "-o", str(out)]) != 0:
+                return float("nan")
+            err = np.max(np.abs(predict_clamped(load_model(out), vt, None)[0] - xt))
+    return float(err / e2e.oracle_reference(p, xs, v, xt, vt))
+
+
+def run_flow(a) -> None:
+    with Pool(2) as pool:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            r = np.array(pool.map(flow_ratio, [(seed, i, a.sweeps, a.steps) for i in range(a.n)], chunksize=1))
+            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the whole flow, held-out max error / "
+                  f"oracle: {summary('flann', r[~np.isnan(r)])}; not through: {int(np.isnan(r).sum())}",
+                  flush=True)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -143,9 +184,15 @@ def main() -> int:
     d.add_argument("--seed", type=int, default=7)
     d.add_argument("--index", type=int, default=1)
     d.add_argument("--draws", type=int, default=16)
+    f = sub.add_parser("flow")
+    f.add_argument("--seeds", default="202,404")
+    f.add_argument("--n", type=int, default=30)
+    f.add_argument("--sweeps", type=int, default=2)
+    f.add_argument("--steps", type=int, default=0, help="positions per sweep (0: the check's draw)")
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
-    {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws}[a.what](a)
+    {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
+     "flow": run_flow}[a.what](a)
     return 0
 
 
