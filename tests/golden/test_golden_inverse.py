@@ -14,7 +14,7 @@ from flann.golden import inverse
 from flann.golden.inverse import (DENSE_TEACHER_TOL, SPARSE_POSITIONS, Forward, fit_to_forward, forward_curve,
                                   inverse_fit, spline_curve)
 from flann.golden.model import load_model
-from flann.golden.sigmoids import SPREADS, Units, fit_forward, refit
+from flann.golden.sigmoids import MAX_UNITS, SPREADS, Units, fit_forward, refit
 from flann.golden.train import AUTO_NORMS, fit_auto
 from flann.hardware.fixed.cost import fixed_point_cost
 from flann.physics import filament
@@ -124,6 +124,57 @@ def test_the_forward_curve_follows_a_shape_outside_its_family():
     assert np.max(np.abs(fw(fine) - sensor(fine))) < 1.5e-3
     again = fit_forward(x, v)                       # deterministic: same starts, same fit
     assert np.array_equal(again(fine), fw(fine))
+
+
+def knee(x):
+    """A roll-off of this test's own with a knee sharper than six tanh units follow: the slope
+    falls from 2.1 to 0.3 within a twentieth of the stroke (soft-plus corners at +-0.6)."""
+    def corner(z):
+        return np.logaddexp(0.0, 25.0 * z) / 25.0
+    return 2.0 * (x - corner(x - 0.6) + corner(-x - 0.6)) + 0.1 * x ** 3
+
+
+def knee_readings(sweeps: int):
+    rng = np.random.default_rng(5)
+    one = np.linspace(-1.0, 1.0, 201)
+    x = np.concatenate([one if k % 2 == 0 else one[::-1] for k in range(sweeps)])
+    return x, knee(x) + rng.normal(0, 2e-4, x.size)
+
+
+def inverse_max_error(fw, truth) -> float:
+    g = np.linspace(*fw.stroke, 4001)
+    c = fw(g)
+    o = np.argsort(c)
+    return float(np.max(np.abs(np.interp(truth(g), c[o], g[o]) - g)))
+
+
+def test_a_knee_six_units_miss_grows_more_units_from_the_repeats():
+    """Four sweeps: the position means are known to a quarter of the noise, and six units
+    miss them at the knees by far more; more units are grown, and follow the knee."""
+    x, v = knee_readings(4)
+    grown, capped = fit_forward(x, v), fit_forward(x, v, more_units=MAX_UNITS)
+    assert capped.describe()["largest_units"] == MAX_UNITS
+    assert grown.describe()["largest_units"] > MAX_UNITS
+    # measured 0.00066 against 0.0049 (of a stroke of 2)
+    assert inverse_max_error(grown, knee) < inverse_max_error(capped, knee) / 3
+
+
+def test_no_units_past_six_without_repeats_to_judge_the_misfit_by():
+    x, v = knee_readings(1)
+    assert fit_forward(x, v).describe()["largest_units"] == MAX_UNITS
+
+
+def test_repeats_on_one_converter_code_are_no_misfit(tmp_path):
+    """Noise far below the converter's step: the two sweeps mostly read the same code, so
+    the readings scatter about their position means by nearly nothing, and what the curve
+    leaves is the quantisation.  `flann train` takes the step from the readings' grid as the
+    smallest scatter, and grows no units past six; without the step the quantisation reads
+    as a misfit."""
+    rec, out = tmp_path / "rec.csv", tmp_path / "m.json"
+    x, v = recording(rec, 81, 8, sweeps=2, noise=2e-5)
+    assert flann(["train", str(rec), "-o", str(out)]) == 0
+    assert load_model(out).training["forward_model"]["largest_units"] <= MAX_UNITS
+    assert fit_forward(x, v).describe()["largest_units"] > MAX_UNITS
 
 
 def test_near_equal_local_optima_are_members_of_the_average():

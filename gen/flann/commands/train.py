@@ -92,12 +92,10 @@ def converter(args, rec) -> dict | None:
             "from": "the recording's converter grid"}
 
 
-def _screen(rec) -> tuple[object, dict, str]:
+def _screen(rec, step_v: float) -> tuple[object, dict, str]:
     """Gross outliers left out (one warning line), or refused above the stated share."""
     try:
-        # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
-        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction,
-                             converter_step(rec.voltage_v))
+        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction, step_v)
     except OutlierShareError as exc:
         raise FlannError(
             f"{rec.source}: {exc.n_out} of {exc.n} readings are more than {OUTLIER_K:g} noise units "
@@ -151,7 +149,9 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
                          "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
     conv = converter(args, rec)
-    rec, record, outlier_text = _screen(rec)
+    # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
+    step_v = converter_step(rec.voltage_v)
+    rec, record, outlier_text = _screen(rec, step_v)
     if outlier_text:
         warnings.warn(outlier_text)
     provenance.update(record)
@@ -163,7 +163,7 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         return fixed_point_cost(m, adc)
 
     model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
-    inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training)
+    inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training, step_v)
     t = model.training
     direct_text = (f"held-out error (cross-validation, {t['cv_folds']} folds"
                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")

@@ -98,6 +98,11 @@ def _rms(e: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
 
 
+def _trend(displacement_mm, voltage_v) -> SigmoidForward | None:
+    """The few-positions trend: at most :data:`TREND_UNITS` units, never grown."""
+    return fit_forward(displacement_mm, voltage_v, max_units=TREND_UNITS, more_units=TREND_UNITS)
+
+
 def spline_curve(displacement_mm, voltage_v) -> Forward | None:
     """The spline v(x) through the position means, or None (too few positions, or no
     monotone curve through them: the readings fold back or sit within noise of each other).
@@ -118,19 +123,20 @@ def spline_curve(displacement_mm, voltage_v) -> Forward | None:
 
     def judged(fw):
         return replace(fw, left_out_mm=leave_one_out_mm(fw, displacement_mm, voltage_v))
-    trend = fit_forward(displacement_mm, voltage_v, max_units=TREND_UNITS)
+    trend = _trend(displacement_mm, voltage_v)
     found = [judged(fw) for fw in (monotone(None), None if trend is None else monotone(trend))
              if fw is not None]
     # plain first: it keeps a tie
     return min(found, key=lambda fw: _rms(fw.left_out_mm), default=None)
 
 
-def forward_curve(displacement_mm, voltage_v) -> SigmoidForward | Forward | None:
+def forward_curve(displacement_mm, voltage_v, step_v: float = 0.0) -> SigmoidForward | Forward | None:
     """With fewer than :data:`SPARSE_POSITIONS` positions the spline through the position
-    means, else the tanh units' average; None when there is no monotone one."""
+    means, else the tanh units' average (``step_v``: the converter's step, 0 off-grid); None
+    when there is no monotone one."""
     if np.unique(np.asarray(displacement_mm, float)).size < SPARSE_POSITIONS:
         return spline_curve(displacement_mm, voltage_v)
-    return fit_forward(displacement_mm, voltage_v)
+    return fit_forward(displacement_mm, voltage_v, step_v=step_v)
 
 
 def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
@@ -162,7 +168,7 @@ def leave_one_out_mm(fw: Forward, displacement_mm, voltage_v) -> np.ndarray:
 
     def predict(keep, mean_v):
         pos = aggregate(x[keep], v[keep])
-        trend = None if fw.trend is None else fit_forward(x[keep], v[keep], max_units=TREND_UNITS)
+        trend = None if fw.trend is None else _trend(x[keep], v[keep])
         return _invert(fw.curve(pos.x, pos.v, trend), x.min(), x.max(), np.array([mean_v]))[0]
     return _left_out_mm(x, v, predict)
 
@@ -236,17 +242,19 @@ def fit_to_forward(fw, cost, training: dict, tol: float = TEACHER_TOL) -> tuple[
                                                          "term_bits", "output_lsb_mm")}}
 
 
-def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict) -> FlannModel | None:
+def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict,
+                step_v: float = 0.0) -> FlannModel | None:
     """The model fitted to the inverted forward curve, or None: no forward curve, a straight
     one (without curvature there is no flattening at the ends to undo, and the FLANN would
     spend 61 terms following the curved members' 1e-4 mm wiggles where the direct fit takes
     1), no candidate that builds, or (:data:`SPARSE_POSITIONS` or more positions) none that follows
     the curve more closely than the direct fit's held-out max error.  ``direct`` is the
     direct fit's :class:`~flann.golden.train.CvResult`; ``training`` the record to extend
-    (with many positions, the direct fit's own, whose held-out figures it keeps)."""
+    (with many positions, the direct fit's own, whose held-out figures it keeps); ``step_v``
+    the recording's converter step (0 off-grid)."""
     x = np.asarray(displacement_mm, dtype=float)
     positions = int(np.unique(x).size)
-    fw = forward_curve(x, voltage_v)
+    fw = forward_curve(x, voltage_v, step_v)
     if fw is None or fw.straight:
         return None
     record = {k: val for k, val in training.items()

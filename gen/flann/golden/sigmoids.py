@@ -10,12 +10,14 @@ the inverse's max error sits:
 
 (a one-hidden-layer network in x; no sensor's formula).  The linear parameters (c, d, a_k)
 are solved exactly for every trial of the others (variable projection), the units are grown
-one at a time from the previous fit, and every K with and without the linear term (and the
-straight line, K = 0) is kept when its curve is monotone over the stroke, together with the
-other local optima within 5 % of its residual: which of near-equal optima the solver reaches
-turns on rounding, and they part at the ends.  Their curves are averaged with Akaike
-weights: choosing one K by a held-out score is a noisy choice (the score is set by the
-interior of the stroke, the max error by its ends), averaging is not.
+one at a time from the previous fit (up to six; more only while the closest member misses the
+position means by more than the readings' repeat scatter allows), and every K with and
+without the linear term (and the straight line, K = 0) is kept when its curve is monotone
+over the stroke, together with the other local optima within 5 % of its residual: which of
+near-equal optima the solver reaches turns on rounding, and they part at the ends.  Their
+curves are averaged with Akaike weights: choosing one K by a held-out score is a noisy
+choice (the score is set by the interior of the stroke, the max error by its ends),
+averaging is not.
 
 A differential sensor (an LVDT's two secondaries in opposition) is odd about its null, up
 to a gain that differs between the two halves of the stroke (its datasheet's "symmetry").
@@ -42,10 +44,18 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.stats import f as f_distribution
 
-from .forward import aggregate, strictly_monotone
+from .forward import aggregate, noise_floor_v, strictly_monotone
 
 MAX_UNITS = 6
+# Past MAX_UNITS units are grown one at a time, up to MORE_UNITS, only while the closest member
+# misses the position means by more than the readings' own repeat scatter allows (an F test at
+# MISFIT_P): a knee too sharp for six units (on four sweeps of a 16-bit sensor, 4.6 times the
+# scatter, the inverse 7.3 times the oracle's error; 1.4 with eight).  Where six units reach the
+# scatter, more only spread the average's weight over curves that follow noise.
+MORE_UNITS = 10
+MISFIT_P = 1e-4
 MIN_POSITIONS = 6           # the smallest model (one unit and an offset) has 3 parameters
 LOG_WIDTH = (np.log(0.02), np.log(5.0))     # unit widths, in halves of the stroke
 CENTRE = (-1.5, 1.5)                        # unit centres, in halves of the stroke
@@ -311,11 +321,11 @@ def _near_best(fits: list[Units]) -> list[Units]:
     return kept
 
 
-def _path(x, y, sw, kmax: int, linear: bool, rng) -> list[Units]:
-    """The best fits (:func:`_near_best`) with 1..kmax units, each K grown from the best
-    with one unit fewer."""
-    out, prev = [], np.zeros(0)
-    for k in range(1, kmax + 1):
+def _path(x, y, sw, ks: range, linear: bool, rng, prev=np.zeros(0)) -> list[Units]:
+    """The best fits (:func:`_near_best`) with each K in ``ks`` units, each K grown from the
+    best with one unit fewer (``prev``'s units before the first)."""
+    out = []
+    for k in ks:
         starts = [np.concatenate([prev, [b, ls]]) for b in GRID_CENTRES for ls in GRID_WIDTHS]
         starts += [np.column_stack([rng.uniform(-1, 1, k), rng.uniform(np.log(0.05), np.log(2.0), k)]).ravel()
                    for _ in range(RANDOM_STARTS)]
@@ -336,11 +346,12 @@ def _null_starts(null: float) -> list[np.ndarray]:
     return [np.array([null, g, ls]) for g in (-0.03, 0.0, 0.03) for ls in GRID_WIDTHS]
 
 
-def _odd_path(x, y, sw, kmax: int, linear: bool, null: float) -> list[Units]:
-    """The best odd members (:func:`_near_best`) with 1..kmax units about a null first placed
-    at ``null``, each K grown from the best with one unit fewer."""
-    out, prev = [], None
-    for k in range(1, kmax + 1):
+def _odd_path(x, y, sw, ks: range, linear: bool, null: float, prev=None) -> list[Units]:
+    """The best odd members (:func:`_near_best`) with each K in ``ks`` units about a null
+    first placed at ``null``, each K grown from the best with one unit fewer (``prev``'s
+    units before the first)."""
+    out = []
+    for k in ks:
         if prev is None:
             starts = _null_starts(null)
         else:
@@ -395,7 +406,8 @@ class SigmoidForward:
                "members": [{"units": m.units, "shape": m.shape.name, "linear_term": m.linear,
                             "weight": round(float(w), 4)}
                            for m, w in zip(self.members, self.weights) if w >= 1e-4],
-               "heaviest_units": self.members[top].units}
+               "heaviest_units": self.members[top].units,
+               "largest_units": max(m.units for m in self.members)}
         odd = [k for k, m in enumerate(self.members) if m.shape is not _Free]
         if odd:
             h, g = self.members[max(odd, key=lambda k: self.weights[k])].nl[:2]
@@ -463,9 +475,31 @@ def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForwar
     return SigmoidForward(tuple(members), w / w.sum(), *geometry, bool(straight))
 
 
-def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> SigmoidForward | None:
+def _misfit(fitted: list[Units], d: _Scaled, floor: float) -> bool:
+    """Whether the closest member misses the position means by more than the scatter of the
+    readings about them allows (F test at :data:`MISFIT_P`; the scatter no smaller than
+    ``floor``, the converter's quantisation, which repeats on one code do not show).  Without
+    repeated readings there is no scatter to judge by: False."""
+    groups = d.xn.size
+    best = min(fitted, key=lambda u: u.sse)
+    dof = groups - best.params
+    if d.n <= groups or dof <= 0:
+        return False
+    scatter = max(d.within / (d.n - groups), floor * floor)
+    return bool(f_distribution.sf(best.sse / dof / scatter, dof, d.n - groups) < MISFIT_P)
+
+
+def _closest(fitted: list[Units], shape, linear: bool, units: int) -> np.ndarray:
+    """The nonlinear parameters of the closest member of this kind and size."""
+    return min((u for u in fitted if u.shape is shape and u.linear == linear and u.units == units),
+               key=lambda u: u.sse).nl
+
+
+def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS, more_units: int = MORE_UNITS,
+                step_v: float = 0.0) -> SigmoidForward | None:
     """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
-    no monotone member."""
+    no monotone member.  Units past ``max_units``, up to ``more_units``, are grown while the
+    members miss the readings (:func:`_misfit`; ``step_v`` the converter's step, 0 off-grid)."""
     x = np.asarray(displacement_mm, float)
     v = np.asarray(voltage_v, float)
     v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
@@ -475,18 +509,26 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS) -> Sigmo
     d = _scaled(x, v, *geometry)
     if d.xn.size < MIN_POSITIONS:
         return None
-    kmax = max(1, min(max_units, (d.xn.size - 3) // 3))
+    most = max(1, (d.xn.size - 3) // 3)      # three positions a unit
+    kmax = min(max_units, most)
     rng = np.random.default_rng(0)
     fitted = [_line(d)]     # no unit: a straight sensor
-    fitted += [u for linear in (False, True) for u in _path(d.xn, d.y, d.sw, kmax, linear, rng)]
+    fitted += [u for linear in (False, True) for u in _path(d.xn, d.y, d.sw, range(1, kmax + 1), linear, rng)]
     free = _averaged(fitted, d, geometry)
     if free is None:
         return None
     # the odd members' null starts where the free units' curve is steepest
     null = float(np.clip(_CHECK[np.argmax(np.abs(np.gradient(free.normalised(_CHECK))))], *NULL))
-    fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, kmax, linear, null)]
+    fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, range(1, kmax + 1), linear, null)]
     fitted += [u for linear in (False, True)
                for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
+    floor = noise_floor_v(v, step_v) / v_half
+    for k in range(kmax + 1, min(more_units, most) + 1):
+        if not _misfit(fitted, d, floor):
+            break
+        fitted += [u for linear in (False, True) for u in
+                   _path(d.xn, d.y, d.sw, range(k, k + 1), linear, rng, _closest(fitted, _Free, linear, k - 1))
+                   + _odd_path(d.xn, d.y, d.sw, range(k, k + 1), linear, null, _closest(fitted, _Odd, linear, k - 1))]
     return _averaged(fitted, d, geometry)
 
 
@@ -504,4 +546,4 @@ def refit(fw: SigmoidForward, displacement_mm, voltage_v, min_weight: float = 0.
     return _averaged(fitted, d, geometry)
 
 
-__all__ = ["MAX_UNITS", "MIN_POSITIONS", "SigmoidForward", "Units", "fit_forward", "refit"]
+__all__ = ["MAX_UNITS", "MIN_POSITIONS", "MORE_UNITS", "SigmoidForward", "Units", "fit_forward", "refit"]
