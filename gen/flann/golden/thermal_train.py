@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import FlannError, RecordingsError
 from .thermal import ThermalModel, corrected_voltage, temperature_groups, thermal_design
-from .train import AUTO_PAIRED_Z, normalisation, solve_lstsq
+from .train import AUTO_NORMS, AUTO_PAIRED_Z, normalisation, solve_lstsq
 
 MAX_ORDER = 2
 AUTO_TERMS = (0, 1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41)
@@ -45,7 +45,6 @@ WEIGHT_LIMIT = 16.0
 # the order datapaths' terms, and past it the finest output LSB that builds is coarser than the
 # model's own error (a 2 mm sensor at 122x built at nothing finer than 180 ppm FS)
 WEIGHT_SUM_LIMIT = 64.0
-AUTO_NORMS = ("range", "half")
 AUTO_RIDGES = (0.0, 1e-12, 1e-10, 1e-8, 1e-6)
 POSITION_FOLDS = 10
 MIN_TEMPERATURES = 2
