@@ -14,7 +14,7 @@ from flann.golden import inverse
 from flann.golden.inverse import (DENSE_TEACHER_TOL, SPARSE_POSITIONS, Forward, fit_to_forward, forward_curve,
                                   inverse_fit, spline_curve)
 from flann.golden.model import load_model
-from flann.golden.sigmoids import MAX_UNITS, SPREADS, Units, fit_forward, refit
+from flann.golden.sigmoids import MAX_UNITS, SPREADS, Units, _Free, _Odd, fit_forward, refit
 from flann.golden.train import AUTO_NORMS, fit_auto
 from flann.hardware.fixed.cost import fixed_point_cost
 from flann.physics import filament
@@ -192,17 +192,22 @@ def test_near_equal_local_optima_are_members_of_the_average():
         assert len(set(np.round(np.array(sse) / min(sse), 9))) == len(sse)
 
 
-@pytest.mark.parametrize("shape", SPREADS, ids=lambda s: f"{s.unit}-{s.derivatives}-derivatives")
+MEMBER_KINDS = ([(_Free, np.array([0.1, np.log(0.5), -0.4, np.log(0.2)])),
+                 (_Odd, np.array([0.07, 0.05, np.log(0.6), np.log(0.2)]))]
+                + [(shape, np.array([0.07, 0.05, np.log(0.6)])) for shape in SPREADS])
+
+
+@pytest.mark.parametrize("shape, nl", MEMBER_KINDS,
+                         ids=lambda k: getattr(k, "unit", getattr(k, "name", ""))[:12] + str(getattr(k, "derivatives", "")))
 @pytest.mark.parametrize("linear", [False, True])
-def test_an_odd_spread_members_derivative_is_its_curves(shape, linear):
-    """The analytic derivative in (null, gain step, log width) the solver's Jacobian is built
+def test_each_members_derivative_is_its_curves(shape, nl, linear):
+    """The analytic derivative in the nonlinear parameters the solver's Jacobian is built
     from, against central differences of the curve (off the null, where the gain steps)."""
     x = np.linspace(-1, 1, 200)
-    nl = np.array([0.07, 0.05, np.log(0.6)])
     beta = np.random.default_rng(1).normal(size=shape.basis(nl, x, linear).shape[1])
     numeric = []
     for k in range(nl.size):
-        step = np.zeros(3)
+        step = np.zeros(nl.size)
         step[k] = 1e-6
         numeric.append((Units(nl + step, beta, linear, 0.0, shape)(x)
                         - Units(nl - step, beta, linear, 0.0, shape)(x)) / 2e-6)

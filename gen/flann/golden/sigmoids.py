@@ -72,11 +72,13 @@ MAX_GROUPS = 1000           # a logger's continuous positions are averaged in th
 _CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
 
 
-def _orthogonal_to(B: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """``D``'s columns projected orthogonally to the basis ``B``: Kaufman's approximation of
-    the variable-projection Jacobian from the basis' derivatives times their weights."""
+def _jacobian(shape, nl, x, sw, linear, B, beta) -> np.ndarray:
+    """d(weighted residual)/d(nonlinear parameters) by Kaufman's variable-projection
+    approximation: each column of the shape's ``derivative`` (the curve's, at the linear
+    parameters ``beta``), weighted, projected orthogonally to the weighted basis ``B``."""
     q, _r = np.linalg.qr(B)
-    return D - q @ (q.T @ D)
+    d = shape.derivative(nl, x, linear, beta) * sw[:, None]
+    return d - q @ (q.T @ d)
 
 
 class _Free:
@@ -100,18 +102,16 @@ class _Free:
         return np.tile([CENTRE[0], LOG_WIDTH[0]], k), np.tile([CENTRE[1], LOG_WIDTH[1]], k)
 
     @staticmethod
-    def jacobian(nl, x, sw, linear, B, beta):
-        """d(residual)/d(centres, log widths) by Kaufman's variable-projection approximation:
-        the projection, orthogonal to the basis ``B``, of each unit's derivative times its
-        weight in ``beta``."""
+    def derivative(nl, x, linear, beta):
+        """d(curve)/d(centres, log widths)."""
         first = 2 if linear else 1
         cols = []
         for k, (b, ls) in enumerate(nl.reshape(-1, 2)):
             inv_w = np.exp(-ls)
             t = np.tanh((x - b) * inv_w)
-            d = -(1.0 - t * t) * inv_w * beta[first + k] * sw
+            d = -(1.0 - t * t) * inv_w * beta[first + k]
             cols += [d, d * (x - b)]
-        return _orthogonal_to(B, np.column_stack(cols))
+        return np.column_stack(cols)
 
 
 class _Odd:
@@ -139,9 +139,9 @@ class _Odd:
                 np.array([NULL[1], GAIN_STEP[1]] + [LOG_WIDTH[1]] * k))
 
     @staticmethod
-    def jacobian(nl, x, sw, linear, B, beta):
-        """d(residual)/d(null, gain step, log widths), Kaufman's approximation as for
-        :meth:`_Free.jacobian`: the null and the gain step move every column but the offset."""
+    def derivative(nl, x, linear, beta):
+        """d(curve)/d(null, gain step, log widths): the null and the gain step move every
+        column but the offset."""
         z = x - nl[0]
         side = np.sign(z)
         gain = 1.0 + nl[1] * side
@@ -160,7 +160,7 @@ class _Odd:
             d_null -= dt
             d_gain += t * side * beta[first + k]
             widths.append(-dt * z)
-        return _orthogonal_to(B, np.column_stack([d_null, d_gain] + widths) * sw[:, None])
+        return np.column_stack([d_null, d_gain] + widths)
 
 
 class _TanhUnit:
@@ -248,9 +248,6 @@ class _OddSpread:
             d_gain = d_gain + np.abs(z) * beta[1]
         return np.column_stack([d_null, d_gain, -slope * gain * u])
 
-    def jacobian(self, nl, x, sw, linear, B, beta):
-        return _orthogonal_to(B, self.derivative(nl, x, linear, beta) * sw[:, None])
-
 
 # no derivative: one tanh unit is an _Odd member already, one algebraic unit is not
 SPREADS = (tuple(_OddSpread(j) for j in range(1, SPREAD_DERIVATIVES + 1))
@@ -302,7 +299,7 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
         return last[key]
 
     r = least_squares(lambda nl: solved(nl)[2], nl0, bounds=(lo, hi),
-                      jac=lambda nl: shape.jacobian(nl, x, sw, linear, *solved(nl)[:2]),
+                      jac=lambda nl: _jacobian(shape, nl, x, sw, linear, *solved(nl)[:2]),
                       method="trf", max_nfev=300)
     _B, beta, res = solved(r.x)
     return Units(r.x, beta, linear, float(res @ res), shape)
