@@ -10,7 +10,7 @@ the curve `flann train` wrote before the odd members).
     .venv/bin/python bench/odd_members.py off-centre [--draws 16]
     .venv/bin/python bench/odd_members.py e2e --seeds 3,7,11 [--n 20]          # needs ../shared/checks
     .venv/bin/python bench/odd_members.py draws --seed 7 --index 1 [--draws 16]  # needs ../shared/checks
-    .venv/bin/python bench/odd_members.py flow --seeds 202,404 [--n 30] [--sweeps 2] [--steps M]
+    .venv/bin/python bench/odd_members.py flow --seeds 202,404 [--n 30] [--sweeps 2] [--steps M] [--each]
 
 filament: random geometries of the independent forward model (`flann.physics.filament`),
 161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
@@ -167,6 +167,8 @@ def run_flow(a) -> None:
     with Pool(2) as pool:
         for seed in (int(s) for s in a.seeds.split(",")):
             r = np.array(pool.map(flow_ratio, [(seed, i, a.sweeps, a.steps) for i in range(a.n)], chunksize=1))
+            if a.each:
+                print(f"seed {seed}: " + " ".join(f"#{i} {x:.2f}" for i, x in enumerate(r)), flush=True)
             print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the whole flow, held-out max error / "
                   f"oracle: {summary('flann', r[~np.isnan(r)])}; not through: {int(np.isnan(r).sum())}",
                   flush=True)
@@ -189,6 +191,7 @@ def main() -> int:
     f.add_argument("--n", type=int, default=30)
     f.add_argument("--sweeps", type=int, default=2)
     f.add_argument("--steps", type=int, default=0, help="positions per sweep (0: the check's draw)")
+    f.add_argument("--each", action="store_true", help="also each sensor's ratio")
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
     {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
