@@ -11,6 +11,8 @@ the curve `flann train` wrote before the odd members).
     .venv/bin/python bench/odd_members.py e2e --seeds 3,7,11 [--n 20]          # needs ../shared/checks
     .venv/bin/python bench/odd_members.py draws --seed 7 --index 1 [--draws 16]  # needs ../shared/checks
     .venv/bin/python bench/odd_members.py flow --seeds 202,404 [--n 30] [--sweeps 2] [--steps M] [--each]
+    .venv/bin/python bench/odd_members.py units --seeds 111,222 [--n 30] [--sweeps 2] [--caps 6,8,10]
+    .venv/bin/python bench/odd_members.py weights --seeds 111,222 [--n 30] [--sweeps 2]
 
 filament: random geometries of the independent forward model (`flann.physics.filament`),
 161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
@@ -21,7 +23,11 @@ geometric mean and worst per seed.  draws: one of those sensors recorded again w
 draws (generator seed 99).  flow: the whole flow instead of the curve alone, in process
 (`flann train` through `flann.cli.main`, the written model on the held-out points as
 `flann eval` clamps them), on both cores: the figures `e2e_sensors.py` prints, without
-`flann gen`; against other code with PYTHONPATH=<worktree>/gen.
+`flann gen`; against other code with PYTHONPATH=<worktree>/gen.  units: the curve alone on
+the check's sensors with the units capped at each of ``--caps`` (no growth past the cap), and
+whether six units miss the readings (the growth's test, without the converter's step).
+weights: the same members weighted by other rules than Akaike's (AICc, Bayes', 3 per
+parameter, the best member alone).
 """
 
 from __future__ import annotations
@@ -174,6 +180,70 @@ def run_flow(a) -> None:
                   flush=True)
 
 
+def check_sensor(seed: int, index: int, sweeps: int):
+    """(parameters, recordings, held-out points) of sensor ``index`` of ``seed``."""
+    e2e = e2e_module()
+    rng = np.random.default_rng(seed)
+    for _ in range(index + 1):
+        p = e2e.draw(rng)
+        (xs, v, _d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, sweeps)
+    return e2e, p, xs, v, xt, vt
+
+
+def units_ratios(job) -> tuple[bool, list[float]]:
+    seed, index, sweeps, caps = job
+    warnings.filterwarnings("ignore")
+    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    oracle = e2e.oracle_reference(p, xs, v, xt, vt)
+    six = sigmoids.fit_forward(xs, v, more_units=sigmoids.MAX_UNITS)
+    d = sigmoids._scaled(xs, v, six.x_lo, six.x_hi, six.v_mid, six.v_half)
+    misfit = sigmoids._misfit(list(six.members), d, 0.0)
+    return misfit, [inverse_max(sigmoids.fit_forward(xs, v, max_units=k, more_units=k), xs.min(), xs.max(),
+                                xt, vt) / oracle for k in caps]
+
+
+def run_units(a) -> None:
+    caps = [int(k) for k in a.caps.split(",")]
+    with Pool(2) as pool:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            got = pool.map(units_ratios, [(seed, i, a.sweeps, caps) for i in range(a.n)], chunksize=1)
+            r = np.array([g[1] for g in got])
+            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
+                  + "; ".join(summary(f"K <= {k}", r[:, j]) for j, k in enumerate(caps))
+                  + f"; six units miss the readings on {sum(g[0] for g in got)}", flush=True)
+
+
+WEIGHT_RULES = ("Akaike", "AICc", "Bayes", "3 per parameter", "best alone")
+
+
+def weight_ratios(job) -> list[float]:
+    seed, index, sweeps = job
+    warnings.filterwarnings("ignore")
+    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    oracle = e2e.oracle_reference(p, xs, v, xt, vt)
+    fw = sigmoids.fit_forward(xs, v)
+    d = sigmoids._scaled(xs, v, fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+    m = min(d.positions, d.n)
+    k = np.array([u.params for u in fw.members], float)
+    fit = m * np.log(np.maximum((np.array([u.sse for u in fw.members]) + d.within) / d.n, 1e-24))
+    crits = [fit + 2 * k, fit + 2 * k + 2 * k * (k + 1) / np.maximum(m - k - 1, 1), fit + np.log(m) * k,
+             fit + 3 * k, np.where(np.arange(k.size) == np.argmin(fit + 2 * k), 0.0, np.inf)]
+    out = []
+    for c in crits:
+        w = np.exp(-0.5 * (c - c.min()))
+        curve = sigmoids.SigmoidForward(fw.members, w / w.sum(), fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+        out.append(inverse_max(curve, xs.min(), xs.max(), xt, vt) / oracle)
+    return out
+
+
+def run_weights(a) -> None:
+    with Pool(2) as pool:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            r = np.array(pool.map(weight_ratios, [(seed, i, a.sweeps) for i in range(a.n)], chunksize=1))
+            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
+                  + "; ".join(summary(rule, r[:, j]) for j, rule in enumerate(WEIGHT_RULES)), flush=True)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -192,10 +262,19 @@ def main() -> int:
     f.add_argument("--sweeps", type=int, default=2)
     f.add_argument("--steps", type=int, default=0, help="positions per sweep (0: the check's draw)")
     f.add_argument("--each", action="store_true", help="also each sensor's ratio")
+    u = sub.add_parser("units")
+    u.add_argument("--seeds", default="111,222")
+    u.add_argument("--n", type=int, default=30)
+    u.add_argument("--sweeps", type=int, default=2)
+    u.add_argument("--caps", default="6,8,10")
+    w = sub.add_parser("weights")
+    w.add_argument("--seeds", default="111,222")
+    w.add_argument("--n", type=int, default=30)
+    w.add_argument("--sweeps", type=int, default=2)
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
     {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
-     "flow": run_flow}[a.what](a)
+     "flow": run_flow, "units": run_units, "weights": run_weights}[a.what](a)
     return 0
 
 
