@@ -474,15 +474,17 @@ def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForwar
 
 def _misfit(fitted: list[Units], d: _Scaled, floor: float) -> bool:
     """Whether the closest member misses the position means by more than the scatter of the
-    readings about them allows (F test at :data:`MISFIT_P`; the scatter no smaller than
-    ``floor``, the converter's quantisation, which repeats on one code do not show).  Without
-    repeated readings there is no scatter to judge by: False."""
+    readings about them allows (F test at :data:`MISFIT_P`).  Repeats that read one code show
+    no scatter, yet their mean is off by the converter's quantisation (``floor``, its
+    standard deviation) as much as one reading is: the scatter is taken no smaller than the
+    floor times the readings a position.  Without repeated readings there is no scatter to
+    judge by: False."""
     groups = d.xn.size
     best = min(fitted, key=lambda u: u.sse)
     dof = groups - best.params
     if d.n <= groups or dof <= 0:
         return False
-    scatter = max(d.within / (d.n - groups), floor * floor)
+    scatter = max(d.within / (d.n - groups), floor * floor * d.n / groups)
     return bool(f_distribution.sf(best.sse / dof / scatter, dof, d.n - groups) < MISFIT_P)
 
 
