@@ -25,7 +25,7 @@ draws (generator seed 99).  flow: the whole flow instead of the curve alone, in 
 `flann eval` clamps them), on both cores: the figures `e2e_sensors.py` prints, without
 `flann gen`; against other code with PYTHONPATH=<worktree>/gen.  units: the curve alone on
 the check's sensors with the units capped at each of ``--caps`` (no growth past the cap), and
-whether six units miss the readings (the growth's test, without the converter's step).
+whether six units miss the readings (the growth's test, as `flann train` makes it).
 weights: the same members weighted by other rules than Akaike's (AICc, Bayes', 3 per
 parameter, the best member alone).
 """
@@ -47,8 +47,10 @@ import numpy as np
 from flann.cli import main as flann
 from flann.commands.predict import predict_clamped
 from flann.golden import sigmoids
+from flann.golden.forward import noise_floor_v
 from flann.golden.model import load_model
 from flann.physics import filament
+from flann.recordings import converter_step
 
 E2E = Path(__file__).resolve().parents[2] / "shared" / "checks" / "e2e_sensors.py"
 
@@ -197,7 +199,8 @@ def units_ratios(job) -> tuple[bool, list[float]]:
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
     six = sigmoids.fit_forward(xs, v, more_units=sigmoids.MAX_UNITS)
     d = sigmoids._scaled(xs, v, six.x_lo, six.x_hi, six.v_mid, six.v_half)
-    misfit = sigmoids._misfit(list(six.members), d, 0.0)
+    # the floor `flann train` gives the test: the readings' converter step
+    misfit = sigmoids._misfit(list(six.members), d, noise_floor_v(v, converter_step(v)) / six.v_half)
     return misfit, [inverse_max(sigmoids.fit_forward(xs, v, max_units=k, more_units=k), xs.min(), xs.max(),
                                 xt, vt) / oracle for k in caps]
 
