@@ -13,6 +13,7 @@ the curve `flann train` wrote before the odd members).
     .venv/bin/python bench/odd_members.py flow --seeds 202,404 [--n 30] [--sweeps 2] [--steps M] [--each]
     .venv/bin/python bench/odd_members.py units --seeds 111,222 [--n 30] [--sweeps 2] [--caps 6,8,10]
     .venv/bin/python bench/odd_members.py weights --seeds 111,222 [--n 30] [--sweeps 2]
+    .venv/bin/python bench/odd_members.py oracles --seeds 111,222,333 [--n 30] [--sweeps 2]
 
 filament: random geometries of the independent forward model (`flann.physics.filament`),
 161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
@@ -27,7 +28,10 @@ draws (generator seed 99).  flow: the whole flow instead of the curve alone, in 
 the check's sensors with the units capped at each of ``--caps`` (no growth past the cap), and
 whether six units miss the readings (the growth's test, as `flann train` makes it).
 weights: the same members weighted by other rules than Akaike's (AICc, Bayes', 3 per
-parameter, the best member alone).
+parameter, the best member alone).  oracles: how far apart two fits that both know the
+check's formula land: the check's oracle (least squares) against the same formula fitted with
+a soft-L1 loss (as good under Gaussian noise, a different estimator), held-out max error of
+the second / the first: the spread the metric has when nothing is wrong with either fit.
 """
 
 from __future__ import annotations
@@ -43,11 +47,13 @@ from multiprocessing import Pool
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from flann.cli import main as flann
 from flann.commands.predict import predict_clamped
 from flann.golden import sigmoids
 from flann.golden.forward import noise_floor_v
+from flann.golden.inverse import invert
 from flann.golden.model import load_model
 from flann.physics import filament
 from flann.recordings import converter_step
@@ -65,10 +71,7 @@ def free_only(fw: sigmoids.SigmoidForward, x, v) -> sigmoids.SigmoidForward:
 
 
 def inverse_max(curve, lo: float, hi: float, xt, vt) -> float:
-    g = np.linspace(lo, hi, 40001)
-    c = curve(g)
-    o = np.argsort(c)
-    return float(np.max(np.abs(np.interp(np.clip(vt, c.min(), c.max()), c[o], g[o]) - xt)))
+    return float(np.max(np.abs(invert(curve, lo, hi, vt, points=40001) - xt)))
 
 
 def both_and_free(x, v, lo, hi, xt, vt) -> tuple[float, float, float]:
@@ -247,6 +250,31 @@ def run_weights(a) -> None:
                   + "; ".join(summary(rule, r[:, j]) for j, rule in enumerate(WEIGHT_RULES)), flush=True)
 
 
+def robust_oracle(e2e, p, xs, v, xt, vt) -> float:
+    """The check's oracle fitted with a soft-L1 loss in noise units instead of least squares."""
+    def curve(th, x):
+        return e2e.s_curve(x, {**p, **dict(zip(e2e.ORACLE_KEYS, th))})
+    th0 = np.array([p[k] for k in e2e.ORACLE_KEYS])
+    th0 = th0 * np.array([1.02, 1.02, 1.01, 1.0, 1.0, 1.0]) + np.array([0, 0, 0, 0.001, 0.0005, 0.01])
+    fit = least_squares(lambda th: (curve(th, xs) - v) / p["noise_v"], th0, loss="soft_l1")
+    return inverse_max(lambda x: curve(fit.x, x), xs.min(), xs.max(), xt, vt)
+
+
+def oracle_ratio(job) -> float:
+    seed, index, sweeps = job
+    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    return robust_oracle(e2e, p, xs, v, xt, vt) / e2e.oracle_reference(p, xs, v, xt, vt)
+
+
+def run_oracles(a) -> None:
+    with Pool(2) as pool:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            r = np.array(pool.map(oracle_ratio, [(seed, i, a.sweeps) for i in range(a.n)], chunksize=1))
+            label = "the soft-L1 oracle / the check's"
+            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), held-out max error, {summary(label, r)}, "
+                  f"best {r.min():.2f}", flush=True)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -274,10 +302,14 @@ def main() -> int:
     w.add_argument("--seeds", default="111,222")
     w.add_argument("--n", type=int, default=30)
     w.add_argument("--sweeps", type=int, default=2)
+    o = sub.add_parser("oracles")
+    o.add_argument("--seeds", default="111,222,333")
+    o.add_argument("--n", type=int, default=30)
+    o.add_argument("--sweeps", type=int, default=2)
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
     {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
-     "flow": run_flow, "units": run_units, "weights": run_weights}[a.what](a)
+     "flow": run_flow, "units": run_units, "weights": run_weights, "oracles": run_oracles}[a.what](a)
     return 0
 
 

@@ -139,8 +139,10 @@ def forward_curve(displacement_mm, voltage_v, step_v: float = 0.0) -> SigmoidFor
     return fit_forward(displacement_mm, voltage_v, step_v=step_v)
 
 
-def _invert(curve, lo: float, hi: float, v: np.ndarray) -> np.ndarray:
-    x = np.linspace(lo, hi, 8 * DENSE)
+def invert(curve, lo: float, hi: float, v: np.ndarray, points: int = 8 * DENSE) -> np.ndarray:
+    """x where the monotone ``curve`` reads ``v``, on ``points`` uniform in x over lo..hi;
+    readings past the curve's ends give the ends."""
+    x = np.linspace(lo, hi, points)
     f = curve(x)
     order = np.argsort(f)
     return np.interp(v, f[order], x[order])
@@ -169,7 +171,7 @@ def leave_one_out_mm(fw: Forward, displacement_mm, voltage_v) -> np.ndarray:
     def predict(keep, mean_v):
         pos = aggregate(x[keep], v[keep])
         trend = None if fw.trend is None else _trend(x[keep], v[keep])
-        return _invert(fw.curve(pos.x, pos.v, trend), x.min(), x.max(), np.array([mean_v]))[0]
+        return invert(fw.curve(pos.x, pos.v, trend), x.min(), x.max(), np.array([mean_v]))[0]
     return _left_out_mm(x, v, predict)
 
 
@@ -189,7 +191,7 @@ def forward_heldout(fw: SigmoidForward, displacement_mm, voltage_v) -> dict | No
         curve = refit(fw, x[keep], v[keep], min_weight=REFIT_WEIGHT)
         if curve is None:
             return None
-        err[held] = _invert(curve, *fw.stroke, v[held]) - x[held]
+        err[held] = invert(curve, *fw.stroke, v[held]) - x[held]
     e = err[np.sort(np.concatenate(folds))]
     return {"folds": len(folds), "points": int(e.size),
             "refit": "the members' units refined from the full fit's, not grown again",
