@@ -120,6 +120,27 @@ def e2e_module():
     return mod
 
 
+def check_sensor(seed: int, index: int, sweeps: int, steps: int = 0):
+    """(the check, parameters, recordings (x, v, direction), held-out points (x, v)) of sensor
+    ``index`` of ``seed``: the check's own draws, ``steps`` positions a sweep when not 0."""
+    e2e = e2e_module()
+    rng = np.random.default_rng(seed)
+    for _ in range(index + 1):
+        p = e2e.draw(rng)
+        if steps:
+            p["steps"] = steps
+        recorded, held, _lsb, _limit = e2e.recordings(p, rng, sweeps)
+    return e2e, p, recorded, held
+
+
+def per_seed(a, work, *extra):
+    """(seed, ``work``'s results for the seed's ``a.n`` sensors) per seed of ``a.seeds``, on
+    both cores; each job is (seed, index, sweeps, *extra)."""
+    with Pool(2) as pool:
+        for seed in (int(s) for s in a.seeds.split(",")):
+            yield seed, pool.map(work, [(seed, i, a.sweeps, *extra) for i in range(a.n)], chunksize=1)
+
+
 def ratios(e2e, p, rng) -> tuple[float, float]:
     (xs, v, _d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, 2)
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
@@ -142,11 +163,7 @@ def run_e2e(a) -> None:
 
 
 def run_draws(a) -> None:
-    e2e = e2e_module()
-    rng = np.random.default_rng(a.seed)
-    for _ in range(a.index + 1):
-        p = e2e.draw(rng)
-        e2e.recordings(p, rng, 2)       # the check's own draws, to reach sensor `index`
+    e2e, p, _recorded, _held = check_sensor(a.seed, a.index, 2)
     again = np.random.default_rng(99)
     r = np.array([ratios(e2e, p, again) for _ in range(a.draws)])
     print(f"seed {a.seed} #{a.index}, {a.draws} new noise draws, held-out max error / oracle: "
@@ -156,13 +173,7 @@ def run_draws(a) -> None:
 def flow_ratio(job) -> float:
     """Held-out max error / oracle of sensor ``index`` of ``seed`` through `flann train`."""
     seed, index, sweeps, steps = job
-    e2e = e2e_module()
-    rng = np.random.default_rng(seed)
-    for _ in range(index + 1):        # the check's own draws, to reach sensor `index`
-        p = e2e.draw(rng)
-        if steps:
-            p["steps"] = steps
-        (xs, v, d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, sweeps)
+    e2e, p, (xs, v, d), (xt, vt) = check_sensor(seed, index, sweeps, steps)
     with tempfile.TemporaryDirectory() as t:
         rec, out = Path(t) / "rec.csv", Path(t) / "model.json"
         e2e.write_csv(str(rec), (xs, v, d), ("displacement_mm", "voltage_v", "direction"))
@@ -175,30 +186,21 @@ def flow_ratio(job) -> float:
 
 
 def run_flow(a) -> None:
-    with Pool(2) as pool:
-        for seed in (int(s) for s in a.seeds.split(",")):
-            r = np.array(pool.map(flow_ratio, [(seed, i, a.sweeps, a.steps) for i in range(a.n)], chunksize=1))
-            if a.each:
-                print(f"seed {seed}: " + " ".join(f"#{i} {x:.2f}" for i, x in enumerate(r)), flush=True)
-            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the whole flow, held-out max error / "
-                  f"oracle: {summary('flann', r[~np.isnan(r)])}; not through: {int(np.isnan(r).sum())}",
-                  flush=True)
+    for seed, got in per_seed(a, flow_ratio, a.steps):
+        r = np.array(got)
+        if a.each:
+            print(f"seed {seed}: " + " ".join(f"#{i} {x:.2f}" for i, x in enumerate(r)), flush=True)
+        print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the whole flow, held-out max error / "
+              f"oracle: {summary('flann', r[~np.isnan(r)])}; not through: {int(np.isnan(r).sum())}",
+              flush=True)
 
 
-def check_sensor(seed: int, index: int, sweeps: int):
-    """(parameters, recordings, held-out points) of sensor ``index`` of ``seed``."""
-    e2e = e2e_module()
-    rng = np.random.default_rng(seed)
-    for _ in range(index + 1):
-        p = e2e.draw(rng)
-        (xs, v, _d), (xt, vt), _lsb, _limit = e2e.recordings(p, rng, sweeps)
-    return e2e, p, xs, v, xt, vt
 
 
 def units_ratios(job) -> tuple[bool, list[float]]:
     seed, index, sweeps, caps = job
     warnings.filterwarnings("ignore")
-    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
     six = sigmoids.fit_forward(xs, v, more_units=sigmoids.MAX_UNITS)
     d = sigmoids._scaled(xs, v, six.x_lo, six.x_hi, six.v_mid, six.v_half)
@@ -210,13 +212,11 @@ def units_ratios(job) -> tuple[bool, list[float]]:
 
 def run_units(a) -> None:
     caps = [int(k) for k in a.caps.split(",")]
-    with Pool(2) as pool:
-        for seed in (int(s) for s in a.seeds.split(",")):
-            got = pool.map(units_ratios, [(seed, i, a.sweeps, caps) for i in range(a.n)], chunksize=1)
-            r = np.array([g[1] for g in got])
-            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
-                  + "; ".join(summary(f"K <= {k}", r[:, j]) for j, k in enumerate(caps))
-                  + f"; six units miss the readings on {sum(g[0] for g in got)}", flush=True)
+    for seed, got in per_seed(a, units_ratios, caps):
+        r = np.array([g[1] for g in got])
+        print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
+              + "; ".join(summary(f"K <= {k}", r[:, j]) for j, k in enumerate(caps))
+              + f"; six units miss the readings on {sum(g[0] for g in got)}", flush=True)
 
 
 WEIGHT_RULES = ("Akaike", "AICc", "Bayes", "3 per parameter", "best alone")
@@ -225,7 +225,7 @@ WEIGHT_RULES = ("Akaike", "AICc", "Bayes", "3 per parameter", "best alone")
 def weight_ratios(job) -> list[float]:
     seed, index, sweeps = job
     warnings.filterwarnings("ignore")
-    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
     fw = sigmoids.fit_forward(xs, v)
     d = sigmoids._scaled(xs, v, fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
@@ -243,11 +243,10 @@ def weight_ratios(job) -> list[float]:
 
 
 def run_weights(a) -> None:
-    with Pool(2) as pool:
-        for seed in (int(s) for s in a.seeds.split(",")):
-            r = np.array(pool.map(weight_ratios, [(seed, i, a.sweeps) for i in range(a.n)], chunksize=1))
-            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
-                  + "; ".join(summary(rule, r[:, j]) for j, rule in enumerate(WEIGHT_RULES)), flush=True)
+    for seed, got in per_seed(a, weight_ratios):
+        r = np.array(got)
+        print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
+              + "; ".join(summary(rule, r[:, j]) for j, rule in enumerate(WEIGHT_RULES)), flush=True)
 
 
 def robust_oracle(e2e, p, xs, v, xt, vt) -> float:
@@ -262,17 +261,25 @@ def robust_oracle(e2e, p, xs, v, xt, vt) -> float:
 
 def oracle_ratio(job) -> float:
     seed, index, sweeps = job
-    e2e, p, xs, v, xt, vt = check_sensor(seed, index, sweeps)
+    e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
     return robust_oracle(e2e, p, xs, v, xt, vt) / e2e.oracle_reference(p, xs, v, xt, vt)
 
 
 def run_oracles(a) -> None:
-    with Pool(2) as pool:
-        for seed in (int(s) for s in a.seeds.split(",")):
-            r = np.array(pool.map(oracle_ratio, [(seed, i, a.sweeps) for i in range(a.n)], chunksize=1))
-            label = "the soft-L1 oracle / the check's"
-            print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), held-out max error, {summary(label, r)}, "
-                  f"best {r.min():.2f}", flush=True)
+    label = "the soft-L1 oracle / the check's"
+    for seed, got in per_seed(a, oracle_ratio):
+        r = np.array(got)
+        print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), held-out max error, {summary(label, r)}, "
+              f"best {r.min():.2f}", flush=True)
+
+
+def seeded(sub, name: str, seeds: str) -> argparse.ArgumentParser:
+    """A mode over the check's sensors: --seeds, --n a seed, --sweeps."""
+    p = sub.add_parser(name)
+    p.add_argument("--seeds", default=seeds)
+    p.add_argument("--n", type=int, default=30)
+    p.add_argument("--sweeps", type=int, default=2)
+    return p
 
 
 def main() -> int:
@@ -287,25 +294,12 @@ def main() -> int:
     d.add_argument("--seed", type=int, default=7)
     d.add_argument("--index", type=int, default=1)
     d.add_argument("--draws", type=int, default=16)
-    f = sub.add_parser("flow")
-    f.add_argument("--seeds", default="202,404")
-    f.add_argument("--n", type=int, default=30)
-    f.add_argument("--sweeps", type=int, default=2)
+    f = seeded(sub, "flow", "202,404")
     f.add_argument("--steps", type=int, default=0, help="positions per sweep (0: the check's draw)")
     f.add_argument("--each", action="store_true", help="also each sensor's ratio")
-    u = sub.add_parser("units")
-    u.add_argument("--seeds", default="111,222")
-    u.add_argument("--n", type=int, default=30)
-    u.add_argument("--sweeps", type=int, default=2)
-    u.add_argument("--caps", default="6,8,10")
-    w = sub.add_parser("weights")
-    w.add_argument("--seeds", default="111,222")
-    w.add_argument("--n", type=int, default=30)
-    w.add_argument("--sweeps", type=int, default=2)
-    o = sub.add_parser("oracles")
-    o.add_argument("--seeds", default="111,222,333")
-    o.add_argument("--n", type=int, default=30)
-    o.add_argument("--sweeps", type=int, default=2)
+    seeded(sub, "units", "111,222").add_argument("--caps", default="6,8,10")
+    seeded(sub, "weights", "111,222")
+    seeded(sub, "oracles", "111,222,333")
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
     {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
