@@ -143,9 +143,7 @@ def knee_readings(sweeps: int):
 
 def inverse_max_error(fw, truth) -> float:
     g = np.linspace(*fw.stroke, 4001)
-    c = fw(g)
-    o = np.argsort(c)
-    return float(np.max(np.abs(np.interp(truth(g), c[o], g[o]) - g)))
+    return float(np.max(np.abs(inverse.invert(fw, *fw.stroke, truth(g), points=g.size) - g)))
 
 
 def test_a_knee_six_units_miss_grows_more_units_from_the_repeats():
