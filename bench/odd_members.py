@@ -28,7 +28,7 @@ draws (generator seed 99).  flow: the whole flow instead of the curve alone, in 
 the check's sensors with the units capped at each of ``--caps`` (no growth past the cap), and
 whether six units miss the readings (the growth's test, as `flann train` makes it).
 weights: the same members weighted by other rules than Akaike's (AICc, Bayes', 3 per
-parameter, the best member alone).  oracles: how far apart two fits that both know the
+parameter, the best member alone, the fewest parameters the repeats accept).  oracles: how far apart two fits that both know the
 check's formula land: the check's oracle (least squares) against the same formula fitted with
 a soft-L1 loss (as good under Gaussian noise, a different estimator), held-out max error of
 the second / the first: the spread the metric has when nothing is wrong with either fit.
@@ -64,10 +64,9 @@ E2E = Path(__file__).resolve().parents[2] / "shared" / "checks" / "e2e_sensors.p
 def free_only(fw: sigmoids.SigmoidForward, x, v) -> sigmoids.SigmoidForward:
     """The same fit's free members weighted again: the curve without the odd members (the
     module's own averaging, reached into on purpose: no public switch is worth adding)."""
-    geometry = (fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
     free = [m for m in fw.members if m.shape is sigmoids._Free]
-    return sigmoids._averaged(free, sigmoids._scaled(np.asarray(x, float), np.asarray(v, float), *geometry),
-                              geometry)
+    return sigmoids._averaged(free, scaled(fw, np.asarray(x, float), np.asarray(v, float)),
+                              (fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half))
 
 
 def inverse_max(curve, lo: float, hi: float, xt, vt) -> float:
@@ -195,6 +194,15 @@ def run_flow(a) -> None:
               flush=True)
 
 
+def scaled(fw: sigmoids.SigmoidForward, x, v):
+    """The readings averaged per position, in ``fw``'s normalised x and v."""
+    return sigmoids._scaled(x, v, fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+
+
+def train_floor(fw: sigmoids.SigmoidForward, v) -> float:
+    """The floor `flann train` gives the misfit test (the readings' converter step), in
+    ``fw``'s normalised v."""
+    return noise_floor_v(v, converter_step(v)) / fw.v_half
 
 
 def units_ratios(job) -> tuple[bool, list[float]]:
@@ -203,9 +211,7 @@ def units_ratios(job) -> tuple[bool, list[float]]:
     e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
     six = sigmoids.fit_forward(xs, v, more_units=sigmoids.MAX_UNITS)
-    d = sigmoids._scaled(xs, v, six.x_lo, six.x_hi, six.v_mid, six.v_half)
-    # the floor `flann train` gives the test: the readings' converter step
-    misfit = sigmoids._misfit(list(six.members), d, noise_floor_v(v, converter_step(v)) / six.v_half)
+    misfit = sigmoids._misfit(list(six.members), scaled(six, xs, v), train_floor(six, v))
     return misfit, [inverse_max(sigmoids.fit_forward(xs, v, max_units=k, more_units=k), xs.min(), xs.max(),
                                 xt, vt) / oracle for k in caps]
 
@@ -219,7 +225,13 @@ def run_units(a) -> None:
               + f"; six units miss the readings on {sum(g[0] for g in got)}", flush=True)
 
 
-WEIGHT_RULES = ("Akaike", "AICc", "Bayes", "3 per parameter", "best alone")
+WEIGHT_RULES = ("Akaike", "AICc", "Bayes", "3 per parameter", "best alone",
+                "smallest accepted (p > 0.05)", "smallest accepted (p > 0.01)", "accepted, up to 2 more (p > 0.05)")
+
+
+def accepted(fw: sigmoids.SigmoidForward, d, floor: float, p_min: float) -> np.ndarray:
+    """Which members the repeats accept: the misfit test's p-value above ``p_min``."""
+    return np.array([(p := sigmoids._misfit_p(u, d, floor)) is not None and p > p_min for u in fw.members])
 
 
 def weight_ratios(job) -> list[float]:
@@ -227,19 +239,37 @@ def weight_ratios(job) -> list[float]:
     warnings.filterwarnings("ignore")
     e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
-    fw = sigmoids.fit_forward(xs, v)
-    d = sigmoids._scaled(xs, v, fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
+    fw = sigmoids.fit_forward(xs, v, step_v=converter_step(v))     # as `flann train` fits it
+    d = scaled(fw, xs, v)
     m = min(d.positions, d.n)
     k = np.array([u.params for u in fw.members], float)
-    fit = m * np.log(np.maximum((np.array([u.sse for u in fw.members]) + d.within) / d.n, 1e-24))
-    crits = [fit + 2 * k, fit + 2 * k + 2 * k * (k + 1) / np.maximum(m - k - 1, 1), fit + np.log(m) * k,
-             fit + 3 * k, np.where(np.arange(k.size) == np.argmin(fit + 2 * k), 0.0, np.inf)]
+    sse = np.array([u.sse for u in fw.members])
+    fit = m * np.log(np.maximum((sse + d.within) / d.n, 1e-24))
+    aic = fit + 2 * k
+    crits = [aic, aic + 2 * k * (k + 1) / np.maximum(m - k - 1, 1), fit + np.log(m) * k,
+             fit + 3 * k, alone(np.arange(k.size) == np.argmin(aic))]
+    # the fewest parameters the repeats accept, alone (the closest of that size) or with the
+    # accepted members up to 2 parameters more under Akaike's weights; none accepted: Akaike's
+    for p_min, more in ((0.05, None), (0.01, None), (0.05, 2)):
+        ok = accepted(fw, d, train_floor(fw, v), p_min)
+        if not ok.any():
+            crits.append(aic)
+        elif more is None:
+            fewest = ok & (k == k[ok].min())
+            crits.append(alone(fewest & (sse == sse[fewest].min())))
+        else:
+            crits.append(np.where(ok & (k <= k[ok].min() + more), aic, np.inf))
     out = []
     for c in crits:
         w = np.exp(-0.5 * (c - c.min()))
         curve = sigmoids.SigmoidForward(fw.members, w / w.sum(), fw.x_lo, fw.x_hi, fw.v_mid, fw.v_half)
         out.append(inverse_max(curve, xs.min(), xs.max(), xt, vt) / oracle)
     return out
+
+
+def alone(chosen: np.ndarray) -> np.ndarray:
+    """A criterion that gives the ``chosen`` member all the weight."""
+    return np.where(chosen, 0.0, np.inf)
 
 
 def run_weights(a) -> None:

@@ -472,20 +472,26 @@ def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForwar
     return SigmoidForward(tuple(members), w / w.sum(), *geometry, bool(straight))
 
 
-def _misfit(fitted: list[Units], d: _Scaled, floor: float) -> bool:
-    """Whether the closest member misses the position means by more than the scatter of the
-    readings about them allows (F test at :data:`MISFIT_P`).  Repeats that read one code show
-    no scatter, yet their mean is off by the converter's quantisation (``floor``, its
-    standard deviation) as much as one reading is: the scatter is taken no smaller than the
-    floor times the readings a position.  Without repeated readings there is no scatter to
-    judge by: False."""
+def _misfit_p(member: Units, d: _Scaled, floor: float) -> float | None:
+    """The F test's p-value that ``member`` misses the position means by no more than the
+    scatter of the readings about them allows, or None without repeated readings (no scatter
+    to judge by) or without the positions to spare.  Repeats that read one code show no
+    scatter, yet their mean is off by the converter's quantisation (``floor``, its standard
+    deviation) as much as one reading is: the scatter is taken no smaller than the floor
+    times the readings a position."""
     groups = d.xn.size
-    best = min(fitted, key=lambda u: u.sse)
-    dof = groups - best.params
+    dof = groups - member.params
     if d.n <= groups or dof <= 0:
-        return False
+        return None
     scatter = max(d.within / (d.n - groups), floor * floor * d.n / groups)
-    return bool(f_distribution.sf(best.sse / dof / scatter, dof, d.n - groups) < MISFIT_P)
+    return float(f_distribution.sf(member.sse / dof / scatter, dof, d.n - groups))
+
+
+def _misfit(fitted: list[Units], d: _Scaled, floor: float) -> bool:
+    """Whether the closest member misses the position means by more than the readings'
+    scatter allows (:func:`_misfit_p` below :data:`MISFIT_P`)."""
+    p = _misfit_p(min(fitted, key=lambda u: u.sse), d, floor)
+    return p is not None and p < MISFIT_P
 
 
 def _closest(fitted: list[Units], shape, linear: bool, units: int) -> np.ndarray:
