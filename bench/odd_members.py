@@ -241,10 +241,8 @@ def weight_ratios(job) -> list[float]:
     oracle = e2e.oracle_reference(p, xs, v, xt, vt)
     fw = sigmoids.fit_forward(xs, v, step_v=converter_step(v))     # as `flann train` fits it
     d = scaled(fw, xs, v)
-    m = min(d.positions, d.n)
-    k = np.array([u.params for u in fw.members], float)
+    fit, k, m = sigmoids.criterion_terms(fw.members, d)
     sse = np.array([u.sse for u in fw.members])
-    fit = m * np.log(np.maximum((sse + d.within) / d.n, 1e-24))
     aic = fit + 2 * k
     crits = [aic, aic + 2 * k * (k + 1) / np.maximum(m - k - 1, 1), fit + np.log(m) * k,
              fit + 3 * k, alone(np.arange(k.size) == np.argmin(aic))]

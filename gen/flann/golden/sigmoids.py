@@ -454,18 +454,24 @@ def _line(d: _Scaled) -> Units:
     return Units(np.zeros(0), beta, True, float(res @ res))
 
 
+def criterion_terms(members, d: _Scaled) -> tuple[np.ndarray, np.ndarray, int]:
+    """(each member's fit term, its parameters, the sample size) of an information
+    criterion, fit + penalty(parameters, sample size): Akaike's is fit + 2 parameters."""
+    # the positions are the sample size: repeated readings at one position share its error
+    # (backlash, hysteresis, drift between sweeps), so the evidence about the curve's shape
+    # grows with the positions, not the readings
+    m = min(d.positions, d.n)
+    # residuals below 1e-12 of the range are rounding: noise-free readings tie every member
+    fit = np.array([m * np.log(max((u.sse + d.within) / d.n, 1e-24)) for u in members])
+    return fit, np.array([u.params for u in members]), m
+
+
 def _averaged(fitted: list[Units], d: _Scaled, geometry: tuple) -> SigmoidForward | None:
     """The Akaike-weighted average of the monotone members, or None when none is."""
     members = [u for u in fitted if strictly_monotone(u(_CHECK))]
     if not members:
         return None
-    # Akaike's criterion with the positions as the sample size: repeated readings at one
-    # position share its error (backlash, hysteresis, drift between sweeps), so the evidence
-    # about the curve's shape grows with the positions, not the readings
-    m = min(d.positions, d.n)
-    # residuals below 1e-12 of the range are rounding: noise-free readings tie every member
-    fit = np.array([m * np.log(max((u.sse + d.within) / d.n, 1e-24)) for u in members])
-    params = np.array([u.params for u in members])
+    fit, params, m = criterion_terms(members, d)
     aic = fit + 2 * params
     w = np.exp(-0.5 * (aic - aic.min()))
     straight = members[int(np.argmin(fit + np.log(m) * params))].units == 0
@@ -551,4 +557,5 @@ def refit(fw: SigmoidForward, displacement_mm, voltage_v, min_weight: float = 0.
     return _averaged(fitted, d, geometry)
 
 
-__all__ = ["MAX_UNITS", "MIN_POSITIONS", "MORE_UNITS", "SigmoidForward", "Units", "fit_forward", "refit"]
+__all__ = ["MAX_UNITS", "MIN_POSITIONS", "MORE_UNITS", "SigmoidForward", "Units", "criterion_terms", "fit_forward",
+           "refit"]
