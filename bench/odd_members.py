@@ -14,6 +14,7 @@ the curve `flann train` wrote before the odd members).
     .venv/bin/python bench/odd_members.py units --seeds 111,222 [--n 30] [--sweeps 2] [--caps 6,8,10]
     .venv/bin/python bench/odd_members.py weights --seeds 111,222 [--n 30] [--sweeps 2]
     .venv/bin/python bench/odd_members.py oracles --seeds 111,222,333 [--n 30] [--sweeps 2]
+    .venv/bin/python bench/odd_members.py noise-free --seeds 111,222,333 [--n 30] [--sweeps 2] [--each]
 
 filament: random geometries of the independent forward model (`flann.physics.filament`),
 161 positions x 2 over 85 % of the monotone range, noise 2e-4 of the span; the inverse's max
@@ -32,6 +33,8 @@ parameter, the best member alone, the fewest parameters the repeats accept).  or
 check's formula land: the check's oracle (least squares) against the same formula fitted with
 a soft-L1 loss (as good under Gaussian noise, a different estimator), held-out max error of
 the second / the first: the spread the metric has when nothing is wrong with either fit.
+noise-free: the curve fitted to the readings and to the noise-free curve at the same
+positions, each over the oracle on the readings: how much of the error is bias, how much noise.
 """
 
 from __future__ import annotations
@@ -301,6 +304,27 @@ def run_oracles(a) -> None:
               f"best {r.min():.2f}", flush=True)
 
 
+def noise_free_ratios(job) -> tuple[float, float]:
+    """(the curve fitted as `flann train` fits it, the same fitted to the noise-free curve at
+    the same positions), held-out max error / the oracle's on the noisy readings: the second
+    is the bias alone, the rest of the first is the noise's."""
+    seed, index, sweeps = job
+    e2e, p, (xs, v, _d), (xt, vt) = check_sensor(seed, index, sweeps)
+    oracle = e2e.oracle_reference(p, xs, v, xt, vt)
+    noisy = sigmoids.fit_forward(xs, v, step_v=converter_step(v))
+    clean = sigmoids.fit_forward(xs, e2e.s_curve(xs, p))
+    return tuple(inverse_max(fw, xs.min(), xs.max(), xt, vt) / oracle for fw in (noisy, clean))
+
+
+def run_noise_free(a) -> None:
+    for seed, got in per_seed(a, noise_free_ratios):
+        r = np.array(got)
+        if a.each:
+            print(f"seed {seed}: " + " ".join(f"#{i} {x:.2f} ({y:.2f})" for i, (x, y) in enumerate(r)), flush=True)
+        print(f"seed {seed}, {a.n} sensors, {a.sweeps} sweep(s), the curve alone, held-out max error / oracle: "
+              f"{summary('noisy readings', r[:, 0])}; {summary('noise-free', r[:, 1])}", flush=True)
+
+
 def seeded(sub, name: str, seeds: str) -> argparse.ArgumentParser:
     """A mode over the check's sensors: --seeds, --n a seed, --sweeps."""
     p = sub.add_parser(name)
@@ -328,10 +352,13 @@ def main() -> int:
     seeded(sub, "units", "111,222").add_argument("--caps", default="6,8,10")
     seeded(sub, "weights", "111,222")
     seeded(sub, "oracles", "111,222,333")
+    seeded(sub, "noise-free", "111,222,333").add_argument("--each", action="store_true",
+                                                           help="also each sensor's ratios")
     a = ap.parse_args()
     warnings.filterwarnings("ignore")   # scipy's optimiser warnings on hopeless starts
     {"filament": run_filament, "off-centre": run_off_centre, "e2e": run_e2e, "draws": run_draws,
-     "flow": run_flow, "units": run_units, "weights": run_weights, "oracles": run_oracles}[a.what](a)
+     "flow": run_flow, "units": run_units, "weights": run_weights, "oracles": run_oracles,
+     "noise-free": run_noise_free}[a.what](a)
     return 0
 
 

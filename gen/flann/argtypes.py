@@ -48,6 +48,25 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
     return parse
 
 
+def terms_or_auto(lo: int, hi: int):
+    """An argparse ``type`` for ``--terms``: ``auto`` or an integer in ``[lo, hi]`` (``hi``:
+    :data:`flann.golden.model.MAX_TERMS`, passed in: this module stays free of numpy, which
+    every command's start-up would load)."""
+    def parse(text: str):
+        if text == "auto":
+            return "auto"
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer or 'auto', got {text!r}") from None
+        if not lo <= n <= hi:
+            raise argparse.ArgumentTypeError(f"must be {lo}..{hi} (the most terms flann fits and builds), got {n}")
+        return n
+
+    parse.__name__ = "terms"
+    return parse
+
+
 def checked(parse_value):
     """An argparse ``type`` from ``parse_value(text)``, which returns the value or raises
     :class:`~flann.errors.FlannError`: the rule stays where the value is used."""
@@ -61,4 +80,4 @@ def checked(parse_value):
     return parse
 
 
-__all__ = ["bounded", "checked", "finite_float"]
+__all__ = ["bounded", "checked", "finite_float", "terms_or_auto"]

@@ -14,7 +14,10 @@ TABLE1 = "data/paper_table1.csv"
 
 
 def run(argv, capsys):
-    rc = main([str(a) for a in argv])
+    try:
+        rc = main([str(a) for a in argv])
+    except SystemExit as exc:   # a flag refused by its argparse type: one line, exit 2
+        rc = exc.code
     out, err = capsys.readouterr()
     return rc, out, err
 

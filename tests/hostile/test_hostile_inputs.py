@@ -119,6 +119,20 @@ def p_nested(w):
     _write(w / "bad.json", "[" * 100_000 + "]" * 100_000)
 
 
+def p_nested_manifest(w):
+    (w / "design" / "manifest.json").write_text("[" * 100_000 + "]" * 100_000)
+
+
+def p_nested_spec(w):
+    _write(w / "bad.toml", "x = " + "[" * 100_000 + "]" * 100_000 + "\n")
+
+
+def p_bad_image(w):
+    """A sensor's image whose last word does not fit the memory's width."""
+    words = (w / "fam" / "image_s0.hex").read_text().splitlines()
+    _write(w / "a.hex", "\n".join(words[:-1] + ["1" + "0" * 40]) + "\n")
+
+
 def p_terms_true(w):
     _write(w / "bad.json", json.dumps(_model(w, terms=True)))
 
@@ -278,6 +292,11 @@ CASES = [
     Case("sim-nested-json", "11", ("sim", "bad.json"), 2, "nested deeper", (), "p_nested"),
     Case("predict-nested-json", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "nested deeper", (), "p_nested"),
     Case("gen-nested-json", "11", ("gen", "bad.json", "-o", "new"), 2, "nested deeper", (), "p_nested"),
+    Case("sim-nested-manifest", "11", ("sim", "design"), 2, "nested deeper", (), "p_nested_manifest"),
+    Case("synth-nested-manifest", "11", ("synth", "design", "--no-lint"), 2, "nested deeper", (), "p_nested_manifest"),
+    Case("ise-nested-manifest", "11", ("ise", "design", "-o", "ise"), 2, "nested deeper", (), "p_nested_manifest"),
+    Case("sim-image-too-wide", "11", ("sim", "fam", "--image", "a.hex", "--image", "fam/image_s1.hex"), 2,
+         "does not fit", (), "p_bad_image"),
     Case("eval-terms-true", "11", ("eval", "bad.json", "rec.csv"), 2, "must be a number", (), "p_terms_true"),
     Case("predict-terms-61.7", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "must be an integer", (), "p_terms_frac"),
     Case("gen-weights-string", "11", ("gen", "bad.json", "-o", "new"), 2, "'weights' must be a list", (), "p_weights_str"),
@@ -287,6 +306,8 @@ CASES = [
     Case("diagnose-sensor-toml-deep", "12", ("diagnose", "rec.csv", "--sensor", "bad.toml"), 2, "nested deeper", (), "p_toml_deep"),
     Case("calibrate-sensor-toml-int", "12", ("calibrate", "s1.csv", "-o", "out", "--sensor", "bad.toml", *FAM), 2,
          "too large", (), "p_toml_int"),
+    Case("calibrate-spec-toml-deep", "12", ("calibrate", "s1.csv", "-o", "out", "--spec", "bad.toml", *FAM), 2,
+         "nested deeper", (), "p_nested_spec"),
     # 14 flags that crashed
     Case("simulate-from-nan", "14", ("simulate", "-o", "o.csv", "--from-mm", "nan"), 2, "finite"),
     Case("simulate-seed-negative", "14", ("simulate", "-o", "o.csv", "--seed", "-1"), 2, "--seed"),
@@ -299,6 +320,11 @@ CASES = [
     Case("paper-eta-nan", "14", ("paper", "--eta", "nan"), 2, "finite"),
     # 16 resource bounds
     Case("train-terms-million", "16", ("train", "rec.csv", "-o", "o.json", "--terms", "1000000"), 2, "1..61"),
+    Case("train-epochs-1e11", "16", ("train", "rec.csv", "-o", "o.json", "--terms", "5", "--method", "lms",
+                                     "--epochs", "100000000000"), 2, "--epochs"),
+    Case("paper-epochs-1e11", "16", ("paper", "--epochs", "100000000000"), 2, "--epochs"),
+    Case("gen-family-terms-100", "16", ("gen", "--family", "s0.csv", "s1.csv", "-o", "newfam", "--terms", "100"), 2,
+         "--terms"),
     Case("train-too-many-rows", "16", ("train", "bad.csv", "-o", "o.json", "--terms", "5"), 2, "more than flann reads",
          (), "p_many_rows"),
     # 17 exit codes and lines

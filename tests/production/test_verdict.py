@@ -84,7 +84,7 @@ def test_spec_file_and_flags(tmp_path):
     ("[tolerance]\nworking_range_mm = [5, -5]\n", "below high"),
     ("[limits]\nfail_on_effects = [\"gremlins\"]\n", "unknown effect"),
     ("[tolerance]\nmax_eror_mm = 0.1\n", "unknown key"),
-    ("[tolerance\n", "not TOML"),
+    ("[tolerance\n", "not valid TOML"),
 ])
 def test_bad_spec_files_are_one_line_errors(tmp_path, text, words):
     p = tmp_path / "bad.toml"

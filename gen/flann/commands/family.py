@@ -2,20 +2,13 @@
 
 from __future__ import annotations
 
-import argparse
 
+from ..argtypes import terms_or_auto
 from ..errors import FlannError
+from ..golden.model import MAX_TERMS
+from ..hardware.family.build import MIN_TERMS
 from ..hardware.family.spec import DEFAULT_MARGIN
 from ..hardware.registry import FAMILY
-
-
-def _terms(text: str):
-    if text == "auto":
-        return "auto"
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer or 'auto', got {text!r}") from None
 
 
 def add_family_arguments(parser) -> None:
@@ -24,7 +17,7 @@ def add_family_arguments(parser) -> None:
                    help="size one design for these sensors (recordings .csv or model .json); per-sensor "
                         "values go to a weight memory loadable through cfg_we/cfg_addr/cfg_data; recordings "
                         "at several temperatures add in_temp and one memory per temperature order")
-    g.add_argument("--terms", type=_terms, default=None,
+    g.add_argument("--terms", type=terms_or_auto(MIN_TERMS, MAX_TERMS), default=None,
                    help="--family: expansion terms (per temperature order with temperature) when training "
                         "recordings, or 'auto' (default): chosen like flann train --terms auto (--temperature "
                         "with temperature) for the member that needs the most (docs/production.md)")

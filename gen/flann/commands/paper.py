@@ -6,12 +6,12 @@ import json
 
 import numpy as np
 
-from ..argtypes import checked
+from ..argtypes import bounded, checked
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..golden.train import fit_auto, fit_lstsq, normalisation, normalisation_kind
+from ..golden.train import MAX_EPOCHS, fit_auto, fit_lstsq, normalisation, normalisation_kind
 from ..golden import paper
 from ..hardware.fixed.cost import fixed_point_cost
 
@@ -28,10 +28,10 @@ def add_arguments(p) -> None:
                    help="print {raw_linearity_pct, tolerance_pct_fs, rows: [...]} as JSON")
     p.add_argument("--plot", metavar="DIR", default=None,
                    help="write PNGs equivalent to the paper's Fig. 5 into DIR")
-    p.add_argument("--eta", type=float, default=paper.DEFAULT_ETA,
+    p.add_argument("--eta", type=bounded(float, 0, lo_open=True), default=paper.DEFAULT_ETA,
                    help="LMS learning rate (the paper gives none; default %(default)g)")
-    p.add_argument("--epochs", type=int, default=paper.DEFAULT_EPOCHS,
-                   help="LMS epochs (the paper gives none; default %(default)d)")
+    p.add_argument("--epochs", type=bounded(int, 1, MAX_EPOCHS), default=paper.DEFAULT_EPOCHS,
+                   help=f"LMS epochs (the paper gives none; default %(default)d, at most {MAX_EPOCHS})")
     p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
                    help="linearity tolerance, %% of full scale (default %(default)g)")
     p.add_argument("--data", default=None,
@@ -47,10 +47,6 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    if not (args.eta > 0):
-        raise FlannError(f"--eta must be > 0, got {args.eta:g}")
-    if args.epochs < 1:
-        raise FlannError(f"--epochs must be >= 1, got {args.epochs}")
     if not (args.tol >= 0):
         raise FlannError(f"--tol must be >= 0 % FS, got {args.tol:g}")
     rec = paper.table1() if args.data is None else read_recordings(args.data)

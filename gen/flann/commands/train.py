@@ -9,14 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..argtypes import bounded, checked
+from ..argtypes import bounded, checked, terms_or_auto
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
+from ..golden.model import MAX_TERMS
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
-from ..golden.train import (PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
-from ..golden.model import MAX_TERMS
 from ..golden.inverse import inverse_fit
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
@@ -25,22 +25,10 @@ from .train_thermal import compensation_hint, run_thermal
 HELP = "train a FLANN inverse model on recordings"
 
 
-def _terms(text: str):
-    if text == "auto":
-        return "auto"
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a positive integer or 'auto', got {text!r}")
-    if not 1 <= n <= MAX_TERMS:
-        raise argparse.ArgumentTypeError(f"must be 1..{MAX_TERMS} (the most terms flann fits and builds), got {n}")
-    return n
-
-
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...)")
     p.add_argument("-o", "--output", required=True, help="model.json to write")
-    p.add_argument("--terms", type=_terms, default="auto",
+    p.add_argument("--terms", type=terms_or_auto(1, MAX_TERMS), default="auto",
                    help="expansion terms N (paper: %s) or 'auto' (default): the forward curve "
                         "v(x) fitted where the noise is, inverted, and the FLANN (terms, "
                         "normalisation, ridge) fitted to that inverse at the converter; the "
@@ -48,8 +36,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         % ", ".join(map(str, PAPER_TERMS)))
     p.add_argument("--method", choices=("lstsq", "lms"), default="lstsq",
                    help="closed-form least squares (default) or the paper's LMS")
-    p.add_argument("--eta", type=float, default=0.01, help="LMS learning rate (default 0.01)")
-    p.add_argument("--epochs", type=int, default=1000, help="LMS epochs (default 1000)")
+    p.add_argument("--eta", type=bounded(float, 0, lo_open=True), default=0.01,
+                   help="LMS learning rate (default 0.01)")
+    p.add_argument("--epochs", type=bounded(int, 1, MAX_EPOCHS), default=1000,
+                   help=f"LMS epochs (default 1000, at most {MAX_EPOCHS})")
     p.add_argument("--ridge", type=bounded(float, 0, 1e6), default=0.0,
                    help="lstsq ridge penalty on mean squared error (default 0)")
     p.add_argument("--normalise", type=checked(normalisation_kind), default=None,

@@ -200,11 +200,14 @@ def fit_lstsq(voltage_v, displacement_mm, terms: int, *, norm: str = "range",
 
 
 # -- LMS -----------------------------------------------------------------------------------
+MAX_EPOCHS = 100_000     # the paper's fits settle within a few thousand; one float per epoch is kept
+
+
 def _check_lms(eta: float, epochs: int) -> None:
     if not (eta > 0 and math.isfinite(eta)):
         raise FlannError(f"--eta must be a finite number > 0, got {eta!r}")
-    if epochs < 1:
-        raise FlannError(f"--epochs must be >= 1, got {epochs}")
+    if not 1 <= epochs <= MAX_EPOCHS:
+        raise FlannError(f"--epochs must be 1..{MAX_EPOCHS}, got {epochs}")
 
 
 def _diverged(S: np.ndarray, eta: float, where: str) -> FlannError:

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..fileio import atomic_directory
+from ..inputs import parse_json, read_text
 
 MANIFEST = "manifest.json"
 
@@ -53,10 +54,7 @@ def read_manifest(directory) -> Manifest:
     path = directory / MANIFEST
     if not path.is_file():
         raise FlannError(f"{path} not found: generate the design first (flann gen MODEL -o {directory})")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise FlannError(f"{path}: not valid JSON ({exc})") from None
+    data = parse_json(read_text(path, FlannError, "a design's manifest.json"), str(path), FlannError)
     if not isinstance(data, dict):
         raise FlannError(f"{path}: expected a JSON object with 'top' and 'files'")
     top, files = data.get("top"), data.get("files")

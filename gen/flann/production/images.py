@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 from ..errors import FlannError
+from ..inputs import read_text
 from ..hardware.family.spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
@@ -44,6 +45,11 @@ def parse_hex(text: str, source: str = "<hex>") -> list[int]:
     return words
 
 
+def read_image(path) -> list[int]:
+    """The words of a weight image file (``weights.hex``), or one error line."""
+    return parse_hex(read_text(path, FlannError, "a weight image (.hex)"), str(path))
+
+
 def mem_text(words, header: list[str] = ()) -> str:
     """Data2MEM .mem: the block RAM's 16-bit words from address 0, 8 a line."""
     halves = bram_image(words)
@@ -69,4 +75,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["hex_text", "parse_hex", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["hex_text", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]

@@ -17,11 +17,11 @@ range is stated.  Flags override the file's values one by one.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import FlannError
+from ..inputs import parse_toml, read_text
 from ..physics.effects import EFFECTS
 
 SPEC_KEYS = {"": {"name", "tolerance", "limits"},
@@ -107,14 +107,7 @@ def _check(spec: ProductionSpec, what: str) -> ProductionSpec:
 def load_spec(path) -> ProductionSpec:
     """A spec file (TOML, keys as in the module's docstring); one-line errors name the key."""
     path = Path(path)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise FlannError(f"{path}: no such spec file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FlannError(f"{path}: cannot read the spec file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise FlannError(f"{path}: not TOML ({exc})") from None
+    raw = parse_toml(read_text(path, FlannError, "a production spec (TOML)"), str(path), FlannError)
     for table, keys in SPEC_KEYS.items():
         sub = raw if not table else raw.get(table, {})
         if not isinstance(sub, dict):

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
+from ..production.images import read_image
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
@@ -61,6 +62,8 @@ def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
         raise FlannError(f"{design.directory}: the family bench loads two sensors' weight images through the "
                          f"cfg port; the design holds {len(images)} (pass --image A.hex --image B.hex, "
                          "written by flann calibrate)")
+    for im in images:      # a bad file is one line here, not a failed bench
+        read_image(im["hex"])
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
     codes = len(rec.get("codes", [])) * len(rec.get("outputs", {}))
@@ -127,22 +130,6 @@ def family_thermal_temperature_codes(spec) -> list[int]:
     return sorted({spec.temp_code_min, spec.temp_code_max, *inner})
 
 
-def _read_image(path) -> list[int]:
-    try:
-        text = Path(path).read_text()
-    except OSError as exc:
-        raise FlannError(f"{path}: cannot read the image ({exc.strerror})") from None
-    words = []
-    for n, line in enumerate(text.splitlines(), 1):
-        line = line.strip()
-        if line and not line.startswith("#"):
-            try:
-                words.append(int(line, 16))
-            except ValueError:
-                raise FlannError(f"{path}:{n}: {line!r} is not a hex word") from None
-    return words
-
-
 def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
     """One sensor's image (the last --image, else the design's last member: not the memories'
     initial sensor, so the cfg port is what loads it) at every voltage code and the stated
@@ -153,7 +140,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     if not images:
         raise FlannError(f"{design.directory}: no weight image to load (pass --image A.hex, written by flann calibrate)")
     image = images[-1]
-    words = _read_image(image["hex"])
+    words = read_image(image["hex"])
     if len(words) != spec.image_words:
         raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
     temps = family_thermal_temperature_codes(spec)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...errors import FlannError
-from ...golden.model import FlannModel, load_model
+from ...golden.model import MAX_TERMS, FlannModel, load_model
 from ...golden.family import family_terms
 from ...golden.train import fit_lstsq
 from ..fixed.cost import fixed_point_cost
@@ -18,6 +18,7 @@ from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
 
 DEFAULT_TERMS = "auto"  # chosen for the worst member, like train --terms auto (FIXED_TERMS: no recordings)
+MIN_TERMS = 2    # a family's weight memory holds the term v and at least one harmonic
 FIXED_TERMS = 15  # a CSV's terms when --terms auto has no recordings to choose from, and calibrate's fallback
 NORMALISATION = "half"  # v_n in [-0.5, 0.5]: the periodic terms need not join the two ends
 RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in accuracy
@@ -73,6 +74,12 @@ def load_member(path, terms: int = FIXED_TERMS, rec=None) -> FlannModel:
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
 
+def check_terms(terms: int) -> None:
+    """A family's term count (per temperature order with temperature): what a model file holds."""
+    if not MIN_TERMS <= int(terms) <= MAX_TERMS:
+        raise FlannError(f"--terms {terms}: must be {MIN_TERMS}..{MAX_TERMS}")
+
+
 def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
                     **options) -> dict:
     """Size one design for every source and write it (nothing written if any step fails)."""
@@ -81,9 +88,8 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     choices, read = [], read_csvs(sources)
     if terms == "auto":
         terms, choices = auto_terms(sources, options, margin, read)
-        terms = FIXED_TERMS if terms is None else max(2, terms)
-    if not 2 <= int(terms) <= 200:
-        raise FlannError(f"--terms {terms}: must be 2..200")
+        terms = FIXED_TERMS if terms is None else max(MIN_TERMS, terms)
+    check_terms(terms)
     models, bad = [], []
     for k, p in enumerate(sources):   # every member is tried: the user learns of all bad files at once
         try:
@@ -104,4 +110,4 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     return man
 
 
-__all__ = ["generate_family", "train_model", "load_member", "read_csvs", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]
+__all__ = ["check_terms", "generate_family", "MIN_TERMS", "train_model", "load_member", "read_csvs", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]

@@ -18,7 +18,7 @@ from ...golden.family import family_thermal_terms
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
 from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
-from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, read_csvs
+from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, check_terms, read_csvs
 from ..family.spec import DEFAULT_MARGIN
 from .render import write
 from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
@@ -144,8 +144,8 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    if terms != "auto" and not 2 <= int(terms) <= 60:
-        raise FlannError(f"--terms {terms}: must be 2..60")
+    if terms != "auto":
+        check_terms(terms)
     read = read_csvs(sources)
     try:
         temp = temp_norm(_range_of(sources, read), temp_bits, temp_lsb_c)
