@@ -1,4 +1,4 @@
-"""Resources and accuracy of the fixed and float18 designs side by side (issue 7, item 4).
+"""Resources and accuracy of the fixed and float18 designs side by side.
 
     .venv/bin/python bench/bench_float18.py [MODEL] [--device PART]
 

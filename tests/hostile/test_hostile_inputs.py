@@ -27,7 +27,7 @@ from flann.recordings import csvio
 @dataclass(frozen=True)
 class Case:
     id: str
-    klass: str          # the defect class of issue 18 (1..17) or "own"
+    klass: str          # the hostile-input defect class (1..17, docs/hostile_inputs.md) or "own"
     argv: tuple         # {w} is the world directory
     rc: int
     expect: str = ""    # a substring of the error line (rc != 0) or of stdout+stderr (rc 0)
@@ -435,8 +435,8 @@ def pytest_sessionfinish_table(path: Path) -> None:
              f"**{len(CASES)} cases** over all {len({c.argv[0] for c in CASES})} subcommands, {passed} with the "
              "expected exit code.  Each case also asserts: exactly one `error:` line when the exit code is "
              "not 0 (none when it is), no traceback, and no file created, changed or removed outside the "
-             "paths it may write (the whole temporary tree is hashed before and after).  Class = the defect "
-             "class of issue 18 (1-17) or `own`.  Faults (a 200 kB tmpfs, a write error inside a design and "
+             "paths it may write (the whole temporary tree is hashed before and after).  Class = the hostile-input "
+             "defect class (1-17) or `own`.  Faults (a 200 kB tmpfs, a write error inside a design and "
              "inside one sensor of a batch, Ctrl-C during start-up and in a calibrate pool) are in "
              "`tests/hostile/test_faults.py`.", "",
              "| # | case | class | command | expected | observed |", "|---|---|---|---|---|---|"]

@@ -94,6 +94,23 @@ def test_errors_are_one_line(small, tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("command", ["sim", "synth"])
+def test_post_route_of_another_datapath_is_refused_before_any_tool(small, tmp_path, capsys, command):
+    """The sweep driver drives flann_top's ports: a float18 design is refused in one line, by
+    both commands, before synthesis or a bench starts (no build directory is made)."""
+    model, _hdl = small
+    f18 = tmp_path / "f18"
+    assert main(["gen", str(model), "-o", str(f18), "--format", "float18"]) == 0
+    capsys.readouterr()
+    argv = {"sim": ["sim", str(f18), "--post-route", "--build", str(tmp_path / "b")],
+            "synth": ["synth", str(f18), "--device", "ice40-hx8k-ct256", "--post-route", "--no-lint",
+                      "--model", str(model), "-o", str(tmp_path / "o")]}[command]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the sweep driver drives flann_top's ports" in err[0] and "float18" in err[0], err
+    assert not (tmp_path / "o").exists()
+
+
 def test_every_table_part_has_its_package_in_the_chip_database():
     if not shutil.which("nextpnr-ice40"):
         pytest.skip("needs fpga-icestorm's chip database")

@@ -31,7 +31,7 @@ def test_table_matches_ds001_per_clb_arithmetic():
 
 
 def test_brief_figures():
-    # LUT4/FF and block RAM counts as listed in issue 4's brief
+    # LUT4/FF and block RAM counts as the device data sheets list them (DS001)
     assert [(d.luts, d.brams) for d in DEVICES] == [(384, 4), (864, 6), (1536, 8), (2400, 10), (3456, 12), (4704, 14)]
 
 

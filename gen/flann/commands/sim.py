@@ -20,6 +20,7 @@ from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
 from ..implement import ice40
 from ..verify.design import open_design
 from ..verify.datapaths import simulate
+from ..verify.netlist import require_sweep_driver
 from ..verify.post_route import checker
 from ..verify.runner import ENGINES, plot
 from ..verify.shards import terminal_progress
@@ -70,9 +71,8 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
-        if args.post_route and not design.datapath.netlist:
-            raise FlannError(f"--post-route: the sweep driver drives flann_top's ports; this is a "
-                             f"{design.datapath.name} design")
+        if args.post_route:
+            require_sweep_driver(design.datapath, args.model)
         images = [{"name": Path(h).stem, "hex": str(Path(h).resolve())} for h in args.image or []]
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=terminal_progress, images=images or None)

@@ -9,11 +9,11 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..implement import ice40, synth, timing
-from ..hardware.registry import FIXED, read_design
+from ..hardware.registry import read_design
 from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
-from ..verify.netlist import check_synthesized
+from ..verify.netlist import check_synthesized, require_sweep_driver
 from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
@@ -69,9 +69,7 @@ def post_route_check(directory, model):
     """The post-route simulation as :func:`flann.implement.ice40.implement` calls it; refuses a
     routed design that disagrees with its twin (nothing is written then)."""
     man, dp = read_design(directory)
-    if not dp.netlist:
-        raise FlannError(f"--post-route: the sweep driver drives {FIXED.top}'s ports; {directory} holds a "
-                         f"{dp.name} design")
+    require_sweep_driver(dp, directory)
     if model is None and not man.get("model"):
         raise FlannError("--post-route: pass --model MODEL.json (the twin is built from the model)")
     return checker(from_directory(directory, model), refuse=True)

@@ -18,6 +18,7 @@ from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_vali
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
 from ..golden.inverse import inverse_fit
+from ..hardware.adc import ADC_BITS
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .train_thermal import compensation_hint, run_thermal
@@ -55,10 +56,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--temperature", action="store_true",
                    help="a two-input model x(voltage, temperature) from a calibration at several "
                         "temperatures (the temperature_c column; docs/temperature.md)")
-    p.add_argument("--input-bits", type=int, default=None,
+    p.add_argument("--input-bits", type=bounded(int, *ADC_BITS), default=None,
                    help="--terms auto: the converter the model will be generated for (signed code "
                         "width); default: read from the recording's converter grid")
-    p.add_argument("--input-lsb-v", type=float, default=None,
+    p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None,
                    help="--terms auto: volts per code of that converter (default: the grid's step, "
                         "or flann gen's default for --input-bits)")
 
@@ -67,11 +68,7 @@ def converter(args, rec) -> dict | None:
     """The converter buildability is judged at: the user's (--input-bits/--input-lsb-v), else
     the recording's grid (every reading a whole number of one step), else None (the generator's
     default and widest converter, 12 and 16 bits)."""
-    if args.input_lsb_v is not None and not args.input_lsb_v > 0:
-        raise FlannError(f"--input-lsb-v must be a positive number of volts, got {args.input_lsb_v!r}")
     if args.input_bits is not None:
-        if not 4 <= args.input_bits <= 32:
-            raise FlannError(f"--input-bits must be 4..32, got {args.input_bits}")
         return {"input_bits": args.input_bits, "input_lsb_v": args.input_lsb_v, "from": "--input-bits"}
     if args.input_lsb_v is not None:
         raise FlannError("--input-lsb-v needs --input-bits")

@@ -1,4 +1,4 @@
-"""The float18 design as a row of the design-space table (issue 7, item 4).
+"""The float18 design as a row of the design-space table.
 
 ``measure(model_path, device)`` generates the float18 design, measures it with the same
 flow as ``flann synth`` (GHDL synthesis + Yosys ``synth_xilinx -family xcv``) and takes

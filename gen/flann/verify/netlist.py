@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
+from ..hardware.fixed.datapath import DATAPATH as FIXED
 from ..hardware.fixed.twin import FlannTop
 from ..implement import synth
 from .benches import BENCH_DIR
@@ -27,6 +28,7 @@ from .design import Design
 from .shards import cores, count_lines, merge, read_results, split
 
 DRIVER = "netlist_main.cpp"
+DRIVER_TOP = FIXED.top      # the driver is written against this entity's ports (Vflann_top)
 RAM_MODELS = "ramb4_sim.v"
 
 
@@ -72,13 +74,13 @@ def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cel
     if models is None:
         models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
     cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
-           "--top-module", "flann_top", "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
+           "--top-module", DRIVER_TOP, "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
            "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
            "-CFLAGS", f"-DIN_BITS={in_bits} -DOUT_BITS={out_bits}"]
     log = build / "verilator.log"
     with open(log, "w") as fh:
         r = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=build)
-    exe = build / "obj" / "Vflann_top"
+    exe = build / "obj" / f"V{DRIVER_TOP}"
     if r.returncode != 0 or not exe.is_file():
         text = log.read_text(errors="replace")
         first = next((ln.strip() for ln in text.splitlines() if "%Error" in ln or "error:" in ln), f"see {log}")
@@ -153,11 +155,19 @@ def check_rtl_netlist(design: Design, build, progress=None) -> dict:
     return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1)}
 
 
+def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> None:
+    """The netlist and post-route sweeps drive :data:`DRIVER_TOP`'s flat ports: refuse another
+    datapath's design before any slow step."""
+    if not datapath.netlist:
+        raise FlannError(f"{flag}: the sweep driver drives {DRIVER_TOP}'s ports; {directory} holds a "
+                         f"{datapath.name} design")
+
+
 def check_synthesized(design: Design, netlist: Path) -> dict:
     """``flann synth``'s check of the netlist it just counted (temporary build directory)."""
     with tempfile.TemporaryDirectory(prefix="flann-netlist-") as tmp:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["DRIVER_TOP", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

@@ -19,7 +19,7 @@ from pathlib import Path
 from ..errors import FlannError
 from ..hardware.target import Ice40Part
 from .design import Design
-from .netlist import compare, compile_netlist, run_netlist, yosys_datdir
+from .netlist import DRIVER_TOP, compare, compile_netlist, run_netlist, yosys_datdir
 from .shards import cores
 
 # cells_sim.v gives some cell inputs default values, which Verilator does not parse
@@ -69,8 +69,7 @@ def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, buil
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     man = design.manifest
-    top = "flann_top"
-    netlist = routed_verilog(Path(asc), Path(pcf), part, top, build / "post_route.v")
+    netlist = routed_verilog(Path(asc), Path(pcf), part, DRIVER_TOP, build / "post_route.v")
     models = [yosys_datdir() / "ice40" / "cells_sim.v"]
     exe = compile_netlist(netlist, build / "verilator_post_route", man["input_bits"], man["output_bits"],
                           models=models, defines=DEFINES)

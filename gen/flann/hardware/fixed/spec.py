@@ -239,7 +239,7 @@ class Spec(FrontEnd):
 
     # provenance
     generator_version: str
-    number_format: str  # "fixed" (room for "float18", issue 7)
+    number_format: str  # "fixed" or "float18": the datapath this spec sizes
     # architecture
     mult_style: str
     mult_digit_bits: int  # shift-add: weight bits per cycle
@@ -398,12 +398,10 @@ def derive_input(model: FlannModel, input_bits, input_lsb_v, clamp) -> InputStag
     plan = adc.plan_adc(model, input_bits, input_lsb_v, clamp)  # ranges, units, wide ADCs
     for note in plan.notes:
         warnings.warn(note)
-    B, input_lsb_v = _check_int("input_bits", plan.input_bits, 4, 16), plan.input_lsb_v
+    B = _check_int("input_bits", plan.input_bits, adc.ADC_BITS[0], adc.MAX_DESIGN_INPUT_BITS)
     vlo, vhi = sorted(model.voltage_range_v)
     cmin, cmax = signed_range(B)
-    if input_lsb_v is None:
-        # cover the trained range with 10 % margin, 3 significant digits (rounded up)
-        input_lsb_v = round_sig(max(abs(vlo), abs(vhi), 1e-12) * 1.10 / (1 << (B - 1)))
+    input_lsb_v = adc.default_input_lsb(model, B) if plan.input_lsb_v is None else plan.input_lsb_v
     if not (isinstance(input_lsb_v, (int, float)) and math.isfinite(input_lsb_v) and input_lsb_v > 0):
         raise SpecError(f"input_lsb_v = {input_lsb_v!r}: must be a positive number of volts")
     lsb = float(input_lsb_v)
