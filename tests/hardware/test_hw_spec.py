@@ -262,3 +262,14 @@ def test_shared_table_term_is_within_its_bound_at_every_quarter_wave_phase(model
     err = np.abs(terms / 2.0 ** Tf - ref)
     assert err.max() <= bound, (err.max(), bound)
     assert err.max() > bound / 20  # the check sees the table's error, not a vacuous bound
+
+
+@pytest.mark.parametrize("fmt", [FixedFormat(20, 3), FixedFormat(12, -2, False, "trn", "wrap"), FixedFormat(5, 5)])
+def test_a_described_format_parses_back(fmt):
+    assert FixedFormat.parse(fmt.describe()) == fmt
+
+
+@pytest.mark.parametrize("text", ["sfix<1,2>", "fix<8,2,rnd,sat>", "sfix<8,2,round,sat>", "sfix<0,0,rnd,sat>"])
+def test_a_malformed_format_is_a_spec_error(text):
+    with pytest.raises(SpecError):
+        FixedFormat.parse(text)

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from flann.cli import main
+from flann.implement.synth import SynthCheckError, yosys_cells
 
 FIX = Path(__file__).parent / "fixtures" / "synth"
 ISSUE_KEYS = {"device", "luts", "ffs", "brams", "lut_pct", "ff_pct", "bram_pct", "fits", "smallest_device"}
@@ -231,3 +232,14 @@ def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, 
     rc, out, err = _run(capsys, tmp_path / "d", "--model", model, "--no-lint", "--abc", "fast", "--json")
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and "disagrees with its twin" in err
+
+
+@pytest.mark.synth
+@needs_tools
+def test_yosys_check_refuses_two_drivers_by_its_exit_code(tmp_path):
+    """A netlist with two drivers on one wire passes GHDL's front end (it is Verilog here) and
+    must stop at Yosys's ``check -assert``, naming what the check found."""
+    (tmp_path / "two.v").write_text("module top(input a, input b, output y);\n"
+                                    "  assign y = a;\n  assign y = b;\nendmodule\n")
+    with pytest.raises(SynthCheckError, match="conflicting drivers"):
+        yosys_cells(tmp_path / "two.v", "top", tmp_path)

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import FlannError, RecordingsError
 from .thermal import ThermalModel, corrected_voltage, temperature_groups, thermal_design
-from .train import AUTO_NORMS, AUTO_PAIRED_Z, normalisation, solve_lstsq
+from .train import AUTO_MAX_CV_POINTS, AUTO_NORMS, AUTO_PAIRED_Z, normalisation, solve_lstsq
 
 MAX_ORDER = 2
 AUTO_TERMS = (0, 1, 3, 5, 7, 9, 11, 13, 15, 19, 25, 31, 41)
@@ -49,7 +49,6 @@ AUTO_RIDGES = (0.0, 1e-12, 1e-10, 1e-8, 1e-6)
 POSITION_FOLDS = 10
 MIN_TEMPERATURES = 2
 MIN_POSITIONS = 4
-AUTO_MAX_CV_POINTS = 20000
 
 
 def _temperature_norm(temperature_c) -> tuple[float, float]:

@@ -338,7 +338,7 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
         raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
     head = [f"read_verilog {verilog}"]
     # the netlist the counts describe, for post-synthesis simulation (flann.verify.netlist)
-    tail = ["check", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}",
+    tail = ["check -assert", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}",
             # last: flattening and dropping the cell library change nothing written above
             "flatten", "delete =A:blackbox", f"write_json {MAPPED_JSON}"]
     if abc == "full":
@@ -376,12 +376,11 @@ def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple
     text = log.read_text() if log.exists() else r.stderr
     if r.returncode != 0:
         err = next((ln for ln in (r.stderr + text).splitlines() if "ERROR" in ln), "see yosys log")
+        if "check -assert" in err:   # the netlist was built, and it has multiple drivers or loops
+            last_check = text.rsplit("Executing CHECK pass", 1)[-1]
+            found = [ln[len("Warning:"):].strip() for ln in last_check.splitlines() if ln.startswith("Warning:")]
+            raise SynthCheckError(f"{top}: yosys check failed: {found[0] if found else err.strip()}")
         raise FlannError(f"yosys synth_xilinx -family {FAMILY} failed: {err.strip()}")
-    problems = re.findall(r"Found and reported (\d+) problems", text)
-    if problems and int(problems[-1]) > 0:
-        driver_lines = [ln.strip() for ln in text.splitlines() if "conflicting driver" in ln or "multiple" in ln.lower()]
-        detail = driver_lines[0] if driver_lines else f"{problems[-1]} problems reported by yosys check"
-        raise SynthCheckError(f"{top}: yosys check failed: {detail}")
     warnings = []
     for ln in text.splitlines():
         if ln.startswith("Warning:"):

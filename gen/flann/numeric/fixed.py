@@ -14,6 +14,7 @@ the bit-true twin and the benches, so all three do the same integer arithmetic.
 
 from __future__ import annotations
 
+import re
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -22,6 +23,7 @@ from ..errors import SpecError
 
 ROUNDING = ("rnd", "trn")
 OVERFLOW = ("sat", "wrap")
+_DESCRIBED = re.compile(r"([su])fix<(\d+),(-?\d+),(\w+),(\w+)>")
 
 
 @dataclass(frozen=True)
@@ -99,6 +101,14 @@ class FixedFormat:
     def describe(self) -> str:
         s = "s" if self.signed else "u"
         return f"{s}fix<{self.width},{self.int_bits},{self.rounding},{self.overflow}>"
+
+    @classmethod
+    def parse(cls, text: str) -> FixedFormat:
+        """The format :meth:`describe` wrote (a manifest's), or :class:`SpecError`."""
+        m = _DESCRIBED.fullmatch(str(text).strip())
+        if not m:
+            raise SpecError(f"{text!r} is not a fixed-point format (sfix<W,I,rnd|trn,sat|wrap>)")
+        return cls(int(m.group(2)), int(m.group(3)), m.group(1) == "s", m.group(4), m.group(5))
 
     def to_dict(self) -> dict:
         d = asdict(self)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from ..errors import FlannError
 from ..inputs import read_text
+from ..hardware.family.render import image_text
 from ..hardware.family.spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
@@ -24,9 +25,8 @@ MEM_DIGITS = HALF_BITS // 4
 
 
 def hex_text(words, header: list[str] = ()) -> str:
-    lines = [f"# {h}" for h in header]
-    lines += [format(int(w), f"0{HEX_DIGITS}x") for w in words]
-    return "\n".join(lines) + "\n"
+    """``weights.hex``: ``#`` header lines, then the words as the design's own images hold them."""
+    return "".join(f"# {h}\n" for h in header) + image_text(words)
 
 
 def parse_hex(text: str, source: str = "<hex>") -> list[int]:

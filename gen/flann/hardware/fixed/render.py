@@ -9,12 +9,11 @@ and the spec, so regenerating gives identical bytes.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from ...errors import FlannError, SpecError
 from ...textgen import template
-from ...numeric.fixed import bits_literal, bits_needed
+from ...numeric.fixed import FixedFormat, bits_literal, bits_needed
 from ...golden.model import FlannModel, load_model, model_sha256
 from ..adc import AdcPlan, plan_adc
 from ..header import header
@@ -256,15 +255,13 @@ def write(spec: Spec, out_dir, adc_plan: AdcPlan | None = None, model: str | Non
 
 
 # -- a generated design, rebuilt from its manifest ----------------------------------------
-_FMT_RE = re.compile(r"^[us]fix<(\d+),(-?\d+),")
-
-
 def _format_bits(fmt: str, field: str) -> tuple[int, int]:
     """(width, fraction bits) of a format as the manifest writes it (``sfix<W,I,...>``)."""
-    m = _FMT_RE.match(str(fmt))
-    if not m:
-        raise FlannError(f"manifest spec field {field!r} = {fmt!r}: not a fixed-point format")
-    return int(m.group(1)), int(m.group(1)) - int(m.group(2))
+    try:
+        f = FixedFormat.parse(fmt)
+    except SpecError as exc:
+        raise FlannError(f"manifest spec field {field!r}: {exc}") from None
+    return f.width, f.frac_bits
 
 
 def manifest_options(man: dict, clamp: bool = True) -> dict:
