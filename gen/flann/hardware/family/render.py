@@ -60,11 +60,16 @@ def _fetch_plan(fam: FamilySpec) -> dict:
                 pidx_bits=max(1, fam.param_words.bit_length()))
 
 
-def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
+MEM = "flann_family_mem"
+
+
+def contexts(fam: FamilySpec, init_name: str, mem_entity: str = MEM) -> dict[str, dict]:
+    """Template context of every entity, by its name in :data:`ENTITIES`; the memory is
+    rendered as ``mem_entity`` (one per temperature order in a family design with temperature)."""
     s = fam.spec
     base = fixed.contexts(s)
     words = FlannFamilyMem.encode(fam, s)
-    mem = dict(depth=fam.mem_depth, data_bits=DATA_BITS, half_bits=HALF_BITS, addr_bits=fam.addr_bits,
+    mem = dict(entity=mem_entity, depth=fam.mem_depth, data_bits=DATA_BITS, half_bits=HALF_BITS, addr_bits=fam.addr_bits,
                init_name=init_name, halves=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)])
     n = base["flann_norm"]
     norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
@@ -80,9 +85,9 @@ def contexts(fam: FamilySpec, init_name: str) -> dict[str, dict]:
     mult = dict(mu, entity="flann_family_multiplier", weight=f"{FIXED_T}/multiplier/weight/memory",
                 data_bits=DATA_BITS)
     t = base["flann_top"]
-    top = dict(t, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
+    top = dict(t, mem_entity=mem_entity, latency=fam.latency_cycles, depth=fam.mem_depth, data_bits=DATA_BITS, addr_bits=fam.addr_bits,
                param_base=fam.param_base, step_bits=step_bits, pidx_bits=max(1, fam.param_words.bit_length()))
-    return {"flann_family_mem": mem, "flann_family_norm": norm, "flann_expansion": base["flann_expansion"],
+    return {MEM: mem, "flann_family_norm": norm, "flann_expansion": base["flann_expansion"],
             "flann_family_multiplier": mult, "flann_adder": base["flann_adder"], "flann_seq": base["flann_seq"],
             "flann_family_top": top}
 
@@ -95,12 +100,14 @@ def header_spec(fam: FamilySpec) -> dict:
                 **{f"family_{k}": v for k, v in d["widths"].items()})
 
 
-def render(fam: FamilySpec, init_name: str = "") -> dict[str, str]:
-    ctx = contexts(fam, init_name or "(first member)")
+def render(fam: FamilySpec, init_name: str = "", mem_entity: str = MEM) -> dict[str, str]:
+    """{file name: VHDL text} in compile order, the memory named ``mem_entity``."""
+    ctx = contexts(fam, init_name or "(first member)", mem_entity)
     out = {}
     for name, title, tpl in ENTITIES:
-        h = header(f"{name}.vhd", title, "flann gen --family", header_spec(fam), fam.spec.model_sha256)
-        out[f"{name}.vhd"] = template(f"{tpl}.vhd.j2").render(h=h, **ctx[name])
+        file = f"{mem_entity if name == MEM else name}.vhd"
+        h = header(file, title, "flann gen --family", header_spec(fam), fam.spec.model_sha256)
+        out[file] = template(f"{tpl}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 

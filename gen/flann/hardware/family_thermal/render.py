@@ -2,7 +2,7 @@
 
 The blocks are the family design's entities (:func:`flann.hardware.family.render.render`, its
 templates unchanged): the normaliser, expansion, multiplier, adder and sequencer written
-once, the weight memory once per order (renamed ``flann_ft<j>_mem``, initialised from order
+once, the weight memory once per order (named ``flann_ft<j>_mem``, initialised from order
 j of the initial sensor).  ``flann_family_thermal_top`` (this folder's template) wires them as
 the family top does, with one sequencer and one expansion shared by the orders (the orders'
 memories hold one input scale and clamp) and a memory, normaliser, multiplier and adder per
@@ -13,7 +13,6 @@ member's image (every order's memory in turn).
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 
 from ...numeric.fixed import bits_literal
@@ -29,35 +28,23 @@ TOP = "flann_family_thermal_top"
 DATAPATH = "family_thermal"
 INIT_MODEL = "init_model.json"
 TEMPLATES = "hardware/family_thermal/templates"
-PER_ORDER = ("flann_family_mem",)
 UNUSED = ("flann_family_top",)   # the top here wires the blocks itself
-_PER_ORDER_RE = re.compile(r"\b(" + "|".join(PER_ORDER) + r")\b")
 
 
 def order_name(entity: str, j: int) -> str:
     return f"flann_ft{j}_" + entity[len("flann_family_"):]
 
 
-def _rename(text: str, j: int) -> str:
-    return _PER_ORDER_RE.sub(lambda mt: order_name(mt.group(1), j), text)
-
-
 def order_files(spec: FamilyThermalSpec, init_name: str) -> dict[str, str]:
-    """The shared family entities once, every order's memory and family top renamed."""
-    out = {}
+    """The shared family entities once, then every order's memory (named for its order)."""
+    shared, memories = {}, {}
     for j, order_spec in enumerate(check_member(spec, spec.model)):
-        texts = family_render.render(replace(spec.fam, spec=order_spec), f"{init_name}, order {j}")
-        for name, text in texts.items():
-            entity = name[:-len(".vhd")]
-            if entity in UNUSED:
-                continue
-            if entity in PER_ORDER:
-                out[f"{order_name(entity, j)}.vhd"] = _rename(text, j)
-            elif j == 0:
-                out[name] = text
-    # compile order: shared entities, then each order's memory and top
-    shared = [n for n in out if not n.startswith("flann_ft")]
-    return {n: out[n] for n in shared + [n for n in out if n.startswith("flann_ft")]}
+        mem = order_name(family_render.MEM, j)
+        texts = family_render.render(replace(spec.fam, spec=order_spec), f"{init_name}, order {j}", mem)
+        memories[f"{mem}.vhd"] = texts[f"{mem}.vhd"]
+        if j == 0:
+            shared = {n: t for n, t in texts.items() if n[:-len(".vhd")] not in (mem, *UNUSED)}
+    return {**shared, **memories}
 
 
 def contexts(spec: FamilyThermalSpec) -> dict:
@@ -68,6 +55,7 @@ def contexts(spec: FamilyThermalSpec) -> dict:
     return dict(
         **{k: top[k] for k in ("phase_bits", "lin_bits", "term_bits", "product_bits", "step_bits", "pidx_bits",
                                "param_base")},
+        mem_entities=[order_name(family_render.MEM, j) for j in range(s.orders)],
         in_bits=s.input_bits, temp_bits=t.bits, out_bits=s.out_fmt.width, input_lsb_v=s.input_lsb_v,
         temp_lsb_c=t.lsb_c, output_lsb_mm=s.output_lsb_mm, latency=s.latency_cycles, orders=s.orders,
         order_bits=s.order_bits, acc_bits=acc, prod_bits=prod, t_bits=t.t_bits, t_shift=t.shift,

@@ -40,6 +40,12 @@ ENTITIES = (
 
 
 
+def entity_names(prefix: str = "flann_") -> dict[str, str]:
+    """Each entity's VHDL name by its short name (norm, expansion, ..., top): ``prefix`` and the
+    short name, so one library can hold several datapaths (the thermal design's orders)."""
+    return {short: prefix + short for short in (name[len("flann_"):] for name, _title in ENTITIES)}
+
+
 def _ubits(n: int) -> int:
     """Width of an unsigned counter holding 0..n."""
     return max(1, int(n).bit_length())
@@ -131,12 +137,14 @@ def render_front(fe: FrontEnd, command: str, spec_dict: dict) -> dict[str, str]:
     for name, title in ENTITIES:
         if name in FRONT_END:
             h = header(f"{name}.vhd", title, command, spec_dict, fe.model_sha256)
-            out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **FRONT_END[name](fe))
+            out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, entity=name, **FRONT_END[name](fe))
     return out
 
 
-def contexts(spec: Spec) -> dict[str, dict]:
-    """Template context of every entity."""
+def contexts(spec: Spec, names: dict[str, str] | None = None) -> dict[str, dict]:
+    """Template context of every entity, by its name in :data:`ENTITIES`; ``names``: the VHDL
+    names (:func:`entity_names`) they are rendered under."""
+    names = names or entity_names()
     s = spec
     B, L = s.input_bits, s.lanes
     T, W = s.term_fmt.width, s.weight_fmt.width
@@ -154,7 +162,7 @@ def contexts(spec: Spec) -> dict[str, dict]:
     K, WX = s.mult_digits, s.weight_reg_bits
     cnt_bits = _ubits(WX // K)
     multiplier = dict(
-        common, entity="flann_multiplier", weight=f"{TEMPLATES}/multiplier/weight/rom", style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
+        common, weight=f"{TEMPLATES}/multiplier/weight/rom", style=s.mult_style, fragments=f"{TEMPLATES}/multiplier/{s.mult_style}", weight_bits=W, weight_frac=s.weight_fmt.frac_bits,
         weight_type=s.weight_fmt.vhdl_type, product_type=s.product_fmt.vhdl_type,
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
@@ -182,17 +190,20 @@ def contexts(spec: Spec) -> dict[str, dict]:
         adv_period=s.adv_period, timer_bits=_ubits(max(1, s.adv_period - 1)), adv_cnt_bits=_ubits(n_advs),
     )
     seq = seq_context(s.steps, n_advs, s.adv_period)
-    return {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
-            "flann_adder": adder, "flann_seq": seq, "flann_top": top}
+    ctx = {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
+           "flann_adder": adder, "flann_seq": seq, "flann_top": dict(top, names=names)}
+    return {name: dict(c, entity=names[name[len("flann_"):]]) for name, c in ctx.items()}
 
 
-def render(spec: Spec) -> dict[str, str]:
-    """{file name: VHDL text} in compile order."""
-    ctx = contexts(spec)
+def render(spec: Spec, prefix: str = "flann_") -> dict[str, str]:
+    """{file name: VHDL text} in compile order, the entities named ``prefix`` + their short name."""
+    names = entity_names(prefix)
+    ctx = contexts(spec, names)
     out = {}
     for name, title in ENTITIES:
-        h = header(f"{name}.vhd", title, "flann gen", spec.to_dict(), spec.model_sha256)
-        out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **ctx[name])
+        entity = ctx[name]["entity"]
+        h = header(f"{entity}.vhd", title, "flann gen", spec.to_dict(), spec.model_sha256)
+        out[f"{entity}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **ctx[name])
     return out
 
 
@@ -290,7 +301,7 @@ def rebuild_spec(model_path, man: dict, where, check_device: bool = True) -> tup
     return rebuild_matching(man, where, lambda o: load(model_path, check_device=check_device, **o),
                             lambda clamp: manifest_options(man, clamp))
 
-__all__ = ["seq_context", "norm_context", "expansion_context", "render_front", "FRONT_END", "generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
+__all__ = ["entity_names", "seq_context", "norm_context", "expansion_context", "render_front", "FRONT_END", "generate", "write", "model_text", "MODEL_FILE", "DATAPATH", "render", "contexts", "manifest", "load", "read_manifest", "manifest_options",
            "rebuild_spec", "TOP",
            "ENTITIES", "MANIFEST", "write_design"]
 

@@ -123,7 +123,7 @@ def render_design(fspec) -> dict[str, str]:
     h = header(f"{SEQ}.vhd", "sequencer of one sample (shared by every top level)", COMMAND, fspec.to_dict(),
                b.model_sha256)
     out[f"{SEQ}.vhd"] = template(f"{FIXED_TEMPLATES}/{SEQ}.vhd.j2").render(
-        h=h, **seq_context(b.steps, fspec.n_advs, fspec.adv_period))
+        h=h, entity=SEQ, **seq_context(b.steps, fspec.n_advs, fspec.adv_period))
     ctx = cvt_context(fmt, b.term_fmt.width, b.term_fmt.frac_bits)
     cvt_spec = dict(_format_spec(fmt), in_bits=ctx["in_bits"], in_frac_bits=ctx["in_frac"])
     h = header(f"{CVT}.vhd", "signed fixed point terms to float18", COMMAND, cvt_spec, BLOCK_MODEL)

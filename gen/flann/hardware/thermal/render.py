@@ -11,7 +11,6 @@ spec's integer ranges; the template only places text.
 
 from __future__ import annotations
 
-import re
 import warnings
 from pathlib import Path
 
@@ -32,8 +31,6 @@ TOP = "flann_thermal_top"
 DATAPATH = "thermal"
 MODEL_FILE = fixed_render.MODEL_FILE
 TEMPLATES = "hardware/thermal/templates"
-# the fixed datapath's entities, renamed per order
-_ENTITY_RE = re.compile(r"\b(" + "|".join(name for name, _ in fixed_render.ENTITIES) + r")\b")
 
 
 def order_prefix(j: int) -> str:
@@ -41,13 +38,8 @@ def order_prefix(j: int) -> str:
 
 
 def order_files(spec: ThermalSpec, j: int) -> dict[str, str]:
-    """Order j's one-input datapath, its entities prefixed (file and entity names)."""
-    prefix = order_prefix(j)
-
-    def rename(text: str) -> str:
-        return _ENTITY_RE.sub(lambda m: prefix + m.group(1)[len("flann_"):], text)
-
-    return {rename(name): rename(text) for name, text in fixed_render.render(spec.orders[j]).items()}
+    """Order j's one-input datapath, its entities named with the order's prefix."""
+    return fixed_render.render(spec.orders[j], order_prefix(j))
 
 
 def contexts(spec: ThermalSpec) -> dict:
