@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from flann.cli import main as flann
+from flann.hardware.accuracy import physical_limit_mm
 
 
 def s_curve(x, p):
@@ -63,9 +64,30 @@ def recordings(p, rng):
     v = np.round((s_curve(xs, p) + rng.normal(0, p["noise_v"], xs.size)) / lsb) * lsb
     xt = np.sort(rng.uniform(lo, hi, 2000))
     vt = np.round(s_curve(xt, p) / lsb) * lsb
-    fine = np.linspace(lo, hi, 20001)
-    limit = float(np.max(0.5 * lsb / np.abs(np.gradient(s_curve(fine, p), fine))))
-    return (xs, v, direction), (xt, vt), lsb, limit
+    return (xs, v, direction), (xt, vt), lsb, true_limit_mm(p, lo, hi, lsb)
+
+
+class TrueInverse:
+    """The sensor's true x(v) (its curve inverted on a fine grid), as a model for
+    :func:`physical_limit_mm`: the limit is the sensor's, not the trained model's.  Its range
+    is the stroke's; the grid reaches past it, where a code's bin at the stroke's end does."""
+
+    def __init__(self, p, lo, hi, points=20001):
+        pad = 0.05 * (hi - lo)
+        x = np.linspace(lo - pad, hi + pad, points)
+        v = s_curve(x, p)
+        order = np.argsort(v)   # the curve falls with x when its sign is negative
+        self.v, self.x = v[order], x[order]
+        self.voltage_range_v = tuple(sorted(float(e) for e in s_curve(np.array([lo, hi]), p)))
+
+    def predict(self, voltage_v):
+        return np.interp(voltage_v, self.v, self.x)
+
+
+def true_limit_mm(p, lo, hi, lsb) -> float:
+    """The physical limit (flann eval's rule) on the true curve, worst over the stroke."""
+    inv = TrueInverse(p, lo, hi)
+    return float(np.max(physical_limit_mm(inv, s_curve(np.linspace(lo, hi, 20001), p), lsb)))
 
 
 def spline_max_error(v, x, vt, xt) -> float:

@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
+from ..hardware.accuracy import nearest_codes
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import F18Top
 from ..hardware.registry import FORMATS, datapath
@@ -251,8 +252,8 @@ class TraceResult:
         rows = []
         pos = {int(c): k for k, c in enumerate(self.codes)}
         for v in np.asarray(voltages, dtype=float):
-            # the nearest code, clamped as the hardware clamps its input
-            c = int(np.clip(np.rint(v / self.input_lsb_v), self.codes.min(), self.codes.max()))
+            # the converter's code, clamped as the hardware clamps its input
+            c = int(nearest_codes(v, self.input_lsb_v, self.codes.min(), self.codes.max()))
             k = pos[c]
             rows.append({"voltage_v": float(v), "code": c, "golden_mm": float(self.golden_mm[k]),
                          "hardware_mm": float(self.hardware_mm[k]),

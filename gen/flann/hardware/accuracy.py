@@ -17,7 +17,6 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
-from ..golden.model import FlannModel
 from ..numeric.fixed import signed_range
 from .registry import read_design
 from .fixed.cost import fixed_point_cost
@@ -57,7 +56,20 @@ def design_adc(design_dir) -> tuple[int, float]:
     return bits, float(lsb)
 
 
-# -- hardware accuracy against the physical limit ------------------------------------------
+# -- the converter -----------------------------------------------------------------------
+def nearest_codes(value, lsb, code_min: int, code_max: int) -> np.ndarray:
+    """The converter's rule, for voltages and temperatures alike: the nearest code with a tie
+    going up (``floor(value / lsb + 1/2)``), saturated to ``code_min..code_max``.
+
+    The twins and the HDL take integer codes; the converter in front of them is this model of
+    it, and the family designs are built with the same rule (their clamp codes and calibrated
+    temperature codes are the codes the trained range's ends round to this way).  Every path
+    from a reading to a code goes through here, so a reading exactly between two codes gets
+    one code everywhere (round half to even would take the even one)."""
+    c = np.floor(np.asarray(value, dtype=float) / lsb + 0.5)
+    return np.clip(c, code_min, code_max).astype(np.int64)
+
+
 def adc_codes(spec: Spec, voltage_v, adc: tuple[int, float] | None = None) -> np.ndarray:
     """Voltages as the design receives them: the converter's nearest code, saturated to its
     range; from a converter wider than the design, its top ``spec.input_bits`` bits (the low
@@ -66,20 +78,47 @@ def adc_codes(spec: Spec, voltage_v, adc: tuple[int, float] | None = None) -> np
     drop = bits - spec.input_bits
     if drop < 0:
         raise FlannError(f"ADC of {bits} bits is narrower than the design's {spec.input_bits}-bit input")
-    c = np.floor(np.asarray(voltage_v, dtype=float) / lsb + 0.5)
-    c = np.clip(c, *signed_range(bits)).astype(np.int64) >> drop
+    c = nearest_codes(voltage_v, lsb, *signed_range(bits)) >> drop
     return np.clip(c, spec.code_min, spec.code_max)
 
 
-def physical_limit_mm(model: FlannModel, voltage_v, input_lsb_v: float) -> np.ndarray:
-    """Half an ADC LSB over the sensor's local slope at each voltage: the error a perfect
-    compensator behind this converter still has.  The slope dv/dx is that of the model's
-    inverse (its dx/dv, by central differences over the trained range)."""
-    vlo, vhi = sorted(model.voltage_range_v)
-    grid = np.linspace(vlo, vhi, 4001)
-    dxdv = np.abs(np.gradient(model.predict(grid), grid))
-    v = np.clip(np.asarray(voltage_v, dtype=float), vlo, vhi)
-    return 0.5 * input_lsb_v * np.interp(v, grid, dxdv)
+def temperature_codes(spec, temperature_c) -> np.ndarray:
+    """Temperatures as a two-input design receives them: the temperature converter's nearest
+    code, saturated to its range (``spec.temp_lsb_c``, ``temp_code_min..temp_code_max``; the
+    design clamps further, to its calibrated codes)."""
+    return nearest_codes(temperature_c, spec.temp_lsb_c, spec.temp_code_min, spec.temp_code_max)
+
+
+# -- hardware accuracy against the physical limit ------------------------------------------
+def physical_limit_mm(model, voltage_v, lsb_v: float, temperature_c=None) -> np.ndarray:
+    """The physical limit at each reading (mm): half an LSB of the converter over the sensor's
+    local slope dv/dx, ``0.5 |x(v + lsb/2) - x(v - lsb/2)|`` with ``x(v)`` the model
+    (``model.predict``; at the reading's temperature for a two-input model) -- half the
+    displacement width of one code's bin.  Every displacement in the bin reads the same code,
+    so this is what a perfect compensator behind this converter is still off by; the headline
+    ``ratio_to_limit`` of ``flann eval --design`` and of the production certificate is the max
+    error over the largest of these, worst over the stroke.
+
+    Readings are clipped to the model's trained voltage range (temperatures to its calibrated
+    range) first: the model is the only knowledge of the slope and is a fit only there (a
+    trigonometric sum far beyond it has a slope no sensor has), and the designs clamp their
+    codes to that range, so a reading beyond it gets the slope at the range's end.  The bin
+    around a reading at the end reaches half an LSB past it: a smooth fit's continuation over
+    that distance is its slope at the end, where the limit is usually largest; clipping the
+    bin instead would take the slope half an LSB inside (1 % lower at the flat end of an
+    S-curve read with 8 bits).
+
+    ``model`` is anything with ``predict`` and ``voltage_range_v`` (a benchmark's true sensor
+    too); ``lsb_v`` is the converter's LSB (the full ADC's when the design drops low bits)."""
+    h = 0.5 * lsb_v
+    v = np.clip(np.asarray(voltage_v, dtype=float), *sorted(model.voltage_range_v))
+    if temperature_c is None:
+        dx = model.predict(v + h) - model.predict(v - h)
+    else:
+        t = np.clip(np.broadcast_to(np.asarray(temperature_c, dtype=float), v.shape),
+                    *sorted(model.temperature_range_c))
+        dx = model.predict(v + h, t) - model.predict(v - h, t)
+    return 0.5 * np.abs(dx)
 
 
 def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, float] | None = None) -> dict:
@@ -133,10 +172,8 @@ def thermal_accuracy(spec: ThermalSpec | FamilyThermalSpec, rec, *, tol, band, f
     if rec.temperature_c is None:
         raise FlannError(f"{rec.source}: a two-input design needs a temperature_c column")
     m, x = spec.model, rec.displacement_mm
-    codes = np.clip(np.floor(np.asarray(rec.voltage_v, dtype=float) / spec.input_lsb_v + 0.5),
-                    spec.code_min, spec.code_max).astype(np.int64)
-    tcodes = np.clip(np.floor(np.asarray(rec.temperature_c, dtype=float) / spec.temp_lsb_c + 0.5),
-                     spec.temp_code_min, spec.temp_code_max).astype(np.int64)
+    codes = adc_codes(spec, rec.voltage_v)
+    tcodes = temperature_codes(spec, rec.temperature_c)
     # the twin once per distinct (code, temperature code)
     pairs, back = np.unique(np.stack([codes, tcodes], axis=1), axis=0, return_inverse=True)
     back = back.ravel()
@@ -144,11 +181,7 @@ def thermal_accuracy(spec: ThermalSpec | FamilyThermalSpec, rec, *, tol, band, f
     hw_mm = out[back] * spec.output_lsb_mm
     v, t, _ = m.clamp(rec.voltage_v, rec.temperature_c)
     fl_mm = m.predict(v, t)
-    vlo, vhi = sorted(m.voltage_range_v)
-    h = 0.5 * spec.input_lsb_v
-    v1, v2 = np.clip(v - h, vlo, vhi), np.clip(v + h, vlo, vhi)
-    slope = np.abs(m.predict(v2, t) - m.predict(v1, t)) / np.maximum(v2 - v1, 1e-300)
-    limit = 0.5 * spec.input_lsb_v * slope
+    limit = physical_limit_mm(m, rec.voltage_v, spec.input_lsb_v, rec.temperature_c)
     e_hw, e_fl = hw_mm - x, fl_mm - x
     rep = error_report(hw_mm, x, tol, band, fs_mm, rec.direction)
     lim_max = float(limit.max())
@@ -201,5 +234,5 @@ def plot_errors(path, x, raw_err, float_err, hw_err, limit, title: str = "") -> 
         plt.close(fig)
 
 
-__all__ = ["fixed_point_cost", "design_spec", "design_adc", "adc_codes", "physical_limit_mm", "hardware_accuracy",
-           "plot_errors"]
+__all__ = ["fixed_point_cost", "design_spec", "design_adc", "nearest_codes", "adc_codes", "temperature_codes",
+           "physical_limit_mm", "hardware_accuracy", "plot_errors"]

@@ -46,6 +46,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
+from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
@@ -144,13 +145,6 @@ def train_for_design(rec, fam: FamilySpec):
     raise last
 
 
-def physical_limit_mm(model, voltage_v, lsb_v: float) -> np.ndarray:
-    """Half an input LSB divided by the local slope dv/dx (from the model's dx/dv), per point."""
-    v = np.asarray(voltage_v, dtype=float)
-    dxdv = (model.predict(v + lsb_v / 2) - model.predict(v - lsb_v / 2)) / lsb_v
-    return 0.5 * lsb_v * np.abs(dxdv)
-
-
 def check_sensor(rec, fam: FamilySpec) -> dict:
     """Train, quantise and check one sensor's recordings against the family design's twin."""
     model, spec = train_for_design(rec, fam)
@@ -166,7 +160,7 @@ def check_sensor(rec, fam: FamilySpec) -> dict:
     bound = float(spec.analysis["bound_total_lsb"])
     # the recording through the hardware: ADC code of each voltage, the twin's output
     v, x = rec.voltage_v, rec.displacement_mm
-    rc = np.clip(np.floor(v / lsb + 0.5).astype(np.int64), s.code_min, s.code_max)
+    rc = adc_codes(s, v)
     hw_mm = out[rc - s.code_min] * q
     err = hw_mm - x
     raw_err = raw_output_mm(v, x) - x
@@ -540,5 +534,5 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design", "physical_limit_mm",
+__all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
            "diagnosis_sample", "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES", "DIAGNOSIS_POINTS"]

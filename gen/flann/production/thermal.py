@@ -22,6 +22,7 @@ import numpy as np
 from ..golden.metrics import full_scale_mm, raw_output_mm
 from ..golden.thermal import temperature_groups
 from ..golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
+from ..hardware.accuracy import adc_codes, physical_limit_mm, temperature_codes
 from ..hardware.family.spec import FitError
 from ..hardware.family_thermal.build import fit_sensor
 from ..hardware.family_thermal.spec import FamilyThermalSpec
@@ -39,11 +40,6 @@ def train_for_design(rec, spec: FamilyThermalSpec, ridges):
     raise last
 
 
-def temperature_codes(spec: FamilyThermalSpec, temperature_c) -> np.ndarray:
-    t = np.floor(np.asarray(temperature_c, dtype=float) / spec.temp.lsb_c + 0.5).astype(np.int64)
-    return np.clip(t, spec.temp.code_min, spec.temp.code_max)
-
-
 def check_sensor_thermal(rec, spec: FamilyThermalSpec, ridges) -> dict:
     """Train (``ridges`` tried in order), quantise and check one sensor's multi-temperature
     recordings (see the module doc)."""
@@ -56,12 +52,10 @@ def check_sensor_thermal(rec, spec: FamilyThermalSpec, ridges) -> dict:
     s = spec.fam.spec
     q, lsb = spec.output_lsb_mm, s.input_lsb_v
     v, x, t = rec.voltage_v, rec.displacement_mm, np.asarray(rec.temperature_c, dtype=float)
-    rc = np.clip(np.floor(v / lsb + 0.5).astype(np.int64), s.code_min, s.code_max)
-    r = twin.process(rc, tcodes)
+    r = twin.process(adc_codes(spec, v), tcodes)
     err = r.out_data * q - x
     raw_err = raw_output_mm(v, x) - x
-    dxdv = (model.predict(v + lsb / 2, t) - model.predict(v - lsb / 2, t)) / lsb
-    limit = 0.5 * lsb * np.abs(dxdv)
+    limit = physical_limit_mm(model, v, lsb, t)
     fs = full_scale_mm(x)   # flann eval's full scale (half the span): one drift figure
     return {"model": model, "words": words, "twin_err_lsb": twin_err, "bound_lsb": float(spec.analysis["bound_lsb"]),
             "hw_err_mm": err, "raw_err_mm": raw_err, "limit_mm": limit, "rec": rec, "temperature_c": t,
