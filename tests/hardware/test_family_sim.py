@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 
 import pytest
 
+from flann.cli import main
 from flann.hardware.family.build import generate_family
 from flann.hardware.family.render import load_design
 from flann.production.calibrate import check_sensor
@@ -52,3 +54,20 @@ def test_two_identical_sensors_verify(tmp_path):
     res = runner.run_family_bench(hdl, images, tmp_path / "build")
     assert res.tests == 3 and res.ok, f"failed: {res.failed_tests}"
     assert res.records["family_every_code"]["mismatches"] == 0
+
+
+def test_calibrate_then_sim_the_weight_files_it_writes(tmp_path, capsys):
+    """The seam a production line walks: gen --family, calibrate two sensors, then sim with the
+    two weights.hex files calibrate wrote (same file name, each in its sensor's folder)."""
+    recs = write_batch(tmp_path / "rec", 3, seed=11, points=400)
+    fam, out = tmp_path / "fam", tmp_path / "cal"
+    assert main(["gen", "--family", *map(str, recs[:2]), "--terms", "9", "--input-bits", "8", "-o", str(fam)]) == 0
+    assert main(["calibrate", *map(str, recs[1:]), "-o", str(out), "--design", str(fam),
+                 "--diagnosis-points", "40", "-j", "1"]) == 0
+    hexes = sorted(out.glob("*/weights.hex"))
+    assert len(hexes) == 2
+    capsys.readouterr()
+    assert main(["sim", str(fam), "--image", str(hexes[0]), "--image", str(hexes[1]), "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["all_passed"] and s["mismatches"] == 0 and s["codes_tested"] == 2 * 2 ** 8
+    assert s["images"] == [f"{h.parent.name}/weights" for h in hexes]

@@ -62,6 +62,19 @@ def add_arguments(parser) -> None:
     gen_options.add_arguments(parser)
 
 
+def image_names(paths) -> list[dict]:
+    """{name, hex} per --image: the file's stem, or its folder and stem where stems repeat
+    (flann calibrate writes every sensor's weights.hex in the sensor's own folder)."""
+    files = [Path(h).resolve() for h in paths]
+    stems = [f.stem for f in files]
+    names = [f"{f.parent.name}/{f.stem}" if stems.count(f.stem) > 1 else f.stem for f in files]
+    names = [str(f) if names.count(n) > 1 else n for f, n in zip(files, names)]
+    if len(set(names)) < len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise FlannError(f"--image {twice}: given twice; give different sensors' images")
+    return [{"name": n, "hex": str(f)} for n, f in zip(names, files)]
+
+
 def run(args) -> int:
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
@@ -73,7 +86,7 @@ def run(args) -> int:
         design = open_design(args.model, build, opts, model=args.design_model)
         if args.post_route:
             require_sweep_driver(design.datapath, args.model)
-        images = [{"name": Path(h).stem, "hex": str(Path(h).resolve())} for h in args.image or []]
+        images = image_names(args.image or [])
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=terminal_progress, images=images or None)
         s = res["summary"]

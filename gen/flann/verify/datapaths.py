@@ -18,6 +18,7 @@ from ..production.images import read_image
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
+from .netlist import require_sweep_driver
 from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
 
 # a two-input sweep over every voltage code at every temperature code up to this many samples;
@@ -55,15 +56,25 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
+def _images(design: Design, images, least: int) -> list[dict]:
+    """The weight images a family bench loads ({name, hex}): those given (--image), else the
+    ones flann gen kept in the design; each read here, so a bad file is one line, not a failed
+    bench."""
+    given = bool(images)
     images = list(images or [{"name": im["name"], "hex": str(design.directory / im["hex"])}
                              for im in design.manifest.get("images", [])])
-    if len(images) < 2:
-        raise FlannError(f"{design.directory}: the family bench loads two sensors' weight images through the "
-                         f"cfg port; the design holds {len(images)} (pass --image A.hex --image B.hex, "
-                         "written by flann calibrate)")
-    for im in images:      # a bad file is one line here, not a failed bench
+    for im in images:
         read_image(im["hex"])
+    if len(images) < least:
+        held = f"got {len(images)} --image" if given else f"the design holds {len(images)}"
+        raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads {least} sensor weight "
+                         f"image(s) through the cfg port; {held} (pass --image A.hex"
+                         f"{' --image B.hex' if least > 1 else ''}, written by flann calibrate)")
+    return images
+
+
+def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
+    images = _images(design, images, 2)
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
     codes = len(rec.get("codes", [])) * len(rec.get("outputs", {}))
@@ -135,11 +146,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     initial sensor, so the cfg port is what loads it) at every voltage code and the stated
     temperature codes."""
     spec, man = design.spec, design.manifest
-    images = list(images or [{"name": im["name"], "hex": str(design.directory / im["hex"])}
-                             for im in man.get("images", [])])
-    if not images:
-        raise FlannError(f"{design.directory}: no weight image to load (pass --image A.hex, written by flann calibrate)")
-    image = images[-1]
+    image = _images(design, images, 1)[-1]
     words = read_image(image["hex"])
     if len(words) != spec.image_words:
         raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
@@ -177,6 +184,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
 
 BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "family": _family,
            "family_thermal": _family_thermal}
+LOADS_IMAGES = (_family, _family_thermal)   # the benches that load weight images (--image)
 
 
 def simulate(design: Design, build_dir, **kw) -> dict:
@@ -184,9 +192,11 @@ def simulate(design: Design, build_dir, **kw) -> dict:
     dp = design.datapath
     if dp.bench is None:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
-    if kw.get("netlist") and not dp.netlist:
-        raise FlannError(f"--netlist: the mapped-netlist check drives flann_top's ports; {design.directory} is "
-                         f"a {dp.name} design ({dp.top})")
+    if kw.get("netlist"):
+        require_sweep_driver(dp, design.directory, "--netlist")
+    if kw.get("images") and BENCHES[dp.bench] not in LOADS_IMAGES:
+        raise FlannError(f"--image: {design.directory} is a {dp.name} design, its weights are built in "
+                         "(weight images load into a family design's memory)")
     return BENCHES[dp.bench](design, build_dir, **kw)
 
 
