@@ -128,7 +128,11 @@ def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     selected = next((a for a in argv if a in COMMANDS), None)
     parser = build_parser(selected)
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:   # the subcommand's flags are the ones to see, not flann's
+        prog = f"flann {args.command}" if args.command else "flann"
+        parser.exit(2, f"error: {prog}: unrecognized arguments: {one_line(' '.join(extra))} "
+                       f"(see {prog} --help)\n")
     if args.command is None:
         parser.print_help()
         return 2

@@ -183,6 +183,16 @@ def _nobody_else_s(path: Path) -> bool:
     return False
 
 
+def check_output_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: str = "directory") -> Path:
+    """The directory :func:`atomic_directory` would write for ``path``, or its one-line
+    refusal now: a command with a long run before its output checks it first."""
+    path = _target(path, directory=True)
+    _parent_dir(path)
+    if path.exists() and any(path.iterdir()) and not replaceable(path):
+        raise FlannError(f"{path}: directory is not empty and is not a {what}; choose a new or empty directory")
+    return path
+
+
 @contextlib.contextmanager
 def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: str = "directory"):
     """Yield a fresh temporary directory that replaces ``path`` as a whole on success.
@@ -197,12 +207,7 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
     replaced); a directory holding one of the command's inputs is refused.
     """
     shown = Path(path)
-    path = _target(path, directory=True)
-    _parent_dir(path)
-    if path.exists():
-        if any(path.iterdir()) and not replaceable(path):
-            raise FlannError(f"{path}: directory is not empty and is not a {what}; "
-                             f"choose a new or empty directory")
+    path = check_output_directory(path, replaceable, what)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.new.", dir=path.parent))
     except OSError as exc:
@@ -245,6 +250,6 @@ def remove_output_directory(path: str | os.PathLike, replaceable) -> None:
         shutil.rmtree(aside, ignore_errors=True)
 
 
-__all__ = ["atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",
+__all__ = ["check_output_directory", "atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",
            "atomic_directory", "note_input", "guarding_inputs", "safe_name", "child",
            "remove_output_directory"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import fnmatch
 import hashlib
 import json
+import math
 import os
 import re
 import stat
@@ -131,6 +132,16 @@ def p_bad_image(w):
     """A sensor's image whose last word does not fit the memory's width."""
     words = (w / "fam" / "image_s0.hex").read_text().splitlines()
     _write(w / "a.hex", "\n".join(words[:-1] + ["1" + "0" * 40]) + "\n")
+
+
+def p_design_notes(w):
+    (w / "design" / "notes.txt").write_text("my notes\n")
+
+
+def p_fold(w):
+    """A sensor read past its turning points at +-23.56 mm (sin of x / 15 on -30..30 mm)."""
+    _write(w / "fold.csv", "displacement_mm,voltage_v\n"
+           + "".join(f"{i * 0.5},{math.sin(i * 0.5 / 15)!r}\n" for i in range(-60, 61)))
 
 
 def p_terms_true(w):
@@ -302,6 +313,14 @@ CASES = [
          "weights are built in"),
     Case("sim-image-twice", "own", ("sim", "fam", "--image", "fam/image_s0.hex", "--image", "fam/image_s0.hex"), 2,
          "given twice"),
+    Case("calibrate-o-is-the-design", "own", ("calibrate", "s1.csv", "-o", "fam", *FAM), 2, "inside the design"),
+    Case("calibrate-o-inside-the-design", "own", ("calibrate", "s1.csv", "-o", "fam/cal", *FAM), 2, "inside the design"),
+    Case("gen-over-a-design-holding-user-files", "own", ("gen", "m.json", "-o", "design", "--input-bits", "10"), 2,
+         "notes.txt", (), "p_design_notes"),
+    Case("calibrate-unknown-flag", "17", ("calibrate", "s1.csv", "-o", "out", "--trim", *FAM), 2,
+         "flann calibrate: unrecognized arguments: --trim (see flann calibrate --help)"),
+    Case("gen-family-foldback-names-the-span", "own", ("gen", "--family", "fold.csv", "s1.csv", "-o", "newfam"), 2,
+         "keep the recording to its monotonic span -23.5 .. 23.5 mm", (), "p_fold"),
     Case("eval-terms-true", "11", ("eval", "bad.json", "rec.csv"), 2, "must be a number", (), "p_terms_true"),
     Case("predict-terms-61.7", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "must be an integer", (), "p_terms_frac"),
     Case("gen-weights-string", "11", ("gen", "bad.json", "-o", "new"), 2, "'weights' must be a list", (), "p_weights_str"),

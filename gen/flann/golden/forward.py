@@ -192,7 +192,7 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
             scored.append((sm, pred, e2))
     if not scored:
         raise RecordingsError("no smooth forward fit is monotonic over the stroke: no inverse "
-                              "exists (use --trim to keep the monotonic span)")
+                              "exists (flann train --trim keeps the monotonic span)")
     if robust:
         sm, pred, e2 = min(scored, key=lambda t: (float(np.median(t[2])), t[0].dof(pos)))
         return sm, pred, float(np.median(e2))

@@ -37,12 +37,38 @@ def is_design(directory: Path) -> bool:
     return (Path(directory) / MANIFEST).is_file()
 
 
+def foreign_entries(directory: Path) -> list[str]:
+    """What a design directory holds beyond what flann gen wrote into it (its manifest's files,
+    model and weight images): a user's notes, calibrate's certificates.  Replacing the design
+    would delete them.  An unreadable manifest owns nothing but itself."""
+    directory = Path(directory)
+    try:
+        man = parse_json(read_text(directory / MANIFEST, FlannError, "manifest.json"), MANIFEST, FlannError)
+    except FlannError:
+        man = {}
+    man = man if isinstance(man, dict) else {}
+    own = {MANIFEST, man.get("model")} | set(f for f in man.get("files", []) if isinstance(f, str))
+    own |= {im.get("hex") for im in man.get("images", []) if isinstance(im, dict)}
+    return sorted(p.name + ("/" if p.is_dir() else "") for p in directory.iterdir() if p.name not in own)
+
+
+def _replaceable(directory: Path) -> bool:
+    """A design flann gen wrote and nothing else (:func:`foreign_entries` is refused in one line)."""
+    if not is_design(directory):
+        return False
+    if extra := foreign_entries(directory):
+        shown = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
+        raise FlannError(f"{directory}: a flann design that also holds what flann gen did not write ({shown}); "
+                         "replacing it would delete them: move them or choose another directory")
+    return True
+
+
 def write_design(texts: dict[str, str], man: dict, out_dir) -> dict:
     """Write rendered files and manifest.json into ``out_dir`` atomically; return the manifest."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise FlannError(f"{out_dir}: exists and is not a directory")
-    with atomic_directory(out_dir, is_design, "flann design") as tmp:
+    with atomic_directory(out_dir, _replaceable, "flann design") as tmp:
         for name, text in texts.items():
             (tmp / name).write_text(text, newline="")
         (tmp / MANIFEST).write_text(json.dumps(man, indent=2) + "\n", newline="")

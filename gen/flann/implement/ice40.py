@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import FlannError
-from ..fileio import atomic_directory
+from ..fileio import atomic_directory, check_output_directory
 from ..hardware.manifest import read_manifest
 from ..hardware.target import CLOCK_HZ, Ice40Part, parse_ice40
 from . import synth
@@ -242,6 +242,7 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
     t0 = time.monotonic()
     part = parse_ice40(device)
     man = read_manifest(directory)
+    check_output_directory(out_dir, _is_ice40_output, "flann iCE40 build")   # before minutes of work
     for name in ("ghdl", "yosys", "nextpnr-ice40", "icepack"):
         _tool(name)
     clock_mhz = CLOCK_HZ / 1e6

@@ -469,6 +469,10 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise FlannError(f"{out_dir}: exists and is not a directory (OUTDIR)")
+    if out_dir.resolve().is_relative_to(Path(design_dir).resolve()):
+        # certificates inside the design would be deleted when it is generated again
+        raise FlannError(f"-o {out_dir}: inside the design directory {design_dir}; write the calibration "
+                         "beside the design, not into it")
     paths = [Path(p) for p in paths]
     if not paths:
         raise FlannError("no recordings given")

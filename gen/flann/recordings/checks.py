@@ -296,8 +296,10 @@ def sweep_direction(displacement_mm) -> np.ndarray | None:
     return d
 
 
-def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None) -> Recordings:
-    """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span.
+def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None,
+                    can_trim: bool = True) -> Recordings:
+    """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span
+    (``can_trim``: the command has a ``--trim`` to advise; without, the span is named instead).
 
     Without a direction column, sweeps are told apart by the file order (:func:`sweep_direction`)
     for the checks: the same position on the way up and on the way back is not a repeat.
@@ -316,10 +318,11 @@ def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None =
         if not span.trimmable:
             raise RecordingsError(span.message + "; the fold-back is inside the span, "
                                   "--trim cannot remove it")
-        if not trim:
-            raise RecordingsError(span.message + "; use --trim to keep the monotonic span")
         kept = rec.subset(span.mask)
         lo, hi = kept.displacement_mm.min(), kept.displacement_mm.max()
+        if not trim:
+            raise RecordingsError(span.message + ("; use --trim to keep the monotonic span" if can_trim else
+                                                  f"; keep the recording to its monotonic span {lo:g} .. {hi:g} mm"))
         warnings.warn(f"{rec.source}: --trim kept {len(kept)} of {len(rec)} rows, "
                       f"the monotonic span {lo:g} .. {hi:g} mm", stacklevel=2)
         if len(kept) < MIN_FIT_POINTS:

@@ -26,7 +26,7 @@ RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in a
 
 def train_model(rec, terms: int = FIXED_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
     """Least-squares FLANN of ``terms`` terms on validated recordings."""
-    rec = prepare_for_fit(rec)
+    rec = prepare_for_fit(rec, can_trim=False)
     info = {"data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})}
     return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
 
@@ -52,7 +52,7 @@ def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, read: dic
     members = []
     for k, raw in (read_csvs(sources) if read is None else read).items():
         try:
-            rec = prepare_for_fit(raw)
+            rec = prepare_for_fit(raw, can_trim=False)
         except FlannError:
             continue   # reported with every other bad member when the members are loaded
         members.append((Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm))

@@ -54,7 +54,7 @@ def is_thermal_family(sources) -> bool:
 def _prepared(rec):
     """(v, T, x): the fit's checks (span, duplicates, fold-back) at each temperature on its own."""
     levels, labels = temperature_groups(rec.temperature_c)
-    parts = [prepare_for_fit(rec.subset(labels == g)) for g in range(levels.size)
+    parts = [prepare_for_fit(rec.subset(labels == g), can_trim=False) for g in range(levels.size)
              if np.count_nonzero(labels == g) >= MIN_ROWS]
     cat = np.concatenate
     return (cat([p.voltage_v for p in parts]), cat([p.temperature_c for p in parts]),
