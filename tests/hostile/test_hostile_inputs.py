@@ -144,6 +144,10 @@ def p_fold(w):
            + "".join(f"{i * 0.5},{math.sin(i * 0.5 / 15)!r}\n" for i in range(-60, 61)))
 
 
+def p_afile(w):
+    (w / "afile").write_text("a file\n")
+
+
 def p_terms_true(w):
     _write(w / "bad.json", json.dumps(_model(w, terms=True)))
 
@@ -321,6 +325,9 @@ CASES = [
          "flann calibrate: unrecognized arguments: --trim (see flann calibrate --help)"),
     Case("gen-family-foldback-names-the-span", "own", ("gen", "--family", "fold.csv", "s1.csv", "-o", "newfam"), 2,
          "keep the recording to its monotonic span -23.5 .. 23.5 mm", (), "p_fold"),
+    Case("synth-ice40-o-is-a-file", "2", ("synth", "design", "--device", "ice40-hx8k-ct256", "-o", "afile", "--no-lint",
+                                          "--work", "wdir"),
+         2, "exists and is not a directory", (), "p_afile"),
     Case("eval-terms-true", "11", ("eval", "bad.json", "rec.csv"), 2, "must be a number", (), "p_terms_true"),
     Case("predict-terms-61.7", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "must be an integer", (), "p_terms_frac"),
     Case("gen-weights-string", "11", ("gen", "bad.json", "-o", "new"), 2, "'weights' must be a list", (), "p_weights_str"),
