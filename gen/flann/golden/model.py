@@ -203,5 +203,11 @@ def model_sha256(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-__all__ = ["FORMAT", "MAX_TERMS", "FlannModel", "ModelFile", "evaluate", "expand", "harmonics", "load_model", "model_sha256",
+def text_sha256(model_json: str) -> str:
+    """sha256 of a model's file text (``to_json()``, the bytes :func:`model_sha256` reads back
+    once written): the hash a certificate and a design name the model by."""
+    return hashlib.sha256(model_json.encode()).hexdigest()
+
+
+__all__ = ["FORMAT", "MAX_TERMS", "FlannModel", "ModelFile", "evaluate", "expand", "harmonics", "load_model", "model_sha256", "text_sha256",
            "term_kind", "asdict"]

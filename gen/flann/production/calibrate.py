@@ -46,9 +46,10 @@ from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
+from ..golden.model import text_sha256
 from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
-from ..hardware.family.build import train_model
+from ..hardware.family.build import RIDGE, train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
@@ -62,7 +63,7 @@ from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
 from .verdict import FAIL, PASS, Verdict, judge, rejected, uncertainty
 
-RIDGES = (1e-6, 1e-5, 1e-4, 1e-3)  # tried in order until the weights fit the design
+RIDGES = (RIDGE, 1e-5, 1e-4, 1e-3)  # the family's own ridge first, then more until the weights fit
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
 # nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
 # sensors tried (docs/production.md); fewer points save little, the fits dominate.
@@ -139,7 +140,7 @@ def train_for_design(rec, fam: FamilySpec):
     for ridge in RIDGES:
         model = train_model(rec, fam.terms, ridge)
         try:
-            return model, member_spec(fam, model, hashlib.sha256(model.to_json().encode()).hexdigest())
+            return model, member_spec(fam, model, text_sha256(model.to_json()))
         except FitError as exc:
             last = exc
     raise last
@@ -296,7 +297,7 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
-        res.model_sha256 = hashlib.sha256(chk["model"].to_json().encode()).hexdigest()
+        res.model_sha256 = text_sha256(chk["model"].to_json())
         reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
                                         cost=lambda m: fixed_point_cost(m, (fam.spec.input_bits, fam.spec.input_lsb_v)))
         if res.max_error_mm > REACH_FACTOR * reach:
@@ -345,7 +346,7 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
-        res.model_sha256 = hashlib.sha256(chk["model"].to_json().encode()).hexdigest()
+        res.model_sha256 = text_sha256(chk["model"].to_json())
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
         findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
         res.diagnosis = diagnosis_cell(named, groups)
@@ -372,7 +373,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     """A passed sensor: its two-input model, its image (every order's memory in turn) and the
     certificate; a failed one: only the certificate."""
     model_json = chk["model"].to_json()
-    mhash = hashlib.sha256(model_json.encode()).hexdigest()
+    mhash = text_sha256(model_json)
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.image_words} words x {images.DATA_BITS} bits, address 0 first: "
             f"order j's memory at j x {fam.fam.mem_depth} (cfg_addr)"]
@@ -419,7 +420,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
     model_json = model.to_json()
-    mhash = hashlib.sha256(model_json.encode()).hexdigest()
+    mhash = text_sha256(model_json)
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)

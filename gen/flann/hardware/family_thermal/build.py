@@ -7,7 +7,6 @@ design's temperature normalisation (:func:`fit_sensor`, also used by ``flann cal
 
 from __future__ import annotations
 
-import hashlib
 import warnings
 from pathlib import Path
 
@@ -15,6 +14,7 @@ import numpy as np
 
 from ...errors import FlannError, SpecError
 from ...golden.family import family_thermal_terms
+from ...golden.model import text_sha256
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
 from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
@@ -181,7 +181,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     if len(unique) < len(names):
         unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
     init_text = loaded[0][1]
-    sha = hashlib.sha256(init_text.encode()).hexdigest()
+    sha = text_sha256(init_text)
     man = write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
     if choices:
         man = {**man, "terms_chosen": [vars(c) for _p, c in choices]}
