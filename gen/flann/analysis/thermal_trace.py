@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.thermal import corrected_voltage
+from ..hardware.family.spec import clamp_codes
 from ..hardware.family_thermal.spec import FamilyThermalSpec, order_models
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.thermal.spec import ThermalSpec
@@ -189,9 +190,7 @@ def trace_family_thermal(spec: FamilyThermalSpec) -> ThermalTraceResult:
     tau = np.repeat(np.asarray(temps, dtype=np.int64), vc.size)
     tr = FlannFamilyThermalTop(spec).trace(c, tau)
     kq = q / 2.0 ** spec.inner_bits                       # the orders' LSB (mm)
-    lo, hi = sorted(m.voltage_range_v)                    # the float model's clamp, as float_reference's
-    clo = max(spec.code_min, int(np.floor(lo / spec.input_lsb_v + 0.5)))
-    chi = min(spec.code_max, int(np.floor(hi / spec.input_lsb_v + 0.5)))
+    clo, chi = clamp_codes(m.voltage_range_v, spec.input_lsb_v, spec.code_min, spec.code_max)   # float_reference's
     v = np.clip(c, clo, chi) * spec.input_lsb_v
     t_n = tr.t_n.astype(float) / 2.0 ** t.shift
     f = [om.predict(v) for om in order_models(m)]

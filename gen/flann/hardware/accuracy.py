@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
-from ..numeric.fixed import signed_range
+from ..numeric.fixed import nearest_codes, signed_range
 from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
@@ -57,19 +57,6 @@ def design_adc(design_dir) -> tuple[int, float]:
 
 
 # -- the converter -----------------------------------------------------------------------
-def nearest_codes(value, lsb, code_min: int, code_max: int) -> np.ndarray:
-    """The converter's rule, for voltages and temperatures alike: the nearest code with a tie
-    going up (``floor(value / lsb + 1/2)``), saturated to ``code_min..code_max``.
-
-    The twins and the HDL take integer codes; the converter in front of them is this model of
-    it, and the family designs are built with the same rule (their clamp codes and calibrated
-    temperature codes are the codes the trained range's ends round to this way).  Every path
-    from a reading to a code goes through here, so a reading exactly between two codes gets
-    one code everywhere (round half to even would take the even one)."""
-    c = np.floor(np.asarray(value, dtype=float) / lsb + 0.5)
-    return np.clip(c, code_min, code_max).astype(np.int64)
-
-
 def adc_codes(spec: Spec, voltage_v, adc: tuple[int, float] | None = None) -> np.ndarray:
     """Voltages as the design receives them: the converter's nearest code, saturated to its
     range; from a converter wider than the design, its top ``spec.input_bits`` bits (the low

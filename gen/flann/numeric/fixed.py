@@ -121,6 +121,19 @@ def signed_range(bits: int) -> tuple[int, int]:
     return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
 
 
+def nearest_codes(value, lsb, code_min: int, code_max: int) -> np.ndarray:
+    """The converter's rule, for voltages and temperatures alike: the nearest code with a tie
+    going up (``floor(value / lsb + 1/2)``), saturated to ``code_min..code_max``.
+
+    The twins and the HDL take integer codes; the converter in front of them is this model of
+    it, and the family designs are built with the same rule (their clamp codes and calibrated
+    temperature codes are the codes the trained range's ends round to this way).  Every path
+    from a reading to a code goes through here, so a reading exactly between two codes gets
+    one code everywhere (round half to even would take the even one)."""
+    c = np.floor(np.asarray(value, dtype=float) / lsb + 0.5)
+    return np.clip(c, code_min, code_max).astype(np.int64)
+
+
 def _code_bound(bits_field: str, end: int) -> property:
     """The lowest (end 0) or highest (end 1) code of the signed word ``spec.<bits_field>`` bits wide."""
     return property(lambda spec: signed_range(getattr(spec, bits_field))[end])

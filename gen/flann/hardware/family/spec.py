@@ -35,7 +35,7 @@ import numpy as np
 
 from ...errors import SpecError
 from ...golden.model import FlannModel
-from ...numeric.fixed import bits_needed
+from ...numeric.fixed import bits_needed, nearest_codes
 from ..fixed.latency import norm_latency
 from ..fixed.spec import (BRAM_BITS, Blocks, Spec, acc_bound_for, assemble, check_fits, compose, derive_adder,
                           derive_blocks, derive_multiplier, derive_normaliser, derive_sequencer, derive_spec,
@@ -360,6 +360,13 @@ def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
     return fam
 
 
+def clamp_codes(voltage_range_v, lsb: float, code_min: int, code_max: int) -> tuple[int, int]:
+    """A member's clamp: the codes its recorded range's ends round to (the ADC rounds too), so
+    the end points of a calibration sweep are measured, not clamped."""
+    lo, hi = nearest_codes(sorted(voltage_range_v), lsb, code_min, code_max)
+    return int(lo), int(hi)
+
+
 def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> Spec:
     """One sensor's values under the family formats; FitError names what does not fit."""
     f = fam.spec
@@ -386,14 +393,11 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
         if need > have:
             raise FitError(f"{what} reach {need}, the design holds {have}: outside the family "
                            f"(margin {fam.margin:g}); regenerate the design with this sensor in --family")
-    # clamp to the codes the recorded range rounds to (the ADC rounds too): the end points of
-    # a calibration sweep are then measured, not clamped
-    clo = max(f.code_min, math.floor(lo / f.input_lsb_v + 0.5))
-    chi = min(f.code_max, math.floor(hi / f.input_lsb_v + 0.5))
+    clo, chi = clamp_codes((lo, hi), f.input_lsb_v, f.code_min, f.code_max)
     return replace(f, model=model, model_sha256=model_sha256, ka=s.ka, kb=s.kb, k1=s.k1, k0=s.k0,
                    clamp_lo=clo, clamp_hi=chi, weight_rom=s.weight_rom,
                    analysis={**s.analysis, "estimate": f.analysis.get("estimate")})
 
 
-__all__ = ["FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
+__all__ = ["clamp_codes", "FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
            "bram_image", "headroom", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED", "SPREAD"]

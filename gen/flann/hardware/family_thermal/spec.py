@@ -35,9 +35,9 @@ import numpy as np
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel
-from ...numeric.fixed import FixedFormat, bits_needed, signed_range
+from ...numeric.fixed import FixedFormat, bits_needed, nearest_codes, signed_range
 from ..delegate import delegated
-from ..family.spec import DEFAULT_MARGIN, FamilySpec, derive_family, member_spec
+from ..family.spec import DEFAULT_MARGIN, FamilySpec, clamp_codes, derive_family, member_spec
 
 DEFAULT_ORDERS = 3          # a 3-temperature calibration determines 3 orders
 MAX_ORDERS = 4
@@ -99,7 +99,7 @@ def temp_norm(temperature_range_c, bits: int, lsb_c: float) -> TempNorm:
     if not (isinstance(lsb_c, (int, float)) and lsb_c > 0 and math.isfinite(lsb_c)):
         raise SpecError(f"--temp-lsb-c {lsb_c!r}: must be a number > 0")
     t_lo, t_hi = sorted(float(t) for t in temperature_range_c)
-    lo, hi = math.floor(t_lo / lsb_c + 0.5), math.floor(t_hi / lsb_c + 0.5)
+    lo, hi = (int(c) for c in nearest_codes([t_lo, t_hi], lsb_c, -np.inf, np.inf))   # as the converter rounds
     cmin, cmax = signed_range(bits)
     if lo < cmin or hi > cmax:
         raise SpecError(f"calibrated temperatures {t_lo:g}..{t_hi:g} degC are codes {lo}..{hi}, outside the "
@@ -199,9 +199,7 @@ class FamilyThermalSpec:
         """The float model (mm) at the codes as the hardware sees them (both clamped)."""
         m = self.model
         s = self.fam.spec
-        lo, hi = sorted(m.voltage_range_v)
-        clo = max(s.code_min, math.floor(lo / s.input_lsb_v + 0.5))
-        chi = min(s.code_max, math.floor(hi / s.input_lsb_v + 0.5))
+        clo, chi = clamp_codes(m.voltage_range_v, s.input_lsb_v, s.code_min, s.code_max)
         c = np.clip(np.asarray(codes, dtype=np.int64), clo, chi)
         t = np.clip(np.asarray(temp_codes, dtype=np.int64), self.temp.lo, self.temp.hi)
         c, t = np.broadcast_arrays(c, t)
