@@ -148,6 +148,10 @@ def p_afile(w):
     (w / "afile").write_text("a file\n")
 
 
+def p_range_point(w):
+    _write(w / "bad.json", json.dumps(_model(w, voltage_range_v=[1.0, 1.0])))
+
+
 def p_terms_true(w):
     _write(w / "bad.json", json.dumps(_model(w, terms=True)))
 
@@ -328,6 +332,9 @@ CASES = [
     Case("synth-ice40-o-is-a-file", "2", ("synth", "design", "--device", "ice40-hx8k-ct256", "-o", "afile", "--no-lint",
                                           "--work", "wdir"),
          2, "exists and is not a directory", (), "p_afile"),
+    Case("gen-model-range-one-point", "11", ("gen", "bad.json", "-o", "new"), 2, "is a single point", (),
+         "p_range_point"),
+    Case("gen-lanes-0-names-the-flag", "17", ("gen", "m.json", "-o", "new", "--lanes", "0"), 2, "(--lanes)"),
     Case("eval-terms-true", "11", ("eval", "bad.json", "rec.csv"), 2, "must be a number", (), "p_terms_true"),
     Case("predict-terms-61.7", "11", ("predict", "bad.json", "rec.csv", "-o", "p.csv"), 2, "must be an integer", (), "p_terms_frac"),
     Case("gen-weights-string", "11", ("gen", "bad.json", "-o", "new"), 2, "'weights' must be a list", (), "p_weights_str"),

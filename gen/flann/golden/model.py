@@ -173,6 +173,8 @@ class FlannModel(ModelFile):
                 if not isinstance(r, list) or len(r) != 2:
                     raise ModelFileError(f"{source}: {key} must be [lo, hi]")
                 ranges[key] = tuple(number(x, key, source, ModelFileError) for x in r)
+                if ranges[key][0] == ranges[key][1]:   # what the model was trained over: never one point
+                    raise ModelFileError(f"{source}: {key} = {list(r)} is a single point; a trained model spans a range")
             training = d.get("training", {})
             if not isinstance(training, dict):
                 raise ModelFileError(f"{source}: 'training' must be an object")

@@ -326,7 +326,7 @@ def _check_int(name: str, value, lo: int, hi: int, derived: str = "") -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= int(value) <= hi:
         if derived:
             raise SpecError(f"derived {name} = {value!r} is outside {lo}..{hi}: {derived}")
-        raise SpecError(f"{name} = {value!r}: must be an integer in {lo}..{hi}")
+        raise SpecError(f"{name} = {value!r} (--{name.replace('_', '-')}): must be an integer in {lo}..{hi}")
     return int(value)
 
 
@@ -431,6 +431,7 @@ class OutputStage:
 def derive_output(inp: InputStage, output_bits, output_lsb_mm) -> OutputStage:
     y = inp.y
     ymax = float(np.max(np.abs(y)))
+    given = "lsb" if output_lsb_mm is not None else "bits" if output_bits is not None else ""
     if output_lsb_mm is None:
         if output_bits is None:
             step = (float(y.max() - y.min()) or 1.0) / max(1, y.size - 1)
@@ -441,6 +442,7 @@ def derive_output(inp: InputStage, output_bits, output_lsb_mm) -> OutputStage:
     if not (isinstance(output_lsb_mm, (int, float)) and math.isfinite(output_lsb_mm) and output_lsb_mm > 0):
         raise SpecError(f"output_lsb_mm = {output_lsb_mm!r}: must be a positive number of mm")
     q = float(output_lsb_mm)
+    adc.check_output_step(inp.model, q, given)   # fewer than 16 codes over the stroke: refused
     need_out = bits_needed(-math.ceil(ymax * 1.05 / q), math.ceil(ymax * 1.05 / q))
     if output_bits is None:
         output_bits = max(4, need_out)
