@@ -13,6 +13,7 @@ from ...golden.model import MAX_TERMS, FlannModel, load_model
 from ...golden.family import family_terms
 from ...golden.train import fit_lstsq
 from ..fixed.cost import fixed_point_cost
+from ..options import default
 from ...recordings import prepare_for_fit, read_recordings
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
@@ -58,7 +59,7 @@ def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, read: dic
         members.append((Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm))
     if not members:
         return None, []
-    adc = (options.get("input_bits", 12), options.get("input_lsb_v"))
+    adc = (options.get("input_bits", default("input_bits")), options.get("input_lsb_v"))
     return family_terms(members, norm=NORMALISATION, ridge=RIDGE, margin=margin,
                         cost=lambda m: fixed_point_cost(m, adc))
 

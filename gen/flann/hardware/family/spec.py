@@ -40,8 +40,7 @@ from ..fixed.latency import norm_latency
 from ..fixed.spec import (BRAM_BITS, Blocks, Spec, acc_bound_for, assemble, check_fits, compose, derive_adder,
                           derive_blocks, derive_multiplier, derive_normaliser, derive_sequencer, derive_spec,
                           estimate_resources, lin_acc_reach, lin_acc_width, nice_125, round_sig)
-from ..options import GenOptions
-from ..target import DEFAULT_PART
+from ..options import GenOptions, default
 
 DATA_BITS = 32  # one memory word: one weight, or one word of a normaliser field
 # The memory is one Spartan-II block RAM (RAMB4_S16_S16, 256 x 16): word k is held as two
@@ -230,13 +229,14 @@ def _scaled(model: FlannModel, k: float) -> FlannModel:
 
 
 def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT_MARGIN,
-                  input_bits: int = 12, input_lsb_v: float | None = None, output_bits: int | None = None,
-                  output_lsb_mm: float | None = None, device: str = DEFAULT_PART,
-                  mult_style: str = "shiftadd", mult_digit_bits: int = 2, interp: bool = True,
+                  input_bits: int = default("input_bits"), input_lsb_v: float | None = None,
+                  output_bits: int | None = None, output_lsb_mm: float | None = None,
+                  device: str = default("device"), mult_style: str = default("mult_style"),
+                  mult_digit_bits: int = default("mult_digit_bits"), interp: bool = default("interp"),
                   phase_bits: int | None = None, table_addr_bits: int | None = None,
                   term_frac_bits: int | None = None, weight_frac_bits: int | None = None,
-                  product_frac_bits: int | None = None, lanes: int = 1, clamp: bool = True,
-                  check_device: bool = True) -> FamilySpec:
+                  product_frac_bits: int | None = None, lanes: int = default("lanes"),
+                  clamp: bool = default("clamp"), check_device: bool = True) -> FamilySpec:
     """Size one design for ``models`` (see the module docstring); the first model initialises the memory."""
     if not models:
         raise SpecError("a family needs at least one sensor")

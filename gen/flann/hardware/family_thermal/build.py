@@ -20,6 +20,7 @@ from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
 from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, check_terms, read_csvs
 from ..family.spec import DEFAULT_MARGIN
+from ..options import default
 from .render import write
 from .spec import DEFAULT_ORDERS, TempNorm, derive_family_thermal, temp_norm
 
@@ -139,7 +140,8 @@ def load_member(path, temp: TempNorm, terms: int, orders: int,
 
 
 def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: float = DEFAULT_MARGIN,
-                            orders: int = DEFAULT_ORDERS, temp_bits: int = 12, temp_lsb_c: float = 0.0625,
+                            orders: int = DEFAULT_ORDERS, temp_bits: int = default("temp_bits"),
+                            temp_lsb_c: float = default("temp_lsb_c"),
                             **options) -> dict:
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:

@@ -11,9 +11,10 @@ import warnings
 from ...errors import SpecError
 from ...golden.model import FlannModel
 from ..adc import MAX_DESIGN_INPUT_BITS
+from ..options import default
 from .spec import derive_spec
 
-COST_BITS = (MAX_DESIGN_INPUT_BITS, 12)   # a model must build at the default and the widest ADC
+COST_BITS = (MAX_DESIGN_INPUT_BITS, default("input_bits"))   # a model must build at the default and the widest ADC
 MAX_BOUND_LSB = 1.0   # worst-case |hardware - float model| at the default widths, output LSB
 
 
