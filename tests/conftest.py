@@ -4,6 +4,8 @@ from pathlib import Path
 
 import pytest
 
+from flann.cli import main
+
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
 
@@ -26,3 +28,17 @@ def table1_csv() -> Path:
 @pytest.fixture(scope="session")
 def default_model_json() -> Path:
     return DATA / "default_model.json"
+
+
+@pytest.fixture
+def cli(capsys):
+    """flann in process: ``cli(argv)`` -> (exit code, stdout, stderr); a flag its argparse type
+    refuses exits 2 through SystemExit, as on the command line."""
+    def run(argv):
+        try:
+            rc = main([str(a) for a in argv])
+        except SystemExit as exc:
+            rc = exc.code
+        out, err = capsys.readouterr()
+        return rc, out, err
+    return run

@@ -7,6 +7,9 @@ voltages quantised to the design's ADC codes, against the physical limit of that
 from __future__ import annotations
 
 import json
+import warnings
+
+import numpy as np
 
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
@@ -63,6 +66,19 @@ def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm
     return res
 
 
+def warn_outside_stroke(model, rec) -> None:
+    """Positions beyond the trained displacement range are said: the model has never seen them,
+    so its error there (and in the figures) is the extrapolation's, not the compensation's."""
+    lo, hi = sorted(model.displacement_range_mm)
+    tol = 1e-9 * max(abs(lo), abs(hi), hi - lo, 1.0)   # a range's end printed and read back
+    x = np.asarray(rec.displacement_mm, dtype=float)
+    n = int(np.count_nonzero((x < lo - tol) | (x > hi + tol)))
+    if n:
+        warnings.warn(f"{rec.source}: {n} of {x.size} points lie outside the model's trained "
+                      f"displacement range [{lo:g}, {hi:g}] mm: the model was not fitted there, "
+                      "the figures include them", stacklevel=2)
+
+
 def run(args) -> int:
     if args.plot and not args.plot.lower().endswith(".png"):
         raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
@@ -75,6 +91,7 @@ def run(args) -> int:
                          "the recordings need a temperature_c column")
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
                        temperature_c=rec.temperature_c)
+    warn_outside_stroke(model, rec)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     errors = res.pop("_errors", None)
     if args.design:

@@ -18,7 +18,7 @@ from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_vali
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
 from ..golden.inverse import inverse_fit
-from ..hardware.adc import ADC_BITS
+from ..hardware.adc import ADC_BITS, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .train_thermal import compensation_hint, run_thermal
@@ -142,6 +142,11 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     if outlier_text:
         warnings.warn(outlier_text)
     provenance.update(record)
+    if args.input_bits is not None:
+        # the user's converter, by gen's own rule, before any fit: one it cannot carry would
+        # otherwise surface as "no candidate builds" or a derived width out of range
+        check_converter((float(rec.voltage_v.min()), float(rec.voltage_v.max())),
+                        conv["input_bits"], conv["input_lsb_v"])
     if conv is not None:
         provenance["converter"] = conv
     adc = None if conv is None else (conv["input_bits"], conv["input_lsb_v"])

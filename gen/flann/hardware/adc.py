@@ -20,6 +20,7 @@ from ..golden.model import FlannModel
 ADC_BITS = (4, 32)           # ADC widths accepted (wider ones give their top MAX_DESIGN_INPUT_BITS)
 MAX_DESIGN_INPUT_BITS = 16   # widest ADC code the datapath takes (serial normaliser, guard bits)
 MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
+MIN_OUTPUT_CODES = 16        # the same floor on the output: codes over the trained stroke
 SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)
 DEFAULT_INPUT_MARGIN = 1.10  # default input LSB: trained range + 10 %
 
@@ -42,7 +43,12 @@ class AdcPlan:
 
 def default_input_lsb(model: FlannModel, bits: int) -> float:
     """Volts per code covering the trained range + 10 %, 3 significant digits (rounded up)."""
-    vlo, vhi = sorted(model.voltage_range_v)
+    return default_lsb_for_range(model.voltage_range_v, bits)
+
+
+def default_lsb_for_range(voltage_range_v, bits: int) -> float:
+    """:func:`default_input_lsb` of a voltage range (before a model exists: flann train)."""
+    vlo, vhi = sorted(voltage_range_v)
     x = max(abs(vlo), abs(vhi), 1e-12) * DEFAULT_INPUT_MARGIN / (1 << (bits - 1))
     e = math.floor(math.log10(x)) - 2
     return float(f"{math.ceil(x / 10.0 ** e) * 10.0 ** e:.12g}")
@@ -62,6 +68,36 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
     * a trained range holding fewer than 16 codes is an error naming --input-lsb-v;
     * a trained range using under 1/16 of the ADC's range is said (resolution thrown away).
     """
+    bits, lsb, lsb_given = check_converter(model.voltage_range_v, input_bits, input_lsb_v, clamp)
+    check_output_range(model)
+    vlo, vhi = sorted(model.voltage_range_v)
+    lo_v, hi_v = -(1 << (bits - 1)) * lsb, ((1 << (bits - 1)) - 1) * lsb
+    opts = _opts(bits, lsb, lsb_given)
+    notes = []
+    used = (vhi - vlo) / (hi_v - lo_v)
+    if used < SMALL_FRACTION:
+        notes.append(
+            f"the trained range {vlo:.6g}..{vhi:.6g} V uses {100 * used:.2g} % of the ADC's "
+            f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): about {math.log2(1 / used):.1f} of its bits "
+            "carry no signal; check the voltage unit or the conditioner's gain")
+    dropped = max(0, bits - MAX_DESIGN_INPUT_BITS)
+    eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
+    if dropped:
+        slope = max_mm_per_v(model)
+        notes.append(
+            f"{bits}-bit ADC: the design takes its top {eff_bits} bits (drops {dropped} low bits; "
+            f"wire the ADC's bits {bits - 1}..{dropped} to in_data): input LSB {lsb:.4g} -> "
+            f"{eff_lsb:.4g} V, adding up to {eff_lsb * slope:.3g} mm of quantisation error "
+            f"at the steepest point (was {0.5 * lsb * slope:.3g} mm; unwired low bits floor the "
+            "code: up to one input LSB, half of it on average as an offset)")
+    return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
+
+
+def check_converter(voltage_range_v, input_bits, input_lsb_v=None,
+                    clamp: bool = True) -> tuple[int, float, bool]:
+    """(bits, volts per code, whether the LSB was given) of a converter that can carry the
+    trained ``voltage_range_v``; SpecError naming the option otherwise.  The rule of
+    :func:`plan_adc`, callable before a model exists (flann train --input-bits)."""
     if isinstance(input_bits, bool) or not isinstance(input_bits, (int, np.integer)) or \
             not ADC_BITS[0] <= int(input_bits) <= ADC_BITS[1]:
         raise SpecError(f"input_bits = {input_bits!r} (--input-bits): must be an integer in "
@@ -72,11 +108,10 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
     if lsb_given and not (isinstance(input_lsb_v, (int, float)) and math.isfinite(input_lsb_v)
                           and input_lsb_v > 0):
         raise SpecError(f"input_lsb_v = {input_lsb_v!r} (--input-lsb-v): must be a positive number of volts")
-    lsb = float(input_lsb_v) if lsb_given else default_input_lsb(model, bits)
-    vlo, vhi = sorted(model.voltage_range_v)
+    lsb = float(input_lsb_v) if lsb_given else default_lsb_for_range(voltage_range_v, bits)
+    vlo, vhi = sorted(voltage_range_v)
     lo_v, hi_v = -(1 << (bits - 1)) * lsb, ((1 << (bits - 1)) - 1) * lsb
     opts = _opts(bits, lsb, lsb_given)
-    notes = []
     if clamp and (vlo < lo_v - lsb or vhi > hi_v + lsb):
         full = (1 << bits) * lsb
         unipolar = (f"; a unipolar 0..{full:.6g} V converter? the design takes two's-complement "
@@ -97,24 +132,26 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             f"input_lsb_v = {lsb:g} V (--input-lsb-v) gives the trained range {vlo:.6g}..{vhi:.6g} V only "
             f"{codes:.3g} ADC codes (need >= {MIN_TRAINED_CODES}): the input LSB is too coarse "
             "for this sensor (volts per code, not the full scale?)")
-    check_output_range(model)
-    used = (vhi - vlo) / (hi_v - lo_v)
-    if used < SMALL_FRACTION:
-        notes.append(
-            f"the trained range {vlo:.6g}..{vhi:.6g} V uses {100 * used:.2g} % of the ADC's "
-            f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): about {math.log2(1 / used):.1f} of its bits "
-            "carry no signal; check the voltage unit or the conditioner's gain")
-    dropped = max(0, bits - MAX_DESIGN_INPUT_BITS)
-    eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
-    if dropped:
-        slope = max_mm_per_v(model)
-        notes.append(
-            f"{bits}-bit ADC: the design takes its top {eff_bits} bits (drops {dropped} low bits; "
-            f"wire the ADC's bits {bits - 1}..{dropped} to in_data): input LSB {lsb:.4g} -> "
-            f"{eff_lsb:.4g} V, adding up to {eff_lsb * slope:.3g} mm of quantisation error "
-            f"at the steepest point (was {0.5 * lsb * slope:.3g} mm; unwired low bits floor the "
-            "code: up to one input LSB, half of it on average as an offset)")
-    return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
+    return bits, lsb, lsb_given
+
+
+def check_output_step(model: FlannModel, output_lsb_mm: float, given: str) -> None:
+    """An output LSB so coarse that the trained displacement range holds fewer than
+    MIN_OUTPUT_CODES output codes is refused, naming where it came from: ``given`` is
+    "lsb" (--output-lsb-mm), "bits" (derived from --output-bits) or "" (the default)."""
+    xlo, xhi = sorted(model.displacement_range_mm)
+    codes = (xhi - xlo) / output_lsb_mm
+    if codes >= MIN_OUTPUT_CODES:
+        return
+    what = (f"output_lsb_mm = {output_lsb_mm:g} mm (--output-lsb-mm)" if given == "lsb" else
+            f"the output LSB {output_lsb_mm:g} mm (from --output-bits)" if given == "bits" else
+            f"the default output LSB {output_lsb_mm:g} mm")
+    fix = ("the output LSB is too coarse for this stroke (mm per code, not the full scale?)"
+           if given == "lsb" else "use more --output-bits" if given == "bits"
+           else "give a finer --output-lsb-mm")
+    raise SpecError(
+        f"{what} gives the trained displacement range {xlo:.6g}..{xhi:.6g} mm only {codes:.3g} "
+        f"output codes (need >= {MIN_OUTPUT_CODES}): {fix}")
 
 
 def check_output_range(model: FlannModel, points: int = 2001) -> None:
@@ -169,6 +206,7 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
             "larger --ridge, or give a coarser --output-lsb-mm")
 
 
-__all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "default_input_lsb", "default_output_step_mm",
+__all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "check_converter", "check_output_step", "default_input_lsb",
+           "default_lsb_for_range", "default_output_step_mm",
            "max_mm_per_v", "model_accuracy_mm", "pathological_hint", "weight_range_text",
-           "MAX_DESIGN_INPUT_BITS"]
+           "MAX_DESIGN_INPUT_BITS", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]

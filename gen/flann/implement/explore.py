@@ -36,6 +36,11 @@ from .synth import Resources, shortfall, smallest_fit, synthesize
 # ----------------------------------------------------------------------------- design space
 WIDTH_PRESETS = ("budget", "narrow")
 NARROW_BITS = 4  # fraction bits taken off terms and weights in the "narrow" preset
+MIN_TERM_FRAC_BITS = 4  # the fewest term fraction bits the fixed datapath takes (spec's range)
+
+
+class NotApplicable(Exception):
+    """A row that does not apply to this model: said in its note (``skipped: ...``), not run."""
 
 
 @dataclass
@@ -65,8 +70,16 @@ def _width_options(model_path, preset: str, base: dict) -> dict:
         return {}
     if preset == "narrow":
         ref = hdlgen.load(model_path, check_device=False, **base)
+        if ref.term_fmt.frac_bits <= MIN_TERM_FRAC_BITS:
+            # sin/cos weights of (nearly) nothing: taking bits off the weights alone breaks
+            # the products' rounding (an internal width constraint), and saves nothing real
+            wsum = float(np.abs(np.asarray(ref.model.weights[1:], dtype=float)).sum())
+            raise NotApplicable(
+                f"nothing to narrow: this {load_model(model_path).terms}-term model's sin/cos weights "
+                f"sum to {wsum:.3g} mm, so its terms already have the fewest fraction bits the "
+                f"datapath takes ({MIN_TERM_FRAC_BITS})")
         return {
-            "term_frac_bits": max(4, ref.term_fmt.frac_bits - NARROW_BITS),
+            "term_frac_bits": max(MIN_TERM_FRAC_BITS, ref.term_fmt.frac_bits - NARROW_BITS),
             "weight_frac_bits": max(0, ref.weight_fmt.frac_bits - NARROW_BITS),
         }
     raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
@@ -100,6 +113,10 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
                 print(f"explore [{k}/{len(combos)}] lanes={lane} mult={style} widths={preset}",
                       file=sys.stderr)
             try:
+                terms = load_model(model_path).terms
+                if lane > max(1, terms - 1):   # the lanes share the sin/cos terms (a line gets one)
+                    raise NotApplicable(f"{lane} lanes: this {terms}-term model has "
+                                        f"{max(1, terms - 1)} sin/cos term(s) to share among them")
                 base = dict(lanes=lane, mult_style=style, **(adc or {}))
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")
@@ -117,6 +134,8 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
                 ddir = Path(tmp) / f"d{k}"
                 hdlgen.write(spec, ddir)
                 _measure(row, ddir, device, None, abc)
+            except NotApplicable as exc:
+                row.note = f"skipped: {exc}"
             except FlannError as exc:
                 row.note = (row.note + "; " if row.note else "") + str(exc)
     if seed:
@@ -125,6 +144,7 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
 
 
 SEED_SCALING_TERMS = (5, 9, 17)
+SEED_MIN_TERMS = 2   # the seed's VHDL has a sin/cos table and multiplier per term after the first
 
 
 def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TERMS,
@@ -134,9 +154,12 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
     The 51-term parallel design is 51 copies of one slice (table look-up, constant
     multiplier, adder); Yosys needs hours for all of them at once, so the slices are
     measured with the first 5, 9 and 17 terms of the model and a least-squares line per
-    resource gives the figure at the full term count (stated in the row's note).
+    resource gives the figure at the full term count (stated in the row's note).  A model
+    with no more terms than the largest slice is synthesised whole instead.
     """
     full = derive_seed_spec(model_path)
+    if full.terms < SEED_MIN_TERMS or full.terms <= max(terms):
+        return [_seed_whole(full, device, abc, terms, progress)]
     rows, pts = [], []
     with tempfile.TemporaryDirectory(prefix="flann-seed-") as tmp:
         for k, n in enumerate(terms, 1):
@@ -153,10 +176,7 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
             except FlannError as exc:
                 row.note = str(exc)
             rows.append(row)
-    err = SeedTop(full).error_vs_float()
-    row = Row(f"seed (paper), {full.terms} terms", None, "constant", f"fixed{full.word}", cycles_per_sample=1,
-              samples_per_s=CLOCK_HZ, max_err_lsb=err["max_err_lsb"], max_err_mm=err["max_err_mm"],
-              output_lsb_mm=full.output_lsb_mm)
+    row = _seed_row(full)
     if len(pts) >= 2:
         n = np.array([p[0] for p in pts], dtype=float)
         est = []
@@ -177,6 +197,38 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
         row.note = "too few seed syntheses succeeded to extrapolate"
     rows.append(row)
     return rows
+
+
+def _seed_row(full) -> Row:
+    """The seed architecture at the model's full term count, accuracy from its twin."""
+    err = SeedTop(full).error_vs_float()
+    return Row(f"seed (paper), {full.terms} terms", None, "constant", f"fixed{full.word}", cycles_per_sample=1,
+               samples_per_s=CLOCK_HZ, max_err_lsb=err["max_err_lsb"], max_err_mm=err["max_err_mm"],
+               output_lsb_mm=full.output_lsb_mm)
+
+
+def _seed_whole(full, device: str, abc: str, terms, progress: bool) -> Row:
+    """A model with no more terms than the largest slice: the first-N-terms slices would be
+    the whole design again, so it is measured as it is (one synthesis, nothing extrapolated);
+    a straight line (1 term) has no sin/cos term to build the seed's tables from."""
+    row = _seed_row(full)
+    if full.terms < SEED_MIN_TERMS:
+        row.note = (f"skipped synthesis: a {full.terms}-term model is a straight line, the seed "
+                    "architecture has no sin/cos table or multiplier to build")
+        return row
+    if progress:
+        print(f"explore: seed architecture, all {full.terms} terms", file=sys.stderr)
+    with tempfile.TemporaryDirectory(prefix="flann-seed-") as tmp:
+        ddir = Path(tmp) / "seed"
+        seed_render.write(full, ddir)
+        try:
+            _measure(row, ddir, device, None, abc)
+            row.note = (f"synthesised whole: its {full.terms} terms are no more than the largest "
+                        f"slice ({max(terms)} terms) that longer models are extrapolated from"
+                        + (f"; {row.note}" if row.note else ""))
+        except FlannError as exc:
+            row.note = str(exc)
+    return row
 
 
 def _fmt(x, spec: str = "") -> str:

@@ -104,6 +104,19 @@ def _panel(top: float, title: str, ylabel: str, lines, sx, bands=()) -> Panel:
                  z if yt[0] < 0 < yt[-1] else None, shaded)
 
 
+def _tolerance(tolerance_mm, working_range_mm, xt, lines: list, legend: list) -> tuple:
+    """The tolerance band over the working range (clipped to the axis): its edges appended to
+    ``lines`` and its entry to ``legend``; returns the panel's shaded band (none without one)."""
+    if tolerance_mm is None:
+        return ()
+    lo, hi = working_range_mm
+    ends = np.array([max(lo, xt[0]), min(hi, xt[-1])])
+    tol = np.full(2, float(tolerance_mm))
+    lines += [(ends, tol, COLOURS["tolerance"], "8,3", 1.4), (ends, -tol, COLOURS["tolerance"], "8,3", 1.4)]
+    legend.append((f"tolerance +-{tolerance_mm:.3g} mm ({lo:g}..{hi:g} mm)", COLOURS["tolerance"], "8,3"))
+    return ((float(ends[0]), float(ends[1]), -tolerance_mm, tolerance_mm, COLOURS["tolerance"]),)
+
+
 def error_plot_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
                    working_range_mm: tuple[float, float] | None = None) -> str:
     """Raw and compensated error vs displacement (mm), with the physical limit and, given a
@@ -120,14 +133,7 @@ def error_plot_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
              (x, -lim, COLOURS["limit"], "3,3", 1.2)]
     legend = [("compensated (hardware twin)", COLOURS["hw"], ""),
               ("physical limit (half an input LSB / slope)", COLOURS["limit"], "3,3")]
-    bands = ()
-    if tolerance_mm is not None:
-        lo, hi = working_range_mm or (float(x[0]), float(x[-1]))
-        bands = ((max(lo, xt[0]), min(hi, xt[-1]), -tolerance_mm, tolerance_mm, COLOURS["tolerance"]),)
-        ends = np.array([max(lo, xt[0]), min(hi, xt[-1])])
-        tol = np.full(2, float(tolerance_mm))
-        lines += [(ends, tol, COLOURS["tolerance"], "8,3", 1.4), (ends, -tol, COLOURS["tolerance"], "8,3", 1.4)]
-        legend.append((f"tolerance +-{tolerance_mm:.3g} mm ({lo:g}..{hi:g} mm)", COLOURS["tolerance"], "8,3"))
+    bands = _tolerance(tolerance_mm, working_range_mm or (float(x[0]), float(x[-1])), xt, lines, legend)
     hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design (bit-true twin)", "compensated error (mm)",
                 lines, sx, bands)
     xstep = xt[1] - xt[0] if len(xt) > 1 else 1.0
@@ -167,14 +173,8 @@ def error_plot_temperatures_svg(chk: dict, sensor: str, tolerance_mm: float | No
         raw_lines.append((x_all[o], chk["raw_err_mm"][o], colour, "", 1.0))
         hw_lines.append((x_all[o], chk["hw_err_mm"][o], colour, "", 1.2))
         legend.append((f"{temp:g} degC", colour, ""))
-    bands = ()
-    if tolerance_mm is not None:
-        lo, hi = working_range_mm or (float(np.min(x_all)), float(np.max(x_all)))
-        bands = ((max(lo, xt[0]), min(hi, xt[-1]), -tolerance_mm, tolerance_mm, COLOURS["tolerance"]),)
-        ends = np.array([max(lo, xt[0]), min(hi, xt[-1])])
-        tol = np.full(2, float(tolerance_mm))
-        hw_lines += [(ends, tol, COLOURS["tolerance"], "8,3", 1.4), (ends, -tol, COLOURS["tolerance"], "8,3", 1.4)]
-        legend.append((f"tolerance +-{tolerance_mm:.3g} mm ({lo:g}..{hi:g} mm)", COLOURS["tolerance"], "8,3"))
+    bands = _tolerance(tolerance_mm, working_range_mm or (float(np.min(x_all)), float(np.max(x_all))), xt,
+                       hw_lines, legend)
     raw = _panel(TOP, f"{sensor}: raw sensor at each temperature (error from one least-squares line)",
                  "raw error (mm)", raw_lines, sx)
     hw = _panel(TOP + PANEL_H + GAP, "compensated by the FPGA design at each temperature (bit-true twin)",

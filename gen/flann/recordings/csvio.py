@@ -158,14 +158,21 @@ class Recordings:
                           lines=lines, recognised=self.recognised)
 
 
+# a number as written in ASCII (the decimal comma is already a point here); inf/nan pass to
+# be refused as "not finite" below
+_ASCII_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+                           r"|inf|infinity|nan)\Z", re.IGNORECASE)
+
+
 def _parse_float(text: str, column: str, where: str, source: str, factor: float = 1.0) -> float:
     """A cell as a number in the canonical unit (x ``factor``), finite and in VALUE_RANGE."""
-    try:
-        value = float(text)
-    except ValueError:
+    # float() also takes '1_0', full-width and other Unicode digits: a cell a logger or
+    # spreadsheet never writes, so it is refused rather than read as some other number
+    if not _ASCII_NUMBER.match(text):
         raise RecordingsError(
-            f"{source}: {where}, column '{column}': '{text[:40]}' is not a number"
-        ) from None
+            f"{source}: {where}, column '{column}': '{text[:40]}' is not a number "
+            "(ASCII digits, sign, '.' or decimal comma, exponent)")
+    value = float(text)   # the pattern is a subset of what float() reads
     if not math.isfinite(value):
         raise RecordingsError(f"{source}: {where}, column '{column}': value {text} is not finite")
     value *= factor

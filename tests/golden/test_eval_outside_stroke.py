@@ -1,0 +1,45 @@
+"""flann eval on a recording wider than the model's trained displacement range: the points
+beyond it are counted in one warning line; the figures are reported as before (exit 0)."""
+
+import json
+
+import pytest
+
+
+
+
+@pytest.fixture
+def model(tmp_path):
+    # y = 2 v over [-2, 2] V, trained on [-4, 4] mm
+    m = {"format": "flann-model/1", "terms": 1, "input_offset_v": 0.0, "input_scale_v": 1.0,
+         "bias": 0.0, "weights": [2.0], "voltage_range_v": [-2.0, 2.0],
+         "displacement_range_mm": [-4.0, 4.0], "training": {}}
+    p = tmp_path / "m.json"
+    p.write_text(json.dumps(m))
+    return p
+
+
+def test_points_beyond_the_trained_stroke_are_counted(cli, tmp_path, model):
+    # x = 2 v everywhere; -6, -5, 5 and 6 mm lie outside [-4, 4] (4 of 9), -4 and 4 on its ends
+    data = tmp_path / "wide.csv"
+    data.write_text("displacement_mm,voltage_v\n" + "".join(
+        f"{x},{x / 2}\n" for x in (-6, -5, -4, -2, 0, 2, 4, 5, 6)))
+    rc, out, err = cli(["eval", model, data, "--json"])
+    assert rc == 0
+    stroke = [ln for ln in err.splitlines() if "displacement range" in ln]
+    assert len(stroke) == 1 and stroke[0].startswith("warning: ")
+    assert "4 of 9 points" in stroke[0] and "[-4, 4] mm" in stroke[0]
+    # the figures as before: clamped at +-2 V -> +-4 mm, so the worst point is 2 mm off
+    assert json.loads(out)["compensated"]["max_error_mm"] == pytest.approx(2.0)
+    text = tmp_path / "wide_text.csv"   # another name: an identical warning is shown once a process
+    text.write_text(data.read_text())
+    rc, out, err = cli(["eval", model, text])
+    assert rc == 0 and "max error (mm)" in out
+    assert sum("displacement range" in ln for ln in err.splitlines()) == 1
+
+
+def test_no_warning_within_the_trained_stroke(cli, tmp_path, model):
+    data = tmp_path / "in.csv"
+    data.write_text("displacement_mm,voltage_v\n-4,-2\n0,0\n4,2\n")
+    rc, _, err = cli(["eval", model, data])
+    assert rc == 0 and "displacement range" not in err
