@@ -5,17 +5,17 @@ import json
 
 import pytest
 
+from flann.golden.model import FlannModel
+
 
 
 
 @pytest.fixture
 def model(tmp_path):
     # y = 2 v over [-2, 2] V, trained on [-4, 4] mm
-    m = {"format": "flann-model/1", "terms": 1, "input_offset_v": 0.0, "input_scale_v": 1.0,
-         "bias": 0.0, "weights": [2.0], "voltage_range_v": [-2.0, 2.0],
-         "displacement_range_mm": [-4.0, 4.0], "training": {}}
     p = tmp_path / "m.json"
-    p.write_text(json.dumps(m))
+    p.write_text(FlannModel(weights=(2.0,), bias=0.0, input_offset_v=0.0, input_scale_v=1.0,
+                            voltage_range_v=(-2.0, 2.0), displacement_range_mm=(-4.0, 4.0)).to_json())
     return p
 
 
