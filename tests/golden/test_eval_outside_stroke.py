@@ -8,8 +8,6 @@ import pytest
 from flann.golden.model import FlannModel
 
 
-
-
 @pytest.fixture
 def model(tmp_path):
     # y = 2 v over [-2, 2] V, trained on [-4, 4] mm

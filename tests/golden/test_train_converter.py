@@ -6,8 +6,6 @@ import numpy as np
 import pytest
 
 
-
-
 @pytest.fixture
 def recording(tmp_path):
     # an LVDT-like S curve, +-4.17 V over +-30 mm (41 positions, two readings each)

@@ -10,7 +10,6 @@ from flann.errors import RecordingsError
 from flann.recordings import parse_recordings
 
 
-
 @pytest.mark.parametrize("cell", ["1_0", "0.1_5", "\uff11", "\u0663", "1\u0660", "\u00b2", "+\uff15e1"])
 def test_non_ascii_or_underscored_number_is_refused(cell):
     text = f"displacement_mm,voltage_v\n0,0\n{cell},0.5\n2,0.6\n"
