@@ -126,6 +126,12 @@ def _check_generatable(model) -> None:
                          "use fewer --terms, a --ridge, or --terms auto (the default)") from None
 
 
+def _stage(text: str) -> None:
+    """What --terms auto is doing, on a terminal only (a logger's file takes it a minute)."""
+    if sys.stderr.isatty():
+        print(f"train: {text}", file=sys.stderr, flush=True)
+
+
 def _train_auto(args, rec, provenance: dict) -> tuple:
     """(model, lines to print) of --terms auto: the FLANN fitted to the inverse of the forward
     curve (:mod:`flann.golden.inverse`), or the direct fit's cross-validated choice."""
@@ -138,6 +144,7 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     conv = converter(args, rec)
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)
+    _stage(f"{len(rec)} readings at {positions} positions: screening for gross outliers")
     rec, record, outlier_text = _screen(rec, step_v)
     if outlier_text:
         warnings.warn(outlier_text)
@@ -154,7 +161,9 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     def cost(m):
         return fixed_point_cost(m, adc)
 
+    _stage("the direct fit x(v): terms, normalisation and ridge by cross-validation")
     model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
+    _stage("the forward curve v(x), and the FLANN fitted to its inverse")
     inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training, step_v)
     t = model.training
     direct_text = (f"held-out error (cross-validation, {t['cv_folds']} folds"
