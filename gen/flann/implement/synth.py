@@ -185,8 +185,9 @@ class SynthReport:
         lines = [f"{self.top} on {self.part.name} (yosys synth_xilinx -family {FAMILY}{how})"]
         for name, used, avail in rows:
             lines.append(f"  {name:<20} {used:>6} / {avail:<6} {_pct(used, avail):5.1f} %")
-        lines.append(f"  {'carry (MUXCY/XORCY)':<20} {r.carry:>6} / {r.xorcy}")
-        lines.append(f"  {'MUXF5 / MUXF6':<20} {r.muxf5:>6} / {r.muxf6}")
+        # counts of two cell kinds each, not used / available as in the rows above
+        lines.append(f"  {'MUXCY, XORCY':<20} {r.carry:>6}, {r.xorcy} (carry chain cells)")
+        lines.append(f"  {'MUXF5, MUXF6':<20} {r.muxf5:>6}, {r.muxf6}")
         if len(self.entities) > 1:
             lines.append("  per entity (LUT4 / FF / BRAM): " + ", ".join(
                 f"{n} {e['luts']}/{e['ffs']}/{e['brams']}" for n, e in self.entities.items()))
