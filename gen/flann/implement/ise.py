@@ -158,14 +158,14 @@ def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
     return rows
 
 
-def check_fits(man, dp, part, force: bool = False) -> None:
+def check_fits(man, dp, part, force: bool = False, warn: bool = True) -> None:
     """Refuse (one line naming the smallest part that fits) a part the design's resource
-    estimate exceeds, unless ``force``; a datapath without an estimate is not checked, one
-    without an ISE handoff is refused."""
+    estimate exceeds, unless ``force`` (then a warning, when ``warn``); a datapath without an
+    estimate is not checked, one without an ISE handoff is refused."""
     if dp.why_no_ise:
         raise FlannError(f"{man.directory}: {dp.why_no_ise}")
     est = dp.estimate(man)
-    if est is None or force:
+    if est is None:
         return
     res = Resources(luts=est["luts"], ffs=est["ffs"], brams=est["brams"], carry=0, xorcy=0, mult_and=0,
                     muxf5=0, muxf6=0, io=sum(len(p.bits()) for p in top_ports(man) if p.name != "clk"))
@@ -174,14 +174,19 @@ def check_fits(man, dp, part, force: bool = False) -> None:
         return
     best = smallest_fit(res, part)
     where = f"smallest Spartan-II that fits: {best.name}" if best else "no Spartan-II holds it"
-    raise FlannError(f"{man.top} does not fit {part.name} (estimate: {'; '.join(short)}); {where} "
-                     "(--force writes the project anyway)")
+    why = f"{man.top} does not fit {part.name} (estimate: {'; '.join(short)}); {where}"
+    if force:
+        if warn:
+            warnings.warn(f"{why}; the project is written anyway (--force)")
+        return
+    raise FlannError(f"{why} (--force writes the project anyway)")
 
 
 def check_directory_fits(directory, device: str, force: bool = False) -> None:
-    """:func:`check_fits` for a design directory, before anything slow runs."""
+    """:func:`check_fits` for a design directory, before anything slow runs (the warning
+    under ``force`` is :func:`write_ise`'s)."""
     man, dp = read_design(directory)
-    check_fits(man, dp, parse_part(device), force)
+    check_fits(man, dp, parse_part(device), force, warn=False)
 
 
 def check_clock_mhz(clock_mhz: float) -> None:
