@@ -159,7 +159,7 @@ def test_quoted_decimal_commas_in_a_comma_file():
 def test_direction_in_words():
     rec = parse_recordings("displacement_mm,voltage_v,Direction\n0,0,up\n1,1,Up\n1,1.01,down\n0,0.01,-\n")
     np.testing.assert_array_equal(rec.direction, [1, 1, -1, -1])
-    with pytest.raises(RecordingsError, match="'sideways' is not a number"):
+    with pytest.raises(RecordingsError, match="'sideways' is not a direction"):
         parse_recordings("displacement_mm,voltage_v,direction\n0,0,sideways\n")
 
 

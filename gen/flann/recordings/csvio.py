@@ -382,6 +382,9 @@ def parse_recordings(text: str, source: str = "<memory>",
         for c, (i, factor) in columns.items():
             cell = row[i].strip()
             if c == "direction":
+                if cell.lower() not in DIRECTION_WORDS and cell and not cell.lstrip("+-").replace(".", "").isdigit():
+                    raise RecordingsError(f"{source}: {where}, column {header[i]!r}: {cell[:40]!r} is not a "
+                                          f"direction (+1, -1 or a word: {', '.join(sorted(DIRECTION_WORDS))})")
                 cell = DIRECTION_WORDS.get(cell.lower(), cell)
             # a comma inside a cell is a decimal comma (in a comma-separated file only
             # when quoted, "1,5"); with a point as well it is a thousands separator: refused
