@@ -51,7 +51,7 @@ from flann.golden.thermal import load_any_model
 from flann.errors import SpecError
 from flann.golden.thermal_metrics import by_temperature, drift_ppm_fs_per_c
 from flann.hardware.thermal.spec import derive_thermal_spec
-from flann.hardware.thermal.twin import ThermalTop
+from flann.hardware.thermal.twin import FlannThermalTop
 
 TEMP_BITS, TEMP_LSB_C = 12, 0.0625     # a digital temperature sensor's code
 # output LSB asked of the datapath: its rounding adds up to one LSB to the change of the error
@@ -192,7 +192,7 @@ def hardware_drift(p, model_path, held_csv, fs_mm) -> dict:
     x, v, temp = data[:, 0], data[:, 1], data[:, 2]
     codes = np.clip(np.floor(v / lsb + 0.5), spec.code_min, spec.code_max).astype(np.int64)
     tcodes = np.round(temp / TEMP_LSB_C).astype(np.int64)
-    out = ThermalTop(spec).process(codes, tcodes).out_data * spec.output_lsb_mm
+    out = FlannThermalTop(spec).process(codes, tcodes).out_data * spec.output_lsb_mm
     ref = spec.float_reference(codes, tcodes)
     return {"hw_drift": drift_ppm_fs_per_c(out - x, x, temp, fs_mm),
             "hw_held_max_mm": max(r["max_error_mm"] for r in by_temperature(out - x, temp)),

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.hardware.float18.spec import F18Top, derive_f18_spec
+from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 from flann.golden.model import load_model, term_kind
 from flann.recordings import read_recordings
 from flann.hardware.fixed.spec import derive_spec
@@ -40,7 +40,7 @@ def test_contributions_add_up_to_twin_minus_golden(default_model):
     assert np.max(np.abs(got - want)) < 1e-9
 
     fspec = derive_f18_spec(default_model)
-    want = F18Top(fspec).out_mm(codes) - default_model.predict(codes * spec.input_lsb_v)
+    want = FlannF18Top(fspec).out_mm(codes) - default_model.predict(codes * spec.input_lsb_v)
     got = sum(s.contrib for s in attribute(stages_float18(fspec, codes)))
     assert np.max(np.abs(got - want)) < 1e-9
 

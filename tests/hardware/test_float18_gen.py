@@ -137,12 +137,12 @@ def test_float18_builds_a_straight_line_model():
     import numpy as np
 
     from flann.golden.model import FlannModel
-    from flann.hardware.float18.spec import F18Top, derive_f18_spec
+    from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 
     line = FlannModel(weights=(-12.5,), bias=0.75, input_offset_v=0.1, input_scale_v=2.0,
                       voltage_range_v=(-1.9, 2.1), displacement_range_mm=(-12.0, 13.0))
     spec = derive_f18_spec(line)
-    top = F18Top(spec)
+    top = FlannF18Top(spec)
     codes = top.all_codes()
     v = np.clip(codes, spec.front.clamp_lo, spec.front.clamp_hi) * spec.front.input_lsb_v
     by_hand = 0.75 - 12.5 * (v - 0.1) / 2.0

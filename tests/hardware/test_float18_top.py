@@ -10,7 +10,7 @@ import pytest
 
 from flann.errors import SpecError
 from flann.numeric.float18 import FLOAT18 as F
-from flann.hardware.float18.spec import F18Top, derive_f18_spec
+from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 from flann.golden.model import load_model
 from flann.recordings import read_recordings
 from flann.golden.train import fit_lstsq
@@ -30,7 +30,7 @@ def test_twin_equals_scalar_exact_chain(paper_model):
     spec = derive_f18_spec(paper_model)
     base = spec.front
     codes = np.array([base.clamp_lo, -1000, -1, 0, 1, 777, base.clamp_hi, base.code_max])
-    out, sat = F18Top(spec).process(codes)
+    out, sat = FlannF18Top(spec).process(codes)
     theta = FlannNorm(base).process(codes).out_theta
     trig = FlannExpansion(base).process(theta).out_terms.reshape(codes.size, -1)
     Tf = base.term_fmt.frac_bits
@@ -50,7 +50,7 @@ def test_twin_equals_scalar_exact_chain(paper_model):
 
 def test_float18_error_is_small_relative_to_output(paper_model):
     spec = derive_f18_spec(paper_model)
-    top = F18Top(spec)
+    top = FlannF18Top(spec)
     c = np.arange(spec.front.clamp_lo, spec.front.clamp_hi + 1)
     y = top.out_mm(c)
     ref = paper_model.predict(c * spec.front.input_lsb_v)

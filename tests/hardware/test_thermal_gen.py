@@ -16,7 +16,7 @@ import pytest
 from flann.golden.thermal_train import fit_thermal
 from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
-from flann.hardware.thermal.twin import ThermalTop
+from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
 from flann.verify.design import from_directory
 
@@ -194,7 +194,7 @@ def test_trace_design_splits_the_error_into_its_stages(design, tmp_path):
     temps = res["temperature_codes"]
     assert temps[0] == s.temp_lo and temps[-1] == s.temp_hi
     c = np.arange(s.clamp_lo, s.clamp_hi + 1)
-    worst = max(np.abs(ThermalTop(s).process(c, tau).out_data * s.output_lsb_mm - s.float_reference(c, tau)).max()
+    worst = max(np.abs(FlannThermalTop(s).process(c, tau).out_data * s.output_lsb_mm - s.float_reference(c, tau)).max()
                 for tau in temps)
     assert res["total"]["max_mm"] == pytest.approx(worst, abs=1e-12) and worst <= s.output_lsb_mm
     for name, st in res["stages"].items():

@@ -7,7 +7,7 @@ import pytest
 from flann.errors import SpecError
 from flann.golden.thermal_train import fit_thermal
 from flann.hardware.thermal.spec import derive_thermal_spec
-from flann.hardware.thermal.twin import ThermalTop
+from flann.hardware.thermal.twin import FlannThermalTop
 
 
 def sensor_v(x, temp):
@@ -34,7 +34,7 @@ def spec(model):
 def test_every_voltage_code_at_every_temperature_code_within_one_lsb(spec):
     assert spec.analysis["pre_rounding_lsb"] <= 0.5
     temps = np.arange(spec.temp_code_min, spec.temp_code_max + 1)    # 256 codes, both ends
-    res = ThermalTop(spec).error_vs_float(temps)
+    res = FlannThermalTop(spec).error_vs_float(temps)
     assert res["codes"] == 1024 and res["temperature_codes"] == 256
     assert 0.05 < res["max_err_lsb"] <= 1.0
     # the output LSB is not vacuous: finer than 0.1 % of the 10 mm full scale
@@ -42,7 +42,7 @@ def test_every_voltage_code_at_every_temperature_code_within_one_lsb(spec):
 
 
 def test_temperature_normalisation_and_clamping(spec, model):
-    top = ThermalTop(spec)
+    top = FlannThermalTop(spec)
     codes = np.array([-300, 0, 300])
     lo = top.trace(codes, spec.temp_lo)
     hi = top.trace(codes, spec.temp_hi)
@@ -73,7 +73,7 @@ def test_sixteen_bit_input_interpolates_below_the_adc_step(model):
                                temp_lsb_c=1.0)
     assert spec.fine_bits == 0 and spec.interp_bits > 0
     assert spec.output_lsb_mm < 0.5 * spec.analysis["slope_mm_per_v"] * spec.input_lsb_v
-    res = ThermalTop(spec).error_vs_float([spec.temp_lo, 25, spec.temp_hi])
+    res = FlannThermalTop(spec).error_vs_float([spec.temp_lo, 25, spec.temp_hi])
     assert res["codes"] == 65536 and 0.05 < res["max_err_lsb"] <= 1.0
 
 
@@ -84,7 +84,7 @@ def test_an_adc_wider_than_the_order_datapaths_keeps_its_low_bits(model):
     lsb = 2.0 / (1 << 17)
     spec = derive_thermal_spec(model, input_bits=18, input_lsb_v=lsb, temp_bits=8, temp_lsb_c=1.0)
     assert spec.fine_bits == -2 and spec.interp_bits >= 2
-    top = ThermalTop(spec)
+    top = FlannThermalTop(spec)
     res = top.error_vs_float([spec.temp_lo, 25, spec.temp_hi])
     assert res["codes"] == 1 << 18 and res["max_err_lsb"] <= 1.0
     # where a code moves the output by more than an LSB, neighbouring codes give distinct

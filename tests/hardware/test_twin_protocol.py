@@ -43,8 +43,8 @@ def test_top_twin_protocol(model, name):
 def _block_twins(model):
     """(twin, inputs of process) of every block: the fixed datapath's, float18's converter and arithmetic."""
     from flann.hardware.fixed.twin import FlannAdder, FlannExpansion, FlannMultiplier, FlannNorm
-    from flann.hardware.float18.spec import F18Cvt
-    from flann.numeric.float18 import F18Add, F18Mul
+    from flann.hardware.float18.spec import FlannF18Cvt
+    from flann.numeric.float18 import FlannF18Add, FlannF18Mul
 
     s = derive_spec(model, input_bits=8)
     codes = np.arange(-128, 128)
@@ -55,8 +55,8 @@ def _block_twins(model):
     return [(FlannNorm(s), (codes,), "out_theta"), (FlannExpansion(s), (n.out_theta,), "out_terms"),
             (FlannMultiplier(s), (e.out_terms,), "out_products"),
             (FlannAdder(s), (n.out_lin, p.out_products, n.out_sat), "out_data"),
-            (F18Cvt(s.term_fmt.frac_bits), (np.arange(-8, 8),), "out_y"),
-            (F18Mul(), (one, one), "out_y"), (F18Add(), (one, one), "out_y")]
+            (FlannF18Cvt(s.term_fmt.frac_bits), (np.arange(-8, 8),), "out_y"),
+            (FlannF18Mul(), (one, one), "out_y"), (FlannF18Add(), (one, one), "out_y")]
 
 
 def test_block_twin_protocol(model):

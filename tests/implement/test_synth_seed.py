@@ -1,4 +1,4 @@
-"""The seed paper's fully parallel architecture (hardware/seed: SeedSpec, SeedTop, flann_seed_top)."""
+"""The seed paper's fully parallel architecture (hardware/seed: SeedSpec, FlannSeedTop, flann_seed_top)."""
 
 import dataclasses
 import math
@@ -11,7 +11,7 @@ import pytest
 from flann.hardware.seed import render
 from flann.hardware.seed.render import SEED_FILE
 from flann.hardware.seed.spec import SeedSpec
-from flann.hardware.seed.twin import SeedTop
+from flann.hardware.seed.twin import FlannSeedTop
 from flann.golden.model import load_model
 
 MODEL = "data/default_model.json"
@@ -37,12 +37,12 @@ def test_seed_structure_is_the_papers():
     assert "constant terms_c    : natural := 51;" in text
     assert "entity flann_seed_top is" in text and "flann_top" not in text.replace("flann_seed_top", "")
     assert render.manifest(s)["cycles_per_sample"] == 1 and render.manifest(s)["top"] == "flann_seed_top"
-    assert SeedTop(s).entity == "flann_seed_top" and SeedTop(s).latency == s.latency_cycles
+    assert FlannSeedTop(s).entity == "flann_seed_top" and FlannSeedTop(s).latency == s.latency_cycles
 
 
 def test_seed_error_within_the_table_step_bound():
     s = _seed()
-    err = SeedTop(s).error_vs_float()
+    err = FlannSeedTop(s).error_vs_float()
     m = s.model
     # full-wave table with 2^A midpoint samples: |sin error| <= pi / 2^A per trig term,
     # plus half an LSB per rounding (v, terms, weights, products) -- a loose independent bound
@@ -120,7 +120,7 @@ def test_seed_vhdl_equals_its_twin(tmp_path):
     vals = np.array([int(g[0]) for g in got])
     sats = np.array([g[1] == "'1'" for g in got])
     codes = np.arange(lo, hi + 1)
-    out, sat = SeedTop(s).process(codes)
+    out, sat = FlannSeedTop(s).process(codes)
     assert vals.size == codes.size
     np.testing.assert_array_equal(vals, out)
     np.testing.assert_array_equal(sats, sat)

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from flann.errors import FlannError
-from flann.numeric.float18 import FLOAT18, F18Add, F18Mul
+from flann.numeric.float18 import FLOAT18, FlannF18Add, FlannF18Mul
 
 F = FLOAT18
 SEED = 20261122
@@ -272,7 +272,7 @@ def test_vectorised_ops_equal_scalar_exact():
 # -- twins' pipelines ---------------------------------------------------------------------
 def test_twin_latency_and_valid():
     one, two = F.encode(1), F.encode(2)
-    for twin, lat in ((F18Mul(), 2), (F18Add(), 3)):
+    for twin, lat in ((FlannF18Mul(), 2), (FlannF18Add(), 3)):
         assert twin.latency == lat
         outs = [twin.step(True, one, two)] + [twin.step(False) for _ in range(lat + 1)]
         valid = [v for v, _ in outs]
@@ -280,4 +280,4 @@ def test_twin_latency_and_valid():
         assert outs[lat - 1][1] == (F.encode(2) if lat == 2 else F.encode(3))
         twin.reset()
         assert twin.step(False) == (False, None)
-    assert F18Mul().entity == "flann_f18_mul" and F18Add().entity == "flann_f18_add"
+    assert FlannF18Mul().entity == "flann_f18_mul" and FlannF18Add().entity == "flann_f18_add"

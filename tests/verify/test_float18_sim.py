@@ -72,9 +72,9 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
 # -- top level: every input code ------------------------------------------------------------
 def _run_top(tmp_path, model, step: int, seed: int, **options):
     from flann.verify.float18 import run_top
-    from flann.hardware.float18.spec import F18Top, derive_f18_spec
+    from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 
-    codes = F18Top(derive_f18_spec(model, **options)).all_codes()[::step]
+    codes = FlannF18Top(derive_f18_spec(model, **options)).all_codes()[::step]
     r = run_top(model, tmp_path, codes=codes, seed=seed, **options)
     assert not r["bench_failed"], "cocotb reported a failure (see sim.log)"
     assert r["mismatches"] == 0 and r["codes"].size == codes.size

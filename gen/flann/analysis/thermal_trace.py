@@ -32,7 +32,7 @@ from ..hardware.family.spec import clamp_codes
 from ..hardware.family_thermal.spec import FamilyThermalSpec, order_models
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.thermal.spec import ThermalSpec
-from ..hardware.thermal.twin import ThermalTop
+from ..hardware.thermal.twin import FlannThermalTop
 from ..verify.datapaths import family_thermal_temperature_codes, thermal_temperature_codes
 
 STAGES = ("temperature", "correction", "interpolation", "orders", "horner", "output")
@@ -119,7 +119,7 @@ def trace_thermal(spec: ThermalSpec) -> ThermalTraceResult:
     vc = _voltage_codes(spec)
     c = np.tile(vc, len(temps))
     tau = np.repeat(np.asarray(temps, dtype=np.int64), vc.size)
-    tr = ThermalTop(spec).trace(c, tau)
+    tr = FlannThermalTop(spec).trace(c, tau)
     h = spec.input_lsb_v / 2.0 ** spec.fine_bits          # the order datapaths' grid (V)
     kq = q / 2.0 ** spec.inner_bits                       # the orders' LSB (mm)
 

@@ -34,7 +34,7 @@ from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
 from ..hardware.accuracy import nearest_codes
 from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import F18Top
+from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import FORMATS, datapath
 from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
@@ -141,7 +141,7 @@ def stages_fixed(spec, codes=None) -> Stages:
 
 
 def stages_float18(fspec, codes=None) -> Stages:
-    top = F18Top(fspec)
+    top = FlannF18Top(fspec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     t = top.trace(codes)
     fmt = fspec.fmt

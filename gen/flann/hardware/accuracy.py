@@ -25,10 +25,10 @@ from .fixed.twin import FlannTop
 from .family_thermal.spec import FamilyThermalSpec
 from .family_thermal.twin import FlannFamilyThermalTop
 from .thermal.spec import ThermalSpec
-from .thermal.twin import ThermalTop
+from .thermal.twin import FlannThermalTop
 
 # the two-input specs and their top-level twins (process(in_data, in_temp) -> out_data, out_sat)
-TWO_INPUT_TWINS = {ThermalSpec: ThermalTop, FamilyThermalSpec: FlannFamilyThermalTop}
+TWO_INPUT_TWINS = {ThermalSpec: FlannThermalTop, FamilyThermalSpec: FlannFamilyThermalTop}
 
 # -- a generated design, rebuilt ---------------------------------------------------------
 def design_spec(model_path, design_dir) -> Spec:

@@ -27,7 +27,7 @@ from ..hardware.manifest import write_design
 from ..hardware.registry import FLOAT18
 from ..hardware.seed import render as seed_render
 from ..hardware.seed.spec import derive_seed_spec
-from ..hardware.seed.twin import SeedTop
+from ..hardware.seed.twin import FlannSeedTop
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
 from .explore_float18 import measure
 from .synth import Resources, shortfall, smallest_fit, synthesize
@@ -201,7 +201,7 @@ def seed_rows(model_path, device: str, abc: str = "fast", terms=SEED_SCALING_TER
 
 def _seed_row(full) -> Row:
     """The seed architecture at the model's full term count, accuracy from its twin."""
-    err = SeedTop(full).error_vs_float()
+    err = FlannSeedTop(full).error_vs_float()
     return Row(f"seed (paper), {full.terms} terms", None, "constant", f"fixed{full.word}", cycles_per_sample=1,
                samples_per_s=CLOCK_HZ, max_err_lsb=err["max_err_lsb"], max_err_mm=err["max_err_mm"],
                output_lsb_mm=full.output_lsb_mm)

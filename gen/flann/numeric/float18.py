@@ -28,7 +28,7 @@ against an independent Fraction reference:
   correctly rounded sum; rounding that again to 12 bits equals rounding the exact sum once
   because 53 >= 2 * 12 + 2 (double rounding is innocuous for +, -, *; Figueroa 1995).
 
-The twins :class:`F18Mul` and :class:`F18Add` carry the VHDL entities' names and latencies
+The twins :class:`FlannF18Mul` and :class:`FlannF18Add` carry the VHDL entities' names and latencies
 and model their valid pipelines cycle by cycle (``reset`` / ``step``).
 """
 
@@ -320,7 +320,7 @@ class _PipelinedTwin:
         return self._pipe[0]
 
 
-class F18Mul(_PipelinedTwin):
+class FlannF18Mul(_PipelinedTwin):
     """Twin of ``flann_f18_mul``: out_y = RNE(in_a * in_b), 2 clock cycles later."""
 
     latency = 2
@@ -333,7 +333,7 @@ class F18Mul(_PipelinedTwin):
         return self.fmt.mul_array(a, b)
 
 
-class F18Add(_PipelinedTwin):
+class FlannF18Add(_PipelinedTwin):
     """Twin of ``flann_f18_add``: out_y = RNE(in_a + in_b), 3 clock cycles later."""
 
     latency = 3
@@ -346,4 +346,4 @@ class F18Add(_PipelinedTwin):
         return self.fmt.add_array(a, b)
 
 
-__all__ = ["FloatOut", "FLOAT18", "F18Add", "F18Mul", "FloatFormat"]
+__all__ = ["FloatOut", "FLOAT18", "FlannF18Add", "FlannF18Mul", "FloatFormat"]

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import FlannError
 from .runner import run_cocotb
 from ..hardware.float18.render import generate
-from ..hardware.float18.spec import F18Top, derive_f18_spec
+from ..hardware.float18.spec import FlannF18Top, derive_f18_spec
 from ..golden.model import FlannModel, load_model, model_sha256
 
 
@@ -39,7 +39,7 @@ def run_design(design, build_dir, codes=None, seed: int = 1, stage_codes=()) -> 
 
 
 def run_files(fspec, man: dict, files, build_dir: Path, codes=None, seed: int = 1, stage_codes=()) -> dict:
-    top = F18Top(fspec)
+    top = FlannF18Top(fspec)
     codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
     out, sat = top.process(codes)
     rec = build_dir / "hdl_outputs.json"

@@ -26,7 +26,7 @@ from ..errors import FlannError
 from ..golden.train import fit_lstsq
 from ..hardware.fixed.render import write
 from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import F18Top
+from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import DATAPATHS, datapath
 from .design import Design
 from .float18 import run_top
@@ -148,7 +148,7 @@ def _check_sweep(model, case: Case, spec, rng, work: Path, hdl_codes: int) -> Ca
 
 def _check_f18_top(model, case: Case, fspec, rng, work: Path, hdl_codes: int) -> Case:
     try:
-        top = F18Top(fspec)
+        top = FlannF18Top(fspec)
         codes = top.all_codes()
         lo, hi = _window(int(codes[0]), int(codes[-1]), rng, hdl_codes)
         r = run_top(model, work, codes=np.arange(lo, hi + 1), seed=case.index, **case.options)

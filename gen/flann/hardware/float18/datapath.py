@@ -9,7 +9,7 @@ from ..datapath import Datapath, Field, _int, rebuild_matching
 from ..fixed.render import _format_bits
 from ..options import GenOptions
 from . import render
-from .spec import F18Top, derive_f18_spec, float18_options
+from .spec import FlannF18Top, derive_f18_spec, float18_options
 
 # LUT4 / flip-flops of flann_f18_cvt + flann_f18_mul + flann_f18_add and the top's sequencer,
 # measured by `flann synth` (GHDL + Yosys, abc full) of an 8-bit, 5-term float18 design
@@ -72,7 +72,7 @@ FIELDS = (
 
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="the seed's 18-bit floating point after the fixed front end",
-    generate=generate, rebuild=rebuild, twin=F18Top, estimate=estimate, fields=FIELDS,
+    generate=generate, rebuild=rebuild, twin=FlannF18Top, estimate=estimate, fields=FIELDS,
     # compared with the fixed design, fixed-only options are meant for that one
     derive_options=lambda options, compared=False: float18_options(options, fixed_too=compared),
     bench="f18_top", stages="float18_terms", explore="float18_widths", summary=summary, derive=derive_f18_spec,

@@ -11,7 +11,7 @@ from pathlib import Path
 from ... import __version__
 from ...errors import SpecError
 from ...numeric.fixed import bits_literal, bits_needed
-from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat
+from ...numeric.float18 import FLOAT18, FlannF18Add, FlannF18Mul, FloatFormat
 from ...textgen import template
 from ..header import header
 from ..manifest import write_design
@@ -21,7 +21,7 @@ from .spec import CVT, TOP, derive_f18_spec
 
 DATAPATH = "float18"
 SEQ = "flann_seq"
-BLOCKS = {"mul": F18Mul, "add": F18Add}
+BLOCKS = {"mul": FlannF18Mul, "add": FlannF18Add}
 BLOCK_TITLES = {"mul": "multiplier", "add": "adder"}
 TEMPLATES = "hardware/float18/templates"
 COMMAND = "flann gen --format float18"
@@ -100,8 +100,8 @@ def top_context(fspec) -> dict:
     n_advs = fspec.n_advs
     widx_bits = max(1, n_terms.bit_length())
     return {
-        "entity": TOP, "cvt_entity": CVT, "mul_entity": F18Mul(fmt).entity,
-        "add_entity": F18Add(fmt).entity, "width": fmt.width, "fmt_name": fmt.name,
+        "entity": TOP, "cvt_entity": CVT, "mul_entity": FlannF18Mul(fmt).entity,
+        "add_entity": FlannF18Add(fmt).entity, "width": fmt.width, "fmt_name": fmt.name,
         "fmt_text": fmt.describe(), "in_bits": b.input_bits, "input_lsb_v": b.input_lsb_v,
         "term_bits": b.term_fmt.width, "phase_bits": b.phase_bits, "lin_bits": b.lin_fmt.width,
         "n_advs": n_advs, "adv_period": fspec.adv_period, "n_terms": n_terms, "widx_bits": widx_bits,

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import SpecError
-from ...numeric.float18 import FLOAT18, F18Add, F18Mul, FloatFormat, FloatOut
+from ...numeric.float18 import FLOAT18, FlannF18Add, FlannF18Mul, FloatFormat, FloatOut
 from ...golden.model import FlannModel
 from ..fixed.latency import EXPANSION_ADVANCES, SEQ_START_EDGES, norm_latency
 from ..fixed.spec import FrontEnd, derive_front, front_end
@@ -91,7 +91,7 @@ class F18Spec:
         # n_advs - 1), then converter + multiplier + adder, then this top's own three edges:
         # the sum register and count, done_r (flann_seq's in_done), the output register
         return (norm_latency(self.front.input_bits) + SEQ_START_EDGES + (self.n_advs - 1) * self.adv_period
-                + F18Cvt.latency + F18Mul.latency + F18Add.latency + TOP_DRAIN_EDGES)
+                + FlannF18Cvt.latency + FlannF18Mul.latency + FlannF18Add.latency + TOP_DRAIN_EDGES)
 
     @property
     def cycles_per_sample(self) -> int:
@@ -142,7 +142,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     # The front end takes an advance every adder latency and forms the slope correction in one
     # step (the array form: only a shift-add multiplier's idle cycles make the serial one pay).
     front = front_end(derive_front(model, o, terms_hold_code=True), model_sha256=sha, device=o.device, lanes=1,
-                      adv_period=F18Add.latency)
+                      adv_period=FlannF18Add.latency)
     fmt = FLOAT18
     Tf = front.term_fmt.frac_bits
     if front.input_bits > fmt.sig_bits:
@@ -166,7 +166,7 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
 
 
 # -- twins ---------------------------------------------------------------------------------
-class F18Cvt:
+class FlannF18Cvt:
     """Twin of ``flann_f18_cvt``: signed fixed (``frac_bits`` fraction bits) -> float18, RNE."""
 
     entity = CVT
@@ -203,7 +203,7 @@ class F18Trace:
     sat: np.ndarray            # (n,) input clamped or output at +-max finite
 
 
-class F18Top:
+class FlannF18Top:
     """Twin of ``flann_f18_top``: out_data (float18 code) and out_sat for each input code."""
 
     entity = TOP
@@ -213,7 +213,7 @@ class F18Top:
         self.latency = spec.latency_cycles
         self.norm = FlannNorm(spec.front)
         self.expansion = FlannExpansion(spec.front)
-        self.cvt = F18Cvt(spec.term_frac_bits, spec.fmt)
+        self.cvt = FlannF18Cvt(spec.term_frac_bits, spec.fmt)
         self.fmt = spec.fmt
 
     def trace(self, codes) -> F18Trace:
@@ -254,4 +254,4 @@ class F18Top:
         return {"max_err_lsb": None, "max_err_mm": e, "codes": int(codes.size)}
 
 
-__all__ = ["float18_options", "FRONT_END_OPTIONS", "F18Spec", "derive_f18_spec", "F18Cvt", "F18Top", "F18Trace"]
+__all__ = ["float18_options", "FRONT_END_OPTIONS", "F18Spec", "derive_f18_spec", "FlannF18Cvt", "FlannF18Top", "F18Trace"]

@@ -6,7 +6,7 @@ from ...errors import FlannError
 from ..datapath import Datapath, _int, _num
 from . import render
 from .spec import ENTITY
-from .twin import SeedTop
+from .twin import FlannSeedTop
 
 WHY = "the seed architecture is a comparison design that flann explore measures; it has no {}"
 
@@ -25,7 +25,7 @@ def estimate(man: dict) -> dict | None:
 
 DATAPATH = Datapath(
     name=render.DATAPATH, top=ENTITY, about="the seed paper's parallel architecture (comparison only)",
-    generate=generate, rebuild=rebuild, twin=SeedTop, estimate=estimate,
+    generate=generate, rebuild=rebuild, twin=FlannSeedTop, estimate=estimate,
     fields=(_num("output_lsb_mm", 0), _int("spec.terms")), model_field="",
     why_no_bench=WHY.format("simulation bench"), why_no_eval=WHY.format("twin rebuilt from a directory"),
     why_no_explore=WHY.format("model kept in its directory"), why_no_stages=WHY.format("stage model for flann trace"),

@@ -9,7 +9,7 @@ from ..twin import TopOut
 from .spec import ENTITY, SeedSpec
 
 
-class SeedTop:
+class FlannSeedTop:
     """out_data / out_sat of flann_seed_top for each input code, exactly as the VHDL computes them."""
 
     entity = ENTITY
@@ -52,4 +52,4 @@ class SeedTop:
         return {"max_err_lsb": e / s.output_lsb_mm, "max_err_mm": e, "codes": int(codes.size)}
 
 
-__all__ = ["SeedTop"]
+__all__ = ["FlannSeedTop"]

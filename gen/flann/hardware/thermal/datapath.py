@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..datapath import Datapath, Field, _int, _num, check_design_model
 from ..fixed.datapath import DATAPATH as FIXED
 from . import render
-from .twin import ThermalTop
+from .twin import FlannThermalTop
 
 
 def eval_spec(model, man: dict, directory):
@@ -40,7 +40,7 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP,
     about="two inputs (voltage, temperature): one fixed datapath per temperature order",
-    generate=render.generate, rebuild=render.rebuild, twin=ThermalTop, estimate=estimate, fields=FIELDS,
+    generate=render.generate, rebuild=render.rebuild, twin=FlannThermalTop, estimate=estimate, fields=FIELDS,
     bench="thermal_sweep", summary=summary, number_format=FIXED.number_format,
     stages="thermal",
     eval_spec=eval_spec,

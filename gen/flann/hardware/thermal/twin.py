@@ -1,6 +1,6 @@
 """Bit-true twin of the two-input datapath (:mod:`.spec`): the same integer arithmetic.
 
-``ThermalTop(spec).process(in_data, in_temp)`` returns the output ports ``out_data`` (in
+``FlannThermalTop(spec).process(in_data, in_temp)`` returns the output ports ``out_data`` (in
 output LSBs) and ``out_sat`` (an input outside the calibrated codes, clamped, or the output
 saturated), plus the internal stages in :class:`ThermalTrace`.  The order datapaths are
 :class:`flann.hardware.fixed.twin.FlannTop`, unchanged.  The entity is the rendered top's (:mod:`.render`).
@@ -37,7 +37,7 @@ class ThermalTrace:
     out_sat: np.ndarray
 
 
-class ThermalTop:
+class FlannThermalTop:
     entity = "flann_thermal_top"
 
     def __init__(self, spec: ThermalSpec):
@@ -101,4 +101,4 @@ class ThermalTop:
                 "codes": int(codes.size), "temperature_codes": int(np.size(temp_codes))}
 
 
-__all__ = ["ThermalTop", "ThermalTrace"]
+__all__ = ["FlannThermalTop", "ThermalTrace"]

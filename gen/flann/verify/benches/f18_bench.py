@@ -15,10 +15,10 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from flann.numeric.float18 import F18Add, F18Mul, FloatFormat
+from flann.numeric.float18 import FlannF18Add, FlannF18Mul, FloatFormat
 from flann.verify.benches import CLK_NS, config
 
-TWINS = {"mul": F18Mul, "add": F18Add}
+TWINS = {"mul": FlannF18Mul, "add": FlannF18Add}
 
 
 def load_spec() -> dict:

@@ -1,5 +1,5 @@
 """cocotb tests of a float18 block (flann_f18_mul or flann_f18_add, the spec's ``kind``) against
-its twin (F18Mul, F18Add), bit-exact, cycle by cycle."""
+its twin (FlannF18Mul, FlannF18Add), bit-exact, cycle by cycle."""
 
 import cocotb
 from flann.verify.benches.f18_bench import Bench, stimuli

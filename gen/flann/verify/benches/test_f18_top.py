@@ -1,4 +1,4 @@
-"""cocotb: flann_f18_top against its twin F18Top over a list of input codes (bit-exact).
+"""cocotb: flann_f18_top against its twin FlannF18Top over a list of input codes (bit-exact).
 
 The expected outputs come from the twin, computed by the runner and passed in the bench
 configuration (flann.verify.benches.config; GHDL's VPI cannot read generics):

@@ -8,7 +8,7 @@ import cocotb
 import numpy as np
 
 from flann.hardware.thermal.render import rebuild
-from flann.hardware.thermal.twin import ThermalTop
+from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.benches.flann_bench import judge_two_input, two_input_sweep
 
 
@@ -16,7 +16,7 @@ from flann.verify.benches.flann_bench import judge_two_input, two_input_sweep
 async def thermal_sweep_vs_twin(dut):
     """Every (voltage code, temperature code) of the sweep, bit-exact vs the twin, fixed latency."""
     cfg, spec, got, want_c, want_t = await two_input_sweep(dut, rebuild, "thermal sweep")
-    out, sat = ThermalTop(spec).process(want_c, want_t)
+    out, sat = FlannThermalTop(spec).process(want_c, want_t)
     ref = spec.float_reference(want_c, want_t) / spec.output_lsb_mm
     ok = ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
     err = float(np.max(np.abs(got[:, 2] - ref)[ok])) if ok.any() else 0.0
