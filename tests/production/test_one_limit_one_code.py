@@ -13,10 +13,11 @@ from flann.analysis.trace import run_trace
 from flann.cli import main
 from flann.golden.model import load_model
 from flann.golden.metrics import DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, full_scale_mm
-from flann.hardware.accuracy import (adc_codes, design_adc, design_spec, hardware_accuracy, nearest_codes,
-                                     physical_limit_mm, temperature_codes)
+from flann.hardware.accuracy import (adc_codes, design_adc, design_spec, hardware_accuracy, physical_limit_mm,
+                                     temperature_codes)
 from flann.hardware.family.render import load_design
 from flann.hardware.registry import FAMILY_THERMAL, datapath, read_design
+from flann.numeric.fixed import nearest_codes
 from flann.production.calibrate import RIDGES, check_sensor
 from flann.production.thermal import check_sensor_thermal
 from flann.recordings import Recordings, read_recordings, write_recordings

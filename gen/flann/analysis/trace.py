@@ -32,10 +32,10 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
-from ..hardware.accuracy import nearest_codes
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import FORMATS, datapath
+from ..numeric.fixed import nearest_codes
 from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
 from ..hardware.family.twin import FlannFamilyTop

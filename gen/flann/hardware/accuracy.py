@@ -221,5 +221,5 @@ def plot_errors(path, x, raw_err, float_err, hw_err, limit, title: str = "") -> 
         plt.close(fig)
 
 
-__all__ = ["fixed_point_cost", "design_spec", "design_adc", "nearest_codes", "adc_codes", "temperature_codes",
+__all__ = ["fixed_point_cost", "design_spec", "design_adc", "adc_codes", "temperature_codes",
            "physical_limit_mm", "hardware_accuracy", "plot_errors"]

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..hardware.fixed import render as hdlgen
+from ..hardware.fixed.spec import max_lanes
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.render import render_block
 from ..hardware.manifest import write_design
@@ -103,6 +104,7 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
     """Generate, synthesise and score each candidate; the seed architecture last.  ``adc``:
     input_bits / input_lsb_v of the converter, as flann gen takes them."""
     parse_part(device)
+    terms = load_model(model_path).terms
     rows: list[Row] = []
     combos = [(l, s, w) for w in widths for s in styles for l in lanes]
     with tempfile.TemporaryDirectory(prefix="flann-explore-") as tmp:
@@ -113,10 +115,9 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
                 print(f"explore [{k}/{len(combos)}] lanes={lane} mult={style} widths={preset}",
                       file=sys.stderr)
             try:
-                terms = load_model(model_path).terms
-                if lane > max(1, terms - 1):   # the lanes share the sin/cos terms (a line gets one)
+                if lane > max_lanes(terms):
                     raise NotApplicable(f"{lane} lanes: this {terms}-term model has "
-                                        f"{max(1, terms - 1)} sin/cos term(s) to share among them")
+                                        f"{max_lanes(terms)} sin/cos term(s) to share among them")
                 base = dict(lanes=lane, mult_style=style, **(adc or {}))
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always")

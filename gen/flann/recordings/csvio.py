@@ -382,7 +382,7 @@ def parse_recordings(text: str, source: str = "<memory>",
         for c, (i, factor) in columns.items():
             cell = row[i].strip()
             if c == "direction":
-                if cell.lower() not in DIRECTION_WORDS and cell and not cell.lstrip("+-").replace(".", "").isdigit():
+                if cell and cell.lower() not in DIRECTION_WORDS and not _ASCII_NUMBER.match(cell):
                     raise RecordingsError(f"{source}: {where}, column {header[i]!r}: {cell[:40]!r} is not a "
                                           f"direction (+1, -1 or a word: {', '.join(sorted(DIRECTION_WORDS))})")
                 cell = DIRECTION_WORDS.get(cell.lower(), cell)

@@ -56,25 +56,24 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-def _images(design: Design, images, least: int) -> list[dict]:
-    """The weight images a family bench loads ({name, hex}): those given (--image), else the
-    ones flann gen kept in the design; each read here, so a bad file is one line, not a failed
-    bench."""
+def _images(design: Design, images, least: int) -> list[tuple[dict, list[int]]]:
+    """The weight images a family bench loads, ({name, hex}, words) each: those given (--image),
+    else the ones flann gen kept in the design; read here, so a bad file is one line, not a
+    failed bench."""
     given = bool(images)
     images = list(images or [{"name": im["name"], "hex": str(design.directory / im["hex"])}
                              for im in design.manifest.get("images", [])])
-    for im in images:
-        read_image(im["hex"])
+    loaded = [(im, read_image(im["hex"])) for im in images]
     if len(images) < least:
         held = f"got {len(images)} --image" if given else f"the design holds {len(images)}"
         raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads {least} sensor weight "
                          f"image(s) through the cfg port; {held} (pass --image A.hex"
                          f"{' --image B.hex' if least > 1 else ''}, written by flann calibrate)")
-    return images
+    return loaded
 
 
 def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
-    images = _images(design, images, 2)
+    images = [im for im, _words in _images(design, images, 2)]
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
     codes = len(rec.get("codes", [])) * len(rec.get("outputs", {}))
@@ -146,8 +145,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     initial sensor, so the cfg port is what loads it) at every voltage code and the stated
     temperature codes."""
     spec, man = design.spec, design.manifest
-    image = _images(design, images, 1)[-1]
-    words = read_image(image["hex"])
+    image, words = _images(design, images, 1)[-1]
     if len(words) != spec.image_words:
         raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
     temps = family_thermal_temperature_codes(spec)

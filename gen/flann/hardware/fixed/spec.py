@@ -788,12 +788,18 @@ class Blocks:
     sequencer: Sequencer
 
 
+def max_lanes(terms: int) -> int:
+    """The most lanes a model of ``terms`` terms takes: the lanes share its sin/cos terms
+    (a straight line, one term, still gets one lane)."""
+    return max(1, terms - 1)
+
+
 def derive_blocks(model: FlannModel, o: GenOptions) -> Blocks:
     """Every block of the fixed datapath for ``model`` under the options ``o``: the front end,
     then the multiplier, the adder and the sequencer."""
     parse_device(o.device)
     # the lanes and the multiplier style are checked before the widths they shape
-    L = _check_int("lanes", o.lanes, 1, max(1, model.terms - 1))
+    L = _check_int("lanes", o.lanes, 1, max_lanes(model.terms))
     check_mult_style(o.mult_style)
     f = derive_front(model, o)
     mult = derive_multiplier(f.budget, f.expansion, o.weight_frac_bits, f.product_frac_bits, L)
@@ -968,7 +974,7 @@ def check_fits(spec: Spec, part: str) -> None:
     )
 
 
-__all__ = ["Spec", "serial_interp_for", "Front", "derive_front", "FrontEnd", "front_end", "steps_for", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
+__all__ = ["max_lanes", "Spec", "serial_interp_for", "Front", "derive_front", "FrontEnd", "front_end", "steps_for", "derive_spec", "table_brams", "round_sig", "MULT_STYLES", "parse_device", "estimate_resources",
            "error_analysis", "BUDGET", "CLOCK_HZ", "Blocks", "derive_blocks", "compose", "assemble", "sfix",
            "InputStage", "derive_input", "OutputStage", "derive_output", "Budget", "error_budget",
            "derive_phase_bits", "Expansion", "derive_expansion", "Multiplier", "product_frac_bits_for",
