@@ -19,7 +19,9 @@ from flann.hardware.family.render import load_design
 from flann.hardware.registry import FAMILY_THERMAL, datapath, read_design
 from flann.numeric.fixed import nearest_codes
 from flann.production.calibrate import RIDGES, check_sensor
+from flann.production.spec import ProductionSpec
 from flann.production.thermal import check_sensor_thermal
+from flann.production.verdict import judge
 from flann.recordings import Recordings, read_recordings, write_recordings
 
 SPAN_MM, W_MM, SHARP = 10.0, 7.0, 2.5
@@ -83,6 +85,10 @@ def test_certificate_limit_is_evals_limit(family, capsys):
     assert hw["max_error_mm"] == pytest.approx(float(np.max(np.abs(chk["hw_err_mm"]))), rel=1e-12)
     np.testing.assert_allclose(pts["limit"], chk["limit_mm"], rtol=1e-12)
     np.testing.assert_allclose(pts["hardware"], chk["hw_err_mm"], rtol=0, atol=1e-12)
+    # one full scale: the verdict's % FS over the whole stroke is eval's
+    verdict = judge(ProductionSpec(max_error_mm=1.0), read_recordings(rec_path).displacement_mm,
+                    chk["hw_err_mm"], None, ())
+    assert verdict.max_error_pct_fs == pytest.approx(hw["max_error_pct_fs"], rel=1e-12)
 
 
 def test_limit_is_half_a_code_bin_and_clips_to_the_trained_range(family):

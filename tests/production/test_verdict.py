@@ -28,14 +28,14 @@ def test_tolerance_in_mm_over_the_whole_stroke_and_a_working_range():
     assert "0.08 mm > tolerance 0.05 mm" in v.reasons[0]
     v = judge(ProductionSpec(max_error_mm=0.05, working_range_mm=(-8, 8)), X, err, 2.0, ())
     assert v.verdict == PASS and v.max_error_mm == pytest.approx(0.01) and v.reasons == ()
-    assert v.full_scale_mm == 16 and v.max_error_pct_fs == pytest.approx(100 * 0.01 / 16)
+    assert v.full_scale_mm == 8 and v.max_error_pct_fs == pytest.approx(100 * 0.01 / 8)
 
 
 def test_tolerance_in_percent_of_full_scale():
-    err = _err(0.0, 0.05)   # 0.05 mm of a 20 mm span = 0.25 % FS
-    assert judge(ProductionSpec(max_error_pct_fs=0.3), X, err, None, ()).verdict == PASS
-    v = judge(ProductionSpec(max_error_pct_fs=0.2), X, err, None, ())
-    assert v.verdict == FAIL and "0.25 % FS > tolerance 0.2 % FS" in v.reasons[0]
+    err = _err(0.0, 0.05)   # 0.05 mm of a +-10 mm stroke (FS 10 mm) = 0.5 % FS
+    assert judge(ProductionSpec(max_error_pct_fs=0.6), X, err, None, ()).verdict == PASS
+    v = judge(ProductionSpec(max_error_pct_fs=0.4), X, err, None, ())
+    assert v.verdict == FAIL and "0.5 % FS > tolerance 0.4 % FS" in v.reasons[0]
 
 
 def test_a_working_range_the_recording_does_not_cover_fails():

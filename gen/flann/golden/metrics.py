@@ -28,10 +28,16 @@ DEFAULT_TOL_PCT_FS = 2.0
 DEFAULT_BAND_PCT_FS = 0.1
 
 
+def full_scale_of_span(lo_mm: float, hi_mm: float) -> float:
+    """Full scale of the span lo..hi (mm): half of it, the +-full-scale stroke of a sensor
+    centred on it (a +-30 mm LVDT has a 30 mm full scale, as its data sheet states)."""
+    return 0.5 * (float(hi_mm) - float(lo_mm))
+
+
 def full_scale_mm(displacement_mm) -> float:
-    """Half the displacement span (mm): the +-full-scale stroke."""
+    """The full scale of the displacements' span (:func:`full_scale_of_span`)."""
     x = np.asarray(displacement_mm, dtype=float)
-    fs = float(np.ptp(x)) / 2.0 if x.size else 0.0
+    fs = full_scale_of_span(np.min(x), np.max(x)) if x.size else 0.0
     if not fs > 0:
         raise FlannError("displacement_mm spans no range: full scale is 0, % FS is undefined")
     return fs

@@ -47,7 +47,7 @@ def _specification(spec, verdict) -> tuple:
     if verdict.range_text:
         rows.append(("judged over", verdict.range_text))
     if verdict.full_scale_mm is not None:
-        rows.append(("full scale (FS)", f"{verdict.full_scale_mm:.4g} mm (span judged over)"))
+        rows.append(("full scale (FS)", f"{verdict.full_scale_mm:.4g} mm (half the span judged over, as flann eval reports it)"))
     rows.append(("decision rule", DECISION_RULE))
     rows.append(("verdict", verdict.verdict))
     return ("Specification and verdict", rows)

@@ -10,8 +10,8 @@ A spec file (every key optional except one tolerance)::
     max_ratio_to_limit = 100       # compensated max error / physical limit
     fail_on_effects = ["adc_clipping", "backlash"]   # the diagnosis must not name these
 
-Full scale (FS) is the span of the working range, or of the recording's displacement when no
-range is stated.  Flags override the file's values one by one.
+Full scale (FS) is half the span of the working range, or of the recording's displacement when
+no range is stated: a +-10 mm stroke has a 10 mm FS, as in ``flann eval``.  Flags override the file's values one by one.
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..golden.metrics import full_scale_of_span
 from ..recordings.checks import estimate_noise_v
 from .spec import ProductionSpec
 
@@ -100,7 +101,7 @@ def judge(spec: ProductionSpec, x_mm, err_mm, ratio_to_limit: float | None,
         lo, hi = lo_x, hi_x
         rng = f"the recorded stroke {lo_x:.4g}..{hi_x:.4g} mm"
         inside = np.ones(x.size, bool)
-    fs = hi - lo
+    fs = full_scale_of_span(lo, hi)
     max_err = float(np.max(e[inside])) if inside.any() else None
     pct = 100.0 * max_err / fs if max_err is not None and fs > 0 else None
     if max_err is None:
