@@ -51,7 +51,7 @@ def test_directory_and_manifest(design):
     orders = len(man["spec"]["orders"])
     # every order is the fixed datapath's set of entities, renamed; nothing else
     names = {re.match(r"flann_t(\d+)_(\w+)\.vhd$", f).groups() for f in files[:-1]}
-    assert names == {(str(j), e[len("flann_"):]) for j in range(orders) for e, _ in ENTITIES}
+    assert names == {(str(j), e.short) for j in range(orders) for e in ENTITIES}
     for f in files[:-1]:
         text = (design["dir"] / f).read_text()
         declared = re.findall(r"^entity (\w+) is", text, re.M)

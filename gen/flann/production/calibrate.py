@@ -372,8 +372,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
                           extra: dict) -> None:
     """A passed sensor: its two-input model, its image (every order's memory in turn) and the
     certificate; a failed one: only the certificate."""
-    model_json = chk["model"].to_json()
-    mhash = text_sha256(model_json)
+    model_json, mhash = chk["model"].to_json(), res.model_sha256
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.image_words} words x {images.DATA_BITS} bits, address 0 first: "
             f"order j's memory at j x {fam.fam.mem_depth} (cfg_addr)"]
@@ -419,8 +418,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     """A passed sensor: its model, weight images and certificate; a failed one: only the
     certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
-    model_json = model.to_json()
-    mhash = text_sha256(model_json)
+    model_json, mhash = model.to_json(), res.model_sha256
     head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
             f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)

@@ -9,6 +9,7 @@ and the spec, so regenerating gives identical bytes.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from ...errors import FlannError, SpecError
@@ -28,22 +29,37 @@ DATAPATH = "fixed"
 MODEL_FILE = "model.json"
 # the entities' templates; a variant the spec chooses is a fragment in a sub-folder
 TEMPLATES = "hardware/fixed/templates"
+
+
+@dataclass(frozen=True)
+class Entity:
+    """One entity of the datapath: its short name (norm, ..., top), rendered as a prefix and
+    the short name, from the template ``flann_<short>.vhd.j2``."""
+
+    short: str
+    title: str
+
+    @property
+    def name(self) -> str:
+        """The default VHDL name, and the template's: ``flann_`` and the short name."""
+        return f"flann_{self.short}"
+
+
 # compile order
 ENTITIES = (
-    ("flann_norm", "input clamp and normalisation (serial code x constant)"),
-    ("flann_expansion", "trigonometric expansion (phase accumulation, quarter-wave table)"),
-    ("flann_multiplier", "terms x trained weights"),
-    ("flann_adder", "accumulation, rounding, saturation"),
-    ("flann_seq", "sequencer of one sample (shared by every top level)"),
-    ("flann_top", "FLANN LVDT compensator, top level"),
+    Entity("norm", "input clamp and normalisation (serial code x constant)"),
+    Entity("expansion", "trigonometric expansion (phase accumulation, quarter-wave table)"),
+    Entity("multiplier", "terms x trained weights"),
+    Entity("adder", "accumulation, rounding, saturation"),
+    Entity("seq", "sequencer of one sample (shared by every top level)"),
+    Entity("top", "FLANN LVDT compensator, top level"),
 )
-
 
 
 def entity_names(prefix: str = "flann_") -> dict[str, str]:
     """Each entity's VHDL name by its short name (norm, expansion, ..., top): ``prefix`` and the
     short name, so one library can hold several datapaths (the thermal design's orders)."""
-    return {short: prefix + short for short in (name[len("flann_"):] for name, _title in ENTITIES)}
+    return {e.short: prefix + e.short for e in ENTITIES}
 
 
 def _ubits(n: int) -> int:
@@ -134,10 +150,11 @@ def render_front(fe: FrontEnd, command: str, spec_dict: dict) -> dict[str, str]:
     """{file: text} of flann_norm and flann_expansion (compile order), their headers stamped with
     ``command`` and the design's ``spec_dict``."""
     out = {}
-    for name, title in ENTITIES:
-        if name in FRONT_END:
-            h = header(f"{name}.vhd", title, command, spec_dict, fe.model_sha256)
-            out[f"{name}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, entity=name, **FRONT_END[name](fe))
+    for e in ENTITIES:
+        if e.name in FRONT_END:
+            h = header(f"{e.name}.vhd", e.title, command, spec_dict, fe.model_sha256)
+            out[f"{e.name}.vhd"] = template(f"{TEMPLATES}/{e.name}.vhd.j2").render(
+                h=h, entity=e.name, **FRONT_END[e.name](fe))
     return out
 
 
@@ -192,7 +209,7 @@ def contexts(spec: Spec, names: dict[str, str] | None = None) -> dict[str, dict]
     seq = seq_context(s.steps, n_advs, s.adv_period)
     ctx = {"flann_norm": norm, "flann_expansion": expansion, "flann_multiplier": multiplier,
            "flann_adder": adder, "flann_seq": seq, "flann_top": dict(top, names=names)}
-    return {name: dict(c, entity=names[name[len("flann_"):]]) for name, c in ctx.items()}
+    return {e.name: dict(ctx[e.name], entity=names[e.short]) for e in ENTITIES}
 
 
 def render(spec: Spec, prefix: str = "flann_") -> dict[str, str]:
@@ -200,10 +217,10 @@ def render(spec: Spec, prefix: str = "flann_") -> dict[str, str]:
     names = entity_names(prefix)
     ctx = contexts(spec, names)
     out = {}
-    for name, title in ENTITIES:
-        entity = ctx[name]["entity"]
-        h = header(f"{entity}.vhd", title, "flann gen", spec.to_dict(), spec.model_sha256)
-        out[f"{entity}.vhd"] = template(f"{TEMPLATES}/{name}.vhd.j2").render(h=h, **ctx[name])
+    for e in ENTITIES:
+        entity = ctx[e.name]["entity"]
+        h = header(f"{entity}.vhd", e.title, "flann gen", spec.to_dict(), spec.model_sha256)
+        out[f"{entity}.vhd"] = template(f"{TEMPLATES}/{e.name}.vhd.j2").render(h=h, **ctx[e.name])
     return out
 
 
