@@ -48,6 +48,15 @@ def test_adc_quantises_and_saturates():
     np.testing.assert_allclose(codes, np.round(codes), atol=1e-6)
 
 
+def test_adc_ties_round_up_as_in_the_hardwares_converter():
+    """A reading exactly between two codes takes the code above, as eval, calibrate and trace
+    do (round half to even would take 0, 2, -2 here)."""
+    s = default_sensor()
+    lsb = 20.0 / 65536      # a power of two: the ties are exact
+    ties = np.array([0.5, 1.5, -1.5, -2.5]) * lsb
+    np.testing.assert_array_equal(adc_convert(s, ties) / lsb, [1, 2, -1, -2])
+
+
 def test_temperature_profile_ramp_drives_thermal_drift():
     s = default_sensor().with_effect("thermal_drift", coefficient_per_c=-0.004,
                                      reference_temperature_c=20.0)

@@ -33,6 +33,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import FlannError
+from ..numeric.fixed import nearest_codes, signed_range
 from ..recordings import Recordings
 from .effects import EFFECTS, Context, Signal
 from .lvdt import demodulate_v, inductances_h
@@ -141,13 +142,14 @@ def contributions_v(s: Sensor, displacement_mm, direction=None, temperature_c=No
 
 def adc_convert(s: Sensor, volts) -> np.ndarray:
     """The sensor's converter: saturate at its bipolar full scale (never wrap) and round to
-    its LSB, ``2 full_scale / 2**bits``."""
+    its LSB, ``2 full_scale / 2**bits``, by the one converter rule the hardware's paths use
+    (:func:`flann.numeric.fixed.nearest_codes`)."""
     v = np.asarray(volts, dtype=float)
     if s.adc_bits is None:
         return v
     lsb = 2.0 * s.adc_full_scale_v / 2 ** int(s.adc_bits)
-    codes = np.clip(np.round(v / lsb), -(2 ** (int(s.adc_bits) - 1)), 2 ** (int(s.adc_bits) - 1) - 1)
-    return codes * lsb
+    lo, hi = signed_range(int(s.adc_bits))
+    return nearest_codes(v, lsb, lo, hi) * lsb
 
 
 def parse_temperature_profile(spec: str | float | None) -> Callable[[np.ndarray, float], np.ndarray]:
