@@ -42,6 +42,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..diagnose import diagnose
+from ..diagnose.data import find_passes
 from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
@@ -54,6 +56,7 @@ from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
+from ..physics.sensor import load_sensor
 from ..pool import run_batch
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
 from . import images
@@ -178,8 +181,6 @@ def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
     spans a turn of direction), so the noise of a bin mean is 1/sqrt(k) of a reading's and
     an effect that varies slowly over a bin keeps its size; rows in no order are sampled
     evenly instead.  ``points`` None or 0, or a short recording: every row."""
-    from ..diagnose.data import find_passes  # with the diagnosis (scipy): only when calibrating
-
     n = len(rec)
     if not points or n <= points:
         return rec, f"every one of the {n} points"
@@ -205,8 +206,6 @@ def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
 def _diagnosis(rec, sensor, points: int | None):
     """The diagnosis' findings as sentences (for the certificate), what it was run on, the
     effects it named and the sets of effects it could not tell apart."""
-    from ..diagnose import diagnose  # heavy (scipy): only when calibrating
-
     small, basis = diagnosis_sample(rec, points)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -234,8 +233,6 @@ def diagnosis_cell(named, groups) -> str:
 @lru_cache(maxsize=4)
 def _sensor(toml: str):
     """The --sensor description, read once per process (a Sensor does not pickle)."""
-    from ..physics.sensor import load_sensor  # only with --sensor
-
     return load_sensor(toml)
 
 
@@ -509,8 +506,6 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if progress:
             _progress(len(results), len(paths), failed, t0)
 
-    if jobs > 1 and len(todo) > 1:
-        from .. import diagnose  # noqa: F401  imported once here; the forked workers inherit it
     one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
