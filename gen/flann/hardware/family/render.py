@@ -44,7 +44,8 @@ ENTITIES = (
 
 def _fetch_plan(fam: FamilySpec) -> dict:
     """What each parameter word is to flann_family_norm, where its products start, and the
-    last word of its first fetch (clamp range, k1, k0; the second is ka, kb)."""
+    last word of its first fetch (clamp range, k1, k0) and of its second (ka, kb: the last
+    parameter word)."""
     kinds, starts = [], []
     for f in fam.fields[1:]:
         if f.name in ("clamp_lo", "clamp_hi"):
@@ -56,7 +57,8 @@ def _fetch_plan(fam: FamilySpec) -> dict:
         kinds += ks
         starts += ["0"] * (len(ks) - 1) + ["1" if f.name in ("k0", "kb") else "0"]
     k0 = next(f for f in fam.fields if f.name == "k0")
-    return dict(kinds=kinds, starts="".join(starts), last_first=k0.addr + k0.words - 1 - fam.param_base,
+    return dict(kinds=kinds, starts="".join(starts), param_words=len(kinds),
+                last_first=k0.addr + k0.words - 1 - fam.param_base, last_second=len(kinds) - 1,
                 pidx_bits=max(1, fam.param_words.bit_length()))
 
 
@@ -69,12 +71,16 @@ def contexts(fam: FamilySpec, init_name: str, mem_entity: str = MEM) -> dict[str
     s = fam.spec
     base = fixed.contexts(s)
     words = FlannFamilyMem.encode(fam, s)
-    mem = dict(entity=mem_entity, depth=fam.mem_depth, data_bits=DATA_BITS, half_bits=HALF_BITS, addr_bits=fam.addr_bits,
+    # the block RAM holds each word as two halves (low half at 2k, high half at 2k + 1)
+    mem = dict(entity=mem_entity, depth=fam.mem_depth, half_words=2 * fam.mem_depth, data_bits=DATA_BITS,
+               half_bits=HALF_BITS, addr_bits=fam.addr_bits,
                init_name=init_name, halves=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)])
     n = base["flann_norm"]
     norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
                 acc_v_bits=n["acc_v_bits"], lin_width=n["acc_l_bits"], guard_v=n["guard_v"],
                 guard_l=n["guard_l"], cnt_bits=n["cnt_bits"], data_bits=DATA_BITS, width=fam.norm_width,
+                # in_word sign-extended, wider than the register and a word: a field's first word is signed
+                wide_bits=fam.norm_width + DATA_BITS,
                 param_base=fam.param_base, **_fetch_plan(fam))
     mu = base["flann_multiplier"]
     step_bits = mu["step_bits"]

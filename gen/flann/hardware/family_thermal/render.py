@@ -51,6 +51,8 @@ def contexts(spec: FamilyThermalSpec) -> dict:
     s, t = spec, spec.temp
     acc = s.acc_bits
     prod = acc + t.t_bits
+    temp_diff_bits = t.bits + 1  # the clamped temperature code minus the mid code, one bit wider
+    round_bits = acc + 1         # the accumulator rounded to the output LSB (one bit wider), then saturated
     top = family_render.contexts(s.fam, "")["flann_family_top"]
     return dict(
         **{k: top[k] for k in ("phase_bits", "lin_bits", "term_bits", "product_bits", "step_bits", "pidx_bits",
@@ -62,9 +64,9 @@ def contexts(spec: FamilyThermalSpec) -> dict:
         inner_bits=s.inner_bits, sel_bits=s.sel_bits, addr_bits=s.fam.addr_bits, cfg_addr_bits=s.cfg_addr_bits,
         data_bits=DATA_BITS, temp_mid=t.mid, temp_lo_int=t.lo, temp_hi_int=t.hi,
         temp_lo=bits_literal(t.lo, t.bits), temp_hi=bits_literal(t.hi, t.bits),
-        temp_mid_lit=bits_literal(t.mid, t.bits + 1),
-        half_t=bits_literal(1 << (t.shift - 1), prod), half_k=bits_literal(1 << (s.inner_bits - 1), acc + 1),
-        out_max=bits_literal(s.out_fmt.max_int, acc + 1), out_min=bits_literal(s.out_fmt.min_int, acc + 1),
+        temp_diff_bits=temp_diff_bits, temp_mid_lit=bits_literal(t.mid, temp_diff_bits), round_bits=round_bits,
+        half_t=bits_literal(1 << (t.shift - 1), prod), half_k=bits_literal(1 << (s.inner_bits - 1), round_bits),
+        out_max=bits_literal(s.out_fmt.max_int, round_bits), out_min=bits_literal(s.out_fmt.min_int, round_bits),
         cnt_bits=max(1, t.t_bits.bit_length()), idx_bits=max(1, (s.orders - 1).bit_length()),
         last_idx=max(0, s.orders - 2), after_run="s_mul" if s.orders > 1 else "s_out",
     )

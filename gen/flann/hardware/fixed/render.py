@@ -100,7 +100,8 @@ def norm_context(s: FrontEnd) -> dict:
     """flann_norm: the clamp and the two serial code x constant products."""
     B, NV = s.input_bits, s.phase_bits + s.norm_guard
     return dict(
-        code_bits=B, phase_bits=s.phase_bits, lin_bits=s.lin_fmt.width, lin_type=s.lin_fmt.vhdl_type,
+        code_bits=B, code_low_bits=B - 1,  # the code's bits below its sign bit
+        phase_bits=s.phase_bits, lin_bits=s.lin_fmt.width, lin_type=s.lin_fmt.vhdl_type,
         acc_v_bits=NV, acc_l_bits=s.lin_width, guard_v=s.norm_guard, guard_l=s.lin_guard, cnt_bits=_ubits(B),
         cnt_init=bits_literal(B, _ubits(B), False),
         clamp_lo=bits_literal(s.clamp_lo, B), clamp_hi=bits_literal(s.clamp_hi, B),
@@ -118,6 +119,10 @@ def expansion_context(s: FrontEnd) -> dict:
     icnt_bits = _ubits(slope_reg // kx + 1)
     return dict(
         lanes=L, phase_bits=P, term_bits=s.term_fmt.width, term_type=s.term_fmt.vhdl_type,
+        terms_bus_bits=L * s.term_fmt.width,  # out_terms: every lane's term side by side
+        # the phase inside a quadrant (table address and offset), and the bit above it that
+        # mirrors the odd quadrants
+        quarter_phase_bits=P - 2, mirror_bit=P - 2,
         delta_even=de, delta_odd=do,
         fragments=f"{TEMPLATES}/expansion/interp/{s.interp_style}",
         parity=f"{TEMPLATES}/expansion/parity/{'alternate' if s.lane_kind_alternates else 'fixed'}.vhd.j2",
@@ -133,6 +138,10 @@ def expansion_context(s: FrontEnd) -> dict:
         start_par='"' + "".join("1" if s.trig_term(l)[0] == "cos" else "0" for l in range(L)) + '"',
         quarter=bits_literal(1 << (P - 2), P, False),
         table_depth=1 << A, addr_bits=A, offset_bits=s.offset_bits, dq_bits=s.dq_bits,
+        # the offset's dq_bits kept from its offset_bits + 1 (the appended '1'): the lowest kept bit
+        dq_lsb=s.offset_bits + 1 - s.dq_bits,
+        # the serial offset x slope step's adder: the dq_bits + 1 bit partial product plus its carry
+        interp_add_bits=s.dq_bits + 2,
         value_bits=s.value_fmt.width, value_type=s.value_fmt.vhdl_type, slope_bits=slope_bits, interp_digit=kx, slope_reg_bits=slope_reg,
         interp_cnt_bits=icnt_bits, interp_cnt_init=bits_literal(slope_reg // kx + 1, icnt_bits, False),
         prod_bits=s.interp_prod_bits,
@@ -169,7 +178,9 @@ def contexts(spec: Spec, names: dict[str, str] | None = None) -> dict[str, dict]
     lin_bits = s.lin_fmt.width
 
     common = dict(lanes=L, phase_bits=s.phase_bits, term_bits=T, product_bits=Wp, lin_bits=lin_bits,
-                  term_type=s.term_fmt.vhdl_type)
+                  term_type=s.term_fmt.vhdl_type,
+                  # the buses between the blocks: every lane's term / product side by side
+                  terms_bus_bits=L * T, products_bus_bits=L * Wp)
     norm = norm_context(s)
     expansion = expansion_context(s)
     step_bits = _ubits(max(1, s.steps - 1))
@@ -184,6 +195,8 @@ def contexts(spec: Spec, names: dict[str, str] | None = None) -> dict[str, dict]
         full_bits=(T + 1 + WX) if s.mult_style == "shiftadd" else (T + W), shift=s.product_shift, half=1 << (s.product_shift - 1),
         rom_depth=depth, step_bits=step_bits, weight_words=words,
         cnt_bits=cnt_bits, cnt_init=bits_literal(WX // K, cnt_bits, False), digit_bits=K,
+        # shift-add: the adder of one weight digit, the term with a sign bit and a carry bit
+        digit_adder_bits=T + 2,
         shift_bits=WX if s.mult_style == "shiftadd" else W,
         style_note=("inferred `*` (LUT array multiplier), one product per lane and cycle"
                     if s.mult_style == "lut" else
@@ -191,15 +204,16 @@ def contexts(spec: Spec, names: dict[str, str] | None = None) -> dict[str, dict]
     )
     AB = s.acc_fmt.width
     Pf = s.product_fmt.frac_bits
+    round_bits = AB + 1  # the accumulator with room for the rounding carry; saturated from there
     adder = dict(
-        common, acc_bits=AB, out_bits=s.out_fmt.width, acc_frac=Pf,
+        common, acc_bits=AB, round_bits=round_bits, out_bits=s.out_fmt.width, acc_frac=Pf,
         acc_type=s.acc_fmt.vhdl_type, out_type=s.out_fmt.vhdl_type,
         acc_half=(1 << (Pf - 1)) if Pf > 0 else 0,
         round=f"{TEMPLATES}/adder/round/{'half_up' if Pf > 0 else 'exact'}.vhd.j2", output_lsb_mm=s.output_lsb_mm,
-        out_max=bits_literal(s.out_fmt.max_int, AB + 1), out_min=bits_literal(s.out_fmt.min_int, AB + 1),
+        out_max=bits_literal(s.out_fmt.max_int, round_bits), out_min=bits_literal(s.out_fmt.min_int, round_bits),
     )
-    if s.out_fmt.width > AB + 1:
-        raise SpecError(f"output_bits = {s.out_fmt.width} exceeds the accumulator's range; use <= {AB + 1}")
+    if s.out_fmt.width > round_bits:
+        raise SpecError(f"output_bits = {s.out_fmt.width} exceeds the accumulator's range; use <= {round_bits}")
     n_advs = s.pipeline_advs
     top = dict(
         common, in_bits=B, out_bits=s.out_fmt.width, input_lsb_v=s.input_lsb_v,

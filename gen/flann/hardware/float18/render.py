@@ -102,6 +102,8 @@ def top_context(fspec) -> dict:
     return {
         "entity": TOP, "cvt_entity": CVT, "mul_entity": FlannF18Mul(fmt).entity,
         "add_entity": FlannF18Add(fmt).entity, "width": fmt.width, "fmt_name": fmt.name,
+        # exponent and fraction: a code's bits below its sign (all ones: the largest magnitude)
+        "magnitude_bits": fmt.width - 1,
         "fmt_text": fmt.describe(), "in_bits": b.input_bits, "input_lsb_v": b.input_lsb_v,
         "term_bits": b.term_fmt.width, "phase_bits": b.phase_bits, "lin_bits": b.lin_fmt.width,
         "n_advs": n_advs, "adv_period": fspec.adv_period, "n_terms": n_terms, "widx_bits": widx_bits,

@@ -24,12 +24,13 @@ def context(s: SeedSpec) -> dict:
         ka=bits_literal(s.ka, wd["ka_bits"]), kb=bits_literal(s.kb, wd["norm_bits"]),
         v_max=bits_literal(wf.max_int, wd["norm_bits"]), v_min=bits_literal(wf.min_int, wd["norm_bits"]),
         depth=1 << s.addr_bits, addr_bits=s.addr_bits,
+        addr_lsb=W - s.addr_bits,  # lowest bit of the table address (the phase's top addr_bits bits)
         table=[wf.literal(t) for t in s.table],
         harmonics=s.harmonics,
         phase_offsets=[bits_literal(p, W, False) for p in s.phase_offsets],
         weights=[wf.literal(w) for w in s.weights_q],
         rounds=[bits_literal(r, wd["prod_bits"]) for r in s.rounds],
-        levels=s.levels, nodes=s.nodes, **wd,
+        levels=s.levels, n_levels=len(s.levels), nodes=s.nodes, **wd,
     )
 
 

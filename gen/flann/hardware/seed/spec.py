@@ -149,9 +149,11 @@ class SeedSpec:
         ka_bits = max(2, int(self.ka).bit_length() + 1)
         norm_bits = max(self.input_bits + ka_bits, int(abs(self.kb)).bit_length() + 1) + 1
         harm_bits = max(self.harmonics, default=1).bit_length() + 1
+        phase_prod_bits = self.word + harm_bits  # v x harmonic, before the phase keeps its low word bits
         pmax = (1 << (self.word - 1)) ** 2 + max(abs(r) for r in self.rounds)
         prod_bits = max(2 * self.word, pmax.bit_length() + 1)
-        return dict(ka_bits=ka_bits, norm_bits=norm_bits, harm_bits=harm_bits, prod_bits=prod_bits)
+        return dict(ka_bits=ka_bits, norm_bits=norm_bits, harm_bits=harm_bits, phase_prod_bits=phase_prod_bits,
+                    prod_bits=prod_bits)
 
     def to_dict(self) -> dict:
         return {

@@ -48,11 +48,13 @@ def contexts(spec: ThermalSpec) -> dict:
     d, p = s.horner_degree, len(s.orders)
     gain_bits, offset_bits, t_scale_bits, t_pre_bits = w["gain_bits"], w["offset_bits"], w["t_scale_bits"], w["t_pre_bits"]
     node_bits, node_w, acc_bits = w["node_bits"], w["node_w"], w["acc_bits"]
+    round_bits = acc_bits + 1  # the accumulator rounded to the output LSB (one bit wider), then saturated
     orders = [dict(j=j, top=order_prefix(j) + "top", out_bits=o.out_fmt.width) for j, o in enumerate(s.orders)]
     return dict(
         in_bits=s.input_bits, temp_bits=s.temp_bits, out_bits=s.out_fmt.width,
         input_lsb_v=s.input_lsb_v, temp_lsb_c=s.temp_lsb_c, output_lsb_mm=s.output_lsb_mm,
-        latency=s.latency_cycles, fine_bits=s.fine_bits, degree=d, n_orders=p, orders=orders,
+        latency=s.latency_cycles, degree=d, n_orders=p, orders=orders,
+        grid_lsb_exp=-s.fine_bits,  # the order datapaths' grid: 2^grid_lsb_exp input codes
         **w,
         gain_words=[bits_literal(g, gain_bits) for g in s.gain_int],
         offset_words=[bits_literal(o, offset_bits) for o in s.offset_int],
@@ -64,7 +66,8 @@ def contexts(spec: ThermalSpec) -> dict:
         node_max=bits_literal((1 << (node_bits - 1)) - 1, node_w),
         node_min=bits_literal(-(1 << (node_bits - 1)), node_w),
         inner_bits=s.inner_bits,
-        out_max=bits_literal(s.out_fmt.max_int, acc_bits + 1), out_min=bits_literal(s.out_fmt.min_int, acc_bits + 1),
+        round_bits=round_bits,
+        out_max=bits_literal(s.out_fmt.max_int, round_bits), out_min=bits_literal(s.out_fmt.min_int, round_bits),
     )
 
 

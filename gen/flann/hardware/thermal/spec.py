@@ -349,17 +349,20 @@ def top_widths(spec: "ThermalSpec") -> dict:
     if any(o.input_bits != node_bits for o in s.orders):
         raise SpecError("the order datapaths must share one input width")
     node_w = max(fine_bits_w - s.interp_bits, node_bits) + 1
+    frac_w = s.interp_bits + 1      # c' between its node and the next (interp_bits), signed
     ord_bits = max(o.out_fmt.width for o in s.orders) + 1
     part_bits = ord_bits + 2
     acc_bits = part_bits + p + 1 + max(0, math.ceil(math.log2(max(growth, 1.0))) * p)
     if s.out_fmt.width > acc_bits:
         raise SpecError(f"output width {s.out_fmt.width} exceeds the accumulator's {acc_bits} bits")
-    mul_b_bits = max(s.temp_bits, tn_bits, gain_bits, s.interp_bits + 1)
+    mul_b_bits = max(s.temp_bits, tn_bits, gain_bits, frac_w)
     mul_a_bits = max(t_scale_bits, gain_bits, offset_bits, s.input_bits + shift, ord_bits + 1, acc_bits)
+    # the serial multiplier's shifted operand and product: m_a shifts left once per bit of m_b
+    mul_p_bits = mul_a_bits + mul_b_bits
     return dict(tn_bits=tn_bits, t_scale_bits=t_scale_bits, t_pre_bits=t_pre_bits, gain_bits=gain_bits,
                 offset_bits=offset_bits, fine_shift=shift, fine_pre_bits=fine_pre_bits, fine_bits_w=fine_bits_w,
-                node_bits=node_bits, node_w=node_w, ord_bits=ord_bits, part_bits=part_bits, acc_bits=acc_bits,
-                mul_a_bits=mul_a_bits, mul_b_bits=mul_b_bits)
+                node_bits=node_bits, node_w=node_w, frac_w=frac_w, ord_bits=ord_bits, part_bits=part_bits,
+                acc_bits=acc_bits, mul_a_bits=mul_a_bits, mul_b_bits=mul_b_bits, mul_p_bits=mul_p_bits)
 
 
 def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
