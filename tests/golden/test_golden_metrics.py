@@ -45,6 +45,20 @@ def test_stroke_fraction_averages_the_two_sweeps():
     assert stroke_fraction_within(out, x, 1.0, direction=d) == pytest.approx((1 + 0.25) / 2)
 
 
+def test_stroke_fraction_does_not_depend_on_row_order_or_the_direction_column():
+    """Repeated positions share their stretch of the stroke: the rows reversed, shuffled or
+    without their direction column give the same fraction (by hand: sweep 1 has x = 0, 1
+    within the band (weights 0.5, 1 of 2), sweep 2 only x = 1: (1.5 + 1) / 2 / 2)."""
+    x = np.array([0.0, 1.0, 2.0, 2.0, 1.0, 0.0])
+    out = x + np.array([0, 0, 5, 5, 0, 5])
+    d = np.array([1, 1, 1, -1, -1, -1])
+    want = (1.5 / 2 + 1 / 2) / 2
+    for order in (np.arange(6), np.arange(6)[::-1], np.array([3, 0, 5, 1, 4, 2])):
+        assert stroke_fraction_within(out[order], x[order], 1.0, direction=d[order]) == pytest.approx(want)
+        assert stroke_fraction_within(out[order], x[order], 1.0) == pytest.approx(want)
+    np.testing.assert_allclose(stroke_weights([2.0, 0.0, 2.0]), [0.5, 1.0, 0.5])
+
+
 def test_raw_line_and_linearity_by_hand():
     v = np.array([0.0, 1.0, 2.0, 3.0])
     x = np.array([0.0, 1.0, 2.0, 4.0])

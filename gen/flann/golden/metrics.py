@@ -77,17 +77,17 @@ def raw_linearity_pct(voltage_v, displacement_mm, tol_pct_fs: float = DEFAULT_TO
 
 
 def stroke_weights(displacement_mm) -> np.ndarray:
-    """Length of stroke (mm) each point stands for: half the gap to each neighbour."""
+    """Length of stroke (mm) each point stands for: its position stands for half the gap to
+    each neighbouring position, shared equally by the readings at that position (so the
+    weights do not depend on the rows' order, and a repeated position counts once)."""
     x = np.asarray(displacement_mm, dtype=float)
-    order = np.argsort(x, kind="stable")
-    xs = x[order]
-    gaps = np.diff(xs)
-    w_sorted = np.zeros(x.size)
-    w_sorted[:-1] += gaps / 2.0
-    w_sorted[1:] += gaps / 2.0
-    w = np.empty(x.size)
-    w[order] = w_sorted
-    return w
+    xu, idx, count = np.unique(x, return_inverse=True, return_counts=True)
+    gaps = np.diff(xu)
+    per_position = np.zeros(xu.size)
+    per_position[:-1] += gaps / 2.0
+    per_position[1:] += gaps / 2.0
+    idx = idx.ravel()
+    return per_position[idx] / count[idx]
 
 
 def stroke_fraction_within(output_mm, displacement_mm, band_pct_fs: float = DEFAULT_BAND_PCT_FS,
