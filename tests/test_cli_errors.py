@@ -27,3 +27,20 @@ def test_wrong_flag_or_value_is_one_line(argv, fragment, capsys, tmp_path, monke
     assert len(lines) == 1, err
     assert lines[0].startswith("error: ") and fragment in lines[0]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv", [
+    ["eval", "m.json", "r.csv", "--design", "d", "--plot", "out.txt"],
+    ["diagnose", "r.csv", "--plot", "out.txt"],
+    ["trace", "m.json", "--plot", "out.txt"],
+    ["simulate", "s.toml", "-o", "r.csv", "--plot", "out.txt"],
+    ["sim", "m.json", "--plot", "out.txt"],
+], ids=lambda a: a[0])
+def test_every_plot_is_named_png(argv, cli, tmp_path, monkeypatch):
+    """A figure is PNG whichever command draws it: a name that says otherwise is refused before
+    any work, so no PNG data lands in a .txt file."""
+    monkeypatch.chdir(tmp_path)
+    rc, _out, err = cli(argv)
+    assert rc == 2 and err.strip().splitlines() == [err.strip()]
+    assert err.startswith("error: ") and "out.txt" in err and "*.png" in err
+    assert list(tmp_path.iterdir()) == []

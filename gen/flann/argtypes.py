@@ -81,3 +81,11 @@ def checked(parse_value):
 
 
 __all__ = ["bounded", "checked", "finite_float", "terms_or_auto"]
+
+
+def png_path(text: str) -> str:
+    """An argparse ``type`` for ``--plot``: figures are written as PNG, so the name says so
+    (a figure in ``out.txt`` would be found by nobody)."""
+    if not text.lower().endswith(".png"):
+        raise argparse.ArgumentTypeError(f"{text}: the figure is written as PNG, name it *.png")
+    return text

@@ -225,3 +225,12 @@ def test_plot_that_fails_to_render_leaves_no_file(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError):
         plot_anatomy(default_sensor(), tmp_path / "anatomy.png")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_plot_of_a_sensor_without_effects_warns_nothing(tmp_path, cli):
+    """No effect to draw: the panel says so, with no empty legend (matplotlib warns of one)."""
+    png = tmp_path / "ideal.png"
+    rc, _out, err = cli(["simulate", "data/sensors/paper_lvdt.toml", "--no-effects", "-o", tmp_path / "r.csv",
+                         "--step-mm", "2", "--plot", png])
+    assert rc == 0 and png.stat().st_size > 10_000
+    assert "warning" not in err

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 
+from ..argtypes import png_path
 from ..diagnose import diagnose
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
@@ -25,7 +26,7 @@ def add_arguments(p) -> None:
                         "LVDT with geometry calibrated to the recordings)")
     p.add_argument("--json", nargs="?", const="-", metavar="OUT.json",
                    help="write the diagnosis as JSON (to stdout when no file is given)")
-    p.add_argument("--plot", metavar="OUT.png", help="residuals before/after, mismatch shaded")
+    p.add_argument("--plot", metavar="OUT.png", type=png_path, help="residuals before/after, mismatch shaded")
     p.add_argument("--demo", action="store_true",
                    help="run the concealed-effect demonstration (simulated recordings) and "
                         "print the table")

@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 
+from ..argtypes import png_path
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
 from ..errors import FlannError
@@ -39,7 +40,7 @@ def add_arguments(p) -> None:
                    help="also the accuracy of the design `flann gen MODEL -o DIR` wrote: its bit-true "
                         "twin on the voltages as ADC codes, and the physical limit (half an ADC LSB "
                         "over the local slope)")
-    p.add_argument("--plot", metavar="OUT.png", default=None,
+    p.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                    help="error vs displacement: raw sensor, float model, hardware (needs --design) "
                         "and the physical limit")
 
@@ -80,8 +81,6 @@ def warn_outside_stroke(model, rec) -> None:
 
 
 def run(args) -> int:
-    if args.plot and not args.plot.lower().endswith(".png"):
-        raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)

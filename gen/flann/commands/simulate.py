@@ -15,7 +15,7 @@ import re
 import sys
 import warnings
 
-from ..argtypes import bounded
+from ..argtypes import bounded, png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_json, atomic_write_text
 from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
@@ -60,7 +60,7 @@ def add_arguments(p) -> None:
                         "replaces --temperature-profile")
     p.add_argument("--no-effects", action="store_true",
                    help="ignore the sensor file's [effects] (ideal sensor)")
-    p.add_argument("--plot", help="PNG: curve and each enabled effect's contribution "
+    p.add_argument("--plot", metavar="OUT.png", type=png_path, help="PNG: curve and each enabled effect's contribution "
                                   "(with --fit: calibration and residuals; with --describe: "
                                   "flux along the bore and inductances)")
     p.add_argument("--describe", action="store_true",

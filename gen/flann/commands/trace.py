@@ -14,6 +14,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from ..argtypes import png_path
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
@@ -42,7 +43,7 @@ def add_arguments(parser) -> None:
                         help="also simulate the generated VHDL over every input code (GHDL + cocotb, "
                              "about a minute) and compare its outputs with the twin and the golden model")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
-    parser.add_argument("--plot", metavar="OUT.png", help="plot error per stage vs input voltage")
+    parser.add_argument("--plot", metavar="OUT.png", type=png_path, help="plot error per stage vs input voltage")
     gen_options.add_arguments(parser)
 
 

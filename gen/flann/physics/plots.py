@@ -42,10 +42,9 @@ def plot_simulation(s: Sensor, rec: Recordings, path: str | Path) -> None:
     ax1.grid(alpha=0.3)
     ax1.legend(fontsize=8)
     contrib = contributions_v(s, x, rec.direction, rec.temperature_c, rec.time_s)
-    if len(contrib) == 1:
+    if len(contrib) == 1:   # only "all", which is then the ideal: nothing to draw or name
         ax2.text(0.5, 0.5, "no effects enabled", ha="center", va="center",
                  transform=ax2.transAxes)
-    if len(contrib) == 1:
         contrib = {}
     # One line per pass in run order (not sorted): direction- and time-dependent effects
     # (backlash, drift) then show as separate forward/reverse branches.
@@ -61,7 +60,8 @@ def plot_simulation(s: Sensor, rec: Recordings, path: str | Path) -> None:
     ax2.set_xlabel("displacement (mm)")
     ax2.set_ylabel("contribution (mV)")
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=8, ncol=2)
+    if contrib:
+        ax2.legend(fontsize=8, ncol=2)
     fig.tight_layout()
     _save(fig, path)
 
