@@ -1,6 +1,7 @@
 """Verdicts against a production spec, the spec file, traceability and the uncertainty."""
 
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 from flann.errors import FlannError
 from flann.production.spec import ProductionSpec, build_spec, load_spec
 from flann.production.traceability import Station, comment_fields, traceability
-from flann.production.verdict import FAIL, PASS, judge, rejected, uncertainty
+from flann.production.verdict import FAIL, PASS, judge, noise_v, rejected, uncertainty
 
 X = np.linspace(-10, 10, 201)
 
@@ -118,3 +119,59 @@ def test_expanded_uncertainty_follows_noise_and_positions():
     assert u.noise_v == pytest.approx(0.002, rel=0.15)
     # sigma_x = 2 mm/V x 2 mV = 4 um; U = 2 sigma_x sqrt(1 + 15/400)
     assert u.expanded_mm == pytest.approx(2 * 0.004 * math.sqrt(1 + 15 / 400), rel=0.15)
+
+
+NOISE_V = 0.002
+
+
+def _lvdt(sweeps: int, seed: int):
+    from flann.physics.sensor import load_sensor
+    from flann.physics.simulate import simulate_recordings
+    s = load_sensor(Path(__file__).resolve().parents[2] / "data" / "sensors" / "paper_lvdt.toml")
+    return simulate_recordings(s, sweeps=sweeps, step_mm=0.5, noise_v=NOISE_V, seed=seed)
+
+
+@pytest.mark.parametrize("sweeps", [2, 4])
+def test_noise_of_repeated_sweeps_is_the_noise_of_one_reading(sweeps):
+    """Repeated sweeps read each position several times; the noise figure is still the
+    simulated 2 mV (it was 60 mV on two sweeps) and what one sweep of the sensor gives."""
+    one = noise_v(_lvdt(1, seed=11))
+    many = noise_v(_lvdt(sweeps, seed=11))
+    assert one == pytest.approx(NOISE_V, rel=0.2)
+    assert many == pytest.approx(NOISE_V, rel=0.2)
+    assert many == pytest.approx(one, rel=0.2)
+
+
+def test_noise_without_a_direction_column_in_no_order_and_one_way_passes():
+    rec = _lvdt(2, seed=12)
+    x, v, d = (np.asarray(a, dtype=float) for a in (rec.displacement_mm, rec.voltage_v, rec.direction))
+    # the direction inferred from the row order
+    assert noise_v(SimpleNamespace(displacement_mm=x, voltage_v=v, direction=None)) == \
+        pytest.approx(NOISE_V, rel=0.2)
+    # two forward passes under one direction value (the return strokes not recorded)
+    fwd = d > 0
+    assert noise_v(SimpleNamespace(displacement_mm=x[fwd], voltage_v=v[fwd], direction=d[fwd])) == \
+        pytest.approx(NOISE_V, rel=0.2)
+    # rows shuffled: the readings repeated at one position
+    p = np.random.default_rng(3).permutation(x.size)
+    for direction in (d[p], None):
+        assert noise_v(SimpleNamespace(displacement_mm=x[p], voltage_v=v[p], direction=direction)) == \
+            pytest.approx(NOISE_V, rel=0.2)
+    # a dwell (each position read three times in a row) is not a step of the curve
+    dw = np.repeat(np.arange(x.size), 3)
+    v_dw = v[dw] + np.random.default_rng(4).normal(0, NOISE_V, dw.size) * (np.arange(dw.size) % 3 > 0)
+    assert noise_v(SimpleNamespace(displacement_mm=x[dw], voltage_v=v_dw, direction=d[dw])) < 1.2 * NOISE_V
+
+
+def test_two_sweeps_far_from_the_tolerance_are_not_marginal():
+    """With the 60 mV figure, U was 0.6 mm at 5 mm/V and a sensor 0.05 mm inside a 0.1 mm
+    tolerance read as marginal."""
+    rec = _lvdt(2, seed=13)
+    x = np.asarray(rec.displacement_mm, dtype=float)
+    u = uncertainty(rec, np.full(x.size, 5.0), terms=15, output_lsb_mm=0.001)
+    n = np.unique(x).size
+    want = 2 * math.sqrt((5.0 * NOISE_V) ** 2 * (1 + 15 / n) + 0.001 ** 2 / 12)
+    assert u.expanded_mm == pytest.approx(want, rel=0.2)
+    v = judge(ProductionSpec(max_error_mm=0.1), x, np.full(x.size, 0.05), None, (), expanded_mm=u.expanded_mm)
+    assert v.verdict == PASS and v.reasons == ()
+    assert "along each pass" in u.method and "direction of travel" not in u.method

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 
 from ..argtypes import bounded
-from ..production.calibrate import DIAGNOSIS_POINTS, SUMMARY, calibrate_batch
+from ..production.calibrate import DIAGNOSIS_POINTS, calibrate_batch, summary_path
 from ..production.spec import build_spec
 from ..production.traceability import Station
 
@@ -63,5 +63,5 @@ def run(args) -> int:
         print(f"FAIL: {r.sensor}: {r.reason}", file=sys.stderr)
     passed = len(results) - len(rejected) - len(failed)
     print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
-          f"{len(rejected)} rejected; summary {args.out}/{SUMMARY}")
+          f"{len(rejected)} rejected; summary {summary_path(args.out)}")
     return 2 if rejected else 1 if failed else 0

@@ -80,7 +80,10 @@ SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit"
                   "design_sha256", "model_sha256", "calibrated_at", "station", "operator",
                   "temperature_c",
                   # a family design with temperature: the hardware's drift (empty otherwise)
-                  "drift_ppm_fs_per_c")
+                  "drift_ppm_fs_per_c",
+                  # what the verdict judged: its range and its max error there (max_error_mm
+                  # stays the whole recording's; max_error_pct_fs is over judged_over)
+                  "judged_over", "judged_max_error_mm")
 
 
 @dataclass
@@ -118,8 +121,8 @@ class Result:
                 **self.verdict_cells(), "drift_ppm_fs_per_c": f(self.drift_ppm_fs_per_c, 4)}
 
     def verdict_cells(self) -> dict:
-        """The verdict and traceability columns (a row without a verdict was rejected before
-        it was judged: a duplicate name)."""
+        """The verdict and traceability columns (a row without a verdict was never judged:
+        the batch was interrupted first)."""
         v = self.verdict
         t = self.trace
         reasons = v.reasons if v is not None else (f"rejected: {self.reason}",)
@@ -134,7 +137,10 @@ class Result:
                 "station": t.station if t is not None else "",
                 "operator": t.operator if t is not None else "",
                 "temperature_c": "" if t is None or t.temperature_c is None
-                else f"{t.temperature_c:.4g}"}
+                else f"{t.temperature_c:.4g}",
+                "judged_over": v.range_text if v is not None else "",
+                "judged_max_error_mm": "" if v is None or v.max_error_mm is None
+                else f"{v.max_error_mm:.6g}"}
 
 
 def train_for_design(rec, fam: FamilySpec):
@@ -477,24 +483,30 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     jobs = jobs or os.cpu_count() or 1
     if progress is None:
         progress = sys.stderr.isatty()
+    if spec is None:
+        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
     results: dict[int, Result] = {}
     seen: dict[str, int] = {}
     todo = []
     for i, p in enumerate(paths):
         name = sensor_name(p)
-        if name == SUMMARY:
+        # these cannot have a folder of their own (it is the summary's name, or the folder of
+        # an earlier recording, also on a file system that ignores case): a rejected row with
+        # the reason and no certificate; the batch goes on
+        clash = (f"sensor name {name!r} is the batch summary's file name; rename the recording"
+                 if name.casefold() == SUMMARY else
+                 f"sensor name {name!r} already used by {paths[seen[name.casefold()]]} (one folder "
+                 "per name, letter case ignored); rename this recording"
+                 if name.casefold() in seen else "")
+        if clash:
             results[i] = Result(sensor=name, recording=str(p), design_sha256=dhash)
-            results[i].fail(f"sensor name {name!r} is the batch summary's file name; rename the recording")
-        elif name in seen:  # two files would write the same folder
-            results[i] = Result(sensor=name, recording=str(p), design_sha256=dhash)
-            results[i].fail(f"sensor name {name!r} already used by {paths[seen[name]]}")
+            results[i].fail(clash)
+            results[i].verdict = rejected(spec, results[i].reason)
         else:
-            seen[name] = i
+            seen[name.casefold()] = i
             todo.append(i)
     t0 = time.monotonic()
     failed = sum(1 for r in results.values() if r.status != "ok")
-    if spec is None:
-        spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
 
     def record(item, res: Result) -> None:
         nonlocal failed
@@ -517,10 +529,15 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
             results[i] = Result(sensor=sensor_name(paths[i]), recording=str(paths[i]), status="interrupted",
                                 reason="not calibrated: the batch was interrupted (Ctrl-C)")
     ordered = [results[i] for i in range(len(paths))]
-    write_summary(out_dir / SUMMARY, ordered)
+    write_summary(summary_path(out_dir), ordered)
     if interrupted:
         raise KeyboardInterrupt
     return ordered
+
+
+def summary_path(out_dir) -> Path:
+    """OUTDIR/summary.csv, joined as a path (``-o out/`` must not print ``out//summary.csv``)."""
+    return Path(out_dir) / SUMMARY
 
 
 def write_summary(path, results) -> None:
@@ -533,4 +550,5 @@ def write_summary(path, results) -> None:
 
 
 __all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
-           "diagnosis_sample", "write_summary", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES", "DIAGNOSIS_POINTS"]
+           "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES",
+           "DIAGNOSIS_POINTS"]

@@ -1,9 +1,11 @@
 """Weight images of one sensor for a family design: a plain hex image for a loader on the
 ``cfg_*`` port, a Data2MEM ``.mem`` file and the ``.bmm`` template it needs (docs/production.md).
 
-* ``weights.hex``: one word per line, ``DATA_BITS / 4`` hex digits, line k = address k, every
-  address of the memory (``mem_depth`` lines); ``#`` lines are comments.  A loader writes
-  line k at ``cfg_addr = k`` with ``cfg_we = 1``, one word per clock.
+* ``weights.hex``: ``#`` comment lines first (provenance: sensor, design and model sha256,
+  word count), then one word per line, ``DATA_BITS / 4`` hex digits, address 0 first, every
+  address of the memory (``mem_depth`` word lines).  A loader skips the ``#`` lines and
+  writes the k-th word line at ``cfg_addr = k`` with ``cfg_we = 1``, one word per clock
+  (:func:`parse_hex` reads it so).
 * ``weights.mem``: Data2MEM's format: ``@ADDR`` (hex) then the block RAM's 16-bit words in
   hex, whitespace separated, in block address order: the memory is one RAMB4_S16_S16 holding
   word k as bits 15:0 at 2k and bits 31:16 at 2k + 1 (:func:`flann.hardware.family.spec.bram_image`).

@@ -6,7 +6,8 @@ max error is within the tolerance; the expanded uncertainty U (k = 2) is stated 
 a result within U of the tolerance is flagged as marginal in the reasons.
 
 Uncertainty of the max error (method stated on the certificate): one reading's noise sigma_v
-(from the recording, :func:`flann.recordings.checks.estimate_noise_v` per direction) becomes
+(from the recording, :func:`noise_v`: the median absolute third difference along each pass
+of the actuator in row order, median over the passes) becomes
 sigma_x = sigma_v |dx/dv| in mm (median over the stroke); the fitted curve adds its own
 uncertainty sigma_x sqrt(p / N) (p model terms, N positions); the output code adds
 q / sqrt(12).  u = sqrt(sigma_x^2 (1 + p / N) + q^2 / 12), U = 2 u.
@@ -19,8 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..diagnose.data import find_passes
 from ..golden.metrics import full_scale_of_span
-from ..recordings.checks import estimate_noise_v
+from ..recordings.checks import MIN_REPEAT_PAIRS, repeat_noise_v
 from .spec import ProductionSpec
 
 PASS, FAIL = "PASS", "FAIL"
@@ -29,9 +31,10 @@ COVERAGE = 2.0
 RANGE_SLACK_MM = 1e-6
 UNCERTAINTY_METHOD = (
     "U = 2 u (k = 2, about 95 %); u^2 = sigma_x^2 (1 + p/N) + q^2/12 with sigma_x the "
-    "recording's noise per reading (median absolute second difference along each direction "
-    "of travel / (0.6745 sqrt 6), in V) times the median |dx/dv|, p the model terms, N the "
-    "positions recorded, q the output LSB")
+    "recording's noise per reading (median absolute third difference along each pass of "
+    "the actuator in recorded order, one reading per position, / (0.6745 sqrt 20), in V, the "
+    "median over the passes) times the median |dx/dv|, p the model terms, N the positions "
+    "recorded, q the output LSB")
 
 
 @dataclass(frozen=True)
@@ -60,14 +63,52 @@ class Verdict:
         return self.verdict == PASS
 
 
+def _third_difference_noise(v: np.ndarray) -> float:
+    """Noise (V, 1 sigma) of readings in displacement order: median |third difference| /
+    (0.6745 sqrt 20).  The third difference cancels the curve's slope and curvature, which at
+    coarse steps (an LVDT at 0.5 mm) put as much into a second difference as 2 mV of noise."""
+    if v.size < 4:
+        return 0.0
+    return float(np.median(np.abs(np.diff(v, 3))) / (0.6745 * math.sqrt(20.0)))
+
+
+def _passes(x: np.ndarray, direction) -> list[np.ndarray]:
+    """Row indices of each monotone pass of the actuator, in row order, one reading per
+    position (the first of a dwell: a repeat at one position would put a step of the curve
+    into every difference); [] when the rows are in no order."""
+    passes = find_passes(x, direction)
+    if not passes.ordered:
+        return []
+    out = []
+    for run in passes.runs:
+        run = run[np.concatenate([[True], np.diff(x[run]) != 0])]
+        step = np.sign(np.diff(x[run]))
+        trend = np.sign(step.sum())
+        # a direction column may hold several passes one way (the return stroke not
+        # recorded): cut where the travel goes back
+        out += np.split(run, np.flatnonzero(step == -trend) + 1) if trend else [run]
+    if not out or np.median([p.size for p in out]) < 4:
+        return []
+    return [p for p in out if p.size >= 4]
+
+
 def noise_v(rec) -> float:
-    """One reading's noise (V): the median of the per-direction estimates (both passes of a
-    sweep share the noise; a turn of direction is not a step of the curve)."""
+    """One reading's noise (V): the median of the estimates along each pass of the actuator,
+    in row order.  Sorting all rows by displacement would interleave the readings of repeated
+    sweeps at one position, and the differences would measure the curve's change between
+    sweeps instead of the noise.  Rows in no order: the spread of readings repeated at one
+    position, else the rows of each direction sorted by displacement (one sweep)."""
     v = np.asarray(rec.voltage_v, dtype=float)
     x = np.asarray(rec.displacement_mm, dtype=float)
-    groups = ([np.flatnonzero(rec.direction == d) for d in (1.0, -1.0)]
-              if rec.direction is not None else [np.arange(v.size)])
-    est = [estimate_noise_v(v[g][np.argsort(x[g], kind="stable")]) for g in groups if g.size >= 3]
+    d = None if rec.direction is None else np.asarray(rec.direction, dtype=float)
+    est = [_third_difference_noise(v[p]) for p in _passes(x, d)]
+    if est:
+        return float(np.median(est))
+    sigma, pairs = repeat_noise_v(x, v, d)
+    if pairs >= MIN_REPEAT_PAIRS:
+        return sigma
+    groups = [np.flatnonzero(d == s) for s in (1.0, -1.0)] if d is not None else [np.arange(v.size)]
+    est = [_third_difference_noise(v[g][np.argsort(x[g], kind="stable")]) for g in groups if g.size >= 4]
     return float(np.median(est)) if est else 0.0
 
 
