@@ -1,5 +1,6 @@
 """flann ise: xtclsh project, UCF with a LOC for every port bit, FuseSoC core."""
 
+import json
 import re
 import warnings
 from pathlib import Path
@@ -120,15 +121,48 @@ def test_pin_map_spills_inputs_onto_spare_output_pins():
              Port("in_data", "in", 8), Port("out_valid", "out", 0), Port("out_data", "out", 11),
              Port("out_sat", "out", 0), Port("cfg_we", "in", 0), Port("cfg_addr", "in", 4),
              Port("cfg_data", "in", 32)]
-    rows = pin_map(ports, parse_part("xc2s200-pq208-5"))
+    rows, unplaced = pin_map(ports, parse_part("xc2s200-pq208-5"))
     locs = [loc for _, loc, _ in rows]
-    assert len(rows) == 2 + 46 + 14 and len(set(locs)) == len(locs)
+    assert len(rows) == 2 + 46 + 14 and len(set(locs)) == len(locs) and unplaced == []
     ins = {loc for _, loc, d in rows if d == "in"}
     assert set(INPUT_PINS) <= ins and len(ins - set(INPUT_PINS)) == 10
     assert ins - set(INPUT_PINS) <= set(OUTPUT_PINS)
-    # 71 bits beside clk and rst: more than the 70 example pins, refused naming the widest port
-    with pytest.raises(FlannError, match="57 input and 14 output bits.*cfg_data 43"):
-        pin_map([*ports[:-1], Port("cfg_data", "in", 43)], parse_part("xc2s200-pq208-5"))
+
+
+def _placed_whole_or_listed(ports, rows, unplaced):
+    """Every bit of a placed port has a LOC, an unplaced port none; no pin twice."""
+    nets = [net for net, _, _ in rows]
+    locs = [loc for _, loc, _ in rows]
+    assert len(set(locs)) == len(locs)
+    assert len(set(nets)) == len(nets)
+    for p in ports:
+        if p in unplaced:
+            assert not set(p.bits()) & set(nets), p
+        else:
+            assert set(p.bits()) <= set(nets), p
+
+
+def test_pin_map_beyond_its_pins_leaves_whole_ports_to_ise():
+    from flann.hardware.target import parse_part
+    from flann.implement.ise import INPUT_PINS, OUTPUT_PINS, Port, pin_map
+
+    assert len(INPUT_PINS) + len(OUTPUT_PINS) == 70
+    # 71 bits beside clk and rst; before cfg_data: 14 input + 14 output bits, 42 pins left
+    # for its 43 bits, so it alone has no LOC (not 42 of its bits)
+    ports = [Port("clk", "in", 0), Port("rst", "in", 0), Port("in_valid", "in", 0), Port("in_ready", "out", 0),
+             Port("in_data", "in", 8), Port("out_valid", "out", 0), Port("out_data", "out", 11),
+             Port("out_sat", "out", 0), Port("cfg_we", "in", 0), Port("cfg_addr", "in", 4),
+             Port("cfg_data", "in", 43)]
+    rows, unplaced = pin_map(ports, parse_part("xc2s200-pq208-5"))
+    assert unplaced == [ports[-1]]
+    assert len(rows) == 2 + 14 + 14
+    _placed_whole_or_listed(ports, rows, unplaced)
+    # a port after one left unplaced still gets pins when they are left: 42 - 40 = 2 for cfg_crc
+    ports = [*ports[:-1], Port("cfg_data", "in", 43), Port("cfg_mask", "in", 40), Port("cfg_crc", "out", 2)]
+    rows, unplaced = pin_map(ports, parse_part("xc2s200-pq208-5"))
+    assert [p.name for p in unplaced] == ["cfg_data"]
+    assert len(rows) == 2 + 14 + 14 + 40 + 2
+    _placed_whole_or_listed(ports, rows, unplaced)
 
 
 def test_ports_must_match_the_vhdl(tmp_path):
@@ -168,3 +202,75 @@ def test_tcl_runs_under_tclsh_with_stubbed_ise_commands(tmp_path):
     assert lines.index("xfile add src/flann_top.vhd") < lines.index("xfile add flann_top.ucf")
     assert any(ln.startswith('warning: option "ROM Style"') for ln in lines)  # skipped, not fatal
     assert lines[-2:] == ["process run {Generate Programming File}", "project close"]
+
+
+@pytest.fixture
+def family14(tmp_path, capsys):
+    """A family design of two simulated sensors with a 14-bit ADC: its cfg write port makes
+    more port bits than the example pin map has pins (the user's report: every PQ208 part refused)."""
+    repo = Path(__file__).resolve().parents[2]
+    recs = []
+    for seed in (1, 2):
+        recs.append(tmp_path / f"s{seed}.csv")
+        assert main(["simulate", str(repo / "data" / "sensors" / "paper_lvdt.toml"), "--sweeps", "1", "--step-mm",
+                     "0.5", "--noise-v", "0.002", "--seed", str(seed), "-o", str(recs[-1])]) == 0
+    assert main(["gen", "--family", *map(str, recs), "--input-bits", "14", "-o", str(tmp_path / "fam")]) == 0
+    capsys.readouterr()
+    return tmp_path / "fam"
+
+
+def _entity_ports(directory: Path) -> dict[str, int]:
+    """name -> bits of the top entity's ports, read from its VHDL here (not by flann)."""
+    top = json.loads((directory / "manifest.json").read_text())["top"]
+    text = (directory / f"{top}.vhd").read_text()
+    body = re.search(rf"entity {top} is\s+port \((.*?)\);\s+end entity", text, re.S).group(1)
+    ports = {}
+    for name, hi in re.findall(r"(\w+)\s*:\s*(?:in|out)\s+std_logic(?:_vector\((\d+) downto 0\))?", body):
+        ports[name] = int(hi) + 1 if hi else 1
+    return ports
+
+
+def test_ports_beyond_the_pin_map_are_written_unplaced(family14, tmp_path, capsys):
+    ports = _entity_ports(family14)
+    assert sum(ports.values()) - 2 > 70   # beside clk and rst: more than the example pins
+    out = tmp_path / "ise"
+    assert main(["ise", str(family14), "--device", "xc2s200-pq208-5", "-o", str(out), "--no-timing-check"]) == 0
+    err = capsys.readouterr().err
+    ucf_path = next(out.glob("*.ucf"))
+    ucf = ucf_path.read_text()
+    assert 'PERIOD "clk" 20 ns' in ucf
+    locs = re.findall(r'^NET "([^"<]+)(?:<(\d+)>)?" LOC = "(P\d+)";', ucf, re.M)
+    pins = [pin for _, _, pin in locs]
+    assert len(set(pins)) == len(pins)                  # no pin used twice
+    loc_bits = {}
+    for name, _, _ in locs:
+        loc_bits[name] = loc_bits.get(name, 0) + 1
+    listed = re.findall(r"^#\s+(\w+)(?:<\d+:0>)? \((?:in|out), (\d+) bits?\)$",
+                        ucf.split("NO LOC", 1)[-1], re.M)
+    assert listed                                        # some port is left to ISE
+    for name, bits in ports.items():                     # each port: all bits LOC'd, or listed
+        if name in loc_bits:
+            assert loc_bits[name] == bits, name
+            assert name not in dict(listed), name
+        else:
+            assert dict(listed).get(name) == str(bits), name
+    assert loc_bits["clk"] == 1 and "in_data" in loc_bits and "out_data" in loc_bits
+    # one warning line, naming the UCF just written and the ports left without a LOC
+    warning = [ln for ln in err.splitlines() if ln.startswith("warning:")]
+    assert len(warning) == 1 and str(ucf_path) in warning[0]
+    assert all(name in warning[0] for name, _ in listed)
+    assert "error" not in err
+    assert "NO LOC" in (out / "README.txt").read_text()
+
+
+def test_unplaced_warning_only_for_a_written_ucf(family14, tmp_path, capsys):
+    # an existing directory that is not a flann ISE project is not overwritten: no warning
+    # may point into it
+    out = tmp_path / "taken"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    rc = main(["ise", str(family14), "--device", "xc2s200-pq208-5", "-o", str(out), "--no-timing-check"])
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert len(err.splitlines()) == 1 and err.startswith("error: ")
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

@@ -6,10 +6,12 @@ import json
 import sys
 from pathlib import Path
 
-from ..argtypes import bounded
+from ..argtypes import bounded, checked
+from ..golden.model import MAX_TERMS
 from ..implement import explore, synth
 from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
+from ..hardware.fixed.spec import check_mult_style, max_lanes
 from ..hardware.registry import FORMATS, datapath_for_model, read_design
 from ..hardware.target import DEFAULT_PART
 from ..verify.design import design_model
@@ -17,23 +19,33 @@ from ..verify.design import design_model
 HELP = "design-space table (lanes x multiplier x widths)"
 
 
-def _ints(text: str) -> tuple[int, ...]:
-    try:
-        vals = tuple(int(x) for x in text.split(","))
-    except ValueError:
-        raise FlannError(f"--lanes {text!r}: expected a comma-separated list of integers such as 1,2,4") from None
-    return vals
+def _list_of(parse_item, name: str):
+    """An argparse ``type`` for a comma-separated list, each item read by ``parse_item``: its
+    value, or None to keep the item's text (a check that only raises)."""
+    def parse(text: str) -> tuple:
+        items = [item.strip() for item in text.split(",")]
+        return tuple(item if value is None else value for item, value in zip(items, map(parse_item, items)))
+
+    parse.__name__ = name
+    return parse
+
+
+# a count above what this model takes is a skipped row (its note says why); above what any
+# model takes, or below one lane, it is a typing mistake
+LANES = _list_of(bounded(int, 1, max_lanes(MAX_TERMS)), "lanes")
+STYLES = _list_of(checked(check_mult_style), "multiplier styles")
+WIDTHS = _list_of(checked(explore.check_width_preset), "width presets")
 
 
 def add_arguments(p):
     p.add_argument("model", metavar="MODEL|DIR",
                    help="model.json, or a design directory written by flann gen (its model and its ADC)")
     p.add_argument("--device", default=DEFAULT_PART, metavar="PART", help="target part (default %(default)s)")
-    p.add_argument("--lanes", default=None,
+    p.add_argument("--lanes", type=LANES, metavar="N[,N...]", default=None,
                    help="lane counts to try (default 1,2,4; a float18 design has one lane)")
-    p.add_argument("--mult", default=None,
+    p.add_argument("--mult", type=STYLES, metavar="STYLE[,STYLE...]", default=None,
                    help="multiplier styles (default lut,shiftadd; not for a float18 design: the seed's multiplier)")
-    p.add_argument("--widths", default=",".join(explore.WIDTH_PRESETS),
+    p.add_argument("--widths", type=WIDTHS, metavar="PRESET[,PRESET...]", default=explore.WIDTH_PRESETS,
                    help="width presets: budget (error budget <= 1 LSB), narrow (4 fraction bits fewer; "
                         "a float18 design: of its terms)")
     p.add_argument("--no-seed", action="store_true", help="leave out the seed architecture (its synthesis is slow)")
@@ -73,9 +85,8 @@ def run(args) -> int:
         print(json.dumps([r.to_dict() for r in rows], indent=2) if args.json else explore.markdown(rows, args.device))
         return 0
     rows = explore.EXPLORERS[dp.explore](
-        args.model, args.device, lanes=None if args.lanes is None else _ints(args.lanes),
-        styles=None if args.mult is None else tuple(args.mult.split(",")),
-        widths=tuple(args.widths.split(",")), seed=not args.no_seed, progress=progress, abc=args.abc,
+        args.model, args.device, lanes=args.lanes, styles=args.mult,
+        widths=args.widths, seed=not args.no_seed, progress=progress, abc=args.abc,
         adc={k: v for k, v in (("input_bits", args.input_bits), ("input_lsb_v", args.input_lsb_v)) if v is not None},
     )
     if args.float18:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 import tempfile
@@ -13,7 +14,7 @@ from ..hardware.registry import read_design
 from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
-from ..verify.netlist import check_synthesized, require_sweep_driver
+from ..verify.netlist import DRIVER_TOP, check_synthesized, require_sweep_driver
 from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
@@ -42,20 +43,26 @@ def add_arguments(p):
                    help="LUT mapping: full = synth_xilinx as is (default); fast = abc -fast (large designs)")
     p.add_argument("--work", metavar="DIR", help="keep GHDL/Yosys intermediate files (netlist, yosys.log) here")
     p.add_argument("--model", metavar="MODEL.json", default=None,
-                   help="the model DIR was generated from: the mapped netlist is then simulated over every input "
-                        "code against the twin (Verilator) and a disagreeing design is refused")
-    p.add_argument("--no-netlist-check", action="store_true", help="do not simulate the mapped netlist")
+                   help="the model DIR was generated from, for the netlist check's twin (default: the model "
+                        "DIR/manifest.json records)")
+    p.add_argument("--no-netlist-check", action="store_true",
+                   help="do not simulate the mapped netlist; by default a fixed-point design's mapped netlist is "
+                        "simulated over every input code against the twin (Verilator), with --model or without "
+                        "(the manifest's model), reported as 'netlist check' (JSON: netlist_check, null when not "
+                        "run), and a disagreeing design is refused")
 
 
-def _check_netlist(args, netlist: Path) -> None:
-    """Refuse a design whose mapped netlist disagrees with its twin (needs the model)."""
+def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
+    """The mapped netlist against its twin over every input code: (result, "") or (None, why
+    it was not run); a design whose netlist disagrees is refused."""
     man, dp = read_design(args.directory)
     if not dp.netlist:
-        return  # the netlist is driven by the sweep harness of flann_top's ports
+        return None, (f"no netlist sweep for a {dp.name} design (it drives the fixed-point {DRIVER_TOP} "
+                      "against its twin)")
     if args.model is None and not man.get("model"):
         print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
               file=sys.stderr)
-        return
+        return None, "no model (pass --model MODEL.json)"
     design = from_directory(args.directory, args.model)
     if not args.json:
         print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
@@ -63,6 +70,8 @@ def _check_netlist(args, netlist: Path) -> None:
     if res["mismatches"]:
         raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res['mismatches']} of "
                          f"{res['codes_tested']} input codes (first: {res['first_mismatches']}); not handing it on")
+    return {"codes": res["codes_tested"], "mismatches": res["mismatches"], "passed": not res["mismatches"],
+            "simulator": res["simulator"]}, ""
 
 
 def post_route_check(directory, model):
@@ -110,8 +119,9 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
         work = Path(args.work) if args.work else Path(tmp)
         report = synth.synthesize(args.directory, args.device, work=work, progress=not args.json, abc=args.abc)
-        if not args.no_netlist_check:
-            _check_netlist(args, work / synth.NETLIST)
+        check, why = ((None, "--no-netlist-check") if args.no_netlist_check
+                      else _check_netlist(args, work / synth.NETLIST))
+        report = dataclasses.replace(report, netlist_check=check, netlist_not_run=why)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:

@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..hardware.fixed import render as hdlgen
-from ..hardware.fixed.spec import max_lanes
+from ..hardware.fixed.spec import check_mult_style, max_lanes
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.render import render_block
 from ..hardware.manifest import write_design
@@ -66,6 +66,11 @@ class Row:
         return dict(self.__dict__)
 
 
+def check_width_preset(preset: str) -> None:
+    if preset not in WIDTH_PRESETS:
+        raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
+
+
 def _width_options(model_path, preset: str, base: dict) -> dict:
     if preset == "budget":
         return {}
@@ -83,7 +88,7 @@ def _width_options(model_path, preset: str, base: dict) -> dict:
             "term_frac_bits": max(MIN_TERM_FRAC_BITS, ref.term_fmt.frac_bits - NARROW_BITS),
             "weight_frac_bits": max(0, ref.weight_fmt.frac_bits - NARROW_BITS),
         }
-    raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
+    raise AssertionError(f"width preset {preset!r} has no options")  # a preset added without its options
 
 
 def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: str) -> None:
@@ -104,6 +109,11 @@ def explore(model_path, device: str = DEFAULT_PART, lanes=DEFAULT_LANES, styles=
     """Generate, synthesise and score each candidate; the seed architecture last.  ``adc``:
     input_bits / input_lsb_v of the converter, as flann gen takes them."""
     parse_part(device)
+    # a bad preset or style is the caller's mistake, refused before any row is built
+    for preset in widths:
+        check_width_preset(preset)
+    for style in styles:
+        check_mult_style(style)
     terms = load_model(model_path).terms
     rows: list[Row] = []
     combos = [(l, s, w) for w in widths for s in styles for l in lanes]
@@ -292,12 +302,12 @@ def explore_float18(model_path, device: str = DEFAULT_PART, lanes=None, styles=N
     if styles is not None:
         raise FlannError(f"--mult {','.join(styles)}: a {F18} design multiplies with the seed's {F18} "
                          "multiplier, it has no multiplier style; explore its --widths")
+    for preset in widths:
+        check_width_preset(preset)
     rows = []
     for k, preset in enumerate(widths, 1):
         if progress:
             print(f"explore [{k}/{len(widths)}] {F18} widths={preset}", file=sys.stderr)
-        if preset not in WIDTH_PRESETS:
-            raise FlannError(f"width preset {preset!r}: allowed {', '.join(WIDTH_PRESETS)}")
         options = dict(adc or {})
         if preset == "narrow":
             try:

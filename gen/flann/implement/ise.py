@@ -8,8 +8,9 @@ be carried to the machine that runs ISE, and renders from ``templates/ise_*.j2``
   device/package/speed of the part), adds sources and UCF, sets the XST options and runs
   the flow up to "Generate Programming File";
 * ``flann_top.ucf``: clock PERIOD constraint and a LOC for every bit of every port the top
-  entity's VHDL declares (a family's cfg port too).  The pin map is an *example assignment*
-  to edit for the real board;
+  entity's VHDL declares (a family's cfg port too), as far as the example pins go: a port
+  they cannot hold is listed without a LOC for ISE to place.  The pin map is an *example
+  assignment* to edit for the real board;
 * ``flann_top.core``: FuseSoC CAPI2 description (GHDL simulation target; its ISE target
   is for ISE 11+ because Edalize writes .xise projects);
 * ``README.txt``: the steps.
@@ -129,33 +130,49 @@ def design_ports(man) -> list[Port]:
 PIN_MAP_PACKAGES = ("pq208",)  # packages with an example pin map; on the others ISE chooses the pins
 
 
-def pin_map(ports: list[Port], part: Part) -> list[tuple[str, str, str]]:
-    """(net, LOC, note) for every bit of every port; empty on a package without an example map.
+def pin_map(ports: list[Port], part: Part) -> tuple[list[tuple[str, str, str]], list[Port]]:
+    """(net, LOC, note) for every bit of the ports the example map places, and the ports it
+    leaves without a LOC for ISE to place; ([], []) on a package without an example map.
 
     Inputs take the left-side pins, outputs the right-side ones; a design with more input bits
     (a family's cfg port) or output bits than its side has takes the other side's spare pins,
-    from the far end, so any mix of up to len(INPUT_PINS) + len(OUTPUT_PINS) bits is placed."""
+    from the far end, so any mix of up to len(INPUT_PINS) + len(OUTPUT_PINS) bits is placed.
+    Beyond that, a port is placed whole or not at all (half a bus on placeholder pins helps no
+    board): in declaration order, one whose bits outnumber the pins left is left unplaced and
+    the ports after it are still tried."""
     if part.package not in PIN_MAP_PACKAGES:
-        return []
+        return [], []
+    preference = {"in": INPUT_PINS + OUTPUT_PINS[::-1], "out": OUTPUT_PINS + INPUT_PINS[::-1]}
+    used: set[str] = set()
+    rows, unplaced = [], []
+    for p in ports:
+        if p.name == "clk":
+            rows += [(net, CLOCK_PIN, "GCK1 global clock input") for net in p.bits()]
+        elif p.name == "rst":
+            rows += [(net, RESET_PIN, "synchronous reset, active high") for net in p.bits()]
+        else:
+            free = [pin for pin in preference[p.direction] if pin not in used]
+            if len(p.bits()) > len(free):
+                unplaced.append(p)
+                continue
+            for net, pin in zip(p.bits(), free):
+                rows.append((net, pin, p.direction))
+                used.add(pin)
+    return rows, unplaced
+
+
+def _described(p: Port) -> str:
+    """A port as a UCF comment or a message names it, e.g. ``cfg_data<31:0> (in, 32 bits)``."""
+    bits = len(p.bits())
+    return f"{p.name}{f'<{p.width - 1}:0>' if p.width else ''} ({p.direction}, {bits} bit{'s' * (bits > 1)})"
+
+
+def _unplaced_warning(ports: list[Port], unplaced: list[Port], ucf: Path) -> str:
     bits = {d: sum(len(p.bits()) for p in ports if p.direction == d and p.name not in ("clk", "rst"))
             for d in ("in", "out")}
-    room = len(INPUT_PINS) + len(OUTPUT_PINS)
-    if bits["in"] + bits["out"] > room:
-        widest = ", ".join(f"{p.name} {len(p.bits())}" for p in sorted(ports, key=lambda p: -len(p.bits()))[:3])
-        raise FlannError(f"the design's ports have {bits['in']} input and {bits['out']} output bits beside clk "
-                         f"and rst (widest: {widest}); the example pin map has {room} user I/O pins: assign them "
-                         "in the UCF by hand")
-    pools = {"in": iter(INPUT_PINS + OUTPUT_PINS[::-1]), "out": iter(OUTPUT_PINS + INPUT_PINS[::-1])}
-    rows = []
-    for p in ports:
-        for net in p.bits():
-            if p.name == "clk":
-                rows.append((net, CLOCK_PIN, "GCK1 global clock input"))
-            elif p.name == "rst":
-                rows.append((net, RESET_PIN, "synchronous reset, active high"))
-            else:
-                rows.append((net, next(pools[p.direction]), p.direction))
-    return rows
+    return (f"{ucf}: no LOC for {', '.join(_described(p) for p in unplaced)}, ISE chooses their pins (the ports "
+            f"have {bits['in']} input and {bits['out']} output bits beside clk and rst, more than the example pin "
+            f"map's {len(INPUT_PINS) + len(OUTPUT_PINS)} pins); add their LOCs for your board")
 
 
 def check_fits(man, dp, part, force: bool = False, warn: bool = True) -> None:
@@ -207,14 +224,15 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
             "XC2S200 boards (140): check every LOC against DS001 module 4 before building"
         )
     ports = design_ports(man)
-    pins = pin_map(ports, part)
+    pins, unplaced = pin_map(ports, part)
     sources = [f"src/{f.name}" for f in man.files]
     pins_kind = "pq208" if pins else "unplaced"
     period_ns = 1000.0 / clock_mhz
     ctx = dict(
         version=__version__, part=part, top=man.top, sources=sources, ucf=f"{man.top}.ucf",
         period_ns=f"{period_ns:.3f}".rstrip("0").rstrip("."), clock_mhz=f"{clock_mhz:g}",
-        pins=pins, ports=ports, model_sha256=man.data.get("model_sha256") or "(not recorded)",
+        pins=pins, ports=ports, no_loc=[_described(p) for p in unplaced],
+        model_sha256=man.data.get("model_sha256") or "(not recorded)",
         cycles_per_sample=man.data.get("cycles_per_sample"), latency=man.data.get("latency_cycles"),
         core_name=f"flann:lvdt:{man.top}:{__version__}", input_bits=man.data["input_bits"],
         output_bits=man.data["output_bits"],
@@ -236,6 +254,8 @@ def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: f
         shutil.copyfile(man.directory / "manifest.json", tmp / "src" / "manifest.json")
         for name, text in texts.items():
             (tmp / name).write_text(text, newline="")
+    if unplaced:   # said once the UCF it names is written
+        warnings.warn(_unplaced_warning(ports, unplaced, out / f"{man.top}.ucf"))
     return [*texts, *sources, "src/manifest.json"]
 
 

@@ -129,6 +129,10 @@ class SynthReport:
     abc: str = "full"
     entities: dict = field(default_factory=dict)
     timing: spartan2_timing.Timing | None = None
+    # the mapped netlist simulated against the twin: {codes, mismatches, passed, simulator},
+    # or None with why it was not run
+    netlist_check: dict | None = None
+    netlist_not_run: str = ""
 
     @property
     def fits(self) -> bool:
@@ -166,6 +170,7 @@ class SynthReport:
             "cycles_per_sample": self.manifest.get("cycles_per_sample"),
             "latency_cycles": self.manifest.get("latency_cycles"),
             "timing": self.timing.to_dict(CLOCK_HZ) if self.timing else None,
+            "netlist_check": self.netlist_check,
             "cells": r.cells,
             "entities": self.entities,
             "warnings": list(self.warnings),
@@ -200,6 +205,13 @@ class SynthReport:
                          f"{t.carry_bits} carry bits, {t.delay_ns:.1f} ns; DS001 figures + routing allowance)")
             if not t.meets(CLOCK_HZ):
                 lines.append(f"  DOES NOT MEET the design's clock {CLOCK_HZ / 1e6:g} MHz (estimate)")
+        n = self.netlist_check
+        if n is not None:
+            lines.append(f"  {'netlist check':<20} {n['codes']:>6} input codes simulated on the mapped netlist "
+                         f"({n['simulator']}), {n['mismatches']} mismatches with the twin: "
+                         + ("passed" if n["passed"] else "FAILED"))
+        elif self.netlist_not_run:
+            lines.append(f"  {'netlist check':<20} not run: {self.netlist_not_run}")
         if self.fits:
             lines.append(f"  fits {self.part.name}")
         else:

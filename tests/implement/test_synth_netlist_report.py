@@ -1,0 +1,83 @@
+"""flann synth reports its netlist check: the mapped netlist simulated over every input code
+against the twin (with or without --model: the manifest keeps the model), in the table as
+`netlist check` and in --json as netlist_check (null when it did not run)."""
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from flann.cli import main
+from flann.commands import synth as synth_command
+from flann.implement import synth
+
+REPO = Path(__file__).resolve().parents[2]
+GOOD = Path(__file__).parent / "fixtures" / "synth" / "good"
+
+needs_tools = pytest.mark.skipif(
+    not (shutil.which("ghdl") and shutil.which("yosys") and shutil.which("verilator")),
+    reason="ghdl, yosys and verilator are required (scripts/ensure_tools.sh)")
+
+
+def _run(capsys, *argv):
+    rc = main(["synth", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _once(fn):
+    """``fn`` run once, its result handed out again (a second report of the same design)."""
+    done = []
+
+    def again(*args, **kwargs):
+        if not done:
+            done.append(fn(*args, **kwargs))
+        return done[0]
+    return again
+
+
+@pytest.mark.synth
+@needs_tools
+def test_passing_check_is_reported_in_json_and_text(tmp_path, capsys, monkeypatch):
+    # an 8-bit input: 2^8 = 256 codes; no --model, the manifest's model is the twin's
+    model = tmp_path / "m.json"
+    assert main(["train", str(REPO / "data" / "paper_table1.csv"), "--terms", "11", "--method", "lstsq",
+                 "-o", str(model)]) == 0
+    assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "8"]) == 0
+    capsys.readouterr()
+    # the text run reuses the JSON run's synthesis and simulation (minutes on two cores)
+    monkeypatch.setattr(synth, "synthesize", _once(synth.synthesize))
+    simulated = _once(synth_command.check_synthesized)
+    monkeypatch.setattr(synth_command, "check_synthesized", simulated)
+
+    rc, out, err = _run(capsys, tmp_path / "d", "--no-lint", "--abc", "fast", "--json")
+    assert rc == 0, err
+    check = json.loads(out)["netlist_check"]
+    assert check["codes"] == 256 and check["mismatches"] == 0 and check["passed"] is True
+
+    rc, out, err = _run(capsys, tmp_path / "d", "--no-lint", "--abc", "fast")
+    assert rc == 0, err
+    line = next(ln for ln in out.splitlines() if "netlist check" in ln)
+    assert "256 input codes" in line and "0 mismatches" in line and line.endswith("passed")
+
+
+@pytest.mark.synth
+@needs_tools
+def test_check_not_run_is_null_and_said(tmp_path, capsys):
+    # the fixture is a hand-written design: no twin to simulate against
+    rc, out, err = _run(capsys, GOOD, "--no-lint", "--abc", "fast", "--json")
+    assert rc == 0, err
+    assert json.loads(out)["netlist_check"] is None
+    rc, out, err = _run(capsys, GOOD, "--no-lint", "--abc", "fast", "--no-netlist-check")
+    assert rc == 0, err
+    assert "netlist check        not run: --no-netlist-check" in out
+
+
+def test_help_says_the_check_runs_without_model(capsys):
+    with pytest.raises(SystemExit):
+        main(["synth", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    # the old help said the netlist is simulated only when --model is given
+    assert "then simulated" not in text
+    assert "manifest" in text and "netlist_check" in text
