@@ -13,6 +13,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from ..argtypes import png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_json
 from ..hardware import options as gen_options
@@ -22,7 +23,8 @@ from ..verify.design import open_design
 from ..verify.datapaths import simulate
 from ..verify.netlist import require_sweep_driver
 from ..verify.post_route import checker
-from ..verify.runner import ENGINES, plot
+from ..verify.plots import plot
+from ..verify.runner import ENGINES
 from ..verify.shards import terminal_progress
 
 HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
@@ -50,14 +52,17 @@ def add_arguments(parser) -> None:
                              "synthesised netlist compiled by Verilator (~25x faster), the VHDL on a sample; "
                              "auto (default) = ghdl when that takes about a minute or less, else verilator")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
-    parser.add_argument("--plot", metavar="OUT.png", default=None,
-                        help="HDL vs golden model across the input range and their difference (PNG)")
+    parser.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
+                        help="HDL vs golden model (a family design: the bit-true twin of each weight image) "
+                             "across the input range, at several temperature codes for a design with "
+                             "temperature, and their difference (PNG)")
     parser.add_argument("--build", metavar="DIR", default=None,
                         help="keep generated HDL, logs and results here (default: a temporary directory)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the random stimuli (default %(default)s)")
     parser.add_argument("--image", action="append", metavar="HEX", default=None,
                         help="a family design: a sensor's weight image (flann calibrate) to load through the "
-                             "cfg port; give two or more (default: the images flann gen kept in DIR)")
+                             "cfg port, each simulated; give two or more (one or more for a design with temperature; "
+                             "default: the images flann gen kept in DIR, for a design with temperature its last)")
     parser.add_argument("--summary-json", metavar="FILE", default=None, help="also write the summary here")
     gen_options.add_arguments(parser)
 
@@ -76,8 +81,6 @@ def image_names(paths) -> list[dict]:
 
 
 def run(args) -> int:
-    if args.plot and not args.plot.lower().endswith(".png"):
-        raise FlannError(f"--plot {args.plot}: the figure is written as PNG, name it *.png")
     opts = gen_options.from_args(args).to_kwargs()
     if args.post_route:
         parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
@@ -95,14 +98,20 @@ def run(args) -> int:
                                   seed=args.seed, progress=not args.json, post_route=checker(design))
             s["post_route"] = {**rep.post_route, "device": rep.part.name, "fmax_mhz": rep.fmax_mhz,
                                "timing_met": rep.timing_met}
-        if args.plot and res["curve"] is not None:
+        plotted = bool(args.plot and res["curve"] is not None)
+        if plotted:
             plot(res["curve"], design.manifest, args.plot)
+        # a design generated into the temporary directory is gone when the command returns
+        temporary = Path(tmp).resolve() in design.directory.parents
+        if temporary:
+            s["design"] = None
     if args.summary_json:
         atomic_write_json(args.summary_json, s)
     if args.json:
         print(json.dumps(s, indent=2))
     else:
-        print(f"design                  {s['design']}")
+        where = s["design"] or "generated in a temporary directory (deleted); keep it with --build DIR"
+        print(f"design                  {where}")
         sw = s.get("sweep") or {}
         how = sw.get("backend") or "Verilator on GHDL's synthesised netlist"
         print(f"input codes tested      {s['codes_tested']}"
@@ -120,7 +129,9 @@ def run(args) -> int:
             print(f"temperature codes       {len(s['temperature_codes'])} x every voltage code: "
                   f"{', '.join(map(str, s['temperature_codes']))}")
         if s.get("images"):
-            print(f"weight images           {', '.join(s['images'])} (through the cfg port)")
+            per = s.get("image_mismatches") or {}
+            names = [f"{n} ({per[n]} mismatches)" if per.get(n) is not None else n for n in s["images"]]
+            print(f"weight images           {', '.join(names)} (through the cfg port)")
         print(f"cycles per sample       {s['cycles_per_sample']} (latency {s['latency_cycles']})")
         print(f"{'samples/s at ' + format(s['clock_hz'] / 1e6, 'g') + ' MHz':<24}{s['samples_per_s']:.0f}")
         for name, b in s["benches"].items():
@@ -135,8 +146,10 @@ def run(args) -> int:
             n = s["post_route"]
             print(f"post-route ({n['device']})  {n['codes_tested']} codes, {n['mismatches']} mismatches "
                   f"(Fmax {n['fmax_mhz']:.1f} MHz, {n['seconds']:.0f} s)")
-        if args.plot:
+        if plotted:
             print(f"plot: {args.plot}")
+    if args.plot and not plotted:
+        print(f"{args.plot}: not written, the simulation gave no outputs to plot", file=sys.stderr)
     if s.get("post_route", {}).get("mismatches"):
         if not args.json:
             print("error: the placed-and-routed design disagrees with its twin", file=sys.stderr)

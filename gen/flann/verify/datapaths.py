@@ -14,7 +14,10 @@ import numpy as np
 
 from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
+from ..hardware.family.twin import FlannFamilyTop
+from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..production.images import read_image
+from . import plots
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
@@ -52,7 +55,10 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     benches = {"float18_top": {"tests": 1, "failures": int(r["bench_failed"]), "failed": [], "seconds": None}}
     s = _summary(design, int(codes.size), r["mismatches"], err, benches, ok)
     s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
-    curve = {"codes": codes, "hdl": hdl_mm, "ref": ref, "simulator": "GHDL", "unit_mm": True}
+    # the float18 design states no error bound (its spec has no error analysis): no bound line
+    curve = plots.curve([{"title": None, "series": [plots.series("", codes, hdl_mm, ref)]}],
+                        ref=plots.GOLDEN, simulator="GHDL", unit_mm=True,
+                        diff_label="HDL - golden (float18 states no error bound)")
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
@@ -73,9 +79,17 @@ def _images(design: Design, images, least: int) -> list[tuple[dict, list[int]]]:
 
 
 def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
-    images = [im for im, _words in _images(design, images, 2)]
+    loaded = _images(design, images, 2)
+    images = [im for im, _words in loaded]
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
+    curve = None
+    if rec.get("outputs"):
+        codes = np.asarray(rec["codes"], dtype=np.int64)
+        ss = [plots.series(im["name"], codes, rec["outputs"][im["name"]],
+                           FlannFamilyTop(design.spec, words).process(codes)[0])
+              for im, words in loaded if len(rec["outputs"].get(im["name"], ())) == codes.size]
+        curve = plots.curve([{"title": None, "series": ss}], ref=plots.TWIN, simulator="GHDL") if ss else None
     codes = len(rec.get("codes", [])) * len(rec.get("outputs", {}))
     benches = {"family": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
                           "seconds": round(res.seconds, 1)}}
@@ -83,7 +97,7 @@ def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
                  design.manifest["output_lsb_mm"])
     s["images"] = [im["name"] for im in images]
     s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
-    return {"summary": s, "curve": None, "spec": design.spec}
+    return {"summary": s, "curve": curve, "spec": design.spec}
 
 
 def _fixed(design: Design, build_dir, *, seed=1, netlist=False, engine="auto", progress=None, **_) -> dict:
@@ -130,7 +144,29 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     s["temperature_codes_tested"] = len(temps)
     s["voltage_codes_tested"] = code_hi - code_lo + 1
     s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
-    return {"summary": s, "curve": None, "spec": spec}
+    curve = None
+    got = _sweep_rows(out_file, len(temps) * (code_hi - code_lo + 1))
+    if got is not None:
+        c, t, out, sat = got
+        ref = spec.float_reference(c, t) / lsb
+        bound = man["analysis"]["pre_rounding_lsb"] + 0.5
+        curve = plots.two_input([{"name": "", "codes": c, "temps": t, "hdl": out, "ref": ref,
+                                  "valid": ~(sat & (np.abs(ref) > spec.out_fmt.max_int))}],
+                                temps, spec.temp_lsb_c, ref=plots.GOLDEN, simulator=f"GHDL, {backend}",
+                                bound={"value": bound, "label": f"±{bound:.3g} LSB (the design's error bound)"},
+                                calibrated=(spec.temp_lo, spec.temp_hi))
+    return {"summary": s, "curve": curve, "spec": spec}
+
+
+def _sweep_rows(path: Path, samples: int):
+    """A two-input sweep's output file as (voltage codes, temperature codes, out, sat), or None
+    when the harness did not write every sample (the bench has failed and says why)."""
+    if not path.is_file():
+        return None
+    rows = np.loadtxt(path, dtype=np.int64, ndmin=2)
+    if rows.shape != (samples, 5):
+        return None
+    return rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3].astype(bool)
 
 
 def family_thermal_temperature_codes(spec) -> list[int]:
@@ -141,43 +177,64 @@ def family_thermal_temperature_codes(spec) -> list[int]:
 
 
 def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
-    """One sensor's image (the last --image, else the design's last member: not the memories'
-    initial sensor, so the cfg port is what loads it) at every voltage code and the stated
-    temperature codes."""
+    """Each sensor's image given (--image), else the design's last member (not the memories'
+    initial sensor, so the cfg port is what loads it), at every voltage code and the stated
+    temperature codes: one run of the sweep harness per image."""
     spec, man = design.spec, design.manifest
-    image, words = _images(design, images, 1)[-1]
-    if len(words) != spec.image_words:
-        raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
+    loaded = _images(design, images, 1)
+    if not images:
+        loaded = loaded[-1:]
+    for image, words in loaded:
+        if len(words) != spec.image_words:
+            raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
     temps = family_thermal_temperature_codes(spec)
     build_dir = Path(build_dir).resolve()
     samples = len(temps) * (spec.code_max - spec.code_min + 1)
     backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
     build_dir.mkdir(parents=True, exist_ok=True)
-    temps_file, out_file = build_dir / "family_thermal_temps.txt", build_dir / "family_thermal_sweep.txt"
-    image_file = build_dir / "family_thermal_image.txt"
+    temps_file = build_dir / "family_thermal_temps.txt"
     temps_file.write_text("".join(f"{t}\n" for t in temps))
-    image_file.write_text("".join(f"{a} {w >> 16} {w & 0xFFFF}\n" for a, w in enumerate(words)))
-    sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps,
-             "words": words}
-    params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
-              "addr_bits_g": spec.cfg_addr_bits, "code_lo_g": spec.code_min, "code_hi_g": spec.code_max,
-              "image_file_g": str(image_file), "temps_file_g": str(temps_file), "out_file_g": str(out_file)}
-    # the one sweep harness, its image loaded through the cfg port first
-    res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
-                     "test_family_thermal_sweep", build_dir / "family_thermal_sweep",
-                     {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
-                     name="family_thermal_sweep", parameters=params, seed=seed, backend=backend)
-    rec = res.records.get("family_thermal_sweep", {})
-    benches = {"family_thermal_sweep": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
-                                        "seconds": round(res.seconds, 1)}}
-    s = _summary(design, rec.get("samples", 0), rec.get("mismatches"), None, benches, res.ok and bool(rec),
-                 spec.output_lsb_mm)
-    s["images"] = [image["name"]]
+    bench = {"tests": 0, "failures": 0, "failed": [], "seconds": 0.0}
+    total, mismatches, ok, per_image, groups = 0, 0, True, {}, []
+    for k, (image, words) in enumerate(loaded):
+        tag = f"family_thermal_sweep_{k}" if len(loaded) > 1 else "family_thermal_sweep"
+        out_file, image_file = build_dir / f"{tag}.txt", build_dir / f"{tag}_image.txt"
+        image_file.write_text("".join(f"{a} {w >> 16} {w & 0xFFFF}\n" for a, w in enumerate(words)))
+        sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps,
+                 "words": words}
+        params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
+                  "addr_bits_g": spec.cfg_addr_bits, "code_lo_g": spec.code_min, "code_hi_g": spec.code_max,
+                  "image_file_g": str(image_file), "temps_file_g": str(temps_file), "out_file_g": str(out_file)}
+        # the one sweep harness, its image loaded through the cfg port first
+        res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
+                         "test_family_thermal_sweep", build_dir / tag,
+                         {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
+                         name="family_thermal_sweep", parameters=params, seed=seed, backend=backend)
+        rec = res.records.get("family_thermal_sweep", {})
+        bench["tests"] += res.tests
+        bench["failures"] += res.failures
+        bench["failed"] += [f"{image['name']}: {t}" for t in res.failed_tests]
+        bench["seconds"] = round(bench["seconds"] + res.seconds, 1)
+        ok = ok and res.ok and bool(rec)
+        total += rec.get("samples", 0)
+        mismatches = None if mismatches is None or rec.get("mismatches") is None else mismatches + rec["mismatches"]
+        per_image[image["name"]] = rec.get("mismatches")
+        got = _sweep_rows(out_file, samples)
+        if got is not None:
+            c, t, out, _sat = got
+            twin = FlannFamilyThermalTop(spec, words).process(c, t).out_data
+            groups.append({"name": image["name"], "codes": c, "temps": t, "hdl": out, "ref": twin,
+                           "valid": np.ones(c.size, dtype=bool)})
+    s = _summary(design, total, mismatches, None, {"family_thermal_sweep": bench}, ok, spec.output_lsb_mm)
+    s["images"] = [image["name"] for image, _ in loaded]
+    s["image_mismatches"] = per_image
     s["temperature_codes"] = temps
     s["temperature_codes_tested"] = len(temps)
     s["voltage_codes_tested"] = spec.code_max - spec.code_min + 1
     s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
-    return {"summary": s, "curve": None, "spec": spec}
+    curve = plots.two_input(groups, temps, spec.temp_lsb_c, ref=plots.TWIN, simulator=f"GHDL, {backend}",
+                            calibrated=(spec.temp_lo, spec.temp_hi)) if groups else None
+    return {"summary": s, "curve": curve, "spec": spec}
 
 
 BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "family": _family,

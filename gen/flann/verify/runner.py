@@ -31,10 +31,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FlannError
-from ..fileio import atomic_save_figure
 from ..hardware.target import CLOCK_HZ
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
+from . import plots
 from .design import Design
 from .netlist import check_netlist, check_rtl_netlist
 from .shards import count_lines, cores, merge, read_results, split
@@ -377,7 +377,9 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
                 summary.update(codes_tested=int(codes.size), mismatches=int(np.count_nonzero(bad)),
                                max_err_lsb=round(float(err.max()), 4),
                                max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6))
-                curve = {"codes": codes, "hdl": data, "ref": ref, "simulator": simulator_name(every["about"])}
+                curve = plots.curve([{"title": None, "series": [plots.series("", codes, data, ref)]}],
+                                    ref=plots.GOLDEN, simulator=simulator_name(every["about"]),
+                                    bound={"value": 1.0, "label": "±1 output LSB"})
             summary["sweep"] = every["about"]
         else:
             if progress and sys.stderr.isatty():
@@ -399,38 +401,5 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
-def plot(curve: dict, man: dict, path) -> None:
-    """HDL output and golden model across the input range, and their difference (paper Fig. 6);
-    ``man``: the design's manifest (input LSB, clamp codes, output LSB)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    lsb_v = man["input_lsb_v"]
-    v = curve["codes"] * lsb_v
-    q = 1.0 if curve.get("unit_mm") else man["output_lsb_mm"]
-    clamp_lo, clamp_hi = man["clamp_codes"]
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    a1.plot(v, curve["ref"] * q, label="golden model (float64)", lw=2, color="0.7")
-    a1.plot(v, curve["hdl"] * q, label=f"HDL ({curve.get('simulator', 'GHDL')})", lw=0.8, color="C0")
-    a1.axvspan(clamp_lo * lsb_v, clamp_hi * lsb_v, color="C2", alpha=0.06,
-               label="trained range")
-    a1.set_ylabel("displacement (mm)")
-    a1.legend(loc="best", fontsize=8)
-    a1.set_title("(a) FLANN output: HDL vs golden model")
-    a2.plot(v, curve["hdl"] - curve["ref"], lw=0.6, color="C3")
-    a2.axhline(1, ls=":", color="k")
-    a2.axhline(-1, ls=":", color="k")
-    a2.set_ylabel("HDL - golden (mm)" if curve.get("unit_mm") else "HDL - golden (output LSB)")
-    a2.set_xlabel("input (V)")
-    a2.set_title("(b) difference" if curve.get("unit_mm") else f"(b) difference (1 LSB = {q} mm)")
-    fig.tight_layout()
-    try:
-        atomic_save_figure(fig, path, dpi=120)
-    finally:
-        plt.close(fig)
-
-
-__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "plot", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]

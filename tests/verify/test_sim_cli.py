@@ -1,0 +1,163 @@
+"""`flann sim` on every datapath it runs: the plot it claims is written and says what it shows,
+every weight image given is simulated, a temporary design is not reported as a path."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from flann.cli import main
+from flann.golden.thermal_train import fit_thermal
+from flann.golden.train import fit_lstsq
+from flann.hardware.registry import DATAPATHS
+from flann.production.demo import write_batch
+from flann.recordings import prepare_for_fit, read_recordings
+
+pytestmark = [pytest.mark.sim, pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
+
+BITS = 8
+SIMULATED = ["fixed", "float18", "family", "thermal", "family_thermal"]
+
+
+def _thermal_sensor(x, t, gain=1.0):
+    """A closed-form sensor whose gain, null and roll-off move with temperature (volts)."""
+    u, k = x / 8.0, 2.5 * (1 + 1e-4 * (t - 25))
+    return gain * (1.5 * (1 - 2.5e-4 * (t - 25)) * u / (1 + np.abs(u) ** k) ** (1 / k) + 6e-6 * (t - 25))
+
+
+@pytest.fixture(scope="module")
+def designs(tmp_path_factory):
+    """Small designs (4-5 terms, 8-bit input) of every datapath flann sim runs."""
+    d = tmp_path_factory.mktemp("sim_designs")
+    recs = write_batch(d / "rec", 2, seed=11, points=400)
+    rec = prepare_for_fit(read_recordings(recs[0]))
+    model = d / "m5.json"
+    model.write_text(fit_lstsq(rec.voltage_v, rec.displacement_mm, 5, norm="half").to_json())
+    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
+    thermal = d / "m_thermal.json"
+    thermal.write_text(fit_thermal(_thermal_sensor(x, t), t, x, (5, 3), norm="range").to_json())
+    members = []
+    for k, gain in enumerate((1.0, 1.04)):  # the second sensor 4 % more sensitive
+        members.append(d / f"ft_{k}.csv")
+        members[-1].write_text("displacement_mm,voltage_v,temperature_c\n" + "".join(
+            f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(x, _thermal_sensor(x, t, gain), t)))
+    for args in ((model, "-o", d / "fixed"), (model, "-o", d / "float18", "--format", "float18"),
+                 ("--family", *recs, "--terms", 5, "-o", d / "family"),
+                 (thermal, "-o", d / "thermal", "--temp-bits", 5, "--temp-lsb-c", 6),
+                 ("--family", *members, "--terms", 4, "-o", d / "family_thermal", "--temp-bits", 4,
+                  "--temp-lsb-c", 12)):
+        assert main(["gen", *map(str, args), "--input-bits", str(BITS)]) == 0
+    return {"dir": d, "model": model}
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """What each figure --plot saves holds, axis by axis: title, y label, lines (label, x, y)."""
+    seen, save = [], Figure.savefig
+
+    def keep(fig, *args, **kw):
+        seen.append([{"title": ax.get_title(), "ylabel": ax.get_ylabel(),
+                      "lines": [(ln.get_label(), np.asarray(ln.get_xdata(), dtype=float),
+                                 np.asarray(ln.get_ydata(), dtype=float)) for ln in ax.get_lines()]}
+                     for ax in fig.axes])
+        return save(fig, *args, **kw)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    return seen
+
+
+def test_every_datapath_with_a_bench_is_covered():
+    assert sorted(n for n, dp in DATAPATHS.items() if dp.bench) == sorted(SIMULATED)
+
+
+def _is_png(path: Path) -> bool:
+    return path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("datapath", SIMULATED)
+def test_plot_is_written_for_every_datapath(designs, datapath, tmp_path, capsys, figures):
+    png = tmp_path / "sim.png"
+    rc = main(["sim", str(designs["dir"] / datapath), "--plot", str(png), "--json",
+               "--build", str(tmp_path / "b")])
+    s = json.loads(capsys.readouterr().out)
+    assert rc == 0 and s["mismatches"] == 0
+    assert _is_png(png)
+    (axes,) = figures
+    for ax in axes:
+        for label, _x, _y in ax["lines"]:
+            assert label and not label.startswith("_"), f"{datapath}: an unlabelled line in {ax['title']!r}"
+    diff = axes[-1]
+    curves = [(label, x, y) for label, x, y in diff["lines"] if "LSB" not in label]  # not the bound
+    assert curves, f"{datapath}: no difference drawn"
+    for label, x, y in curves:
+        # one point per input code of the 8-bit input (each temperature code folded in)
+        assert np.unique(x[np.isfinite(x)]).size == 2 ** BITS, label
+    if datapath in ("family", "family_thermal"):
+        # against each weight image's twin: bit for bit, so the difference is zero everywhere
+        assert "twin" in diff["ylabel"]
+        assert all(np.all(y == 0) for _l, _x, y in curves)
+    else:
+        assert "golden" in diff["ylabel"] and any(np.nanmax(np.abs(y)) > 0 for _l, _x, y in curves)
+    if datapath in ("thermal", "family_thermal"):
+        assert any("degC" in label for ax in axes[:-1] for label, _x, _y in ax["lines"])
+
+
+def test_float18_plot_draws_no_lsb_bound(designs, tmp_path, capsys, figures):
+    """The float18 design states no error bound: its difference panel (mm) has no +-1 lines."""
+    png = tmp_path / "f18.png"
+    assert main(["sim", str(designs["dir"] / "float18"), "--plot", str(png)]) == 0
+    assert f"plot: {png}" in capsys.readouterr().out and _is_png(png)
+    diff = figures[0][-1]
+    assert "(mm)" in diff["ylabel"]
+    for label, _x, y in diff["lines"]:
+        y = y[np.isfinite(y)]
+        assert not (y.size and np.allclose(np.abs(y), 1.0)), f"a +-1 line drawn: {label}"
+        assert "LSB" not in label
+
+
+def test_fixed_plot_bound_line_is_labelled(designs, tmp_path, capsys, figures):
+    assert main(["sim", str(designs["dir"] / "fixed"), "--plot", str(tmp_path / "f.png")]) == 0
+    bounds = [(label, y) for label, _x, y in figures[0][-1]["lines"] if "LSB" in label]
+    assert len(bounds) == 1
+    assert sorted(set(bounds[0][1][np.isfinite(bounds[0][1])].tolist())) == [-1.0, 1.0]
+
+
+def test_family_thermal_simulates_every_image_given(designs, tmp_path, capsys, figures):
+    d = designs["dir"] / "family_thermal"
+    kept = [d / im["hex"] for im in json.loads((d / "manifest.json").read_text())["images"]]
+    assert len(kept) == 2
+    given = kept[::-1]  # the design's last member first, then its first
+    args = ["sim", str(d), *[a for h in given for a in ("--image", str(h))], "--build", str(tmp_path / "b")]
+    assert main([*args, "--json", "--plot", str(tmp_path / "ft.png")]) == 0
+    s = json.loads(capsys.readouterr().out)
+    names = [h.stem for h in given]
+    assert s["images"] == names
+    assert s["image_mismatches"] == {n: 0 for n in names}
+    assert s["codes_tested"] == len(given) * 2 ** BITS * s["temperature_codes_tested"]
+    # one panel per image, titled by it, and the two sensors' HDL outputs differ (both loaded)
+    panels = figures[0][:-1]
+    assert [p["title"].split(":")[0].removeprefix("(a) ").removeprefix("(b) ") for p in panels] == names
+    hdl = [np.concatenate([y for label, _x, y in p["lines"] if label.startswith("HDL")]) for p in panels]
+    assert not np.array_equal(hdl[0], hdl[1])
+    # the text report names both, each with its mismatches
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert all(f"{n} (0 mismatches)" in out for n in names)
+
+
+def test_temporary_design_is_not_reported_as_a_path(designs, tmp_path, capsys):
+    model = str(designs["model"])
+    assert main(["sim", model, "--json", "--input-bits", str(BITS)]) == 0
+    assert json.loads(capsys.readouterr().out)["design"] is None
+    assert main(["sim", model, "--input-bits", str(BITS)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("design"))
+    assert "temporary" in line and "flann-sim-" not in line
+    # kept with --build: the path is reported, and the design is there
+    assert main(["sim", model, "--json", "--input-bits", str(BITS), "--build", str(tmp_path / "b")]) == 0
+    kept = Path(json.loads(capsys.readouterr().out)["design"])
+    assert kept == (tmp_path / "b" / "hdl").resolve() and (kept / "manifest.json").is_file()
