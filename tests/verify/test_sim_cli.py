@@ -161,3 +161,11 @@ def test_temporary_design_is_not_reported_as_a_path(designs, tmp_path, capsys):
     assert main(["sim", model, "--json", "--input-bits", str(BITS), "--build", str(tmp_path / "b")]) == 0
     kept = Path(json.loads(capsys.readouterr().out)["design"])
     assert kept == (tmp_path / "b" / "hdl").resolve() and (kept / "manifest.json").is_file()
+
+
+@pytest.mark.parametrize("name", [n for n in SIMULATED if n != "fixed"])
+def test_verilator_engine_is_refused_where_it_cannot_run(designs, name, cli):
+    """--engine verilator compiles the sweep driver's netlist: another datapath is refused in
+    one line before any simulation (it ran GHDL instead, saying nothing)."""
+    rc, out, err = cli(["sim", designs["dir"] / name, "--engine", "verilator"])
+    assert rc == 2 and out == "" and err.startswith("error: --engine verilator") and len(err.strip().splitlines()) == 1

@@ -249,6 +249,8 @@ def simulate(design: Design, build_dir, **kw) -> dict:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
     if kw.get("netlist"):
         require_sweep_driver(dp, design.directory, "--netlist")
+    if kw.get("engine") == "verilator":   # the netlist of the sweep driver, compiled by Verilator
+        require_sweep_driver(dp, design.directory, "--engine verilator")
     if kw.get("images") and BENCHES[dp.bench] not in LOADS_IMAGES:
         raise FlannError(f"--image: {design.directory} is a {dp.name} design, its weights are built in "
                          "(weight images load into a family design's memory)")
