@@ -11,7 +11,7 @@ from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..golden.metrics import DEFAULT_TOL_PCT_FS
 from ..recordings import read_recordings
-from ..golden.train import MAX_EPOCHS, fit_auto, fit_lstsq, normalisation, normalisation_kind
+from ..golden.train import MAX_EPOCHS, fit_lstsq, normalisation, normalisation_kind
 from ..golden import paper
 from ..hardware.fixed.cost import fixed_point_cost
 
@@ -44,6 +44,10 @@ def add_arguments(p) -> None:
     p.add_argument("--dense", action="store_true",
                    help="also run the tool's default (--terms auto) on dense physics-like "
                         "data and print the stroke fraction within +-0.1 %% FS before/after")
+
+
+def _loo_text(loo: np.ndarray, interior: np.ndarray) -> str:
+    return f"LOO max {np.max(np.abs(loo)):.3g} mm (interior {np.max(np.abs(loo[interior])):.3g} mm)"
 
 
 def run(args) -> int:
@@ -90,16 +94,15 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
     print(f"Between the {len(rec)} points: leave-one-out, and a dense sweep of v compared with "
           "the monotone PCHIP interpolant of the points:")
     default = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="range")
-    auto, choice = fit_auto(rec.voltage_v, rec.displacement_mm, cost=fixed_point_cost)
-    designs = (("51 terms, paper LMS", details["models"][51], details["loo"][51]),
+    auto = paper.default_fit(rec, fixed_point_cost)
+    designs = (("51 terms, paper LMS", details["models"][51],
+                _loo_text(details["loo"][51], interior)),
                ("51 terms, lstsq, range (default design)", default,
-                paper.lstsq_loo_errors(rec, 51, "range")),
-               (f"auto: {choice.terms} terms, {choice.norm}, ridge {choice.ridge:g}", auto,
-                paper.lstsq_loo_errors(rec, choice.terms, choice.norm, choice.ridge)))
-    for label, model, loo in designs:
+                _loo_text(paper.lstsq_loo_errors(rec, 51, "range"), interior)),
+               (f"flann train default (--terms auto): {auto.label}", auto.model, auto.loo_text))
+    for label, model, loo_text in designs:
         b = paper.between_points(model, rec)
-        print(f"  {label}:\n    LOO max {np.max(np.abs(loo)):.3g} mm (interior "
-              f"{np.max(np.abs(loo[interior])):.3g} mm); max deviation "
+        print(f"  {label}:\n    {loo_text}; max deviation "
               f"{b['max_dev_from_pchip_mm']:.3g} mm "
               f"({b['max_dev_from_pchip_pct_fs']:.3g} % FS) at {b['at_voltage_v']:.3f} V; "
               f"{b['sweep_fraction_within_tol_of_pchip']:.1%} of the sweep within +-{args.tol:g} "
@@ -118,10 +121,9 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
                     f"{c:7.2f}" if c is not None else f"{'-':>7s}" for c in cells))
     if args.dense:
         d = paper.dense_demo(cost=fixed_point_cost)
-        print(f"Tool default (--terms auto) on dense physics-like data (tanh S-curve, "
+        print(f"flann train default (--terms auto) on dense physics-like data (tanh S-curve, "
               f"{d['noise_v'] * 1e3:g} mV noise; 601 training points, 600 held-out points "
-              f"between them): {d['terms']} terms, normalisation {d['normalisation']}, "
-              f"ridge {d['ridge']:g}")
+              f"between them): {d['label']}")
         for key, label in (("before", "before (raw, LS line)"), ("after", "after (FLANN)")):
             r = d[key]
             print(f"  {label:22s}: stroke within +-{d['band_pct_fs']:g} % FS "

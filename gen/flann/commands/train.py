@@ -14,10 +14,10 @@ from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.model import MAX_TERMS
 from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
-from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate, fit_auto,
+from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
-from ..golden.inverse import inverse_fit
+from ..golden.inverse import fit_default
 from ..hardware.adc import ADC_BITS, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
@@ -161,19 +161,16 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     def cost(m):
         return fixed_point_cost(m, adc)
 
-    _stage("the direct fit x(v): terms, normalisation and ridge by cross-validation")
-    model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, training=provenance, cost=cost)
-    _stage("the forward curve v(x), and the FLANN fitted to its inverse")
-    inverse = inverse_fit(rec.displacement_mm, rec.voltage_v, choice, cost, model.training, step_v)
+    model, choice, from_curve = fit_default(rec.displacement_mm, rec.voltage_v, cost, provenance, step_v,
+                                            stage=_stage)
     t = model.training
     direct_text = (f"held-out error (cross-validation, {t['cv_folds']} folds"
                    + (f", chosen on {t['cv_points']} of {len(rec)} points" if "cv_points" in t else "")
                    + f"): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
-    if inverse is None:
+    if not from_curve:
         said.append(f"auto: {choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}; "
                     + direct_text)
     else:
-        model, t = inverse, inverse.training
         loo, own = t.get("leave_one_out"), t["forward_model"].get("heldout")
         if loo:
             heldout = (f"left-out positions RMS {loo['rms_error_mm']:.4g} mm (direct fit "

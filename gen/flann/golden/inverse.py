@@ -31,7 +31,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 from .forward import aggregate, strictly_monotone
 from .model import FlannModel
 from .sigmoids import SigmoidForward, fit_forward, refit
-from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, cv_folds, fit_lstsq
+from .train import AUTO_NORMS, AUTO_RIDGES, AUTO_TERMS, CvResult, cv_folds, fit_auto, fit_lstsq
 
 SPARSE_POSITIONS = 20      # the outlier screen's lower limit: below it, no smooth fit judges noise
 MIN_POSITIONS = 5          # a cubic through fewer is no better than the direct fit's candidates
@@ -290,5 +290,18 @@ def inverse_fit(displacement_mm, voltage_v, direct, cost, training: dict,
     return model
 
 
+def fit_default(displacement_mm, voltage_v, cost, training: dict | None = None,
+                step_v: float = 0.0, stage=lambda text: None) -> tuple[FlannModel, CvResult, bool]:
+    """What ``flann train --terms auto`` fits: the direct fit x(v) chosen by cross-validation,
+    then the FLANN fitted to the forward curve's inverse where it follows the curve more
+    closely (:func:`inverse_fit`).  (model, the direct fit's choice, whether the model is the
+    inverse's); ``stage(text)`` is told as each of the two begins."""
+    stage("the direct fit x(v): terms, normalisation and ridge by cross-validation")
+    direct, choice = fit_auto(voltage_v, displacement_mm, training=training, cost=cost)
+    stage("the forward curve v(x), and the FLANN fitted to its inverse")
+    inverse = inverse_fit(displacement_mm, voltage_v, choice, cost, direct.training, step_v)
+    return (direct, choice, False) if inverse is None else (inverse, choice, True)
+
+
 __all__ = ["DENSE", "Forward", "MIN_POSITIONS", "SPARSE_POSITIONS", "direct_leave_one_out_mm",
-           "fit_to_forward", "forward_curve", "forward_heldout", "inverse_fit", "leave_one_out_mm", "spline_curve"]
+           "fit_default", "fit_to_forward", "forward_curve", "forward_heldout", "inverse_fit", "leave_one_out_mm", "spline_curve"]

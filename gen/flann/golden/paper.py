@@ -15,6 +15,7 @@ compared with a monotone interpolant of the table), and the tool's own default
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +26,8 @@ from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, ful
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
 from ..recordings import Recordings
-from .train import design_matrix, fit_auto, fit_lms, fit_lstsq, lms_epochs, lms_leave_one_out
+from .inverse import fit_default, forward_curve
+from .train import design_matrix, fit_lms, fit_lstsq, lms_epochs, lms_leave_one_out
 
 # The paper's Table 1 (also in data/paper_table1.csv, checked equal by the tests).
 TABLE1_DISPLACEMENT_MM = np.arange(-30.0, 30.0 + 1, 5.0)
@@ -145,6 +147,37 @@ def s_curve(displacement_mm, noise_v: float = 0.0, seed: int = 0) -> np.ndarray:
     return v
 
 
+@dataclass(frozen=True)
+class DefaultFit:
+    """``flann train --terms auto``'s model of a recording, what it is, and its held-out error."""
+
+    model: FlannModel
+    label: str          # "51 terms, normalisation 0.85, ridge 0, fitted to the forward curve's inverse"
+    loo_text: str       # its leave-one-out error, and of what
+
+
+def default_fit(rec: Recordings, cost) -> DefaultFit:
+    """The model ``flann train --terms auto`` writes for ``rec`` (:func:`fit_default`), with
+    the leave-one-out error of what chose it: the forward curve's at the interior positions
+    (the FLANN follows that curve within its teacher tolerance), or the direct fit's."""
+    x, v = rec.displacement_mm, rec.voltage_v
+    model, choice, from_curve = fit_default(x, v, cost)
+    t = model.training
+    if from_curve:
+        label = (f"{model.terms} terms, normalisation {t['normalisation']}, ridge {t['ridge']:g}, "
+                 "fitted to the forward curve's inverse")
+        fw = forward_curve(x, v)
+        loo = getattr(fw, "left_out_mm", None)
+        loo_text = ("its forward curve's LOO max "
+                    f"{np.max(np.abs(loo)):.3g} mm (interior positions)" if loo is not None and loo.size
+                    else "its forward curve's held-out error: " + str(t.get("forward_model", {}).get("heldout")))
+    else:
+        label = f"{choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}, the direct fit x(v)"
+        loo = lstsq_loo_errors(rec, choice.terms, choice.norm, choice.ridge)
+        loo_text = f"LOO max {np.max(np.abs(loo)):.3g} mm"
+    return DefaultFit(model, label, loo_text)
+
+
 def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS, cost=None) -> dict:
     """The tool's default (``--terms auto``; ``cost`` as ``flann train`` gives it) on a dense
     physics-like sweep.
@@ -156,15 +189,15 @@ def dense_demo(noise_v: float = 0.5e-3, band_pct_fs: float = DEFAULT_BAND_PCT_FS
     x_test = x_train[:-1] + 0.05
     v_train = s_curve(x_train, noise_v, seed=1)
     v_test = s_curve(x_test, noise_v, seed=2)
-    model, choice = fit_auto(v_train, x_train, cost=cost)
+    fit = default_fit(Recordings(displacement_mm=x_train, voltage_v=v_train), cost)
+    model = fit.model
     fs = full_scale_mm(x_train)
     after = error_report(model.predict(v_test), x_test, band_pct_fs=band_pct_fs, fs_mm=fs)
     a, b = np.polyfit(v_train, x_train, 1)   # the raw sensor's line, from the training sweep
     before = error_report(a * v_test + b, x_test, band_pct_fs=band_pct_fs, fs_mm=fs)
     return {"noise_v": noise_v, "band_pct_fs": band_pct_fs, "fs_mm": fs,
-            "terms": choice.terms, "normalisation": choice.norm, "ridge": choice.ridge,
-            "cv_heldout_rms_mm": choice.rms_mm, "cv_heldout_max_mm": choice.max_mm,
-            "before": before, "after": after}
+            "terms": model.terms, "normalisation": model.training["normalisation"],
+            "ridge": model.training["ridge"], "label": fit.label, "before": before, "after": after}
 
 
 # -- Fig. 5 ----------------------------------------------------------------------------
