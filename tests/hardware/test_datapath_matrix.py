@@ -13,13 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flann.golden.thermal_train import fit_thermal
-from flann.golden.train import fit_lstsq
 from flann.hardware.seed import render as seed_render
 from flann.hardware.seed.spec import derive_seed_spec
-from flann.production.demo import write_batch
 from flann.implement.synth import lint_vhdl
-from flann.recordings import prepare_for_fit, read_recordings
 from flann.verify.runner import simulator_name, throughput
 
 FLANN = [sys.executable, "-m", "flann.cli"]
@@ -32,49 +28,26 @@ def flann(*args, cwd=None):
 
 
 @pytest.fixture(scope="module")
-def designs(tmp_path_factory):
-    """Small designs (5 terms, 8-bit input) of every datapath flann gen writes."""
-    d = tmp_path_factory.mktemp("designs")
-    recs = write_batch(d / "rec", 2, seed=11, points=400)
-    rec = prepare_for_fit(read_recordings(recs[0]))
-    model = d / "m5.json"
-    model.write_text(fit_lstsq(rec.voltage_v, rec.displacement_mm, 5, norm="half").to_json())
-    for args in ((model, "-o", d / "fixed"), (model, "-o", d / "float18", "--format", "float18"),
-                 ("--family", *recs, "--terms", 5, "-o", d / "family")):
-        r = flann("gen", *args, "--input-bits", BITS)
-        assert r.returncode == 0, r.stderr
-    # a two-input model of a closed-form sensor whose gain, null and roll-off move with temperature
-    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
-    u, k = x / 8.0, 2.5 * (1 + 1e-4 * (t - 25))
-    v = 1.5 * (1 - 2.5e-4 * (t - 25)) * u / (1 + np.abs(u) ** k) ** (1 / k) + 6e-6 * (t - 25)
-    thermal = d / "m_thermal.json"
-    thermal.write_text(fit_thermal(v, t, x, (5, 3), norm="range").to_json())
+def designs(small_designs, thermal_sensor):
+    """Small designs (4-5 terms, 8-bit input) of every datapath flann gen writes
+    (``small_designs``), the seed architecture, a design flann did not write, and held-out
+    recordings of the two-input sensor."""
+    d = small_designs["dir"]
     # its held-out recording (between and beside the calibration temperatures), for flann eval
     xh, th = np.tile(np.linspace(-9.5, 9.5, 39), 2), np.repeat([10.0, 65.0], 39)
-    uh, kh = xh / 8.0, 2.5 * (1 + 1e-4 * (th - 25))
-    vh = 1.5 * (1 - 2.5e-4 * (th - 25)) * uh / (1 + np.abs(uh) ** kh) ** (1 / kh) + 6e-6 * (th - 25)
     held = d / "held_thermal.csv"
     held.write_text("displacement_mm,voltage_v,temperature_c\n"
-                    + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, vh, th)))
-    r = flann("gen", thermal, "-o", d / "thermal", "--input-bits", BITS, "--temp-bits", 5, "--temp-lsb-c", 6)
-    assert r.returncode == 0, r.stderr
-    # a family with temperature: that sensor and one 4 % more sensitive, recorded at the same temperatures
-    # (4 terms, 4-bit temperature code: 10 calibrated codes)
-    members = []
-    for k, gain in enumerate((1.0, 1.04)):
-        members.append(d / f"ft_{k}.csv")
-        members[-1].write_text("displacement_mm,voltage_v,temperature_c\n"
-                               + "".join(f"{a:.12g},{gain * b:.12g},{c:g}\n" for a, b, c in zip(x, v, t)))
-    r = flann("gen", "--family", *members, "--terms", 4, "-o", d / "family_thermal", "--input-bits", BITS,
-              "--temp-bits", 4, "--temp-lsb-c", 12)
-    assert r.returncode == 0, r.stderr
+                    + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, thermal_sensor(xh, th), th)))
     # the seed architecture is written by flann explore only (for comparison)
-    seed_render.write(derive_seed_spec(model, input_bits=int(BITS)), d / "seed")
+    if not (d / "seed").exists():
+        seed_render.write(derive_seed_spec(small_designs["model"], input_bits=int(BITS)), d / "seed")
     # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
-    shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
-    return {"dir": d, "model": model, "rec": recs[0],
+    if not (d / "plain").exists():
+        shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
+    return {"dir": d, "model": small_designs["model"], "rec": small_designs["rec"],
             # the family's initial image is its first member, the sensor the held-out recording is of
-            "eval": {"thermal": (thermal, held), "family_thermal": (d / "family_thermal" / "init_model.json", held)}}
+            "eval": {"thermal": (small_designs["thermal"], held),
+                     "family_thermal": (d / "family_thermal" / "init_model.json", held)}}
 
 
 def one_line_refusal(r) -> None:

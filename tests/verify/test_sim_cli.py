@@ -12,11 +12,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from flann.cli import main
-from flann.golden.thermal_train import fit_thermal
-from flann.golden.train import fit_lstsq
 from flann.hardware.registry import DATAPATHS
-from flann.production.demo import write_batch
-from flann.recordings import prepare_for_fit, read_recordings
 
 pytestmark = [pytest.mark.sim, pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
 
@@ -24,35 +20,10 @@ BITS = 8
 SIMULATED = ["fixed", "float18", "family", "thermal", "family_thermal"]
 
 
-def _thermal_sensor(x, t, gain=1.0):
-    """A closed-form sensor whose gain, null and roll-off move with temperature (volts)."""
-    u, k = x / 8.0, 2.5 * (1 + 1e-4 * (t - 25))
-    return gain * (1.5 * (1 - 2.5e-4 * (t - 25)) * u / (1 + np.abs(u) ** k) ** (1 / k) + 6e-6 * (t - 25))
-
-
 @pytest.fixture(scope="module")
-def designs(tmp_path_factory):
+def designs(small_designs):
     """Small designs (4-5 terms, 8-bit input) of every datapath flann sim runs."""
-    d = tmp_path_factory.mktemp("sim_designs")
-    recs = write_batch(d / "rec", 2, seed=11, points=400)
-    rec = prepare_for_fit(read_recordings(recs[0]))
-    model = d / "m5.json"
-    model.write_text(fit_lstsq(rec.voltage_v, rec.displacement_mm, 5, norm="half").to_json())
-    x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
-    thermal = d / "m_thermal.json"
-    thermal.write_text(fit_thermal(_thermal_sensor(x, t), t, x, (5, 3), norm="range").to_json())
-    members = []
-    for k, gain in enumerate((1.0, 1.04)):  # the second sensor 4 % more sensitive
-        members.append(d / f"ft_{k}.csv")
-        members[-1].write_text("displacement_mm,voltage_v,temperature_c\n" + "".join(
-            f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(x, _thermal_sensor(x, t, gain), t)))
-    for args in ((model, "-o", d / "fixed"), (model, "-o", d / "float18", "--format", "float18"),
-                 ("--family", *recs, "--terms", 5, "-o", d / "family"),
-                 (thermal, "-o", d / "thermal", "--temp-bits", 5, "--temp-lsb-c", 6),
-                 ("--family", *members, "--terms", 4, "-o", d / "family_thermal", "--temp-bits", 4,
-                  "--temp-lsb-c", 12)):
-        assert main(["gen", *map(str, args), "--input-bits", str(BITS)]) == 0
-    return {"dir": d, "model": model}
+    return small_designs
 
 
 @pytest.fixture
