@@ -274,3 +274,19 @@ def test_unplaced_warning_only_for_a_written_ucf(family14, tmp_path, capsys):
     assert rc == 2
     assert len(err.splitlines()) == 1 and err.startswith("error: ")
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+@pytest.mark.parametrize("port", ["in std_logic_vector(7 downto 0)", {"direction": "inout", "width": 8},
+                                  {"direction": "in", "width": -1}, {"direction": "in", "width": True},
+                                  {"direction": "in"}])
+def test_extra_ports_are_read_as_data(family14, tmp_path, cli, port):
+    """The manifest lists a datapath's extra ports as direction and width (what flann gen
+    writes); anything else is refused in one line, nothing written."""
+    man = json.loads((family14 / "manifest.json").read_text())
+    assert man["cfg_port"]["ports"]["cfg_we"] == {"direction": "in", "width": 0}
+    assert man["cfg_port"]["ports"]["cfg_data"]["width"] == _entity_ports(family14)["cfg_data"]
+    man["cfg_port"]["ports"]["cfg_addr"] = port
+    (family14 / "manifest.json").write_text(json.dumps(man))
+    rc, _out, err = cli(["ise", family14, "-o", tmp_path / "ise"])
+    assert rc == 2 and err.startswith("error: manifest.json: cfg_port.ports.cfg_addr") and len(err.splitlines()) == 1
+    assert not (tmp_path / "ise").exists()

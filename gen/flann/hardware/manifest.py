@@ -19,6 +19,12 @@ from ..inputs import parse_json, read_text
 MANIFEST = "manifest.json"
 
 
+def flat_port(direction: str, width: int = 0) -> dict:
+    """A port a datapath adds to the common interface, as its manifest lists it under
+    ``cfg_port.ports``: ``direction`` "in" or "out", ``width`` bits (0: a std_logic)."""
+    return {"direction": direction, "width": int(width)}
+
+
 class Manifest(dict):
     """manifest.json as a dict, plus where it was read: ``directory``, ``top`` and ``files``
     (paths of the VHDL files in compile order)."""

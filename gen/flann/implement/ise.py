@@ -57,6 +57,9 @@ OUTPUT_PINS = (
 PIN_MAP_DEVICES = ("xc2s50", "xc2s100", "xc2s150", "xc2s200")  # 140 user I/O in PQ208
 
 
+MAX_PORT_BITS = 1024     # wider than any flat port a top level of this project has
+
+
 @dataclass(frozen=True)
 class Port:
     name: str
@@ -82,19 +85,25 @@ def top_ports(manifest: dict) -> list[Port]:
     ] + _extra_ports(manifest)
 
 
-_DECL_RE = re.compile(r"^(in|out)\s+std_logic(?:_vector\s*\(\s*(\d+)\s+downto\s+0\s*\))?$", re.I)
-
-
 def _extra_ports(manifest: dict) -> list[Port]:
-    """Ports a datapath adds to the common interface (a family design's cfg_* write port),
-    as its manifest declares them under ``cfg_port.ports``."""
+    """Ports a datapath adds to the common interface (a family design's cfg_* write port,
+    a two-input design's in_temp), as its manifest lists them under ``cfg_port.ports``
+    (:func:`flann.hardware.manifest.flat_port`)."""
     decl = (manifest.get("cfg_port") or {}).get("ports") or {}
+    if not isinstance(decl, dict):
+        raise FlannError("manifest.json: cfg_port.ports must map each port's name to its direction and width")
     out = []
-    for name, text in decl.items():
-        m = _DECL_RE.match(str(text).strip())
-        if not m:
-            raise FlannError(f"manifest.json: cfg_port.ports.{name} = {text!r} is not a flat std_logic port")
-        out.append(Port(name, m.group(1).lower(), int(m.group(2)) + 1 if m.group(2) else 0))
+    for name, port in decl.items():
+        try:
+            direction, width = port["direction"], port["width"]
+            ok = (direction in ("in", "out") and isinstance(width, int) and not isinstance(width, bool)
+                  and 0 <= width <= MAX_PORT_BITS)
+        except (KeyError, TypeError):
+            ok = False
+        if not ok:
+            raise FlannError(f"manifest.json: cfg_port.ports.{name} = {port!r} is not a flat port "
+                             f"(direction in/out, width 0..{MAX_PORT_BITS} bits)")
+        out.append(Port(name, direction, width))
     return out
 
 

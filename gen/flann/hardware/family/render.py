@@ -18,7 +18,7 @@ from ...golden.model import FlannModel, load_model
 from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..header import header
-from ..manifest import write_design
+from ..manifest import flat_port, write_design
 from ..fixed import render as fixed
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image, family_from_dict, member_spec
 from .twin import FlannFamilyMem
@@ -123,8 +123,8 @@ def manifest(fam: FamilySpec, files: list[str]) -> dict:
     man.update(top=TOP, datapath=DATAPATH, model=INIT_MODEL, latency_cycles=fam.latency_cycles,
                cycles_per_sample=fam.cycles_per_sample, family=fam.to_dict(), init_model=INIT_MODEL)
     man["cfg_port"] = {
-        "ports": {"cfg_we": "in std_logic", "cfg_addr": f"in std_logic_vector({fam.addr_bits - 1} downto 0)",
-                  "cfg_data": f"in std_logic_vector({DATA_BITS - 1} downto 0)"},
+        "ports": {"cfg_we": flat_port("in"), "cfg_addr": flat_port("in", fam.addr_bits),
+                  "cfg_data": flat_port("in", DATA_BITS)},
         "timing": "cfg_data is written at cfg_addr on every rising clk edge with cfg_we = 1 (one word per "
                   "cycle, back to back allowed)",
         "in_flight": "a write cancels the sample in flight (no out_valid for it); in_ready is 0 while "

@@ -20,7 +20,7 @@ from ...textgen import template
 from ..family import render as family_render
 from ..family.spec import DATA_BITS
 from ..header import header
-from ..manifest import write_design
+from ..manifest import flat_port, write_design
 from .spec import FamilyThermalSpec, check_member
 from .twin import encode_image
 
@@ -98,9 +98,8 @@ def manifest(spec: FamilyThermalSpec, files: list[str], sha: str) -> dict:
         "generator_version": s.fam.spec.generator_version,
         "spec": s.to_dict(), "family": s.fam.to_dict(), "analysis": dict(s.analysis),
         "cfg_port": {
-            "ports": {"in_temp": f"in std_logic_vector({s.temp_bits - 1} downto 0)", "cfg_we": "in std_logic",
-                      "cfg_addr": f"in std_logic_vector({s.cfg_addr_bits - 1} downto 0)",
-                      "cfg_data": f"in std_logic_vector({DATA_BITS - 1} downto 0)"},
+            "ports": {"in_temp": flat_port("in", s.temp_bits), "cfg_we": flat_port("in"),
+                      "cfg_addr": flat_port("in", s.cfg_addr_bits), "cfg_data": flat_port("in", DATA_BITS)},
             "timing": "cfg_data is written at cfg_addr on every rising clk edge with cfg_we = 1; cfg_addr's top "
                       f"{s.sel_bits} bit(s) name the temperature order's memory, the low {s.fam.addr_bits} the word",
             "image": f"a sensor's image is {s.image_words} words: order j's memory at j x {s.fam.mem_depth}",

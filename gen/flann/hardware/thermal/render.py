@@ -23,7 +23,7 @@ from ..adc import default_input_lsb
 from ..datapath import rebuild_matching
 from ..fixed import render as fixed_render
 from ..header import header
-from ..manifest import write_design
+from ..manifest import flat_port, write_design
 from ..options import GenOptions
 from .spec import ThermalSpec, derive_thermal_spec, top_widths
 
@@ -98,7 +98,7 @@ def manifest(spec: ThermalSpec, files: list[str], sha: str) -> dict:
         "analysis": dict(spec.analysis),
         "model_sha256": sha,
         # the port beyond the common interface, as the ISE pin map reads a datapath's extra ports
-        "cfg_port": {"ports": {"in_temp": f"in std_logic_vector({spec.temp_bits - 1} downto 0)"}},
+        "cfg_port": {"ports": {"in_temp": flat_port("in", spec.temp_bits)}},
     }
 
 
