@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flann.errors import RecordingsError
-from flann.recordings import parse_recordings, read_recordings
+from flann.recordings import estimate_noise_v, parse_recordings, read_recordings
 
 
 def test_paper_table_reads_with_provenance():
@@ -234,3 +234,17 @@ def test_trailing_separator_is_not_an_unknown_column():
         warnings.simplefilter("error")
         rec = parse_recordings("displacement_mm,voltage_v,\n0,0,\n1,0.5,\n2,1,\n")
     np.testing.assert_allclose(rec.voltage_v, [0.0, 0.5, 1.0])
+
+
+def test_noise_estimate_of_either_difference_order():
+    """White noise of 2 mV on a straight line: both orders find it; on a curve sampled coarsely
+    (an S-curve at 0.5 mm steps) the second difference carries the curvature, the third not."""
+    rng = np.random.default_rng(3)
+    x = np.arange(-30.0, 30.01, 0.5)
+    noise = rng.normal(0.0, 0.002, x.size)
+    line = 0.1 * x + noise
+    for order in (2, 3):
+        assert abs(estimate_noise_v(line, order=order) / 0.002 - 1) < 0.2
+    curve = 5.6 * np.tanh(x / 6.0) + noise
+    assert abs(estimate_noise_v(curve, order=3) / 0.002 - 1) < 0.25
+    assert estimate_noise_v(curve, order=2) > 1.3 * estimate_noise_v(curve, order=3)

@@ -22,13 +22,16 @@ import numpy as np
 
 from ..diagnose.data import find_passes
 from ..golden.metrics import full_scale_of_span
-from ..recordings.checks import MIN_REPEAT_PAIRS, repeat_noise_v
+from ..recordings.checks import MIN_REPEAT_PAIRS, estimate_noise_v, repeat_noise_v
 from .spec import ProductionSpec
 
 PASS, FAIL = "PASS", "FAIL"
 COVERAGE = 2.0
 # the working range must lie inside the recorded displacements to within this (mm)
 RANGE_SLACK_MM = 1e-6
+# third differences: they cancel the curve's slope and curvature, which at an LVDT's coarse
+# steps (0.5 mm) put as much into a second difference as 2 mV of noise
+NOISE_ORDER = 3
 UNCERTAINTY_METHOD = (
     "U = 2 u (k = 2, about 95 %); u^2 = sigma_x^2 (1 + p/N) + q^2/12 with sigma_x the "
     "recording's noise per reading (median absolute third difference along each pass of "
@@ -63,15 +66,6 @@ class Verdict:
         return self.verdict == PASS
 
 
-def _third_difference_noise(v: np.ndarray) -> float:
-    """Noise (V, 1 sigma) of readings in displacement order: median |third difference| /
-    (0.6745 sqrt 20).  The third difference cancels the curve's slope and curvature, which at
-    coarse steps (an LVDT at 0.5 mm) put as much into a second difference as 2 mV of noise."""
-    if v.size < 4:
-        return 0.0
-    return float(np.median(np.abs(np.diff(v, 3))) / (0.6745 * math.sqrt(20.0)))
-
-
 def _passes(x: np.ndarray, direction) -> list[np.ndarray]:
     """Row indices of each monotone pass of the actuator, in row order, one reading per
     position (the first of a dwell: a repeat at one position would put a step of the curve
@@ -101,14 +95,15 @@ def noise_v(rec) -> float:
     v = np.asarray(rec.voltage_v, dtype=float)
     x = np.asarray(rec.displacement_mm, dtype=float)
     d = None if rec.direction is None else np.asarray(rec.direction, dtype=float)
-    est = [_third_difference_noise(v[p]) for p in _passes(x, d)]
+    est = [estimate_noise_v(v[p], order=NOISE_ORDER) for p in _passes(x, d)]
     if est:
         return float(np.median(est))
     sigma, pairs = repeat_noise_v(x, v, d)
     if pairs >= MIN_REPEAT_PAIRS:
         return sigma
     groups = [np.flatnonzero(d == s) for s in (1.0, -1.0)] if d is not None else [np.arange(v.size)]
-    est = [_third_difference_noise(v[g][np.argsort(x[g], kind="stable")]) for g in groups if g.size >= 4]
+    est = [estimate_noise_v(v[g][np.argsort(x[g], kind="stable")], order=NOISE_ORDER)
+           for g in groups if g.size >= 4]
     return float(np.median(est)) if est else 0.0
 
 
