@@ -26,7 +26,7 @@ from .metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, ful
                       linearity_pct, raw_line, raw_linearity_pct)
 from .model import FlannModel
 from ..recordings import Recordings
-from .inverse import fit_default, forward_curve
+from .inverse import fit_default
 from .train import design_matrix, fit_lms, fit_lstsq, lms_epochs, lms_leave_one_out
 
 # The paper's Table 1 (also in data/paper_table1.csv, checked equal by the tests).
@@ -158,19 +158,21 @@ class DefaultFit:
 
 def default_fit(rec: Recordings, cost) -> DefaultFit:
     """The model ``flann train --terms auto`` writes for ``rec`` (:func:`fit_default`), with
-    the leave-one-out error of what chose it: the forward curve's at the interior positions
-    (the FLANN follows that curve within its teacher tolerance), or the direct fit's."""
+    the held-out error of what chose it, as its training record states it: the forward
+    curve's (the FLANN follows that curve within its teacher tolerance) at the interior
+    positions left out in turn, or over the direct fit's folds; else the direct fit's LOO."""
     x, v = rec.displacement_mm, rec.voltage_v
     model, choice, from_curve = fit_default(x, v, cost)
     t = model.training
     if from_curve:
         label = (f"{model.terms} terms, normalisation {t['normalisation']}, ridge {t['ridge']:g}, "
                  "fitted to the forward curve's inverse")
-        fw = forward_curve(x, v)
-        loo = getattr(fw, "left_out_mm", None)
-        loo_text = ("its forward curve's LOO max "
-                    f"{np.max(np.abs(loo)):.3g} mm (interior positions)" if loo is not None and loo.size
-                    else "its forward curve's held-out error: " + str(t.get("forward_model", {}).get("heldout")))
+        heldout = t["forward_model"].get("heldout")
+        loo_text = (f"its forward curve's LOO max {t['cv_heldout_max_error_mm']:.3g} mm (interior positions)"
+                    if "leave_one_out" in t else
+                    f"its forward curve's held-out max {heldout['max_error_mm']:.3g} mm "
+                    f"({heldout['folds']} folds of positions)" if heldout else
+                    "its forward curve (no held-out figure: a fold left no monotone curve)")
     else:
         label = f"{choice.terms} terms, normalisation {choice.norm}, ridge {choice.ridge:g}, the direct fit x(v)"
         loo = lstsq_loo_errors(rec, choice.terms, choice.norm, choice.ridge)
