@@ -80,12 +80,12 @@ def checked(parse_value):
     return parse
 
 
-__all__ = ["bounded", "checked", "finite_float", "terms_or_auto"]
-
-
 def png_path(text: str) -> str:
     """An argparse ``type`` for ``--plot``: figures are written as PNG, so the name says so
     (a figure in ``out.txt`` would be found by nobody)."""
     if not text.lower().endswith(".png"):
         raise argparse.ArgumentTypeError(f"{text}: the figure is written as PNG, name it *.png")
     return text
+
+
+__all__ = ["bounded", "checked", "finite_float", "png_path", "terms_or_auto"]

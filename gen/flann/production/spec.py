@@ -11,7 +11,8 @@ A spec file (every key optional except one tolerance)::
     fail_on_effects = ["adc_clipping", "backlash"]   # the diagnosis must not name these
 
 Full scale (FS) is half the span of the working range, or of the recording's displacement when
-no range is stated: a +-10 mm stroke has a 10 mm FS, as in ``flann eval``.  Flags override the file's values one by one.
+no range is stated: a +-10 mm stroke has a 10 mm FS, as in ``flann eval``.  Flags override the
+file's values one by one.
 """
 
 from __future__ import annotations

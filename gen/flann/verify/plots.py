@@ -31,12 +31,12 @@ def curve(panels: list[dict], *, ref: str, simulator: str, unit_mm: bool = False
     ``diff``: panel (b)'s series ({"label", "codes", "diff", optional "ls"}), default HDL - reference of every
     series (labelled ``diff_label``, else the series' own label, else "HDL - reference");
     ``bound``: {"value", "label"} in the same unit, drawn at +-value."""
+    word = "golden" if ref == GOLDEN else "twin"   # the difference panel's short name of the reference
     if diff is None:
-        word = "golden" if ref == GOLDEN else "twin"
         diff = [{"label": diff_label or s["label"] or f"HDL - {word}", "codes": s["codes"],
                  "diff": s["hdl"] - s["ref"]} for p in panels for s in p["series"]]
-    return {"panels": panels, "ref": ref, "simulator": simulator, "unit_mm": unit_mm, "bound": bound,
-            "diff": diff}
+    return {"panels": panels, "ref": ref, "ref_word": word, "simulator": simulator, "unit_mm": unit_mm,
+            "bound": bound, "diff": diff}
 
 
 def shown_temperature_codes(temps, n: int = SHOWN_TEMPS) -> list[int]:
@@ -125,9 +125,8 @@ def plot(c: dict, man: dict, path) -> None:
         ax.plot([0, 1, np.nan, 0, 1], [b, b, np.nan, -b, -b], transform=ax.get_yaxis_transform(),
                 ls=":", color="k", label=c["bound"]["label"])
     ax.legend(loc="best", fontsize=7)
-    ref_word = "golden" if c["ref"] == GOLDEN else "twin"
     unit = "mm" if c["unit_mm"] else "output LSB"
-    ax.set_ylabel(f"HDL - {ref_word} ({unit})")
+    ax.set_ylabel(f"HDL - {c['ref_word']} ({unit})")
     ax.set_xlabel("input (V)")
     title = f"({chr(ord('a') + len(panels))}) difference"
     if not c["unit_mm"]:
