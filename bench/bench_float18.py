@@ -5,7 +5,7 @@
 Generates both designs for MODEL (default data/default_model.json) with the generators'
 default options, measures each with the `flann synth` flow (GHDL synthesis + Yosys
 synth_xilinx -family xcv), also each float18 block alone, and takes the accuracy from
-`flann trace` over every input code (the float18 row is `flann.implement.explore_float18.measure`).
+`flann trace` over every input code (the float18 row is `flann.analysis.explore_float18.measure`).
 Prints a table; takes ~3 min on 2 busy cores.
 """
 

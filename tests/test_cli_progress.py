@@ -1,7 +1,7 @@
 """Progress lines go to a terminal only: a log or a pipe gets the result and nothing else."""
 
 from flann.cli import main
-from flann.implement import explore
+from flann.analysis import explore
 
 
 def test_explore_keeps_progress_out_of_a_log(monkeypatch, capsys, default_model_json):

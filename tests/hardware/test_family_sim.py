@@ -12,7 +12,7 @@ from flann.hardware.family.build import generate_family
 from flann.hardware.family.render import load_design
 from flann.production.calibrate import check_sensor
 from flann.production.demo import write_batch
-from flann.production.images import hex_text
+from flann.hardware.family.images import hex_text
 from flann.recordings import read_recordings
 from flann.verify import runner
 

@@ -15,7 +15,7 @@ from flann.golden.family import FAMILY_SHARE, REACH_FACTOR
 from flann.hardware.family_thermal.build import fit_sensor
 from flann.hardware.family_thermal.spec import inner_bits, temp_norm
 from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
-from flann.production.images import parse_hex
+from flann.hardware.family.images import parse_hex
 from flann.production.thermal import temperature_codes
 from flann.recordings import Recordings, read_recordings, write_recordings
 from flann.verify.design import from_directory

@@ -219,7 +219,7 @@ def test_bad_options_are_one_line(design, tmp_path, args, word):
 
 def test_synth_reads_a_two_level_hierarchy_stat():
     """Yosys 0.23 writes hierarchy text lines into `stat -json` for a top of tops."""
-    from flann.implement.synth import _stat_json
+    from flann.eda import _stat_json
 
     text = ('{\n   "modules": {\n   },\n       flann_t0_adder                1\n       flann_t1_seq   1\n'
             '      "design": {\n         "num_cells_by_type": {\n            "LUT4": 12\n         }\n      }\n}\n')

@@ -33,7 +33,8 @@ def test_docs_name_the_generated_device(tmp_path):
 
 
 def test_default_design_passes_vsg(tmp_path):
-    from flann.implement.synth import lint_vhdl, read_manifest
+    from flann.hardware.manifest import read_manifest
+    from flann.implement.synth import lint_vhdl
 
     man = read_manifest(_default_design(tmp_path))
     assert lint_vhdl(man.files, ROOT / "vsg.yaml") == []

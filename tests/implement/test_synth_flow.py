@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from flann.cli import main
-from flann.implement.synth import SynthCheckError, yosys_cells
+from flann.eda import SynthCheckError, yosys_cells
 
 FIX = Path(__file__).parent / "fixtures" / "synth"
 ISSUE_KEYS = {"device", "luts", "ffs", "brams", "lut_pct", "ff_pct", "bram_pct", "fits", "smallest_device"}
@@ -110,7 +110,7 @@ def test_fast_abc_keeps_the_hand_counts(capsys):
 
 
 def test_pmux_case_blocks_get_a_default():
-    from flann.implement.synth import complete_pmux_cases
+    from flann.eda import complete_pmux_cases
 
     ghdl_style = (
         "  always @*\n"
@@ -126,7 +126,7 @@ def test_pmux_case_blocks_get_a_default():
 
 
 def test_ghdl_crash_is_reported_as_such():
-    from flann.implement.synth import _ghdl_errors
+    from flann.eda import _ghdl_errors
 
     stderr = (
         'x.vhd:10:5:note: found ROM "n1", width: 19 bits, depth: 512\n'
@@ -141,7 +141,7 @@ def test_ghdl_crash_is_reported_as_such():
 # -- the RTL / Verilog-netlist disagreement (GHDL 2.0's Verilog writer) -----------------------
 def test_repair_ghdl_verilog_on_the_writers_two_errata():
     """Text as GHDL 2.0 prints it: a 36-bit constant as a string, an arithmetic shift as >>."""
-    from flann.implement.synth import repair_ghdl_verilog
+    from flann.eda import repair_ghdl_verilog
 
     ghdl = ('  assign n120_o = n115_o + "000000000001000111001010110000010101";\n'
             "  assign n579_o = $signed(n577_o) >> 31'b0000000000000000000000000001010;\n"
@@ -198,7 +198,8 @@ def test_ghdl_verilog_of_the_default_design_agrees_with_the_twin(tmp_path):
     repaired Verilog, the one Yosys maps, agrees with the twin."""
     from flann.hardware.fixed.render import load
     from flann.hardware.fixed.twin import FlannTop
-    from flann.implement.synth import complete_pmux_cases, ghdl_to_verilog, read_manifest, repair_ghdl_verilog
+    from flann.eda import complete_pmux_cases, ghdl_to_verilog, repair_ghdl_verilog
+    from flann.hardware.manifest import read_manifest
 
     repo = Path(__file__).resolve().parents[2]
     work = tmp_path / "w"
@@ -220,7 +221,7 @@ def test_ghdl_verilog_of_the_default_design_agrees_with_the_twin(tmp_path):
 @pytest.mark.skipif(shutil.which("verilator") is None, reason="needs verilator (scripts/ensure_tools.sh)")
 def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, monkeypatch):
     """Without the Verilog repair (GHDL's text as printed) the mapped netlist is wrong: refused."""
-    from flann.implement import synth
+    from flann import eda
 
     repo = Path(__file__).resolve().parents[2]
     model = tmp_path / "m.json"
@@ -228,7 +229,7 @@ def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, 
                  "-o", str(model)]) == 0
     assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "8"]) == 0
     capsys.readouterr()
-    monkeypatch.setattr(synth, "repair_ghdl_verilog", lambda text: (text, 0, 0))
+    monkeypatch.setattr(eda, "repair_ghdl_verilog", lambda text: (text, 0, 0))
     rc, out, err = _run(capsys, tmp_path / "d", "--model", model, "--no-lint", "--abc", "fast", "--json")
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and "disagrees with its twin" in err

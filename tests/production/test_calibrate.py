@@ -13,7 +13,7 @@ from flann.golden.model import load_model
 from flann.hardware.family.render import load_design
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.production.demo import bad_files, write_batch
-from flann.production.images import parse_hex
+from flann.hardware.family.images import parse_hex
 from flann.recordings import read_recordings
 
 

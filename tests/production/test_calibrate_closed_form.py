@@ -12,7 +12,7 @@ import pytest
 from flann.cli import main
 from flann.hardware.family.render import load_design
 from flann.hardware.family.twin import FlannFamilyTop
-from flann.production.images import parse_hex
+from flann.hardware.family.images import parse_hex
 from flann.recordings import Recordings, write_recordings
 
 SPAN_MM, W_MM, SHARP = 10.0, 7.0, 2.5

@@ -17,7 +17,7 @@ import pytest
 from flann.cli import main
 from flann.golden.thermal_metrics import drift_ppm_fs_per_c
 from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
-from flann.production.images import parse_hex
+from flann.hardware.family.images import parse_hex
 from flann.recordings import Recordings, write_recordings
 from flann.verify.design import from_directory
 

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from flann.implement.synth import complete_pmux_cases, ghdl_to_verilog, read_manifest
+from flann.eda import complete_pmux_cases, ghdl_to_verilog
+from flann.hardware.manifest import read_manifest
 from flann.verify.design import from_model
 from flann.verify.netlist import check_netlist
 

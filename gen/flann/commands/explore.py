@@ -8,7 +8,8 @@ from pathlib import Path
 
 from ..argtypes import bounded, checked
 from ..golden.model import MAX_TERMS
-from ..implement import explore, synth
+from ..eda import ABC_MODES
+from ..analysis import explore
 from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
 from ..hardware.fixed.spec import check_mult_style, max_lanes
@@ -52,7 +53,7 @@ def add_arguments(p):
     p.add_argument("--seed-only", action="store_true", help="only the seed architecture rows")
     p.add_argument("--float18", action="store_true",
                    help="add the float18 rows: the serial float18 design and the seed's arithmetic in float18")
-    p.add_argument("--abc", choices=synth.ABC_MODES, default="fast",
+    p.add_argument("--abc", choices=ABC_MODES, default="fast",
                    help="yosys LUT mapping (default fast: abc -fast; full = synth_xilinx as is, slow)")
     p.add_argument("--input-bits", type=bounded(int, *ADC_BITS), default=None, metavar="B",
                    help="ADC width in bits, as for flann gen (default: flann gen's)")

@@ -8,8 +8,10 @@ import sys
 import tempfile
 from pathlib import Path
 
+from ..eda import ABC_MODES, NETLIST
 from ..errors import FlannError
 from ..implement import ice40, synth, timing
+from ..hardware.manifest import read_manifest
 from ..hardware.registry import read_design
 from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
@@ -39,7 +41,7 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
-    p.add_argument("--abc", choices=synth.ABC_MODES, default="full",
+    p.add_argument("--abc", choices=ABC_MODES, default="full",
                    help="LUT mapping: full = synth_xilinx as is (default); fast = abc -fast (large designs)")
     p.add_argument("--work", metavar="DIR", help="keep GHDL/Yosys intermediate files (netlist, yosys.log) here")
     p.add_argument("--model", metavar="MODEL.json", default=None,
@@ -87,7 +89,7 @@ def post_route_check(directory, model):
 def run_ice40(args) -> int:
     parse_ice40(args.device)  # refuse a bad part before any slow step
     if not args.no_lint:
-        synth.check_lint(synth.read_manifest(args.directory).files, args.vsg_config, start=args.directory)
+        synth.check_lint(read_manifest(args.directory).files, args.vsg_config, start=args.directory)
     check = post_route_check(args.directory, args.model) if args.post_route else None
     with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
         report = ice40.implement(args.directory, args.device, args.output, work=Path(args.work or tmp),
@@ -114,13 +116,13 @@ def run(args) -> int:
         raise FlannError(f"--work {args.work}: exists and is not a directory")
     read_design(args.directory)  # a tampered manifest is refused before any slow step
     if not args.no_lint:
-        man = synth.read_manifest(args.directory)
+        man = read_manifest(args.directory)
         synth.check_lint(man.files, args.vsg_config, start=args.directory)
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
         work = Path(args.work) if args.work else Path(tmp)
         report = synth.synthesize(args.directory, args.device, work=work, progress=not args.json, abc=args.abc)
         check, why = ((None, "--no-netlist-check") if args.no_netlist_check
-                      else _check_netlist(args, work / synth.NETLIST))
+                      else _check_netlist(args, work / NETLIST))
         report = dataclasses.replace(report, netlist_check=check, netlist_not_run=why)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))

@@ -141,7 +141,7 @@ class Datapath:
     model_field: str = "model"         # manifest field naming the model file in the directory
     bench: str | None = None           # verification bench (flann.verify.design.BENCHES)
     stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
-    explore: str | None = None         # design space of flann explore (flann.implement.explore.EXPLORERS)
+    explore: str | None = None         # design space of flann explore (flann.analysis.explore.EXPLORERS)
     eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design
     why_no_eval: str = ""
     why_no_explore: str = ""           # why flann explore refuses it (no ``explore``)

@@ -1,6 +1,6 @@
 """iCE40: real place and route, static timing and a bitstream with the open-source flow.
 
-Flow: ``DIR/manifest.json`` → GHDL synthesis (:func:`flann.implement.synth.ghdl_to_verilog`,
+Flow: ``DIR/manifest.json`` → GHDL synthesis (:func:`flann.eda.ghdl_to_verilog`,
 the same repaired Verilog the Spartan-II flow maps) → Yosys ``synth_ice40`` → ``nextpnr-ice40``
 (placement, routing, static timing at the design's clock; ``--report`` JSON: Fmax and
 utilisation) → ``icepack`` (the ``.bin`` bitstream).  The output directory holds the
@@ -24,11 +24,11 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..eda import ghdl_to_verilog, need_tool
 from ..errors import FlannError
 from ..fileio import atomic_directory, check_output_directory
 from ..hardware.manifest import read_manifest
 from ..hardware.target import CLOCK_HZ, Ice40Part, parse_ice40
-from . import synth
 
 SYNTH_JSON = "synth_ice40.json"
 ROUTED_JSON = "routed.json"
@@ -196,7 +196,7 @@ def _first_error(log: Path, fallback: str) -> str:
 
 def yosys_ice40(verilog: Path, top: str, work: Path) -> dict[str, int]:
     """Yosys ``synth_ice40``; writes the JSON netlist nextpnr reads; returns cells by type."""
-    yosys = synth._need_tool("yosys")
+    yosys = need_tool("yosys")
     script = (f"read_verilog {verilog.name}; synth_ice40 -top {top} -json {SYNTH_JSON}; "
               "tee -q -o stat_ice40.json stat -json")
     r = subprocess.run([yosys, "-q", "-l", "yosys_ice40.log", "-p", script], capture_output=True, text=True, cwd=work)
@@ -251,7 +251,7 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
         wdir = Path(work).resolve() if work is not None else Path(tmp)
         wdir.mkdir(parents=True, exist_ok=True)
         say(f"ghdl --synth --std=93c {man.top}")
-        verilog = synth.ghdl_to_verilog(man, wdir)
+        verilog = ghdl_to_verilog(man, wdir)
         say("yosys synth_ice40")
         cells = yosys_ice40(verilog, man.top, wdir)
         luts = cells.get("SB_LUT4", 0)

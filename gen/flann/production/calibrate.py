@@ -59,7 +59,7 @@ from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..physics.sensor import load_sensor
 from ..pool import run_batch
 from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
-from . import images
+from ..hardware.family import images
 from .certificate import render_certificate, render_certificate_thermal, render_rejection
 from .spec import ProductionSpec
 from .thermal import check_sensor_thermal

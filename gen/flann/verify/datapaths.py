@@ -16,7 +16,7 @@ from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
-from ..production.images import read_image
+from ..hardware.family.images import read_image
 from . import plots
 from .design import Design
 from .float18 import run_design

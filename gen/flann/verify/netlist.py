@@ -1,6 +1,6 @@
 """Post-synthesis simulation: the netlist Yosys maps to Spartan-II cells, checked against the twin.
 
-Flow: the design's VHDL -> ``ghdl --synth --out=verilog`` (with :func:`flann.implement.synth.
+Flow: the design's VHDL -> ``ghdl --synth --out=verilog`` (with :func:`flann.eda.
 repair_ghdl_verilog`) -> Yosys ``synth_xilinx -family xcv`` -> ``write_verilog`` (the netlist
 whose cells ``flann synth`` counts) -> Verilator, compiled with Yosys's own Xilinx cell models
 (``<yosys datdir>/xilinx/cells_sim.v``; block RAMs from ``benches/ramb4_sim.v``, which Yosys does
@@ -22,7 +22,8 @@ import numpy as np
 from ..errors import FlannError
 from ..hardware.fixed.datapath import DATAPATH as FIXED
 from ..hardware.fixed.twin import FlannTop
-from ..implement import synth
+from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
+from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR
 from .design import Design
 from .shards import cores, count_lines, merge, read_results, split
@@ -53,10 +54,10 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     """Synthesise ``design`` as ``flann synth`` does; returns the Yosys-mapped Verilog netlist."""
     work = Path(work).resolve()
     work.mkdir(parents=True, exist_ok=True)
-    man = synth.read_manifest(design.directory)
-    verilog = synth.ghdl_to_verilog(man, work)
-    synth.yosys_cells(verilog, man.top, work, abc)
-    return work / synth.NETLIST
+    man = read_manifest(design.directory)
+    verilog = ghdl_to_verilog(man, work)
+    yosys_cells(verilog, man.top, work, abc)
+    return work / NETLIST
 
 
 def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cells: bool = True,
@@ -147,7 +148,7 @@ def check_rtl_netlist(design: Design, build, progress=None) -> dict:
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     man = design.manifest
-    verilog = synth.ghdl_to_verilog(synth.read_manifest(design.directory), build / "ghdl_synth")
+    verilog = ghdl_to_verilog(read_manifest(design.directory), build / "ghdl_synth")
     exe = compile_netlist(verilog, build / "verilator", man["input_bits"], man["output_bits"], cells=False)
     t_build = time.monotonic() - t0
     lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1

@@ -12,7 +12,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
 
 from flann.hardware.family.render import load_design
 from flann.hardware.family.twin import FlannFamilyTop
-from flann.production.images import parse_hex
+from flann.hardware.family.images import parse_hex
 from flann.verify.benches.flann_bench import Scoreboard, TopDriver, TopMonitor, config, reset, rng, start_clock, write_record
 
 

@@ -17,10 +17,10 @@
 
 from __future__ import annotations
 
-from ..errors import FlannError
-from ..inputs import read_text
-from ..hardware.family.render import image_text
-from ..hardware.family.spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
+from ...errors import FlannError
+from ...inputs import read_text
+from .render import image_text
+from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
 MEM_DIGITS = HALF_BITS // 4

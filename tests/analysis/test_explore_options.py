@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from flann.cli import main
-from flann.implement import explore
+from flann.analysis import explore
 
 MODEL = Path(__file__).resolve().parents[2] / "data" / "default_model.json"
 

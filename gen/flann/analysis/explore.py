@@ -31,7 +31,7 @@ from ..hardware.seed.spec import derive_seed_spec
 from ..hardware.seed.twin import FlannSeedTop
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
 from .explore_float18 import measure
-from .synth import Resources, shortfall, smallest_fit, synthesize
+from ..implement.synth import Resources, shortfall, smallest_fit, synthesize
 
 
 # ----------------------------------------------------------------------------- design space

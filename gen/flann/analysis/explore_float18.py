@@ -15,8 +15,8 @@ from ..golden.model import load_model
 from ..hardware.float18.render import generate
 from ..hardware.registry import FLOAT18
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART
-from ..analysis.trace import run_trace
-from . import synth
+from ..implement import synth
+from .trace import run_trace
 
 
 def measure(model_path, device: str = DEFAULT_PART, abc: str = "full", **options) -> dict:

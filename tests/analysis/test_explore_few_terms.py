@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.implement import explore
+from flann.analysis import explore
 
 
 @pytest.fixture
