@@ -152,3 +152,27 @@ def test_summary_path_printed_once_joined(line, tmp_path, capsys):
     assert rc == 0
     printed = capsys.readouterr().out
     assert f"summary {out / 'summary.csv'}" in printed and "//" not in printed
+
+
+def test_too_few_positions_for_the_terms_are_rejected(line, tmp_path, capsys):
+    """Six positions for the design's terms calibrated to PASS at 0 mm (its error between the
+    positions was 21 mm): the error at the positions cannot be judged, so the sensor is
+    rejected, and its row carries no figures measured before the rejection."""
+    rows = read_recordings(line["rec"]["s1"])
+    x = rows.displacement_mm
+    keep = np.isin(x, np.unique(x)[::20])
+    sparse = tmp_path / "sparse.csv"
+    np.savetxt(sparse, np.column_stack([x[keep], rows.voltage_v[keep]]), delimiter=",",
+               header="displacement_mm,voltage_v", comments="")
+    out = tmp_path / "cal"
+    rc, got = _calibrate(line, out, sparse, line["rec"]["s2"], "--tolerance-mm", "0.5")
+    err = capsys.readouterr().err
+    terms = json.loads((line["design"] / "manifest.json").read_text())["spec"]["terms"]
+    row = {r["sensor"]: r for r in got}
+    assert rc != 0 and row["s2"]["verdict"] == "PASS"
+    assert row["sparse"]["verdict"] == "FAIL" and row["sparse"]["status"] == "failed"
+    assert f"{np.unique(x[keep]).size} positions for the design's {terms} terms" in row["sparse"]["reason"]
+    assert all(row["sparse"][k] == "" for k in ("max_error_mm", "ratio_to_limit", "limit_mm",
+                                                 "raw_max_error_mm", "twin_vs_float_lsb", "max_error_pct_fs"))
+    assert not (out / "sparse" / "weights.hex").exists() and (out / "sparse" / "certificate.html").is_file()
+    assert "sparse" in err and "Traceback" not in err

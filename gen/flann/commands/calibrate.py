@@ -30,7 +30,7 @@ def add_arguments(p) -> None:
                    default=None,
                    metavar="MM", help="FAIL a sensor whose hardware max error exceeds this (mm)")
     g.add_argument("--tolerance-pct-fs", type=bounded(float, 0, lo_open=True), default=None, metavar="PCT",
-                   help="the same in %% of full scale (the working range's span, else the recorded one)")
+                   help="the same in %% of full scale (half the span judged over: the working range, else the recorded stroke)")
     g.add_argument("--working-range", default=None, metavar="LO:HI",
                    help="judge the error over this displacement range (mm; default the whole stroke)")
     g.add_argument("--max-ratio-to-limit", type=bounded(float, 0, lo_open=True), default=None, metavar="R",

@@ -64,7 +64,7 @@ from .certificate import render_certificate, render_certificate_thermal, render_
 from .spec import ProductionSpec
 from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
-from .verdict import FAIL, PASS, Verdict, judge, rejected, uncertainty
+from .verdict import FAIL, PASS, Verdict, judge, rejected, require_positions, uncertainty
 
 RIDGES = (RIDGE, 1e-5, 1e-4, 1e-3)  # the family's own ridge first, then more until the weights fit
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
@@ -157,6 +157,7 @@ def train_for_design(rec, fam: FamilySpec):
 
 def check_sensor(rec, fam: FamilySpec) -> dict:
     """Train, quantise and check one sensor's recordings against the family design's twin."""
+    require_positions(rec.displacement_mm, fam.terms)
     model, spec = train_for_design(rec, fam)
     words = FlannFamilyMem.encode(fam, spec)
     twin = FlannFamilyTop(fam, words)
@@ -394,6 +395,9 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
     res.fail(reason)
     res.verdict = rejected(spec, res.reason)
     res.model_sha256 = ""
+    # figures measured before the rejection describe no calibration the row stands for
+    res.max_error_mm = res.limit_mm = res.ratio_to_limit = res.raw_max_error_mm = None
+    res.twin_vs_float_lsb = res.drift_ppm_fs_per_c = None
     try:
         res.trace = traceability(path, rec, station)
     except FlannError:

@@ -27,6 +27,8 @@ from ..hardware.family.spec import FitError
 from ..hardware.family_thermal.build import fit_sensor
 from ..hardware.family_thermal.spec import FamilyThermalSpec
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop, encode_image
+from .verdict import require_positions
+
 
 def train_for_design(rec, spec: FamilyThermalSpec, ridges):
     """(model, image words): the least of ``ridges`` whose every order fits the design's formats."""
@@ -43,6 +45,9 @@ def train_for_design(rec, spec: FamilyThermalSpec, ridges):
 def check_sensor_thermal(rec, spec: FamilyThermalSpec, ridges) -> dict:
     """Train (``ridges`` tried in order), quantise and check one sensor's multi-temperature
     recordings (see the module doc)."""
+    levels, labels = temperature_groups(rec.temperature_c)
+    for k, level in enumerate(levels):
+        require_positions(np.asarray(rec.displacement_mm)[labels == k], spec.fam.terms, f" at {level:g} °C")
     model, words = train_for_design(rec, spec, ridges)
     twin = FlannFamilyThermalTop(spec, words)
     levels, labels = temperature_groups(rec.temperature_c)
