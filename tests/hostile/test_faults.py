@@ -154,6 +154,11 @@ def test_ctrl_c_during_start_up_is_one_line(delay, tmp_path):
     time.sleep(delay)   # the start-up has no state to wait for: several instants are tried
     os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=60)
+    assert not (tmp_path / "m.json").exists()
+    if err.startswith("Fatal Python error: init_import_site"):
+        # the interrupt reached the interpreter while it imported its own site module, before
+        # the first line of flann or of the console script ran: nothing of ours to catch it
+        return
     assert "Traceback" not in err, err
     if p.returncode == -signal.SIGINT:   # before Python installed its handler: killed silently
         assert err == ""

@@ -136,3 +136,43 @@ def test_repeat_noise_on_a_converter_grid_is_not_zero():
     sigma, pairs = repeat_noise_v(x, v)
     assert pairs == 600
     assert 1.5e-3 < sigma < 3.5e-3    # noise (2 mV) and quantisation (1.4 mV) together: 2.4 mV
+
+
+def _arctan_sweeps(x, noise, seed=0):
+    """Two sweeps (forward and back) of an arctan sensor, one reading per position and direction."""
+    rng = np.random.default_rng(seed)
+    xs = np.concatenate([x, x[::-1]])
+    d = np.concatenate([np.ones(x.size), -np.ones(x.size)])
+    return xs, 5.0 * np.arctan(xs / 12.0) + rng.normal(0.0, noise, xs.size), d
+
+
+def test_one_glitch_is_not_a_fold_back():
+    """A single reading 0.3 V off (150 noise units) was refused as a fold-back inside the span;
+    it is the outlier screen's to find."""
+    xs, v, d = _arctan_sweeps(np.arange(-25.0, 25.05, 0.1).round(1), 0.002)
+    v[np.flatnonzero((xs == 5.0) & (d == 1))[0]] -= 0.3
+    span = monotonic_span(Recordings(xs, v, direction=d, source="glitch.csv"))
+    assert not span.foldback
+
+
+def test_a_fold_back_of_some_noise_units_at_the_ends_is_found():
+    """Past its turning points the voltage falls 56 mV over the last 0.75 mm (2 mV noise, about
+    a half per cent of an 11 V span): below the old 1 %-of-span floor, yet no inverse exists."""
+    x = np.arange(-30.0, 30.01, 0.25)
+    xs, v, d = _arctan_sweeps(x, 0.002)
+    past = np.clip(np.abs(xs) - 29.25, 0.0, None)
+    v -= np.sign(xs) * 0.135 * past      # the curve falls 56 mV from 29.25 to 30 mm
+    span = monotonic_span(Recordings(xs, v, direction=d, source="ends.csv"))
+    assert span.foldback and span.trimmable
+    kept = xs[span.mask]
+    assert 29.0 <= kept.max() <= 29.5 and -29.5 <= kept.min() <= -29.0
+
+
+def test_repeated_sweeps_do_not_inflate_the_fold_back_threshold():
+    """Two sweeps in one direction interleave in displacement order; differences of single
+    readings then carry the slope and made the noise estimate 20x too large."""
+    x = np.arange(-30.0, 30.01, 0.25)
+    xs, v, d = _arctan_sweeps(x, 0.002)
+    xs2, v2, d2 = _arctan_sweeps(x, 0.002, seed=1)
+    span = monotonic_span(Recordings(np.r_[xs, xs2], np.r_[v, v2], direction=np.r_[d, d2], source="two.csv"))
+    assert span.noise_v < 0.004

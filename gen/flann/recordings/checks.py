@@ -18,6 +18,13 @@ DRIFT_FACTOR = 2.0
 # An LVDT conditioner's output (and any ADC input) is at most a few tens of volts: a larger
 # number under a volts header is almost surely millivolts.
 MAX_PLAUSIBLE_V = 60.0
+# The fold-back threshold's floors: the noise estimate can come out low (readings on a
+# converter grid whose noise is below a step: most differences are 0), so a fall must also
+# exceed 0.2 % of the voltage span and three converter steps (noise below a step flips the
+# reading by one code; the running median leaves less).  At 1 % of the span a 56 mV
+# fold-back at the ends of an 11 V LVDT with 2 mV noise (26 sigma) was passed.
+FOLDBACK_FLOOR = 0.002
+STEPS_FLOOR = 3
 
 
 @dataclass(frozen=True)
@@ -56,36 +63,73 @@ def estimate_noise_v(voltage_sorted: np.ndarray, order: int = 2) -> float:
     return float(np.median(np.abs(d)) / (0.6745 * math.sqrt(math.comb(2 * order, order))))
 
 
+def median_of_three(u: np.ndarray) -> np.ndarray:
+    """Running median of three neighbours (Tukey's end rule: each end against the line through
+    its two neighbours).  One isolated wrong reading cannot survive it; a curve that turns back
+    over several readings does."""
+    u = np.asarray(u, dtype=float)
+    if u.size < 4:
+        return u.copy()
+    out = np.median(np.stack([u[:-2], u[1:-1], u[2:]]), axis=0)
+    first = np.median([u[0], out[0], 3 * out[0] - 2 * out[1]])
+    last = np.median([u[-1], out[-1], 3 * out[-1] - 2 * out[-2]])
+    return np.concatenate([[first], out, [last]])
+
+
 def _span_one(x: np.ndarray, v: np.ndarray, noise_v: float | None, k_sigma: float,
-              floor_frac: float):
-    """Fold-back test on one sweep sorted by displacement. Returns (keep, kind, text, n, thr)."""
+              floor_frac: float, step_v: float):
+    """Fold-back test on one direction's readings sorted by displacement. Returns (keep per
+    reading, kind, text, noise, thr).
+
+    Judged on the mean reading of each position (repeated sweeps interleave their readings
+    in displacement order, so differences of single readings would measure the slope as
+    noise), and on their running median of three, so one glitch (the outlier screen's to
+    find) is not taken for a curve without an inverse."""
+    xu, inverse = np.unique(x, return_inverse=True)
+    vu = np.bincount(inverse, weights=v) / np.bincount(inverse)
+    keep, kind, text, noise, thr = _span_means(xu, vu, noise_v, k_sigma, floor_frac, step_v)
+    return keep[inverse], kind, text, noise, thr
+
+
+def _extreme_near(u: np.ndarray, i: int, sense: int) -> int:
+    """The largest (``sense`` 1) or smallest (-1) of ``u[i - 1 : i + 2]``."""
+    lo = max(i - 1, 0)
+    window = sense * u[lo:i + 2]
+    return lo + int(np.argmax(window))
+
+
+def _span_means(x: np.ndarray, v: np.ndarray, noise_v: float | None, k_sigma: float,
+                floor_frac: float, step_v: float):
     n = v.size
     slope = np.polyfit(x, v, 1)[0] if n >= 2 and np.ptp(x) > 0 else 1.0
     sign = 1.0 if slope >= 0 else -1.0
-    u = sign * v
     noise = estimate_noise_v(v) if noise_v is None else float(noise_v)
-    thr = max(k_sigma * noise, floor_frac * float(np.ptp(v)))
+    raw = sign * v
+    u = median_of_three(raw)
+    thr = max(k_sigma * noise, floor_frac * float(np.ptp(v)), STEPS_FLOOR * step_v)
     keep = np.ones(n, bool)
     if n < 3 or thr <= 0:
         return keep, None, "", noise, thr
-    i_lo, i_hi = int(np.argmin(u)), int(np.argmax(u))
-    if i_lo > i_hi:
-        return keep, "interior", (f"voltage falls from {v[i_lo]:.6g} V at {x[i_lo]:g} mm back to "
-                                  f"{v[i_hi]:.6g} V at {x[i_hi]:g} mm"), noise, thr
-    inner = u[i_lo:i_hi + 1]
+    f_lo, f_hi = int(np.argmin(u)), int(np.argmax(u))
+    if f_lo > f_hi:
+        return keep, "interior", (f"voltage falls from {v[f_lo]:.6g} V at {x[f_lo]:g} mm back to "
+                                  f"{v[f_hi]:.6g} V at {x[f_hi]:g} mm"), noise, thr
+    inner = u[f_lo:f_hi + 1]
     drop = np.maximum.accumulate(inner) - inner
     if drop.max() > thr:
-        j = int(np.argmax(drop)) + i_lo
-        peak = int(np.argmax(u[i_lo:j + 1])) + i_lo
+        j = int(np.argmax(drop)) + f_lo
+        peak = int(np.argmax(u[f_lo:j + 1])) + f_lo
         return keep, "interior", (f"voltage turns back between {x[peak]:g} mm "
                                   f"({v[peak]:.6g} V) and {x[j]:g} mm ({v[j]:.6g} V)"), noise, thr
+    # the median rounds a sharp turning point off by a reading: the readings beside it say where
+    i_lo, i_hi = _extreme_near(raw, f_lo, -1), _extreme_near(raw, f_hi, 1)
     parts = []
-    if i_hi < n - 1 and (u[i_hi] - u[i_hi + 1:].min()) > thr:
-        j = int(np.argmin(u[i_hi + 1:])) + i_hi + 1
+    if f_hi < n - 1 and (u[f_hi] - u[f_hi + 1:].min()) > thr:
+        j = int(np.argmin(u[f_hi + 1:])) + f_hi + 1
         parts.append(f"beyond {x[i_hi]:g} mm (turning point {v[i_hi]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
         keep[i_hi + 1:] = False
-    if i_lo > 0 and (u[:i_lo].max() - u[i_lo]) > thr:
-        j = int(np.argmax(u[:i_lo]))
+    if f_lo > 0 and (u[:f_lo].max() - u[f_lo]) > thr:
+        j = int(np.argmax(u[:f_lo]))
         parts.append(f"below {x[i_lo]:g} mm (turning point {v[i_lo]:.6g} V; {v[j]:.6g} V at {x[j]:g} mm)")
         keep[:i_lo] = False
     if not parts:
@@ -94,13 +138,14 @@ def _span_one(x: np.ndarray, v: np.ndarray, noise_v: float | None, k_sigma: floa
 
 
 def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float = 8.0,
-                   floor_frac: float = 0.01) -> MonotonicSpan:
+                   floor_frac: float = FOLDBACK_FLOOR) -> MonotonicSpan:
     """Where the voltage folds back beyond the noise (no inverse exists), per direction.
 
     Within each direction (all rows when there is no ``direction`` column) the rows are
-    ordered by displacement and the voltage is oriented to rise.  A fold-back is a fall of
-    more than ``threshold = max(k_sigma * noise, floor_frac * voltage span)`` below an
-    earlier value; point-to-point wiggles smaller than that (noise on the flat ends) are
+    ordered by displacement, the voltage is taken as the running median of three readings
+    (:func:`median_of_three`) and oriented to rise.  A fold-back is a fall of more than
+    ``threshold = max(k_sigma * noise, floor_frac * voltage span, 3 converter steps)`` below
+    an earlier value; point-to-point wiggles smaller than that (noise on the flat ends) are
     not fold-backs.  A fold-back beyond the voltage extremes (the core leaving the coils)
     is *trimmable*: the span from the voltage minimum to its maximum is kept.  A fold-back
     inside that span is not.
@@ -108,13 +153,14 @@ def monotonic_span(rec: Recordings, noise_v: float | None = None, k_sigma: float
     groups = ([np.flatnonzero(rec.direction == d) for d in (1.0, -1.0)]
               if rec.direction is not None else [np.arange(len(rec))])
     mask = np.ones(len(rec), bool)
+    step = converter_step(rec.voltage_v)
     messages, trimmable, noises, thrs = [], True, [], []
     for idx in groups:
         if idx.size == 0:
             continue
         order = idx[np.argsort(rec.displacement_mm[idx], kind="stable")]
         keep, kind, text, noise, thr = _span_one(rec.displacement_mm[order], rec.voltage_v[order],
-                                                 noise_v, k_sigma, floor_frac)
+                                                 noise_v, k_sigma, floor_frac, step)
         noises.append(noise)
         thrs.append(thr)
         if kind is None:
