@@ -3,9 +3,11 @@ beyond it are counted in one warning line; the figures are reported as before (e
 
 import json
 
+import numpy as np
+
 import pytest
 
-from flann.golden.model import FlannModel
+from flann.golden.model import FlannModel, load_model
 
 
 @pytest.fixture
@@ -41,3 +43,23 @@ def test_no_warning_within_the_trained_stroke(cli, tmp_path, model):
     data.write_text("displacement_mm,voltage_v\n-4,-2\n0,0\n4,2\n")
     rc, _, err = cli(["eval", model, data])
     assert rc == 0 and "displacement range" not in err
+
+
+def test_eval_design_clamps_the_float_model_as_its_compensated_figures_do(cli, tmp_path, small_designs):
+    """Beyond the trained range the hardware section compared the hardware with the float
+    model's unclamped sum (|hardware - float| 0.045 mm on a 12-bit design whose datapath is
+    within 0.001 mm), and its float ratio to the limit disagreed with the compensated max."""
+    m = load_model(small_designs["model"])
+    lo, hi = sorted(m.voltage_range_v)
+    v = np.linspace(lo - 0.15 * (hi - lo), hi + 0.15 * (hi - lo), 61)
+    data = tmp_path / "wide.csv"
+    data.write_text("displacement_mm,voltage_v\n" + "".join(
+        f"{x:.12g},{a:.12g}\n" for x, a in zip(m.predict(np.clip(v, lo, hi)), v)))
+    rc, out, err = cli(["eval", small_designs["model"], data, "--design", small_designs["dir"] / "fixed", "--json"])
+    assert rc == 0, err
+    rep = json.loads(out)
+    hw = rep["hardware"]
+    float_max = hw["float_ratio_to_limit"] * hw["physical_limit_mm"]["max"]
+    assert float_max == pytest.approx(rep["compensated"]["max_error_mm"], rel=1e-9, abs=1e-12)
+    # with the float model clamped like the hardware, the two differ by the datapath and the ADC's step
+    assert hw["max_abs_hardware_minus_float_mm"] < 0.05 * float(np.ptp(m.predict(np.array([lo, hi]))))

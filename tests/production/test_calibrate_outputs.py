@@ -176,3 +176,15 @@ def test_too_few_positions_for_the_terms_are_rejected(line, tmp_path, capsys):
                                                  "raw_max_error_mm", "twin_vs_float_lsb", "max_error_pct_fs"))
     assert not (out / "sparse" / "weights.hex").exists() and (out / "sparse" / "certificate.html").is_file()
     assert "sparse" in err and "Traceback" not in err
+
+
+def test_a_recording_at_the_summarys_path_is_refused_before_any_work(line, tmp_path, capsys):
+    """OUTDIR/summary.csv given as a recording was calibrated into OUTDIR/summary/ before the
+    summary's write refused it."""
+    out = tmp_path / "oc"
+    out.mkdir()
+    shutil.copy(line["rec"]["s1"], out / "summary.csv")
+    rc = main(["calibrate", str(out / "summary.csv"), "-o", str(out), "--design", str(line["design"]), "-j", "1"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "is the batch summary this run writes" in err and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in out.iterdir()) == ["summary.csv"]

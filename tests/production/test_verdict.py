@@ -79,6 +79,16 @@ def test_spec_file_and_flags(tmp_path):
     assert s2.source.endswith("+ flags")
 
 
+def test_a_spec_file_without_a_tolerance_is_refused(tmp_path):
+    """An empty or name-only spec passed every sensor with "none (no specification given)"."""
+    for text in ("", 'name = "x"\n', "[limits]\nmax_ratio_to_limit = 50\n"):
+        p = tmp_path / "s.toml"
+        p.write_text(text)
+        with pytest.raises(FlannError, match="states no tolerance"):
+            build_spec(p)
+    assert build_spec(p, max_error_mm=0.1).max_ratio_to_limit == 50.0
+
+
 @pytest.mark.parametrize("text, words", [
     ("[tolerance]\nmax_error_mm = -1\n", "must be > 0"),
     ("[tolerance]\nmax_error_mm = 0.1\nmax_error_pct_fs = 1\n", "not both"),

@@ -32,11 +32,7 @@ def add_arguments(p) -> None:
 
 
 def outside_range(model, voltage_v, temperature_c=None) -> np.ndarray:
-    if is_thermal(model):
-        return model.clamp(voltage_v, temperature_c)[2]
-    lo, hi = sorted(model.voltage_range_v)
-    v = np.asarray(voltage_v, dtype=float)
-    return (v < lo) | (v > hi)
+    return model.clamp(voltage_v, temperature_c)[2]
 
 
 def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
@@ -56,12 +52,8 @@ def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
 def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, np.ndarray]:
     """(displacement mm, clamped flags): the voltage (and a two-input model's temperature)
     clamped to the trained range first."""
-    if is_thermal(model):
-        v, t, outside = model.clamp(voltage_v, temperature_c)
-        return model.predict(v, t), outside
-    lo, hi = sorted(model.voltage_range_v)
-    v = np.asarray(voltage_v, dtype=float)
-    return model.predict(np.clip(v, lo, hi)), outside_range(model, v)
+    v, t, outside = model.clamp(voltage_v, temperature_c)
+    return (model.predict(v, t) if is_thermal(model) else model.predict(v)), outside
 
 
 def _predict_unclamped(model, voltage_v, temperature_c):

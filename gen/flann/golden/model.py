@@ -135,6 +135,13 @@ class FlannModel(ModelFile):
         """Displacement (mm) for voltages (V), float64 (trigonometric sum by recurrence)."""
         return evaluate(self.normalise(voltage_v), self.weights, self.bias)
 
+    def clamp(self, voltage_v, temperature_c=None) -> tuple[np.ndarray, None, np.ndarray]:
+        """(voltage, None, outside flags): the voltage clamped to the trained range, as the
+        hardware's range check does (the same shape as a two-input model's ``clamp``)."""
+        v = np.asarray(voltage_v, dtype=float)
+        lo, hi = sorted(self.voltage_range_v)
+        return np.clip(v, lo, hi), None, (v < lo) | (v > hi)
+
     def predict_direct(self, voltage_v) -> np.ndarray:
         """The same sum term by term (one sin and cos per term): the reference for tests."""
         return self.bias + self.features(voltage_v) @ np.asarray(self.weights)

@@ -482,6 +482,11 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     paths = [Path(p) for p in paths]
     if not paths:
         raise FlannError("no recordings given")
+    summary = summary_path(out_dir).resolve()
+    clobbered = next((p for p in paths if p.resolve() == summary), None)
+    if clobbered is not None:   # refused before any sensor is calibrated, not when the summary is written
+        raise FlannError(f"{clobbered}: is the batch summary this run writes ({SUMMARY} in -o {out_dir}); "
+                         "move the recording or write the calibration elsewhere")
     if jobs is not None and jobs < 1:
         raise FlannError(f"-j {jobs}: must be >= 1")
     jobs = jobs or os.cpu_count() or 1

@@ -156,7 +156,12 @@ def build_spec(spec_path=None, *, max_error_mm=None, max_error_pct_fs=None, work
         changes["fail_on_effects"] = _effects(list(fail_on_effects), "--fail-on-effect")
     if changes:
         changes["source"] = f"{spec.source} + flags" if spec.source else "flags"
-    return _check(replace(spec, **changes), "spec")
+    spec = _check(replace(spec, **changes), "spec")
+    if spec_path and spec.max_error_mm is None and spec.max_error_pct_fs is None:
+        # a spec that states no tolerance would pass every sensor while looking like a spec
+        raise FlannError(f"{spec_path}: states no tolerance: give [tolerance] max_error_mm or "
+                         "max_error_pct_fs (or --tolerance-mm / --tolerance-pct-fs)")
+    return spec
 
 
 __all__ = ["ProductionSpec", "load_spec", "build_spec"]
