@@ -8,6 +8,7 @@ temperature, 3 sensors calibrated at -20, 25 and 80 degC:
 from __future__ import annotations
 
 import csv
+import re
 import json
 import shutil
 
@@ -116,6 +117,10 @@ def test_calibrate_certificates_per_temperature(line):
         assert float(r["max_error_mm"]) < float(r["raw_max_error_mm"]) / 5
         html = (out / name / "certificate.html").read_text()
         assert "drift_ppm_fs_per_c (hardware)" in html
+        # the summary's figures are on the certificate, as on a one-temperature sensor's
+        cells = dict(re.findall(r"<t[hd][^>]*>([^<]+)</t[hd]><td[^>]*>([^<]+)</td>", html))
+        assert cells["ratio to the limit"] == f"{float(r['ratio_to_limit']):.3g}"
+        assert cells["compensated max error, whole recording"].startswith(f"{float(r['max_error_mm']):.4g} ")
         assert "box method" in html and "{" not in html.split("<body")[1].split("<svg")[0]
         assert "Verdict at each calibration temperature" in html
         for t in ("-20 degC", "25 degC", "80 degC"):  # the legend: one curve per temperature

@@ -121,6 +121,7 @@ def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, find
 
     results = ("Results over every calibration temperature (expanded uncertainty U, k = 2)", [
         *_verdict_rows(verdict, u),
+        ("compensated max error, whole recording", f"{res.max_error_mm:.4g} ± {u:.2g} mm"),
         ("raw max error (one least-squares line)", f"{res.raw_max_error_mm:.4g} ± {u:.2g} mm"),
         ("drift_ppm_fs_per_c (hardware)", drift(chk["drift_ppm_fs_per_c"])),
         ("drift_ppm_fs_per_c (raw sensor)", drift(chk["raw_drift_ppm_fs_per_c"])),
@@ -129,6 +130,7 @@ def render_certificate_thermal(res, chk: dict, fam, dhash: str, mhash: str, find
                          f"({chk['full_scale_mm']:.4g} mm, half the recorded span, "
                          "as flann eval reports it)"),
         ("physical limit, worst over the stroke", f"{res.limit_mm:.4g} mm"),
+        ("ratio to the limit", f"{res.ratio_to_limit:.3g}"),
         ("uncertainty method", uncertainty.method + " (the largest of the temperatures')"),
     ])
     by_t = {round(r["temperature_c"], 6): r for r in chk["by_temperature"]}
