@@ -36,20 +36,11 @@ import numpy as np
 
 from ..errors import ModelFileError
 from ..inputs import number, parse_json, read_text
+from ..recordings.checks import TEMPERATURE_RESOLUTION_C, temperature_groups
 from .model import MAX_TERMS, FlannModel, ModelFile, evaluate, expand
 
 FORMAT = "flann-thermal-model/1"
 INPUTS = ("voltage_v", "temperature_c")
-# temperatures closer than this are one calibration temperature (a soak's sensor readings)
-TEMPERATURE_RESOLUTION_C = 0.1
-
-
-def temperature_groups(temperature_c) -> tuple[np.ndarray, np.ndarray]:
-    """(distinct temperatures, label of each row): rows at the same temperature, to
-    :data:`TEMPERATURE_RESOLUTION_C`."""
-    t = np.round(np.asarray(temperature_c, dtype=float) / TEMPERATURE_RESOLUTION_C)
-    levels, labels = np.unique(t, return_inverse=True)
-    return levels * TEMPERATURE_RESOLUTION_C, labels
 
 
 def power_columns(t_n, orders: int) -> np.ndarray:

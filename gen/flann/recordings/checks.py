@@ -25,6 +25,16 @@ MAX_PLAUSIBLE_V = 60.0
 # fold-back at the ends of an 11 V LVDT with 2 mV noise (26 sigma) was passed.
 FOLDBACK_FLOOR = 0.002
 STEPS_FLOOR = 3
+# temperatures closer than this are one calibration temperature (a soak's sensor readings)
+TEMPERATURE_RESOLUTION_C = 0.1
+
+
+def temperature_groups(temperature_c) -> tuple[np.ndarray, np.ndarray]:
+    """(distinct temperatures, label of each row): rows at the same temperature, to
+    :data:`TEMPERATURE_RESOLUTION_C`."""
+    t = np.round(np.asarray(temperature_c, dtype=float) / TEMPERATURE_RESOLUTION_C)
+    levels, labels = np.unique(t, return_inverse=True)
+    return levels * TEMPERATURE_RESOLUTION_C, labels
 
 
 @dataclass(frozen=True)
@@ -244,16 +254,19 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
             continue
         vv = rec.voltage_v[rows]
         for j, i in enumerate(rows):
-            ref = float(np.median(np.delete(vv, j)))
+            others = np.delete(np.arange(len(rows)), j)
+            ref = float(np.median(vv[others]))
             if abs(vv[j] - ref) <= tol:
                 continue
-            other = rows[int(np.argmin(np.abs(np.delete(vv, j) - ref)))] if len(rows) > 2 else rows[1 - j]
+            # the reading named beside this one: the other reading there closest to their median
+            other = rows[int(others[np.argmin(np.abs(vv[others] - ref))])]
             first_row, this_row = sorted((other, i))
             where = "" if rec.direction is None else f" in direction {int(d):+d}" + \
                 (" (sweeps told apart by the row order)" if inferred else "")
             units = f"{abs(vv[j] - ref) / sigma:.3g} noise units" if sigma > 0 else "beyond the noise"
             which = (f"they are {units} apart" if len(rows) == 2 else
                      f"{rec.line_of(i)} is {units} from the other {len(rows) - 1} readings there")
+            _several_temperatures(rec, first_row, this_row, x, which)
             raise RecordingsError(
                 f"{rec.source}: {_pair(rec, first_row, this_row)}: displacement {x:g} mm appears twice"
                 f"{where} with different voltages ({rec.voltage_v[first_row]:.6g} V, "
@@ -262,29 +275,138 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
                 "give each sweep its direction (+1/-1)")
 
 
+def _several_temperatures(rec: Recordings, a: int, b: int, x: float, which: str) -> None:
+    """Refuses rows ``a`` and ``b`` (one position) as readings at two temperatures when they are:
+    a temperature change moves the whole curve, which is no glitch and no joined file."""
+    if rec.temperature_c is None:
+        return
+    levels, labels = temperature_groups(rec.temperature_c)
+    if labels[a] == labels[b]:
+        return
+    t, v = rec.temperature_c, rec.voltage_v
+    raise RecordingsError(
+        f"{rec.source}: {_pair(rec, a, b)}: displacement {x:g} mm reads {v[a]:.6g} V at "
+        f"{t[a]:g} degC and {v[b]:.6g} V at {t[b]:g} degC ({which}): the file holds readings at "
+        f"{levels.size} temperatures ({', '.join(f'{c:g}' for c in levels[:8])}"
+        f"{', ...' if levels.size > 8 else ''} degC), which one curve x(v) cannot fit; "
+        "fit voltage and temperature together with flann train --temperature, "
+        "or give the rows of one temperature")
+
+
+def printed_resolution(values) -> float:
+    """The last printed digit of the readings (V): the largest power of ten (100 at most) every
+    reading is a whole multiple of ('%.6f' volts or '%.3f' millivolts: 1e-6), 0 when there is
+    none that doubles resolve (readings of full precision, or to nine significant digits)."""
+    u = np.abs(np.asarray(values, float))
+    d = -2
+    # a sample first: the whole needs at least its digits (one pass over a long recording)
+    for part in (u[::max(1, u.size // 256)], u):
+        while True:
+            a = part * 10.0 ** d
+            if a.max() > 1e14 or d > 15:   # beyond a double's 15 digits every number is "whole"
+                return 0.0
+            if np.all(np.abs(a - np.rint(a)) <= 1e-9 + 8e-16 * a):
+                break
+            d += 1
+    return 10.0 ** -d
+
+
+# A grid fitted to the readings is taken only where readings off any grid would all fall that
+# close to one of the steps tried with less than this chance.
+GRID_CHANCE = 1e-6
+
+
+def _improbable(n: int, span: float, q: float, off: float) -> bool:
+    """Whether ``n`` readings off any grid would fall within ``off`` of a grid of some step
+    near ``q`` with less than :data:`GRID_CHANCE`: each does with chance 2 off / q, two are
+    fitted, and steps ``2 off / span`` apart are told apart over the span."""
+    p = 2.0 * off / q
+    if not p < 1:
+        return False
+    return (n - 2) * math.log(p) + math.log(max(1.0, span / (2.0 * off))) <= math.log(GRID_CHANCE)
+
+
 def converter_step(voltage_v, max_divisor: int = 64, tol: float = 0.02) -> float:
     """The converter's step (V) when every reading is a whole number of one step, else 0.
 
     The smallest gap between distinct readings is the step or a multiple of it; the largest
-    step that puts every reading on the grid (within ``tol`` of a step) is taken.  Readings
-    with analogue noise or averaging are on no grid and give 0.
+    step that puts every reading on the grid (within ``tol`` of a step, and the printing's
+    rounding: :func:`printed_resolution`) is taken.  Readings with analogue noise or
+    averaging are on no grid and give 0.
     """
     u = np.unique(np.asarray(voltage_v, float))
     if u.size < 8:
         return 0.0
-    g0 = float(np.diff(u).min())
+    gaps = np.diff(u)
+    g0 = float(gaps.min())
     if not g0 > 0:
         return 0.0
+    res = printed_resolution(u)
     rel = u - u[0]
     span = float(rel[-1])
     for k in range(1, max_divisor + 1):
-        # the smallest gap carries the readings' rounding (9 digits of a 16-bit code's volts):
-        # the step is refined over the whole span, where that rounding is negligible
+        # readings of nine digits and more: the gap's rounding is negligible over the span
         q = span / round(span * k / g0)
         frac = rel / q
         if np.max(np.abs(frac - np.round(frac))) <= tol:
             return q
+        q = _grid_step(u, gaps, k, res, tol)
+        if q > 0:
+            return q
     return 0.0
+
+
+def _grid_step(u: np.ndarray, gaps: np.ndarray, k: int, res: float, tol: float) -> float:
+    """The step of a grid that holds every reading (``u``, sorted; ``gaps`` between them)
+    where the smallest gap is ``k`` steps, or 0.
+
+    A step taken from one gap carries its two readings' rounding (half a µV each in a 0.61 mV
+    step of a 14-bit converter printed '%.6f': 3 codes off over its span).  So the gaps are
+    numbered in codes from the smallest up, the step refitted to those numbered so far, and a
+    gap numbered only while six standard errors of the step over it, with its own rounding,
+    stay below half a step; the readings' codes are then the sums of the gaps'.
+    """
+    q = float(gaps.min()) / k
+    if q < 8 * res:
+        # readings are whole multiples of the printed digit: steps of a few digits fit them
+        # in patterns, not by chance (the direct check in converter_step covers these)
+        return 0.0
+    rel = u - u[0]
+    size = float(rel[-1])
+    half = 0.5 * res
+    if not _improbable(rel.size, size, q, tol * q + half):
+        half = 0.0
+        if not _improbable(rel.size, size, q, tol * q):
+            return 0.0
+    eps = 1e-12 * size   # the doubles' own rounding
+    # a reading's rounding: the printed digit's, or nine significant digits' ('%.9g')
+    e = max(half, 1e-9 * max(abs(float(u[0])), abs(float(u[-1]))))
+    sigma = e * math.sqrt(2.0 / 3.0)   # a gap's: two readings each uniform within +-e
+    # gaps of this many codes are numbered without doubt (at first from the smallest alone)
+    numbered = max(float(k), (0.45 * q - 2.0 * e) / (6.0 * sigma / k))
+    while True:
+        sel = gaps <= (numbered + 0.5) * q
+        n = np.rint(gaps[sel] / q)
+        if not n.min() >= 1:
+            return 0.0   # two readings closer than half a step: not on this grid
+        q = float(np.dot(n, gaps[sel]) / np.dot(n, n))
+        if np.max(np.abs(gaps[sel] - n * q)) > 2.0 * (tol * q + half) + eps:
+            return 0.0
+        if sel.all():
+            break
+        wider = (0.45 * q - 2.0 * e) / (6.0 * sigma / math.sqrt(float(np.dot(n, n))))
+        if wider <= 1.01 * numbered:
+            return 0.0   # the rounding is too coarse to number longer gaps
+        numbered = wider
+    codes = np.concatenate([[0.0], np.cumsum(n)])
+    common = int(np.gcd.reduce(n.astype(np.int64)))
+    codes /= common   # codes all multiples of one number: that many steps is the grid's
+    d = codes - codes.mean()
+    q = float(np.dot(d, rel - rel.mean()) / np.dot(d, d))
+    c = float(rel.mean() - q * codes.mean())
+    if np.max(np.abs(rel - q * codes - c)) > tol * q + half + eps:
+        return 0.0
+    return q
 
 
 def converter_of(voltage_v) -> tuple[int, float] | None:

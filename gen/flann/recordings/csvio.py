@@ -33,6 +33,7 @@ import math
 import re
 import sys
 import warnings
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -183,6 +184,87 @@ def _parse_float(text: str, column: str, where: str, source: str, factor: float 
             f"{source}: {where}, column '{column}': value {text[:40]}{unit} is outside what flann "
             f"computes with (0 or {lo:g} <= |value| <= {hi:g})")
     return value
+
+
+# '30,000', '-5.185': a mark before exactly three digits, after one to three without a leading
+# zero, is a decimal mark or a thousands separator; the rest of the file tells which
+_GROUPED = re.compile(r"[+-]?[1-9][0-9]{0,2}[.,][0-9]{3}\Z")
+
+
+class _DecimalMarks:
+    """The decimal mark of a file, settled once every cell has been seen.
+
+    A cell with one comma and no point, or one point and no comma, that cannot be a thousands
+    group ('1,5', '0.250', '1234,5', '4.', '1,5E-1') proves its mark a decimal mark.  A grouped
+    cell is read as a decimal first and settled by :meth:`settle`: a thousands separator when
+    only the other mark is proven, a decimal mark when only its own is; with no proof a point
+    stays the decimal point it always is in CSV and a comma is a decimal comma in a semicolon
+    file (a decimal-comma spreadsheet's export); any other case is refused, naming the cell.
+    """
+
+    def __init__(self):
+        self.proof: dict[str, tuple[int, str] | None] = {",": None, ".": None}
+        self.first: dict[str, tuple[int, str, str] | None] = {",": None, ".": None}
+        self.rows: dict[tuple[str, str], array] = {}   # (mark, column) -> row indices
+        self.decimal_comma = False
+        self.thousands: dict[str, tuple[int, str, float]] = {}
+
+    def see(self, cell: str, column: str, row: int, line_no: int, name: str) -> str:
+        """The cell with its mark as a point (what float() reads)."""
+        if "," in cell and "." in cell:
+            return cell   # '1.234,5', '1,234.5': refused as not a number
+        mark = "," if "," in cell else "."
+        if cell.count(mark) != 1:
+            return cell
+        if _GROUPED.match(cell):
+            self.rows.setdefault((mark, column), array("q")).append(row)
+            if self.first[mark] is None:
+                self.first[mark] = (line_no, name, cell)
+        else:
+            self.decimal_comma |= mark == ","
+            if self.proof[mark] is None:
+                self.proof[mark] = (line_no, cell)
+        return cell.replace(",", ".")
+
+    def settle(self, data: dict[str, list[float]], factors: dict[str, float], sep: str,
+               source: str) -> None:
+        """Grouped cells read with a thousands separator where the file proves it one (values
+        in ``data`` rewritten); refused where nothing tells."""
+        for mark, other in ((",", "."), (".", ",")):
+            if self.first[mark] is None:
+                continue
+            line_no, name, cell = self.first[mark]
+            own, theirs = self.proof[mark], self.proof[other]
+            if theirs and not own:
+                for (m, column), rows in self.rows.items():
+                    if m != mark:
+                        continue
+                    for r in rows:   # read as 'a.bbb': the whole number 'abbb' is 1000 times that
+                        data[column][r] = round(data[column][r] / factors[column] * 1000) * factors[column]
+                self.thousands[mark] = (line_no, cell, float(cell.replace(mark, "")))
+                continue
+            if own and not theirs:
+                self.decimal_comma |= mark == ","
+                continue
+            if own and theirs:
+                why = (f"the file uses both as decimal marks (line {own[0]} '{own[1]}', line {theirs[0]} "
+                       f"'{theirs[1]}')")
+            elif self.first[other] is not None:
+                why = (f"'{other}' is also followed by three digits (line {self.first[other][0]} "
+                       f"'{self.first[other][2]}') and no number shows which is the decimal mark")
+            elif mark == "." or sep == ";":
+                self.decimal_comma |= mark == ","
+                continue
+            else:
+                why = "no other number in the file shows which is the decimal mark"
+            raise RecordingsError(
+                f"{source}: line {line_no}, column '{name}': '{cell}' is ambiguous: '{mark}' before three "
+                f"digits is a decimal mark or a thousands separator, and {why}; export the numbers "
+                "without thousands separators")
+
+    def note(self) -> str:
+        return "".join(f", '{m}' as thousands separator (line {n} '{c}' read as {v:g})"
+                       for m, (n, c, v) in self.thousands.items())
 
 
 def _sniff_separator(header_line: str) -> str:
@@ -357,7 +439,7 @@ def parse_recordings(text: str, source: str = "<memory>",
     columns = {c: found[c] for c in wanted} | {"+" + c: also[c] for c in also}
     data: dict[str, list[float]] = {c: [] for c in columns}
     line_numbers: list[int] = []
-    decimal_comma = False
+    marks = _DecimalMarks()
     # one pass, row by row (no list of split rows: ~100 bytes a row less at the peak)
     cut_candidate = not text.endswith(("\n", "\r")) and len(body) > 3
     shortest_last = None   # the shortest last cell of a full row so far (for a cut-off last line)
@@ -386,10 +468,15 @@ def parse_recordings(text: str, source: str = "<memory>",
                     raise RecordingsError(f"{source}: {where}, column {header[i]!r}: {cell[:40]!r} is not a "
                                           f"direction (+1, -1 or a word: {', '.join(sorted(DIRECTION_WORDS))})")
                 cell = DIRECTION_WORDS.get(cell.lower(), cell)
-            # a comma inside a cell is a decimal comma (in a comma-separated file only
-            # when quoted, "1,5"); with a point as well it is a thousands separator: refused
-            if "," in cell and "." not in cell and cell.count(",") == 1:
-                cell, decimal_comma = cell.replace(",", "."), True
+            # a comma inside a cell is a decimal comma (in a comma-separated file only when
+            # quoted, "1,5") or, in '30,000', maybe a thousands separator: settled below.  Once
+            # a mark is proven decimal, only cells with it before three last digits need a look.
+            if "," in cell or "." in cell:
+                mark = "," if "," in cell else "."
+                if cell[-4:-3] == mark or marks.proof[mark] is None:
+                    cell = marks.see(cell, c, len(data[c]), line_no, header[i])
+                elif mark == "," and "." not in cell and cell.count(",") == 1:
+                    cell = cell.replace(",", ".")
             data[c].append(_parse_float(cell, header[i], where, source, factor))
         line_numbers.append(line_no)
     if len(line_numbers) > MAX_ROWS:
@@ -397,6 +484,7 @@ def parse_recordings(text: str, source: str = "<memory>",
                               "average or decimate the recording first")
     if not data["voltage_v"]:
         raise RecordingsError(f"{source}: no data rows")
+    marks.settle(data, {c: factor for c, (_i, factor) in columns.items()}, sep, source)
     arrays = {c: np.asarray(v, dtype=float) for c, v in data.items()}
     del data
     lines = np.asarray(line_numbers, dtype=np.int64)
@@ -412,8 +500,9 @@ def parse_recordings(text: str, source: str = "<memory>",
                 f"{source}: line {lines[k]}, column 'direction': {arrays['direction'][k]:g} "
                 "is not +1 or -1 (or up/down, forward/reverse)"
             )
-    if sep != "," or decimal_comma:
-        notes.append(f"{SEPARATORS[sep]}-separated" + (" with decimal comma" if decimal_comma else ""))
+    if sep != "," or marks.decimal_comma or marks.thousands:
+        notes.append(f"{SEPARATORS[sep]}-separated" + (" with decimal comma" if marks.decimal_comma else "")
+                     + marks.note())
     notes += col_notes
     arrays.setdefault("displacement_mm", None)
     return Recordings(**arrays, source=source, sha256=sha, comments=tuple(comments), lines=lines,

@@ -1,0 +1,67 @@
+"""A converter's grid printed to the export's resolution (1 µV, or 1 mV for a coarse converter)
+is found: each reading carries up to half the last digit, so the step is fitted over the span,
+not taken from the smallest gap; readings with analogue noise still give no grid."""
+
+from argparse import Namespace
+
+import numpy as np
+import pytest
+
+from flann.commands.train import converter
+from flann.recordings import checks, converter_step, parse_recordings
+
+
+def _codes(bits: int, full_scale_v: float, seed: int = 0, positions: int = 121):
+    """A sensor read out and back through a converter of ``bits`` over +-``full_scale_v``."""
+    rng = np.random.default_rng(seed)
+    lsb = 2 * full_scale_v / 2 ** bits
+    x = np.linspace(-3, 3, positions)
+    x = np.r_[x, x[::-1]]
+    u = x / 3
+    v = 2.5 * (u + 0.12 * u ** 2 - 0.25 * u ** 3) + rng.normal(0, 2e-4, x.size)
+    return x, np.round(v / lsb) * lsb, lsb
+
+
+def _csv(x, v, header="voltage_v", fmt=".6f", scale=1.0):
+    return f"displacement_mm,{header}\n" + "".join(f"{a:g},{b * scale:{fmt}}\n" for a, b in zip(x, v))
+
+
+@pytest.mark.parametrize("bits, fs, header, fmt, scale", [
+    (14, 5.0, "voltage_v", ".6f", 1.0),      # µV: the step 0.61 mV off by up to 0.5 µV a reading
+    (14, 5.0, "voltage_mv", ".3f", 1e3),     # the same in mV
+    (16, 5.0, "voltage_v", ".6f", 1.0),
+    (10, 5.0, "voltage_v", ".3f", 1.0),      # 1 mV digits of a 9.8 mV step
+    (16, 5.0, "voltage_v", ".9g", 1.0),      # nine significant digits: 5 nV at 5 V
+])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_grid_printed_to_its_last_digit_is_found(bits, fs, header, fmt, scale, seed):
+    x, v, lsb = _codes(bits, fs, seed)
+    rec = parse_recordings(_csv(x, v, header, fmt, scale), source="p.csv")
+    step = converter_step(rec.voltage_v)
+    assert abs(step / lsb - 1) * 2 ** bits < 0.05     # within a twentieth of a code over the range
+    found = converter(Namespace(input_bits=None, input_lsb_v=None), rec)
+    assert found["from"] == "the recording's converter grid"
+    assert found["input_bits"] == bits - 1            # the readings span half the range
+    assert abs(found["input_lsb_v"] / lsb - 1) * 2 ** bits < 0.05
+
+
+def test_few_positions_printed_in_microvolts():
+    x, v, lsb = _codes(14, 5.0, positions=25)
+    assert abs(converter_step(parse_recordings(_csv(x, v)).voltage_v) / lsb - 1) < 1e-6
+
+
+@pytest.mark.parametrize("fmt", [".9g", ".6f", ".5f", ".4f", ".3f"])
+@pytest.mark.parametrize("positions", [8, 13, 121])
+def test_analogue_readings_printed_to_any_digit_have_no_converter_grid(fmt, positions):
+    """Noise of 0.2 mV, printed: no step coarser than the printed digit (which holds them all)."""
+    rng = np.random.default_rng(positions)
+    x = np.linspace(-3, 3, positions)
+    v = 2.5 * np.tanh(x / 2) + rng.normal(0, 2e-4, x.size)
+    rec = parse_recordings(_csv(x, v, fmt=fmt))
+    assert converter_step(rec.voltage_v) <= checks.printed_resolution(rec.voltage_v) * (1 + 1e-9)
+
+
+def test_printed_resolution():
+    assert checks.printed_resolution([0.5, 1.25, -3]) == pytest.approx(0.01)
+    assert checks.printed_resolution(np.array([1.234, -0.5]) * 1e-3) == pytest.approx(1e-6)   # mV, 3 decimals
+    assert checks.printed_resolution([0.1 + 1e-12, np.pi]) == 0.0
