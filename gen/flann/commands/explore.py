@@ -56,9 +56,11 @@ def add_arguments(p):
     p.add_argument("--abc", choices=ABC_MODES, default="fast",
                    help="yosys LUT mapping (default fast: abc -fast; full = synth_xilinx as is, slow)")
     p.add_argument("--input-bits", type=bounded(int, *ADC_BITS), default=None, metavar="B",
-                   help="ADC width in bits, as for flann gen (default: flann gen's)")
+                   help="ADC width in bits, as for flann gen (default: flann gen's; not with a design "
+                        "directory: its own)")
     p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None, metavar="V",
-                   help="volts per ADC code, as for flann gen (default: flann gen's)")
+                   help="volts per ADC code, as for flann gen (default: flann gen's; not with a design "
+                        "directory: its own)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
@@ -70,9 +72,16 @@ def _design_model(args):
     if dp.explore is None:
         raise FlannError(f"{args.model}: {dp.why_no_explore}")
     if is_dir:
-        args.model = str(design_model(args.model, man, dp))
-        args.input_bits = man["input_bits"] if args.input_bits is None else args.input_bits
-        args.input_lsb_v = man["input_lsb_v"] if args.input_lsb_v is None else args.input_lsb_v
+        model = design_model(args.model, man, dp)
+        given = " ".join(f"{flag} {value:g}" for flag, value in (("--input-bits", args.input_bits),
+                                                                 ("--input-lsb-v", args.input_lsb_v))
+                         if value is not None)
+        if given:
+            # as flann sim and flann trace: a design directory is taken as written, never re-sized
+            raise FlannError(f"{args.model}: a design directory is explored with the ADC it was generated for; "
+                             f"for another ADC explore its model: flann explore {model} {given}")
+        args.model = str(model)
+        args.input_bits, args.input_lsb_v = man["input_bits"], man["input_lsb_v"]
     return dp
 
 

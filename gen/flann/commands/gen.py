@@ -10,6 +10,7 @@ import json
 import sys
 import warnings
 
+from ..errors import FlannError
 from ..golden.thermal import load_any_model
 from ..golden.train import converter_mismatch
 from ..hardware import options as gen_options
@@ -18,6 +19,25 @@ from ..hardware.registry import FORMATS, datapath_for_model, family_datapath
 from .family import add_family_arguments, check_family_args
 
 HELP = "generate VHDL-93 for a model"
+
+
+def generator_options(args) -> tuple[gen_options.GenOptions, tuple[str, ...]]:
+    """(the options, the names of those given on the command line); refuses a flag the options given make meaningless."""
+    opts = gen_options.from_args(args)
+    given = gen_options.given(args)
+    if "mult_digit_bits" in given and opts.mult_style != "shiftadd":
+        # the lut multiplier takes the whole weight in one cycle: the digit would be recorded, not used
+        raise FlannError(f"--mult-digit-bits {opts.mult_digit_bits}: sets the shift-add multiplier's weight bits "
+                         f"per cycle; --mult-style {opts.mult_style} has no digit (leave --mult-digit-bits out)")
+    return opts, given
+
+
+def refuse_generator_options(target, args, given, verb: str) -> None:
+    """A design directory is used as written: generator flags given with it would be ignored."""
+    if given:
+        flags = " ".join(gen_options.flag_text(n, getattr(args, n)) for n in given)
+        raise FlannError(f"{target}: a design directory is {verb} as written, {flags} would be ignored; "
+                         f"regenerate it with flann gen MODEL -o DIR {flags}, or pass a model.json")
 
 
 def add_arguments(parser) -> None:
@@ -33,7 +53,7 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    opts = gen_options.from_args(args)
+    opts, _given = generator_options(args)
     if args.family is not None or args.model is None:
         check_family_args(args)
         dp, source, extra = family_datapath(args.family), args.family, {"margin": args.margin}

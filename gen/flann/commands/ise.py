@@ -12,9 +12,10 @@ HELP = "write an ISE 10.1 project for the generated VHDL"
 
 def add_arguments(p):
     p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
-    p.add_argument("--device", default=DEFAULT_PART, metavar="PART",
-                   help="Spartan-II part DEVICE-PACKAGE-SPEED, e.g. xc2s15-tq144-5 (default %(default)s; "
-                        "the example pin map is for PQ208, on other packages ISE chooses the pins)")
+    p.add_argument("--device", default=None, metavar="PART",
+                   help="Spartan-II part DEVICE-PACKAGE-SPEED, e.g. xc2s15-tq144-5 (default: the part in "
+                        f"DIR/manifest.json, as for flann synth, else {DEFAULT_PART}; the example pin map is for "
+                        "PQ208, on other packages ISE chooses the pins)")
     p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
     p.add_argument("--force", action="store_true",
                    help="write the project even when the design's resource estimate (or, without one, its synthesized "
@@ -27,6 +28,8 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    # the part the design was generated for unless another is asked for, as flann synth does
+    args.device = args.device or ise.design_device(args.directory)
     parse_part(args.device)  # refuse a bad part before synthesis
     ise.check_directory_fits(args.directory, args.device, force=args.force)
     clock = args.clock_mhz

@@ -15,17 +15,18 @@ from pathlib import Path
 
 from ..argtypes import png_path
 from ..errors import FlannError
-from ..fileio import atomic_write_json
-from ..hardware import options as gen_options
+from ..fileio import atomic_write_json, check_output_directory
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
 from ..implement import ice40
-from ..verify.design import open_design
+from ..verify.design import is_design_dir, open_design
 from ..verify.datapaths import simulate
 from ..verify.netlist import require_sweep_driver
 from ..verify.post_route import checker
 from ..verify.plots import plot
 from ..verify.runner import ENGINES
 from ..verify.shards import terminal_progress
+from ..hardware import options as gen_options
+from .gen import generator_options, refuse_generator_options
 
 HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
 
@@ -61,7 +62,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--seed", type=int, default=1, help="seed of the random stimuli (default %(default)s)")
     parser.add_argument("--image", action="append", metavar="HEX", default=None,
                         help="a family design: a sensor's weight image (flann calibrate) to load through the "
-                             "cfg port, each simulated; give two or more (one or more for a design with temperature; "
+                             "cfg port, each simulated (one alone, on a family without temperature: loaded over an "
+                             "image the design keeps, so that the load is seen to change the outputs; "
                              "default: the images flann gen kept in DIR, for a design with temperature its last)")
     parser.add_argument("--summary-json", metavar="FILE", default=None, help="also write the summary here")
     gen_options.add_arguments(parser)
@@ -81,7 +83,14 @@ def image_names(paths) -> list[dict]:
 
 
 def run(args) -> int:
-    opts = gen_options.from_args(args).to_kwargs()
+    opts, given = generator_options(args)
+    opts = opts.to_kwargs()
+    if is_design_dir(args.model):
+        refuse_generator_options(args.model, args, given, "simulated")
+    if args.build:
+        # a file (or FIFO) where the build directory goes: one line now, not a traceback later;
+        # a directory already holding files (an earlier build) is reused
+        check_output_directory(args.build, lambda _earlier: True, "build directory")
     if args.post_route:
         parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
     with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:

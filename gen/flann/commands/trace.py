@@ -20,9 +20,10 @@ from ..golden.model import load_model
 from ..recordings import read_recordings
 from ..analysis.trace import (TWO_INPUT_STAGE_MODELS, check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
                               trace_design)
-from ..hardware import options as gen_options
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
 from ..verify.design import from_directory
+from ..hardware import options as gen_options
+from .gen import generator_options, refuse_generator_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
 FORMATS = REGISTRY_FORMATS
@@ -48,7 +49,7 @@ def add_arguments(parser) -> None:
 
 
 def _options(args, fmt: str) -> dict:
-    return datapath(fmt).derive_options(gen_options.from_args(args), args.compare)
+    return datapath(fmt).derive_options(generator_options(args)[0], args.compare)
 
 
 def _design_dir(args):
@@ -57,6 +58,7 @@ def _design_dir(args):
         return None
     if args.format is not None or args.compare:
         raise FlannError(f"{args.model}: a design directory is traced as it is (no --format, no --compare)")
+    refuse_generator_options(args.model, args, generator_options(args)[1], "traced")
     return from_directory(args.model, args.design_model)
 
 

@@ -9,6 +9,7 @@ reads it through :func:`read_manifest`, which checks the two fields all of them 
 from __future__ import annotations
 
 import json
+import os
 import re
 from pathlib import Path
 
@@ -96,11 +97,28 @@ def read_manifest(directory) -> Manifest:
         raise FlannError(f"{path}: field 'files' must be a non-empty list of VHDL files in compile order")
     paths = []
     for f in files:
-        p = directory / f
-        if not p.is_file():
-            raise FlannError(f"{path}: listed file {f!r} does not exist in {directory}")
-        paths.append(p)
+        paths.append(_listed_file(path, directory, f))
+        if paths.count(paths[-1]) > 1:
+            raise FlannError(f"{path}: field 'files' lists {f!r} twice")
     return Manifest(directory, top, tuple(paths), data)
+
+
+_VHDL_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+-]*\.vhd")
+
+
+def _listed_file(path: Path, directory: Path, name: str) -> Path:
+    """``directory/name`` for an entry of ``files``: a plain ``*.vhd`` name of a regular file in the
+    directory.  Every consumer hands these to GHDL, cocotb or ISE, so a path out of the directory
+    ('../x.csv', '/etc/passwd', a symlink leading out) or another kind of file is refused here."""
+    if not _VHDL_NAME.fullmatch(name):
+        raise FlannError(f"{path}: listed file {name!r} is not a plain *.vhd file name in {directory} "
+                         "(no directory part, no '..')")
+    p = directory / name
+    if not p.is_file():
+        raise FlannError(f"{path}: listed file {name!r} does not exist in {directory}")
+    if Path(os.path.realpath(p)).parent != Path(os.path.realpath(directory)):
+        raise FlannError(f"{path}: listed file {name!r} leads out of {directory} (a symbolic link)")
+    return p
 
 
 __all__ = ["MANIFEST", "Manifest", "is_design", "read_manifest", "write_design"]

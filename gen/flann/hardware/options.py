@@ -72,8 +72,49 @@ def default(name: str):
     return _DEFAULTS[name]
 
 
+GIVEN = "generator_options_given"  # the parsed command line's names of the options typed on it
+
+
+def _note(namespace, dest: str) -> None:
+    setattr(namespace, GIVEN, (*getattr(namespace, GIVEN, ()), dest))
+
+
+class _Store(argparse.Action):
+    """Store the value and note the option as given: argparse calls an action only for a flag
+    on the command line, so a flag typed at its default value is told from one left out."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        _note(namespace, self.dest)
+
+
+class _SwitchOff(argparse.Action):
+    """A ``--no-...`` flag: store False and note it as given."""
+
+    def __init__(self, option_strings, dest, default=True, help=None):
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, False)
+        _note(namespace, self.dest)
+
+
+def given(args: argparse.Namespace) -> tuple[str, ...]:
+    """The names of the generator options typed on the command line (in field order)."""
+    typed = getattr(args, GIVEN, ())
+    return tuple(n for n in NAMES if n in typed)
+
+
+def flag_text(name: str, value) -> str:
+    """An option as it is typed: ``--input-bits 10``, ``--no-interp``."""
+    md = {f.name: f.metadata for f in fields(GenOptions)}[name]
+    flag = md["flag"] or "--" + name.replace("_", "-")
+    return flag if isinstance(value, bool) else f"{flag} {value}"
+
+
 def add_arguments(parser: argparse.ArgumentParser, only: tuple[str, ...] | None = None) -> None:
-    """Add the generator options (or the ``only`` ones) to a command's parser."""
+    """Add the generator options (or the ``only`` ones) to a command's parser; :func:`given`
+    tells which were typed."""
     g = parser.add_argument_group("architecture and widths (defaults from the error analysis)")
     for f in fields(GenOptions):
         if only is not None and f.name not in only:
@@ -81,10 +122,10 @@ def add_arguments(parser: argparse.ArgumentParser, only: tuple[str, ...] | None 
         md = f.metadata
         if isinstance(f.default, bool):
             # a True default is switched off by its --no-... flag
-            g.add_argument(md["flag"], dest=f.name, action="store_false", help=md["help"])
+            g.add_argument(md["flag"], dest=f.name, action=_SwitchOff, help=md["help"])
             continue
         flag = md["flag"] or "--" + f.name.replace("_", "-")
-        kw = dict(dest=f.name, type=md["type"], default=f.default, help=md["help"])
+        kw = dict(dest=f.name, type=md["type"], default=f.default, help=md["help"], action=_Store)
         if md["choices"]:
             kw["choices"] = md["choices"]
         g.add_argument(flag, **kw)
@@ -95,4 +136,4 @@ def from_args(args: argparse.Namespace) -> GenOptions:
     return GenOptions.of(**{k: getattr(args, k) for k in NAMES if hasattr(args, k)})
 
 
-__all__ = ["GenOptions", "MULT_STYLES", "NAMES", "add_arguments", "default", "from_args"]
+__all__ = ["GenOptions", "MULT_STYLES", "NAMES", "add_arguments", "default", "flag_text", "from_args", "given"]

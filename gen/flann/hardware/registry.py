@@ -10,6 +10,8 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
+from ..numeric.fixed import FixedFormat
+from .adc import ADC_BITS, MAX_DESIGN_INPUT_BITS
 from .datapath import Datapath, Field, _int
 from .family_thermal.build import is_thermal_family
 from .family.datapath import DATAPATH as FAMILY
@@ -19,6 +21,7 @@ from .float18.datapath import DATAPATH as FLOAT18
 from .manifest import MANIFEST, Manifest, read_manifest
 from .seed.datapath import DATAPATH as SEED
 from .thermal.datapath import DATAPATH as THERMAL
+from .thermal.spec import MAX_INPUT_BITS as THERMAL_INPUT_BITS
 
 def _no(what: str):
     def refuse(*_args, **_kw):
@@ -95,7 +98,56 @@ def read_design(directory) -> tuple[Manifest, Datapath]:
         man["datapath"] = name
     dp = DATAPATHS[name]
     dp.check(man, where)
+    if dp is not PLAIN:
+        check_widths(man, where)
     return man, dp
 
 
-__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "FAMILY_THERMAL", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design"]
+# input widths flann gen builds: the one-input datapaths take 16 bits at most, the two-input
+# one more (its grid coarser than the code); the rebuild holds each datapath to its own
+INPUT_BITS = (ADC_BITS[0], max(MAX_DESIGN_INPUT_BITS, THERMAL_INPUT_BITS))
+# what a manifest repeats at its top level of what its spec records: the benches, the netlist
+# sweeps and the ISE pin map read the top level, the rebuilt twin the spec
+REPEATED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "temp_bits", "temp_lsb_c")
+
+
+def _spec_states(spec: dict) -> dict:
+    """The values of REPEATED that ``spec`` records, wherever its datapath keeps them (a key of its
+    own, the width of its ``output`` format, its ``temperature`` object)."""
+    said = {k: spec[k] for k in REPEATED if k in spec}
+    out = spec.get("output")
+    if "output_bits" not in said and isinstance(out, dict) and "width" in out:
+        said["output_bits"] = out["width"]
+    elif "output_bits" not in said and isinstance(out, str):
+        try:
+            said["output_bits"] = FixedFormat.parse(out).width
+        except (FlannError, ValueError):
+            pass  # the datapath's rebuild names a malformed format
+    temp = spec.get("temperature")
+    if isinstance(temp, dict):
+        for key, tkey in (("temp_bits", "bits"), ("temp_lsb_c", "lsb_c")):
+            if key not in said and tkey in temp:
+                said[key] = temp[tkey]
+    return said
+
+
+def check_widths(man: dict, where) -> None:
+    """A flann design's input width within what the generator builds, and its top-level widths
+    and LSBs equal to its spec's: every code of a 64-bit input would be swept for ever, and a
+    top level disagreeing with the spec the twin is rebuilt from tests another design."""
+    lo, hi = INPUT_BITS
+    bits = man["input_bits"]
+    if not lo <= bits <= hi:
+        raise FlannError(f"{where}: field 'input_bits' is {bits}, flann gen builds {lo}..{hi}-bit inputs "
+                         "(regenerate the design with flann gen --input-bits)")
+    adc = man.get("adc_bits")
+    if adc is not None and (isinstance(adc, bool) or not isinstance(adc, int) or not ADC_BITS[0] <= adc <= ADC_BITS[1]):
+        raise FlannError(f"{where}: field 'adc_bits' must be an integer in {ADC_BITS[0]}..{ADC_BITS[1]}, got {adc!r}")
+    for key, value in _spec_states(man["spec"]).items():
+        if key in man and man[key] != value:
+            raise FlannError(f"{where}: field {key!r} is {man[key]!r} but the spec says {value!r}: "
+                             "the manifest was edited; regenerate the design with flann gen")
+
+
+__all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "FAMILY_THERMAL", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design",
+           "check_widths"]

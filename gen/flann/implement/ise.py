@@ -33,12 +33,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from ..hardware.target import CLOCK_HZ, DEFAULT_PART, Part, parse_part
+from ..hardware.target import CLOCK_HZ, Part, parse_part
 from ..errors import FlannError
 from ..fileio import atomic_directory
 from ..textgen import template
 from ..hardware.registry import read_design
-from .synth import Resources, not_fit_message, shortfall, smallest_fit, synthesize
+from .synth import Resources, manifest_device, not_fit_message, shortfall, smallest_fit, synthesize
 from .timing import safe_clock_mhz
 
 CLOCK_PIN = "P77"  # GCK1
@@ -208,6 +208,11 @@ def check_fits(man, dp, part, force: bool = False, warn: bool = True) -> None:
     raise FlannError(f"{why} (--force writes the project anyway)")
 
 
+def design_device(directory) -> str:
+    """The part a design directory was generated for (its manifest's), else the default part."""
+    return manifest_device(read_design(directory)[0])
+
+
 def check_directory_fits(directory, device: str, force: bool = False) -> None:
     """:func:`check_fits` for a design directory, before anything slow runs (the warning
     under ``force`` is :func:`write_ise`'s)."""
@@ -220,11 +225,12 @@ def check_clock_mhz(clock_mhz: float) -> None:
         raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
 
 
-def write_ise(directory, device: str = DEFAULT_PART, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
+def write_ise(directory, device: str | None = None, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
               force: bool = False) -> list[str]:
-    """Write the ISE 10.1 handoff for a generated design; returns the files written."""
-    part = parse_part(device)
+    """Write the ISE 10.1 handoff for a generated design (``device``: default the part its
+    manifest records); returns the files written."""
     man, dp = read_design(directory)
+    part = parse_part(device if device is not None else manifest_device(man))
     check_fits(man, dp, part, force)
     check_clock_mhz(clock_mhz)
     if part.package in PIN_MAP_PACKAGES and part.device.name not in PIN_MAP_DEVICES:
@@ -298,5 +304,5 @@ def summary(files: list[str], out_dir, part: Part | str) -> str:
             f"with ISE 10.1 (see README.txt)")
 
 
-__all__ = ["write_ise", "pin_map", "top_ports", "design_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
+__all__ = ["write_ise", "design_device", "check_directory_fits", "pin_map", "top_ports", "design_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
            "INPUT_PINS", "OUTPUT_PINS"]

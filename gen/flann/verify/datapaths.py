@@ -8,6 +8,7 @@ without a bench is refused in one line saying why.  Every entry returns {"summar
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,9 @@ from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
-from ..hardware.family.images import read_image
+from ..hardware.family.images import parse_hex
+from ..hardware.family.render import design_hash
+from ..inputs import read_text
 from . import plots
 from .design import Design
 from .float18 import run_design
@@ -62,24 +65,66 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-def _images(design: Design, images, least: int) -> list[tuple[dict, list[int]]]:
+# the header lines flann calibrate writes (hardware/family/images.py): the design hashed, the words
+_HEADER_DESIGN = re.compile(r"#\s*design sha256 ([0-9a-f]{64})\b")
+_HEADER_WORDS = re.compile(r"#\s*(\d+) words x (\d+) bits\b")
+
+
+def _image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:
+    """(image, its words) read and checked against the design before anything is simulated: hex
+    words of the memory's width, as many as the design's image holds (``words``), and the design
+    and word count its header names (a weight image flann calibrate wrote says both)."""
+    text = read_text(image["hex"], FlannError, "a weight image (.hex)")
+    got = parse_hex(text, image["hex"])
+    header = [ln.strip() for ln in text.splitlines() if ln.strip().startswith("#")]
+    for line in header:
+        if (m := _HEADER_WORDS.match(line)) and int(m.group(1)) != len(got):
+            raise FlannError(f"{image['hex']}: {len(got)} words, its header says {m.group(1)}: the image is cut "
+                             "short or was edited; write it again with flann calibrate")
+    if len(got) != words:
+        raise FlannError(f"{image['hex']}: {len(got)} words, {design.directory}'s weight image is {words} words "
+                         "(an image of another design?)")
+    named = [m.group(1) for line in header if (m := _HEADER_DESIGN.match(line))]
+    if named and named[0] != (ours := design_hash(design.directory)):
+        raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[0][:12]}..., "
+                         f"{design.directory} is {ours[:12]}...): calibrate the sensor for this design "
+                         "(flann calibrate --design DIR)")
+    return image, got
+
+
+def _images(design: Design, images, words: int) -> list[tuple[dict, list[int]]]:
     """The weight images a family bench loads, ({name, hex}, words) each: those given (--image),
-    else the ones flann gen kept in the design; read here, so a bad file is one line, not a
-    failed bench."""
-    given = bool(images)
-    images = list(images or [{"name": im["name"], "hex": str(design.directory / im["hex"])}
-                             for im in design.manifest.get("images", [])])
-    loaded = [(im, read_image(im["hex"])) for im in images]
-    if len(images) < least:
-        held = f"got {len(images)} --image" if given else f"the design holds {len(images)}"
-        raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads {least} sensor weight "
-                         f"image(s) through the cfg port; {held} (pass --image A.hex"
-                         f"{' --image B.hex' if least > 1 else ''}, written by flann calibrate)")
+    else the ones flann gen kept in the design; each checked by :func:`_image`, so a bad file is
+    one line before the simulation, not a failed bench after it."""
+    images = list(images or _kept_images(design))
+    return [_image(design, im, words) for im in images]
+
+
+def _kept_images(design: Design) -> list[dict]:
+    return [{"name": im["name"], "hex": str(design.directory / im["hex"])} for im in design.manifest.get("images", [])]
+
+
+def _two_images(design: Design, loaded: list, given: bool) -> list:
+    """The family bench loads two images, the second over the first, so that a load is seen to
+    change the outputs: one image given goes second, after an image the design keeps (one that
+    differs from it where the design keeps one)."""
+    if given and len(loaded) == 1:
+        (image, words), = loaded
+        kept = sorted(_images(design, _kept_images(design), len(words)), key=lambda k: k[1] == words)
+        if kept:
+            # named by the design's folder: the summary shows it is the design's own, not one given
+            im, first = kept[0]
+            return [({**im, "name": f"{design.directory.name}/{im['name']}"}, first), *loaded]
+    if len(loaded) < 2:
+        held = f"got {len(loaded)} --image and the design keeps none" if given else f"the design keeps {len(loaded)}"
+        raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads two weight images through the "
+                         f"cfg port, one over the other (a load must be seen to change the outputs); {held}: pass "
+                         "--image A.hex --image B.hex (written by flann calibrate)")
     return loaded
 
 
 def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
-    loaded = _images(design, images, 2)
+    loaded = _two_images(design, _images(design, images, design.spec.mem_depth), bool(images))
     images = [im for im, _words in loaded]
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
@@ -181,12 +226,10 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     initial sensor, so the cfg port is what loads it), at every voltage code and the stated
     temperature codes: one run of the sweep harness per image."""
     spec, man = design.spec, design.manifest
-    loaded = _images(design, images, 1)
-    if not images:
-        loaded = loaded[-1:]
-    for image, words in loaded:
-        if len(words) != spec.image_words:
-            raise FlannError(f"{image['hex']}: {len(words)} words, the design's image is {spec.image_words}")
+    loaded = _images(design, images or _kept_images(design)[-1:], spec.image_words)
+    if not loaded:
+        raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads a sensor weight image through "
+                         "the cfg port; the design holds none: pass --image A.hex (written by flann calibrate)")
     temps = family_thermal_temperature_codes(spec)
     build_dir = Path(build_dir).resolve()
     samples = len(temps) * (spec.code_max - spec.code_min + 1)

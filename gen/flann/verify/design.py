@@ -78,7 +78,22 @@ def from_directory(directory, model=None) -> Design:
         dp.rebuild(None, man, where)  # says why this datapath has no twin rebuilt from a directory
     model = design_model(directory, man, dp, model)
     spec, options = dp.rebuild(model, man, where)
+    _check_top_level(man, spec, directory / MANIFEST)
     return Design(directory, man, model, options, spec, dp)
+
+
+def _check_top_level(man: dict, spec, where) -> None:
+    """The manifest's top-level widths and LSBs (the benches and plots read them) equal to the
+    rebuilt spec's, for what a spec records outside its manifest object (read_design compares
+    the rest)."""
+    out = getattr(spec, "out_fmt", None)
+    rebuilt = {key: getattr(spec, key, None) for key in ("input_bits", "input_lsb_v", "output_lsb_mm",
+                                                         "temp_bits", "temp_lsb_c")}
+    rebuilt["output_bits"] = getattr(out, "width", None)
+    for key, value in rebuilt.items():
+        if value is not None and key in man and man[key] != value:
+            raise FlannError(f"{where}: field {key!r} is {man[key]!r} but the design's spec gives {value!r}: "
+                             "the manifest was edited; regenerate the design with flann gen")
 
 
 def open_design(target, build_dir, options: dict | None = None, model=None) -> Design:
