@@ -135,3 +135,10 @@ def test_lut_ram_is_read_through_a_lut_level(tmp_path):
              _ff(99, 3), ("GND", {"G": [40]})]
     t = analyse(_netlist(tmp_path, cells), PART5)
     assert t.logic_levels == 2 and t.delay_ns == pytest.approx(1.3 + 1.0 + 0.7 + 1.0 + 1.4)
+
+
+def test_a_combinational_block_has_no_clock_to_estimate(tmp_path):
+    """A datapath's block synthesised alone (bench/bench_float18.py's flann_f18_cvt) stopped
+    flann synth with "no register-to-register path"; it is reported as having none."""
+    cells = [("LUT2", {"I0": [10], "I1": [11], "O": [12]}), ("LUT1", {"I0": [12], "O": [99]})]
+    assert analyse(_netlist(tmp_path, cells), PART5) is None

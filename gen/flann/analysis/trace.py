@@ -442,9 +442,10 @@ def plot_trace(result: TraceResult | ThermalTraceResult, path, title: str = "") 
     plt.close(fig)
 
 
-def plot_compare(results: dict, path, points: dict | None = None, title: str = "") -> None:
+def plot_compare(results: dict, path, points: dict | None = None, title: str = "",
+                 points_label: str = "the recordings' inputs") -> None:
     """Total error (hardware - golden) of several formats on the same axes, as the seed's
-    Fig. 6(b); ``points``: {fmt: at_voltages() rows} drawn as markers."""
+    Fig. 6(b); ``points``: {fmt: at_voltages() rows} drawn as markers, named ``points_label``."""
     # matplotlib: imported when a plot is drawn (see plot_trace)
     import matplotlib
     matplotlib.use("Agg")
@@ -458,7 +459,7 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
                 label=f"{fmt}: every input code (max {r.total['max_mm']:.3g} mm, rms {r.total['rms_mm']:.2g} mm)")
     for fmt, rows in (points or {}).items():
         ax.plot([p["voltage_v"] for p in rows], [p["error_mm"] for p in rows], "o", ms=5,
-                color=colours.get(fmt), markeredgecolor="k", label=f"{fmt}: Table 1 inputs")
+                color=colours.get(fmt), markeredgecolor="k", label=f"{fmt}: {points_label}")
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xlabel("input (V)")
     ax.set_ylabel("hardware − golden model (mm)")

@@ -89,7 +89,8 @@ def run(args) -> int:
         points = {f: r.at_voltages(rec.voltage_v) for f, r in results.items()}
     if args.plot:
         if args.compare:
-            plot_compare(results, args.plot, points, title=f"hardware − golden: {args.model}")
+            plot_compare(results, args.plot, points, title=f"hardware − golden: {args.model}",
+                         points_label=f"inputs of {Path(args.at).name}" if args.at else "")
         else:
             plot_trace(results[args.format], args.plot, title=f"flann trace {args.model} ({args.format})")
     if args.json:

@@ -286,7 +286,7 @@ def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full",
     if not force and not report.fits:
         raise FlannError(f"{not_fit_message(report)} (synthesized; --force writes the project anyway)")
     t = report.timing
-    if t.meets(clock_mhz * 1e6):
+    if t is None or t.meets(clock_mhz * 1e6):   # a combinational block has no path to clock
         return clock_mhz, None
     safe = safe_clock_mhz(t)
     return safe, (f"{report.top} is estimated at {t.fmax_mhz:.1f} MHz on {report.part.name} ({t.logic_levels} LUT "

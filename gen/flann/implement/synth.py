@@ -188,7 +188,9 @@ class SynthReport:
         cps = self.manifest.get("cycles_per_sample")
         if cps:
             lines.append(f"  {'cycles per sample':<20} {cps:>6}")
-        if self.timing:
+        if self.timing is None:
+            lines.append(f"  {'Fmax estimate':<20}   none: no register-to-register path (a combinational block)")
+        else:
             t = self.timing
             lines.append(f"  {'Fmax estimate':<20} {t.fmax_mhz:6.1f} MHz (-{t.grade}: {t.logic_levels} LUT levels, "
                          f"{t.carry_bits} carry bits, {t.delay_ns:.1f} ns; DS001 figures + routing allowance)")

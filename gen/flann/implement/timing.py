@@ -125,8 +125,9 @@ def _bits(conn) -> list:
     return [b for b in conn if isinstance(b, int)]  # "0"/"1"/"x" are constants
 
 
-def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Timing:
-    """Longest register-to-register path of ``netlist_json`` (flattened Yosys JSON)."""
+def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Timing | None:
+    """Longest register-to-register path of ``netlist_json`` (flattened Yosys JSON); None for a
+    purely combinational block (a datapath's block synthesised alone), which has no clock."""
     data = json.loads(Path(netlist_json).read_text())
     mod = data.get("modules", {}).get(top)
     if mod is None:
@@ -251,7 +252,7 @@ def analyse(netlist_json: str | Path, part: Part, top: str = "flann_top") -> Tim
             if best is None or total > best[0]:
                 best = (total, b, routed, name)
     if best is None:
-        raise FlannError("timing estimate: no register-to-register path in the netlist")
+        return None
     total, bit, routed, end = best
     levels, carry, nets = 0, 0, int(routed)
     b = bit
