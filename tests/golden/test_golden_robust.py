@@ -69,6 +69,12 @@ def test_converter_is_read_from_the_recordings_grid_and_gen_warns_for_another(tm
     rc, _, err = run(["gen", tmp_path / "m.json", "-o", tmp_path / "h14", "--input-bits", 14,
                       "--input-lsb-v", f"{lsb:.9g}"], capsys)
     assert rc == 0 and "14-bit converter" not in err
+    # the converter's width alone: the volts per code are then derived from the voltage range,
+    # which reads other codes than the recording's converter did; said once
+    rc, _, err = run(["gen", tmp_path / "m.json", "-o", tmp_path / "h14b", "--input-bits", 14], capsys)
+    warned = [line for line in err.splitlines() if line.startswith("warning:")]
+    assert rc == 0 and len(warned) == 1 and "derived from the model's voltage range" in warned[0]
+    assert f"{lsb:.6g} V converter" in warned[0] and "--input-lsb-v" in warned[0]
 
 
 def test_four_sweeps_train_and_their_repeats_give_the_noise(tmp_path, capsys):

@@ -12,7 +12,7 @@ import warnings
 
 from ..errors import FlannError
 from ..golden.thermal import load_any_model
-from ..golden.train import converter_mismatch
+from ..golden.train import converter_mismatch, converter_text, judged_converter, same_converter
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
 from ..hardware.registry import FORMATS, datapath_for_model, family_datapath
@@ -54,6 +54,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     opts, _given = generator_options(args)
+    model, other = None, ""
     if args.family is not None or args.model is None:
         check_family_args(args)
         dp, source, extra = family_datapath(args.family), args.family, {"margin": args.margin}
@@ -61,11 +62,20 @@ def run(args) -> int:
             extra["terms"] = args.terms
     else:
         dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
-        other = converter_mismatch(load_any_model(args.model), opts.input_bits, opts.input_lsb_v)
+        model = load_any_model(args.model)
+        other = converter_mismatch(model, opts.input_bits, opts.input_lsb_v)
         if other:
             warnings.warn(other)
     replacing = is_design(args.out)
     man = dp.generate(source, args.out, opts, **extra)
+    if model is not None and opts.input_lsb_v is None and not other:
+        # the volts per code were derived from the model's voltage range, not given: say so when
+        # the model knows the converter it was recorded with and that one reads other codes
+        conv = judged_converter(model)
+        if conv is not None and not same_converter(conv, man["input_bits"], man["input_lsb_v"]):
+            warnings.warn(f"{args.out}: input LSB {man['input_lsb_v']:.6g} V, derived from the model's voltage "
+                          f"range (no --input-lsb-v), but the model was judged for a {converter_text(*conv[:2])} "
+                          f"converter ({conv[2]}): give --input-lsb-v for the converter the design will read")
     if replacing:
         print(f"flann gen: replaced the flann design in {args.out}", file=sys.stderr)
     if args.json:

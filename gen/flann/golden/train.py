@@ -537,20 +537,36 @@ def _cheapest(v, x, results: list[CvResult], cost) -> tuple[CvResult, FlannModel
     return choice, model, info
 
 
+def judged_converter(model) -> tuple[int, float | None, str] | None:
+    """(bits, volts per code or None, where it came from) of the converter ``model`` was judged
+    buildable at (``training.converter``), or None."""
+    conv = model.training.get("converter") if isinstance(getattr(model, "training", None), dict) else None
+    if not isinstance(conv, dict) or not isinstance(conv.get("input_bits"), int):
+        return None
+    lsb = conv.get("input_lsb_v")
+    return conv["input_bits"], None if lsb is None else float(lsb), str(conv.get("from", "?"))
+
+
+def same_converter(judged: tuple[int, float | None, str], input_bits: int, input_lsb_v: float | None) -> bool:
+    bits, lsb, _ = judged
+    return bits == input_bits and (lsb is None or input_lsb_v is None
+                                   or abs(float(input_lsb_v) - lsb) <= 1e-3 * abs(lsb))
+
+
+def converter_text(bits: int, lsb: float | None) -> str:
+    return f"{bits}-bit" + (f" x {lsb:.6g} V" if lsb is not None else "")
+
+
 def converter_mismatch(model: FlannModel, input_bits: int, input_lsb_v: float | None) -> str:
     """'' when ``model`` was judged buildable at this converter (or at none in particular),
     else one line saying which converter it was judged for."""
-    conv = model.training.get("converter") if isinstance(model.training, dict) else None
-    if not isinstance(conv, dict) or not isinstance(conv.get("input_bits"), int):
+    conv = judged_converter(model)
+    if conv is None or same_converter(conv, input_bits, input_lsb_v):
         return ""
-    bits, lsb = conv["input_bits"], conv.get("input_lsb_v")
-    same_lsb = (lsb is None or input_lsb_v is None
-                or abs(float(input_lsb_v) - float(lsb)) <= 1e-3 * abs(float(lsb)))
-    if bits == input_bits and same_lsb:
-        return ""
-    judged = f"{bits}-bit" + (f" x {lsb:.6g} V" if lsb is not None else "")
+    bits, lsb, _ = conv
+    judged = converter_text(bits, lsb)
     given = f"{input_bits}-bit" + (f" x {input_lsb_v:.6g} V" if input_lsb_v is not None else "")
-    return (f"the model's terms and widths were chosen for a {judged} converter ({conv.get('from', '?')}), "
+    return (f"the model's terms and widths were chosen for a {judged} converter ({conv[2]}), "
             f"this design is for {given}: retrain with flann train --input-bits {input_bits}"
             + (f" --input-lsb-v {input_lsb_v:.6g}" if input_lsb_v is not None else "")
             + " for a model judged at this converter")
