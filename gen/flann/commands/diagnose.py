@@ -5,8 +5,9 @@ from __future__ import annotations
 import json
 import sys
 
-from ..argtypes import png_path
+from ..argtypes import bounded, png_path
 from ..diagnose import diagnose
+from ..diagnose.data import MAX_POINTS
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
 from ..errors import FlannError
@@ -32,6 +33,10 @@ def add_arguments(p) -> None:
                         "print the table")
     p.add_argument("--limits", action="store_true",
                    help="with --demo: also measure detection limits (slow: many simulations)")
+    p.add_argument("--max-points", type=bounded(int, 0), default=MAX_POINTS, metavar="N",
+                   help="diagnose a recording of more rows than N on about N means of "
+                        "neighbouring readings of a pass (the report says so); 0: every row "
+                        "(time and memory grow quickly; default %(default)d)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal anyway)")
 
 
@@ -72,13 +77,16 @@ def run(args) -> int:
     sensor = None
     if args.sensor:
         sensor = load_sensor(args.sensor)
-    dg = diagnose(rec, sensor=sensor, progress=_progress(args.quiet))
+    dg = diagnose(rec, sensor=sensor, progress=_progress(args.quiet),
+                  max_points=args.max_points)
+    # both reports are built before any file is written: a failure leaves no output behind
+    obj, text = to_json(dg), format_text(dg)
     if args.plot:
         plot(dg, args.plot)
     if args.json == "-":
-        print(json.dumps(to_json(dg), indent=2))
+        print(json.dumps(obj, indent=2))
     else:
         if args.json:
-            atomic_write_json(args.json, to_json(dg))
-        print(format_text(dg), end="")
+            atomic_write_json(args.json, obj)
+        print(text, end="")
     return 0

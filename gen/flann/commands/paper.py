@@ -91,8 +91,11 @@ def _print_report(rec, out, details, args, offset_scale) -> None:  # noqa: C901
               f"{details['models'][t].training['mse_per_epoch'][-1]:15.3g}")
     print("LOO: each point held out in turn, same method; 'interior' leaves out the two end "
           "points, whose held-out error is extrapolation.")
-    print(f"Between the {len(rec)} points: leave-one-out, and a dense sweep of v compared with "
-          "the monotone PCHIP interpolant of the points:")
+    positions = np.unique(rec.displacement_mm).size
+    repeats = (f" ({positions} positions: repeated readings averaged per position for the "
+               "interpolant)" if positions < len(rec) else "")
+    print(f"Between the {len(rec)} points{repeats}: leave-one-out, and a dense sweep of v compared "
+          "with the monotone PCHIP interpolant of the points:")
     default = fit_lstsq(rec.voltage_v, rec.displacement_mm, 51, norm="range")
     auto = paper.default_fit(rec, fixed_point_cost)
     designs = (("51 terms, paper LMS", details["models"][51],

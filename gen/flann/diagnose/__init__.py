@@ -7,7 +7,7 @@ simulation + smooth shape term + catalogue effects as one least-squares family) 
 steps in order) -> :mod:`.explain` / :mod:`.report` (sentences, JSON, text, plot).
 :mod:`.demo` proves it on recordings with concealed effects from two forward models.
 
-Public API: :func:`diagnose` (Recordings, sensor=None) -> :class:`Diagnosis`.
+Public API: :func:`diagnose` (Recordings, sensor=None, max_points=None) -> :class:`Diagnosis`.
 """
 
 from .pipeline import Diagnosis, EffectReport, diagnose

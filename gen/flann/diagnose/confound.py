@@ -68,7 +68,8 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     if not named:
         return none_confounded(named)
     first = sel.trials[0] if sel.trials else []
-    strong = [t.name for t in first if math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN]
+    strong = [t.name for t in first if math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN
+              and not t.vetoed]
     pool = [c for c in candidates if c in named or c in strong]
     if len(pool) <= len(named):
         return none_confounded(named)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import RecordingsError
+from ..recordings import OPTIONAL, REQUIRED, Recordings
 from ..recordings.checks import row_directions, run_lengths
 
 MIN_POINTS = 6
@@ -26,6 +27,14 @@ MIN_POINTS = 6
 OUTLIER_Z = 5.0
 # a running mean of w residuals is "off" when it exceeds REGION_Z * sigma / sqrt(w)
 REGION_Z = 4.5
+# flann diagnose takes means beyond this many readings: its time and memory grow faster than
+# the points (900,000 took 4 GB and 3.5 minutes), and a few thousand already resolve every
+# effect of the catalogue
+MAX_POINTS = 5_000
+# means a pass keeps when its readings alone are averaged, and positions a pass keeps when
+# consecutive passes are averaged too (see reduce_points)
+MIN_PASS_BINS = 20
+PASS_POSITIONS = 200
 
 
 @dataclass(frozen=True)
@@ -97,6 +106,75 @@ def find_passes(x: np.ndarray, direction: np.ndarray | None) -> Passes:
     if len(runs) > 1 and np.median(run_lengths(d)) < 4:
         return Passes(None, (np.argsort(x, kind="stable"),), inferred=True, ordered=False)
     return Passes(direction=d, runs=runs, inferred=True, ordered=True)
+
+
+def reduce_points(rec: Recordings, max_points: int | None) -> tuple[Recordings, str]:
+    """About ``max_points`` rows for the diagnosis, and one sentence saying how.
+
+    Means over cells of (stretch of the recording, direction of travel, position).  While
+    every pass keeps ``MIN_PASS_BINS`` means, a cell is ``k`` neighbouring positions of one
+    pass (a mean never spans a turn: what ``flann calibrate`` does for its diagnosis).  With
+    more passes than that (many repeated sweeps) a pass keeps up to ``PASS_POSITIONS``
+    positions and a cell also takes the same positions of ``g`` consecutive passes of its
+    direction: the curve keeps its shape and the recording its order in time (drift,
+    temperature) in steps of ``g`` passes.  Rows in no order are sampled evenly instead.
+    ``max_points`` None or 0, or no more rows: ``rec`` itself and "".
+    """
+    n = len(rec)
+    if not max_points or n <= max_points:
+        return rec, ""
+    x = np.asarray(rec.displacement_mm, dtype=float)
+    passes = find_passes(x, None if rec.direction is None else np.asarray(rec.direction, float))
+    if not passes.ordered:
+        idx = np.unique(np.linspace(0, n - 1, int(max_points)).round().astype(np.int64))
+        return rec.subset(idx), (f"{idx.size} of the {n} readings, evenly sampled (the rows are "
+                                 "in no order); row numbers below count those")
+    factor = -(-n // int(max_points))
+    run_id = np.empty(n, np.int64)
+    for i, r in enumerate(passes.runs):
+        run_id[r] = i
+    length = int(np.median([r.size for r in passes.runs]))
+    if len(passes.runs) * MIN_PASS_BINS <= max_points:
+        k, g = factor, 1      # few passes: means of neighbouring readings of each
+    else:
+        # many short passes (repeated sweeps): the curve needs its positions more than the
+        # time order needs every pass
+        k = int(min(factor, max(1, length // PASS_POSITIONS)))
+        g = -(-factor // k)
+    dx = np.abs(np.diff(x))[run_id[1:] == run_id[:-1]]
+    dx = dx[dx > 0]
+    step = float(np.median(dx)) if dx.size else float(np.ptp(x)) / max(length, 1)
+    direction = passes.direction
+    dirs = np.unique(direction)
+    # runs alternate direction: a block of g runs of each holds g passes each way
+    block = run_id // (g * dirs.size)
+    # positions on the actuator's grid fall in the middle of their bin (jitter stays in it)
+    pos = np.floor(((x - x.min()) / step + 0.5) / k).astype(np.int64)
+    side = (direction > 0).astype(np.int64)
+    key = (block * 2 + side) * (int(pos.max()) + 1) + pos
+    _, first, inv = np.unique(key, return_index=True, return_inverse=True)
+    count = np.bincount(inv)
+    mean = {name: (None if getattr(rec, name) is None else
+                   np.bincount(inv, weights=np.asarray(getattr(rec, name), float)) / count)
+            for name in REQUIRED + OPTIONAL}
+    # cells in recording order: block by block, each direction's pass in the order it came,
+    # positions along it (so the passes read from the order are the recording's)
+    d_cell = np.bincount(inv, weights=direction) / count
+    b_cell = block[first]
+    first_of_block = {}
+    for b, i in zip(b_cell, first):
+        first_of_block[b] = min(first_of_block.get(b, n), i)
+    rank = np.array([0 if direction[first_of_block[b]] == d else 1
+                     for b, d in zip(b_cell, d_cell)])
+    order = np.lexsort((mean["displacement_mm"] * np.sign(d_cell), rank, b_cell))
+    cols = {name: None if a is None else a[order] for name, a in mean.items()}
+    small = Recordings(**cols, source=rec.source, sha256=rec.sha256, comments=rec.comments)
+    cell = (f"up to {k} neighbouring positions of a pass, {k * step:.2g} mm" if k > 1
+            else "each position of a pass")
+    over = f" and of {g} consecutive passes of its direction" if g > 1 else ""
+    return small, (f"{len(small)} means of the {n} readings ({cell}{over}): effects varying "
+                   "over less than that are averaged out, noise figures are those of a mean "
+                   "and row numbers below count the means")
 
 
 def _sorted_groups(x: np.ndarray, passes: Passes, min_size: int = 3) -> list[np.ndarray]:

@@ -69,11 +69,19 @@ def explain(name: str, params: dict, contrib: np.ndarray, x: np.ndarray,
         trange = ""
         if temperature is not None:
             trange = f" (temperature {np.min(temperature):.3g}..{np.max(temperature):.3g} degC)"
+        k = p["coefficient_per_c"]
+        drift, note = f"{k * 100:+.3g} %/degC", ""
+        seen = _drift_of_output(contrib, y, temperature, p.get("reference_temperature_c"))
+        if seen is not None and abs(seen - k) > 0.1 * abs(k):
+            # the coefficient scales the fitted simulation, whose gain can trade with the
+            # shape term: the drift of what was recorded is the number to act on
+            drift = f"{seen * 100:+.3g} %/degC of the recorded output"
+            note = (f"; coefficient_per_c ({k * 100:+.3g} %/degC) is relative to the fitted "
+                    "simulation, whose gain trades with the shape term")
         return (f"the residual follows the recorded temperature{trange} rather than the "
                 f"displacement, scaling with the output itself (up to {_mv(big)} where the "
-                f"output is largest): the sensitivity drifts by "
-                f"{p['coefficient_per_c'] * 100:+.3g} %/degC (primary copper resistance, core "
-                "permeability).")
+                f"output is largest): the sensitivity drifts by {drift} (primary copper "
+                f"resistance, core permeability){note}.")
     if name == "adc_clipping":
         rails = " and ".join(f"{p[k]:+.4g} V" for k in ("rail_high_v", "rail_low_v") if k in p)
         if "readings_on_rail" in p:
@@ -91,6 +99,16 @@ def explain(name: str, params: dict, contrib: np.ndarray, x: np.ndarray,
                 f"periodic position error of {abs(p['amplitude_mm']) * 1e3:.3g} um in the "
                 "actuator's lead screw (pitch, eccentricity).")
     return f"{name}: residual pattern up to {_mv(big)} explained by this effect."
+
+
+def _drift_of_output(contrib, y, temperature, t_ref) -> float | None:
+    """Relative drift per degC of the recorded output that ``contrib`` amounts to (least
+    squares of contrib on y (T - t_ref)), or None without temperatures."""
+    if temperature is None or t_ref is None:
+        return None
+    u = y * (np.asarray(temperature, float) - t_ref)
+    den = float(u @ u)
+    return float(contrib @ u) / den if den > 0 else None
 
 
 def _halves(x, y, contrib, origin) -> str:

@@ -43,6 +43,12 @@ SHAPE_TERMS = (0, 2, 3, 4, 6, 8, 10, 12, 14, 16)
 STOP_AFTER = 2
 # relative singular-value cut-off of the shape term's least squares
 RCOND = 1e-10
+# the shape bases a family keeps for reuse, at most (bytes)
+CACHE_BYTES = 200e6
+# readings a fitted rail clips that rise by more than this fraction of the unclipped model's
+# rise, and by RAIL_T standard errors, are not on a rail (see PhysicsFamily.implausible)
+RAIL_SLOPE = 0.1
+RAIL_T = 3.0
 # Levenberg-Marquardt stops when the relative change of the sum of squares (and of the
 # step) is below this: 1e-5 of the RSS moves BIC (n ln RSS) by 0.02 on 2,000 points, far
 # inside the 10 it must move by; tighter only wandered on (up to 4x the evaluations)
@@ -383,7 +389,10 @@ class PhysicsFamily:
         key = ("disc", basis.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         hit = self._shape_cache.get(key)
         if hit is None:
-            if len(self._shape_cache) > 400:
+            # bounded in bytes too: an entry (basis and pseudo-inverse) is 2 n K floats, and
+            # 400 of them on 10,000 points with 32 columns held 2 GB
+            held = sum(2 * v[0].nbytes for k, v in self._shape_cache.items() if k[0] == "disc")
+            if len(self._shape_cache) > 400 or held > CACHE_BYTES:
                 self._shape_cache.clear()
             B = basis.evaluate(core)
             store: list = []
@@ -670,6 +679,43 @@ class PhysicsFamily:
         best = min(table.values())
         tied = sorted(k for k, v in table.items() if v <= best * 1.01)
         return tied[0], table, fits[tied[0]], tuple(tied)
+
+    def implausible(self, candidate: str, fit: Fit, idx: np.ndarray) -> str:
+        """Why ``fit`` does not show the physics ``candidate`` names ("" when it may).
+
+        A fitted rail must be flat: the readings where the unclipped model passes it sit on
+        it, whatever the model would have read there.  On the ends of a curve the model
+        overshoots (a temperature recording's bin means), a "rail" cutting the model off
+        lowers BIC although the readings it clips still rise with the curve: not a
+        converter's rail.  Judged by the slope of those readings against the unclipped
+        model (0 on a rail, 1 on the curve), which the clipped readings must span well enough
+        to tell.
+        """
+        if candidate != "adc_clipping":
+            return ""
+        theta = fit.theta.copy()
+        sides = [(i, n.endswith("_high_v")) for i, n in enumerate(fit.names)
+                 if n.startswith("adc_clipping.")]
+        for i, high in sides:
+            theta[i] = math.inf if high else -math.inf
+        u = self.evaluate_like(fit, theta, idx)
+        y = self.data_y(idx)
+        for i, high in sides:
+            rail = float(fit.theta[i])
+            on = u > rail if high else u < rail
+            where = f"{rail:+.4g} V"
+            du = u[on] - np.mean(u[on]) if on.any() else np.zeros(0)
+            spread = float(du @ du)
+            # below one noise of spread the slope is not known to within 1: nothing flat seen
+            if on.sum() < 2 or spread <= fit.rms ** 2:
+                return (f"a rail at {where} would clip {int(on.sum())} reading(s) over which "
+                        "the curve hardly moves: no flat run to tell from the curve's end")
+            slope = float(du @ (y[on] - np.mean(y[on]))) / spread
+            se = fit.rms / math.sqrt(spread)
+            if slope > RAIL_SLOPE and slope > RAIL_T * se:
+                return (f"the readings beyond {where} still follow the curve ({slope:.0%} of its "
+                        "rise): not a flat rail")
+        return ""
 
     def least_evidence(self, effects, candidate: str, idx: np.ndarray, without: Fit,
                        with_: Fit) -> float:

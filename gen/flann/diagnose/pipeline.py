@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -84,6 +84,8 @@ class Diagnosis:
     # the candidates tried in each round of the selection (the report names the closest)
     trials: list[list[Trial]] = field(repr=False, default_factory=list)
     plot: PlotArrays | None = field(repr=False, default=None)
+    # how a long recording was reduced to means before the diagnosis ({} when it was not)
+    reduced: dict = field(default_factory=dict)
 
     @property
     def named(self) -> list[str]:
@@ -215,6 +217,16 @@ def rails_pass(shape: ShapeResult) -> RailsResult:
     for r in rails:
         on_rail |= r["mask"]
     off = np.flatnonzero(~on_rail)
+    if rails and (off.size < D.MIN_POINTS or np.unique(x[off]).size < 4):
+        # the simulation is calibrated to the readings between the rails: a step between
+        # two levels leaves none (or too few) to calibrate it to
+        levels = " and ".join(f"{r['level_v']:+.4g} V" for r in rails)
+        raise RecordingsError(
+            f"{shape.source}: {int(on_rail.sum())} of {x.size} readings sit on flat levels at "
+            f"the ends of the travel ({levels}) and only {off.size} at "
+            f"{np.unique(x[off]).size} displacement(s) lie between them; diagnose needs at "
+            f"least {D.MIN_POINTS} at 4 displacements on the curve between the rails "
+            "(a step has no curve to compare with a simulation)")
     passes_off = D.find_passes(x[off], None if direction is None else direction[off])
     return RailsResult(tuple(rails), on_rail, off, passes_off)
 
@@ -382,7 +394,17 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
     # re-chosen once they are in: see PhysicsFamily.choose_terms)
     k_final = family.terms_of(final)
     basis_final = family.basis(k_final)
-    shape_f = family.shape_term(final, all_idx)[fit_idx]
+    # The shape as the difference between the fitted curve with every named effect switched
+    # off and the ideal simulation as calibrated, less what a gain takes.  Not the shape term's
+    # own size: its basis can draw much of the simulated curve, and with effects in the model
+    # the fit may trade gain for shape (a temperature recording doubled gain_ratio and took a
+    # 3 V term back off it, while the two curves differed by 1 mV).
+    curve = _without(family, final, final.effects, fit_idx)
+    ideal = family.evaluate(base.theta, base.names, fit_idx, basis=None)
+    shape_f = curve - ideal
+    den = float(ideal @ ideal)
+    if den > 0:
+        shape_f = shape_f - float(shape_f @ ideal) / den * ideal
     shape_desc = {
         "terms": int(k_final),
         "terms_without_effects": int(term.terms),
@@ -394,7 +416,8 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
                               final.extra.get("cv_table", term.cv_table).items()},
         "meaning": ("a smooth, odd, direction- and time-independent difference between this "
                     "sensor's curve and the simulated one: the shape of this sensor, not an "
-                    "effect"),
+                    "effect; rms_v and peak_v: the fitted curve with the named effects switched "
+                    "off against the calibrated ideal simulation, beyond a change of gain"),
     }
     n_dir = "" if direction is None else (
         "directions " + "/".join(sorted({"+" if v > 0 else "-" for v in np.unique(direction)}))
@@ -426,33 +449,43 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
                         outlier_mask=skip))
 
 
-def diagnose(rec: Recordings, sensor=None, progress=None) -> Diagnosis:
+def diagnose(rec: Recordings, sensor=None, progress=None,
+             max_points: int | None = None) -> Diagnosis:
     """Calibrate the ideal simulation to ``rec``, locate the mismatch, name missing physics.
 
     ``sensor`` (a :class:`flann.physics.sensor.Sensor`) makes geometry and origin known;
     without it the paper's LVDT is the starting point and geometry, gain and origin are
-    calibrated.
+    calibrated.  ``max_points``: a longer recording is diagnosed on means of its readings
+    (:func:`flann.diagnose.data.reduce_points`), which the diagnosis' notes say.
     """
+    n_read = len(rec)
+    rec, how = D.reduce_points(rec, max_points)
     shape = shape_pass(rec, sensor)
     rails = rails_pass(shape)
     calib = calibration_pass(shape, rails, progress)
     term = shape_term_pass(shape, calib, progress)
     chosen = selection_pass(shape, rails, calib, term, progress)
-    return report_pass(shape, rails, calib, term, chosen)
+    dg = report_pass(shape, rails, calib, term, chosen)
+    if how:
+        dg = replace(dg, notes=[how] + dg.notes,
+                     reduced={"points": len(rec), "readings": n_read, "method": how})
+    return dg
 
 
 def _se(fit: Fit, name: str) -> float:
     return float(fit.stderr[fit.names.index(name)])
 
 
-def _without(family: PhysicsFamily, fit: Fit, effect: str, idx) -> np.ndarray:
-    """The fitted model's output with ``effect`` switched off (its parameters neutral)."""
+def _without(family: PhysicsFamily, fit: Fit, effects, idx) -> np.ndarray:
+    """The fitted model's output with ``effects`` (a name or several) switched off (their
+    parameters neutral)."""
     theta = fit.theta.copy()
-    neutral = {**EFFECTS[effect].neutral(), **NEUTRAL_EXTRA.get(effect, {}),
-               "rail_high_v": math.inf, "rail_low_v": -math.inf}
-    for i, n in enumerate(fit.names):
-        if n.startswith(effect + "."):
-            theta[i] = neutral[n.split(".", 1)[1]]
+    for effect in ([effects] if isinstance(effects, str) else effects):
+        neutral = {**EFFECTS[effect].neutral(), **NEUTRAL_EXTRA.get(effect, {}),
+                   "rail_high_v": math.inf, "rail_low_v": -math.inf}
+        for i, n in enumerate(fit.names):
+            if n.startswith(effect + "."):
+                theta[i] = neutral[n.split(".", 1)[1]]
     return family.evaluate_like(fit, theta, idx)
 
 

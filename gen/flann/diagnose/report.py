@@ -16,8 +16,9 @@ def _num(v: float) -> float:
 
 
 def to_json(dg) -> dict:
-    """The issue's JSON, keys exactly as specified (params as {"value", "stderr", "unit"})."""
-    return {
+    """The issue's JSON, keys exactly as specified (params as {"value", "stderr", "unit"}),
+    and "reduced" when a long recording was diagnosed on means of its readings."""
+    out = {
         "baseline": {"rms_v": _num(dg.baseline_rms), "params": dg.baseline_params,
                      "ideal_rms_v": _num(dg.ideal_rms),
                      "shape_term": _clean(dg.shape_description),
@@ -38,6 +39,9 @@ def to_json(dg) -> dict:
         "final": {"rms_v": _num(dg.final_rms)},
         "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
     }
+    if dg.reduced:
+        out["reduced"] = dict(dg.reduced)
+    return out
 
 
 def _clean(obj):
@@ -75,7 +79,9 @@ def format_text(dg) -> str:
     sd = dg.shape_description
     if sd:
         lines.append(f"shape of this sensor (smooth, odd term; not an effect): {sd['description']}; "
-                     f"{_mv(sd['rms_v'])} RMS, up to {_mv(sd['peak_v'])}; ideal simulation alone "
+                     f"with the named effects switched off the fitted curve differs from the "
+                     f"calibrated ideal simulation by {_mv(sd['rms_v'])} RMS, up to "
+                     f"{_mv(sd['peak_v'])} (beyond a change of gain); ideal simulation alone "
                      f"leaves {_mv(dg.ideal_rms)}")
     lines.append(f"noise: {_mv(dg.noise_v)} (1 sigma), {dg.noise_method}")
     if dg.noise_regions:
@@ -85,8 +91,10 @@ def format_text(dg) -> str:
         lines.append(f"isolated outliers ({len(dg.outliers)}, measurement glitches, left out of "
                      "the fits):")
         for o in dg.outliers:
+            times = (f" ({abs(o['residual_v']) / dg.noise_v:.0f} x noise)" if dg.noise_v > 0
+                     else "")
             lines.append(f"  row {o['row']} at {o['displacement_mm']:g} mm: {_mv(o['residual_v'])} "
-                         f"off the curve ({abs(o['residual_v']) / dg.noise_v:.0f} x noise)")
+                         f"off the curve{times}")
     if dg.regions:
         lines.append("where the ideal simulation and the recordings differ beyond the noise:")
         for r in dg.regions:
@@ -121,8 +129,10 @@ def format_text(dg) -> str:
                 lines.append(f"     fits these recordings equally well (BIC within 2): "
                              f"{', '.join(e.alternatives)}; named the simplest")
             prev = e.rms_v_after
-        lines.append(f"final RMS {_mv(dg.final_rms)} (noise {_mv(dg.noise_v)}), improvement "
-                     f"x{dg.baseline_rms / dg.final_rms:.3g}")
+        # a model that meets every reading exactly has no finite improvement factor
+        better = (f"improvement x{dg.baseline_rms / dg.final_rms:.3g}" if dg.final_rms > 0
+                  else "every reading reproduced exactly")
+        lines.append(f"final RMS {_mv(dg.final_rms)} (noise {_mv(dg.noise_v)}), {better}")
     if dg.trials and dg.trials[-1]:
         last = [t for t in dg.trials[-1] if not t.accepted]
         if last:

@@ -108,6 +108,10 @@ class Family(Protocol):
         """The weakest ΔBIC for ``candidate`` over the family's equally good complexities."""
         ...
 
+    def implausible(self, candidate: str, fit: Fit, idx: np.ndarray) -> str:
+        """(Optional) why ``fit`` does not show what ``candidate`` names ("" if it may)."""
+        ...
+
 
 @dataclass
 class Step:
@@ -128,6 +132,7 @@ class Trial:
     cv_t: float | None
     accepted: bool
     note: str = ""
+    vetoed: bool = False         # its fit does not show the physics it names (see note)
 
 
 @dataclass
@@ -208,6 +213,16 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                 g = rechoose(current + [c], idx, f)
                 redone.append((g.bic - best.bic, c, g) if g.ok and g.bic < f.bic else (db, c, f))
             fits = sorted(redone + fits[len(top):], key=lambda t: t[0])
+        # a fit may lower BIC without showing what the candidate names (a "rail" through
+        # readings that still rise): not a candidate, listed with the reason
+        implausible = getattr(family, "implausible", None)
+        vetoed = {}
+        for db, c, f in fits:
+            if implausible is not None and db < -bic_margin:
+                why = implausible(c, f, idx)
+                if why:
+                    vetoed[c] = (db, why)
+        fits = [t for t in fits if t[1] not in vetoed]
         if fits and math.isfinite(fits[0][0]):
             top = fits[0][0]
             tied = [t for t in fits if t[0] - top < TIE_BIC]
@@ -247,6 +262,9 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                                 alternatives=[a for a in tie_names if a != c])
                 break
             trials[j].note = "BIC prefers it but cross-validation does not"
+        for c, (db, why) in vetoed.items():
+            at = next((k for k, t in enumerate(trials) if t.delta_bic > db), len(trials))
+            trials.insert(at, Trial(c, db, None, False, why, vetoed=True))
         trials_all.append(trials)
         if accepted is None:
             break

@@ -76,6 +76,19 @@ def lstsq_loo_errors(rec: Recordings, terms: int, norm: str = "range",
     return err
 
 
+def _strictly_increasing(x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(voltages, displacements) for an interpolant x(v): repeated positions (more sweeps,
+    dwells) are averaged per position, and positions that still read the same voltage (a
+    flat stretch, a converter's grid) share one point at their mean displacement."""
+    x = np.asarray(x, float)
+    v = np.asarray(v, float)
+    xu, inv = np.unique(x, return_inverse=True)
+    vu = np.bincount(inv, weights=v) / np.bincount(inv)
+    v_pts, inv = np.unique(vu, return_inverse=True)
+    x_pts = np.bincount(inv, weights=xu) / np.bincount(inv)
+    return v_pts, x_pts
+
+
 def between_points(model: FlannModel, rec: Recordings, n: int = SWEEP_POINTS) -> dict:
     """The model on a dense sweep of v between the recorded voltages.
 
@@ -84,8 +97,7 @@ def between_points(model: FlannModel, rec: Recordings, n: int = SWEEP_POINTS) ->
     """
     from scipy.interpolate import PchipInterpolator
 
-    order = np.argsort(rec.voltage_v)
-    v_pts, x_pts = rec.voltage_v[order], rec.displacement_mm[order]
+    v_pts, x_pts = _strictly_increasing(rec.displacement_mm, rec.voltage_v)
     v = np.linspace(v_pts[0], v_pts[-1], n)
     y = model.predict(v)
     ref = PchipInterpolator(v_pts, x_pts)(v)
