@@ -43,7 +43,7 @@ import numpy as np
 
 from .. import __version__
 from ..diagnose import diagnose
-from ..diagnose.data import find_passes
+from ..diagnose.data import reduce_points
 from ..errors import FlannError
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
@@ -58,7 +58,7 @@ from ..hardware.family.spec import FamilySpec, FitError, member_spec
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..physics.sensor import load_sensor
 from ..pool import run_batch
-from ..recordings import OPTIONAL, REQUIRED, Recordings, read_recordings
+from ..recordings import Recordings, read_recordings
 from ..hardware.family import images
 from .certificate import render_certificate, render_certificate_thermal, render_rejection
 from .spec import ProductionSpec
@@ -182,32 +182,13 @@ def check_sensor(rec, fam: FamilySpec) -> dict:
 
 
 def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
-    """The recording the diagnosis sees, and one sentence saying how it was reduced.
-
-    At most ``points`` rows: means of ``k`` consecutive rows inside one pass (a bin never
-    spans a turn of direction), so the noise of a bin mean is 1/sqrt(k) of a reading's and
-    an effect that varies slowly over a bin keeps its size; rows in no order are sampled
-    evenly instead.  ``points`` None or 0, or a short recording: every row."""
-    n = len(rec)
-    if not points or n <= points:
-        return rec, f"every one of the {n} points"
-    k = -(-n // int(points))
-    x = np.asarray(rec.displacement_mm, dtype=float)
-    passes = find_passes(x, None if rec.direction is None else np.asarray(rec.direction, dtype=float))
-    if not passes.ordered:
-        idx = np.unique(np.linspace(0, n - 1, int(points)).round().astype(np.int64))
-        return rec.subset(idx), f"{idx.size} of the {n} points, evenly sampled (the rows are in no order)"
-    groups = [run[i:i + k] for run in passes.runs for i in range(0, run.size, k)]
-    cols = {}
-    for name in REQUIRED + OPTIONAL:
-        a = getattr(rec, name)
-        cols[name] = None if a is None else np.array([float(np.mean(np.asarray(a, dtype=float)[g]))
-                                                      for g in groups])
-    width = float(np.median([np.ptp(x[g]) for g in groups if g.size > 1] or [0.0]))
-    small = Recordings(**cols, source=rec.source, sha256=rec.sha256, comments=rec.comments)
-    return small, (f"{len(small)} means of up to {k} consecutive points of one pass (about {width:.2g} mm "
-                   f"each) from the {n} points: effects varying over less than that are averaged out, "
-                   "noise figures are those of a mean")
+    """The recording the diagnosis sees, and one sentence saying how it was reduced: at most
+    about ``points`` means, as ``flann diagnose --max-points`` takes them
+    (:func:`flann.diagnose.data.reduce_points`: a mean never spans a turn of direction; many
+    short sweeps share their positions' means).  ``points`` None or 0, or a short recording:
+    every row."""
+    small, how = reduce_points(rec, points)
+    return small, how or f"every one of the {len(rec)} points"
 
 
 def _diagnosis(rec, sensor, points: int | None):
