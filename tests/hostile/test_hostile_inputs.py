@@ -15,6 +15,7 @@ import json
 import math
 import os
 import re
+import shutil
 import stat
 from dataclasses import dataclass
 from pathlib import Path
@@ -252,6 +253,55 @@ def p_stale(w):
     _write(w / "bad.csv", "displacement_mm,temperature_c\n1,2\n3,4\n")
 
 
+def p_step(w):
+    """A hard step: every reading on one of two flat levels, no curve to diagnose."""
+    _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i},{0.5 if i >= 0 else -0.5}\n"
+                                                                    for i in range(-10, 11)))
+
+
+def p_repeats(w):
+    """Table 1 recorded twice (a second sweep): every position repeats."""
+    rows = [r for r in _table(w) if r and not r.startswith("#")]
+    _write(w / "bad.csv", "\n".join(rows + rows[1:]) + "\n")
+
+
+def _edited_manifest(w, edit):
+    shutil.copytree(w / "design", w / "edited")
+    man = json.loads((w / "edited" / "manifest.json").read_text())
+    edit(man)
+    (w / "edited" / "manifest.json").write_text(json.dumps(man))
+
+
+def p_manifest_outside(w):
+    _edited_manifest(w, lambda m: m["files"].append("../rec.csv"))
+
+
+def p_manifest_wide(w):
+    _edited_manifest(w, lambda m: m.update(input_bits=64))
+
+
+def p_thousands(w):
+    """A quoted thousands separator beside '.' decimals: 30,000 um, not 30 um."""
+    _write(w / "bad.csv", "displacement_um,voltage_v\n" + "".join(
+        f'"{x:,}",{v}\n' for x, v in ((-30000, -5.185), (-20000, -4.717), (-10000, -2.896), (0, 0.05),
+                                     (10000, 2.9), (20000, 4.7), (30000, 5.27))))
+
+
+def p_empty_spec(w):
+    _write(w / "spec.toml", 'name = "line A"\n')
+
+
+def p_summary_input(w):
+    (w / "out").mkdir()
+    shutil.copy(w / "s1.csv", w / "out" / "summary.csv")
+
+
+def p_sparse(w):
+    """Six positions of s1: fewer than the family design's terms."""
+    rows = [r for r in (w / "s1.csv").read_text().splitlines() if r and not r.startswith("#")]
+    _write(w / "sparse.csv", "\n".join([rows[0]] + rows[1::len(rows) // 6][:6]) + "\n")
+
+
 # ------------------------------------------------------------------------------------- table
 FAM = ("--design", "fam", "--diagnosis-points", "40", "-j", "1")
 
@@ -396,6 +446,22 @@ CASES = [
     Case("calibrate-stale-removed", "5", ("calibrate", "bad.csv", "-o", "out", *FAM), 2, "missing column",
          ("out/**",), "p_stale", absent=("out/bad/model.json", "out/bad/weights.hex", "out/bad/weights.mem")),
     Case("simulate-sensor-missing", "own", ("simulate", "nosuch.toml", "-o", "o.csv"), 2, "no such file"),
+    Case("diagnose-a-step", "own", ("diagnose", "bad.csv", "--json", "d.json"), 2, "flat levels", (), "p_step"),
+    Case("paper-data-repeated-positions", "own", ("paper", "--data", "bad.csv"), 0, "repeated readings averaged",
+         (), "p_repeats"),
+    Case("sim-build-is-a-file", "2", ("sim", "design", "--build", "afile"), 2, "exists and is not a directory",
+         (), "p_afile"),
+    Case("sim-manifest-file-outside-dir", "1", ("sim", "edited"), 2, "../rec.csv", (), "p_manifest_outside"),
+    Case("synth-manifest-input-bits-64", "own", ("synth", "edited", "--no-lint"), 2, "input_bits", (),
+         "p_manifest_wide"),
+    Case("train-thousands-separator", "own", ("train", "bad.csv", "-o", "t.json", "--terms", "3"), 0,
+         "thousands separator", ("t.json",), "p_thousands"),
+    Case("calibrate-spec-without-tolerance", "own", ("calibrate", "s1.csv", "-o", "out", "--spec", "spec.toml", *FAM),
+         2, "states no tolerance", (), "p_empty_spec"),
+    Case("calibrate-recording-is-the-summary", "6", ("calibrate", "out/summary.csv", "-o", "out", *FAM), 2,
+         "is the batch summary", (), "p_summary_input"),
+    Case("calibrate-fewer-positions-than-terms", "own", ("calibrate", "sparse.csv", "-o", "out", *FAM), 2,
+         "could not be judged", ("out", "out/**"), "p_sparse", absent=("out/sparse/weights.hex",)),
     Case("ise-o-fifo", "2", ("ise", "design", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
 ]
 OBSERVED: dict[str, tuple[int, str]] = {}
