@@ -18,7 +18,7 @@ def explored(monkeypatch):
     calls = []
 
     def record(model, device, **kw):
-        calls.append(kw)
+        calls.append(dict(kw, device=device))
         return []
     monkeypatch.setitem(explore.EXPLORERS, "fixed_space", record)
     monkeypatch.setitem(explore.EXPLORERS, "float18_widths", record)
@@ -62,6 +62,15 @@ def test_defaults_reach_the_explorer(capsys, explored):
     # None: the explorer's own default (a float18 design takes no lanes or styles)
     assert kw["lanes"] is None and kw["styles"] is None
     assert kw["widths"] == ("budget", "narrow")
+
+
+def test_a_design_directory_is_explored_on_its_own_part(capsys, explored, tmp_path):
+    """explore DIR explored the default XC2S200 whatever part the design was generated for,
+    where synth and ise take the manifest's."""
+    assert main(["gen", str(MODEL), "-o", str(tmp_path / "d"), "--input-bits", "8", "--device", "xc2s50-tq144-5"]) == 0
+    assert main(["explore", str(tmp_path / "d"), "--no-seed", "--json"]) == 0, capsys.readouterr().err
+    assert main(["explore", str(MODEL), "--no-seed", "--input-bits", "8", "--json"]) == 0
+    assert [kw["device"] for kw in explored] == ["xc2s50-tq144-5", "xc2s200-pq208-5"]
 
 
 def test_library_refuses_a_bad_preset_or_style_before_any_row(monkeypatch):

@@ -10,6 +10,8 @@ from ..argtypes import bounded, checked
 from ..golden.model import MAX_TERMS
 from ..eda import ABC_MODES
 from ..analysis import explore
+from ..hardware.manifest import read_manifest
+from ..implement.synth import manifest_device
 from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
 from ..hardware.fixed.spec import check_mult_style, max_lanes
@@ -41,7 +43,8 @@ WIDTHS = _list_of(checked(explore.check_width_preset), "width presets")
 def add_arguments(p):
     p.add_argument("model", metavar="MODEL|DIR",
                    help="model.json, or a design directory written by flann gen (its model and its ADC)")
-    p.add_argument("--device", default=DEFAULT_PART, metavar="PART", help="target part (default %(default)s)")
+    p.add_argument("--device", default=None, metavar="PART",
+                   help=f"target part (default: a design directory's own part, else {DEFAULT_PART})")
     p.add_argument("--lanes", type=LANES, metavar="N[,N...]", default=None,
                    help="lane counts to try (default 1,2,4; a float18 design has one lane)")
     p.add_argument("--mult", type=STYLES, metavar="STYLE[,STYLE...]", default=None,
@@ -67,7 +70,8 @@ def add_arguments(p):
 def _design_model(args):
     """The datapath whose design space is explored: a design directory's own (its model and,
     unless given, its ADC), else the one flann gen MODEL builds."""
-    is_dir = Path(args.model).is_dir()
+    source = args.model
+    is_dir = Path(source).is_dir()
     man, dp = read_design(args.model) if is_dir else ({}, datapath_for_model(args.model, FORMATS[0]))
     if dp.explore is None:
         raise FlannError(f"{args.model}: {dp.why_no_explore}")
@@ -82,6 +86,8 @@ def _design_model(args):
                              f"for another ADC explore its model: flann explore {model} {given}")
         args.model = str(model)
         args.input_bits, args.input_lsb_v = man["input_bits"], man["input_lsb_v"]
+    if args.device is None:   # as flann synth and flann ise: the part the design was generated for
+        args.device = manifest_device(read_manifest(source)) if is_dir else DEFAULT_PART
     return dp
 
 
