@@ -94,6 +94,11 @@ def _one_line_warnings() -> None:
     warnings.showwarning = show
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``timeout``, a job scheduler, systemd): unwound as Ctrl-C is, so temporary
+    directories, half-written files and a batch's summary are dealt with the same way."""
+
+
 def main(argv: list[str] | None = None) -> int:
     interrupted = _interrupted
 
@@ -101,14 +106,22 @@ def main(argv: list[str] | None = None) -> int:
         interrupted.append(signum)
         raise KeyboardInterrupt
 
+    def on_sigterm(signum, frame):
+        interrupted.append(signum)
+        raise Terminated
+
     try:
         # an ignored SIGINT (a background job of a script, nohup) stays ignored
         previous = (None if signal.getsignal(signal.SIGINT) is signal.SIG_IGN
                     else signal.signal(signal.SIGINT, on_sigint))
-    except ValueError:   # not the main thread (an embedding program): leave Ctrl-C alone
-        previous = None
+        previous_term = signal.signal(signal.SIGTERM, on_sigterm)
+    except ValueError:   # not the main thread (an embedding program): leave the signals alone
+        previous = previous_term = None
     try:
         return _main(argv)
+    except Terminated:
+        print("error: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         # anywhere, even while a command's modules are still importing (the first ~0.2 s)
         print("error: interrupted", file=sys.stderr)
@@ -122,6 +135,8 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
+        if previous_term is not None:
+            signal.signal(signal.SIGTERM, previous_term)
 
 
 def _main(argv: list[str] | None) -> int:

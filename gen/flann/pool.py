@@ -20,6 +20,9 @@ POLL_S = 0.1   # how often the parent looks at the Ctrl-C flag while workers run
 
 def _worker_init() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # a forked worker inherits flann's SIGTERM handler; the parent unwinds the batch, a worker
+    # told to stop just stops
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 

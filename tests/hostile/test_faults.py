@@ -220,3 +220,25 @@ def test_ctrl_c_swallowed_by_a_callback_is_one_line(tmp_path):
     assert p.returncode == 130, (p.returncode, p.stderr)
     assert p.stderr.strip().splitlines() == ["error: interrupted"], p.stderr
     assert not (tmp_path / "m.json").exists()
+
+
+def test_sigterm_is_one_line_and_leaves_nothing(tmp_path):
+    """SIGTERM (timeout, a scheduler) killed the process where it stood: temporary directories
+    stayed behind.  It now unwinds as Ctrl-C does: one line, exit 143, no output file, no
+    temporary directory.  The recording is a FIFO: opening it for writing returns once flann
+    has opened it, i.e. once the command is running."""
+    fifo = tmp_path / "rec.csv"
+    os.mkfifo(fifo)
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    p = subprocess.Popen([str(FLANN), "train", str(fifo), "-o", str(tmp_path / "m.json")],
+                         stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                         env={**os.environ, "TMPDIR": str(tmp)})
+    with open(fifo, "w") as fh:      # blocks until flann reads: the command is under way
+        fh.write("displacement_mm,voltage_v\n")
+        fh.flush()
+        p.send_signal(signal.SIGTERM)
+        out, err = p.communicate(timeout=60)
+    assert p.returncode == 128 + signal.SIGTERM, (p.returncode, err)
+    assert err.strip().splitlines() == ["error: terminated"], err
+    assert not (tmp_path / "m.json").exists() and list(tmp.iterdir()) == []

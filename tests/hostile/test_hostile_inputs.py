@@ -542,7 +542,7 @@ def pytest_sessionfinish_table(path: Path) -> None:
              "not 0 (none when it is), no traceback, and no file created, changed or removed outside the "
              "paths it may write (the whole temporary tree is hashed before and after).  Class = the hostile-input "
              "defect class (1-17) or `own`.  Faults (a 200 kB tmpfs, a write error inside a design and "
-             "inside one sensor of a batch, Ctrl-C during start-up and in a calibrate pool) are in "
+             "inside one sensor of a batch, Ctrl-C during start-up and in a calibrate pool, SIGTERM) are in "
              "`tests/hostile/test_faults.py`.", "",
              "| # | case | class | command | expected | observed |", "|---|---|---|---|---|---|"]
     for n, c in enumerate(CASES, 1):
