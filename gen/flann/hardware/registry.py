@@ -143,11 +143,17 @@ def check_widths(man: dict, where) -> None:
     adc = man.get("adc_bits")
     if adc is not None and (isinstance(adc, bool) or not isinstance(adc, int) or not ADC_BITS[0] <= adc <= ADC_BITS[1]):
         raise FlannError(f"{where}: field 'adc_bits' must be an integer in {ADC_BITS[0]}..{ADC_BITS[1]}, got {adc!r}")
-    for key, value in _spec_states(man["spec"]).items():
-        if key in man and man[key] != value:
+    check_repeated(man, _spec_states(man["spec"]), where)
+
+
+def check_repeated(man: dict, stated: dict, where) -> None:
+    """Each of the manifest's top-level REPEATED fields equal to what the spec ``stated`` gives
+    (None: the spec does not say)."""
+    for key, value in stated.items():
+        if value is not None and key in man and man[key] != value:
             raise FlannError(f"{where}: field {key!r} is {man[key]!r} but the spec says {value!r}: "
                              "the manifest was edited; regenerate the design with flann gen")
 
 
 __all__ = ["DATAPATHS", "FORMATS", "PLAIN", "FIXED", "FLOAT18", "FAMILY", "FAMILY_THERMAL", "SEED", "THERMAL", "datapath", "datapath_for_model", "read_design",
-           "check_widths"]
+           "REPEATED", "check_repeated", "check_widths"]

@@ -8,7 +8,6 @@ without a bench is refused in one line saying why.  Every entry returns {"summar
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +16,7 @@ from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
-from ..hardware.family.images import parse_hex
+from ..hardware.family.images import header_fields, parse_hex
 from ..hardware.family.render import design_hash
 from ..inputs import read_text
 from . import plots
@@ -65,28 +64,21 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-# the header lines flann calibrate writes (hardware/family/images.py): the design hashed, the words
-_HEADER_DESIGN = re.compile(r"#\s*design sha256 ([0-9a-f]{64})\b")
-_HEADER_WORDS = re.compile(r"#\s*(\d+) words x (\d+) bits\b")
-
-
 def _image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:
     """(image, its words) read and checked against the design before anything is simulated: hex
     words of the memory's width, as many as the design's image holds (``words``), and the design
     and word count its header names (a weight image flann calibrate wrote says both)."""
     text = read_text(image["hex"], FlannError, "a weight image (.hex)")
     got = parse_hex(text, image["hex"])
-    header = [ln.strip() for ln in text.splitlines() if ln.strip().startswith("#")]
-    for line in header:
-        if (m := _HEADER_WORDS.match(line)) and int(m.group(1)) != len(got):
-            raise FlannError(f"{image['hex']}: {len(got)} words, its header says {m.group(1)}: the image is cut "
-                             "short or was edited; write it again with flann calibrate")
+    named, stated = header_fields(text)
+    if stated is not None and stated != len(got):
+        raise FlannError(f"{image['hex']}: {len(got)} words, its header says {stated}: the image is cut "
+                         "short or was edited; write it again with flann calibrate")
     if len(got) != words:
         raise FlannError(f"{image['hex']}: {len(got)} words, {design.directory}'s weight image is {words} words "
                          "(an image of another design?)")
-    named = [m.group(1) for line in header if (m := _HEADER_DESIGN.match(line))]
-    if named and named[0] != (ours := design_hash(design.directory)):
-        raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[0][:12]}..., "
+    if named is not None and named != (ours := design_hash(design.directory)):
+        raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[:12]}..., "
                          f"{design.directory} is {ours[:12]}...): calibrate the sensor for this design "
                          "(flann calibrate --design DIR)")
     return image, got

@@ -17,7 +17,7 @@ from ..golden.model import model_sha256
 from ..hardware.datapath import Datapath
 from ..hardware.fixed.render import generate, load, manifest_options
 from ..hardware.manifest import MANIFEST
-from ..hardware.registry import FIXED, read_design
+from ..hardware.registry import FIXED, REPEATED, check_repeated, read_design
 
 
 @dataclass(frozen=True)
@@ -86,14 +86,9 @@ def _check_top_level(man: dict, spec, where) -> None:
     """The manifest's top-level widths and LSBs (the benches and plots read them) equal to the
     rebuilt spec's, for what a spec records outside its manifest object (read_design compares
     the rest)."""
-    out = getattr(spec, "out_fmt", None)
-    rebuilt = {key: getattr(spec, key, None) for key in ("input_bits", "input_lsb_v", "output_lsb_mm",
-                                                         "temp_bits", "temp_lsb_c")}
-    rebuilt["output_bits"] = getattr(out, "width", None)
-    for key, value in rebuilt.items():
-        if value is not None and key in man and man[key] != value:
-            raise FlannError(f"{where}: field {key!r} is {man[key]!r} but the design's spec gives {value!r}: "
-                             "the manifest was edited; regenerate the design with flann gen")
+    rebuilt = {key: getattr(spec, key, None) for key in REPEATED if key != "output_bits"}
+    rebuilt["output_bits"] = getattr(getattr(spec, "out_fmt", None), "width", None)
+    check_repeated(man, rebuilt, where)
 
 
 def open_design(target, build_dir, options: dict | None = None, model=None) -> Design:

@@ -17,6 +17,8 @@
 
 from __future__ import annotations
 
+import re
+
 from ...errors import FlannError
 from ...inputs import read_text
 from .render import image_text
@@ -45,6 +47,24 @@ def parse_hex(text: str, source: str = "<hex>") -> list[int]:
             raise FlannError(f"{source}:{n}: {line} does not fit {DATA_BITS} bits")
         words.append(w)
     return words
+
+
+# the provenance lines of the ``#`` header flann calibrate writes: the design, the word count
+_HEADER_DESIGN = re.compile(r"#\s*design sha256 ([0-9a-f]{64})\b")
+_HEADER_WORDS = re.compile(r"#\s*(\d+) words x (\d+) bits\b")
+
+
+def header_fields(text: str) -> tuple[str | None, int | None]:
+    """(design sha256, word count) an image's ``#`` header states (None where it states none)."""
+    design = words = None
+    for line in (ln.strip() for ln in text.splitlines()):
+        if not line.startswith("#"):
+            continue
+        if design is None and (m := _HEADER_DESIGN.match(line)):
+            design = m.group(1)
+        if words is None and (m := _HEADER_WORDS.match(line)):
+            words = int(m.group(1))
+    return design, words
 
 
 def read_image(path) -> list[int]:
@@ -77,4 +97,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["hex_text", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["hex_text", "header_fields", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
