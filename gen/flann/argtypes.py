@@ -28,6 +28,9 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
             lo_open: bool = False, nonzero_abs: float | None = None):
     """An argparse ``type`` for a number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``);
     ``nonzero_abs``: the value's magnitude at least this (and not 0)."""
+    def shown(v) -> str:
+        return str(int(v)) if kind is int else f"{v:g}"
+
     def parse(text: str):
         if kind is int:
             try:
@@ -37,9 +40,9 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
         else:
             value = finite_float(text)
         if lo is not None and (value <= lo if lo_open else value < lo):
-            raise argparse.ArgumentTypeError(f"{text}: must be {'>' if lo_open else '>='} {lo:g}")
+            raise argparse.ArgumentTypeError(f"{text}: must be {'>' if lo_open else '>='} {shown(lo)}")
         if hi is not None and value > hi:
-            raise argparse.ArgumentTypeError(f"{text}: must be <= {hi:g}")
+            raise argparse.ArgumentTypeError(f"{text}: must be <= {shown(hi)}")
         if nonzero_abs is not None and abs(value) < nonzero_abs:
             raise argparse.ArgumentTypeError(f"{text}: |value| must be >= {nonzero_abs:g}")
         return value

@@ -276,6 +276,15 @@ def p_manifest_outside(w):
     _edited_manifest(w, lambda m: m["files"].append("../rec.csv"))
 
 
+def p_manifest_model_outside(w):
+    _edited_manifest(w, lambda m: m.update(model="../m.json"))
+
+
+def p_thermal_toml(w):
+    shutil.copy(Path(__file__).resolve().parents[2] / "data" / "sensors" / "paper_lvdt_thermal.toml",
+                w / "thermal.toml")
+
+
 def p_manifest_wide(w):
     _edited_manifest(w, lambda m: m.update(input_bits=64))
 
@@ -463,6 +472,16 @@ CASES = [
     Case("calibrate-fewer-positions-than-terms", "own", ("calibrate", "sparse.csv", "-o", "out", *FAM), 2,
          "could not be judged", ("out", "out/**"), "p_sparse", absent=("out/sparse/weights.hex",)),
     Case("ise-o-fifo", "2", ("ise", "design", "-o", "pipe"), 2, "FIFO", (), "p_fifo"),
+    Case("simulate-temperatures-1e9", "14", ("simulate", "-o", "o.csv", "--temperatures", "25,1e9"), 2,
+         "within -273.15..1000 degC"),
+    Case("simulate-sine-beyond-range", "14", ("simulate", "-o", "o.csv", "--temperature-profile", "sine:25:2000:60"),
+         2, "within -273.15..1000 degC"),
+    Case("simulate-thermal-below-its-model", "own", ("simulate", "thermal.toml", "-o", "o.csv", "--temperatures",
+                                                     "-260,25"), 2, "not positive", (), "p_thermal_toml"),
+    Case("sim-seed-negative", "14", ("sim", "design", "--seed", "-1"), 2, "--seed"),
+    Case("synth-seed-negative", "14", ("synth", "design", "--seed", "-1", "--no-lint"), 2, "--seed"),
+    Case("sim-kept-model-outside-dir", "1", ("sim", "edited"), 2, "kept model '../m.json'", (),
+         "p_manifest_model_outside"),
 ]
 OBSERVED: dict[str, tuple[int, str]] = {}
 

@@ -65,3 +65,24 @@ def test_printed_resolution():
     assert checks.printed_resolution([0.5, 1.25, -3]) == pytest.approx(0.01)
     assert checks.printed_resolution(np.array([1.234, -0.5]) * 1e-3) == pytest.approx(1e-6)   # mV, 3 decimals
     assert checks.printed_resolution([0.1 + 1e-12, np.pi]) == 0.0
+
+
+@pytest.mark.parametrize("fmt, noise", [(".6f", 1e-3), (".5f", 1e-2)])
+def test_a_long_noisy_file_printed_to_fixed_decimals_is_no_converter(fmt, noise):
+    """4,002 readings with 1 mV (10 mV) of noise fill every printed digit: a grid of the last digit
+    at 23 (19) bits is the printing, and training judges at the generator's converters."""
+    rng = np.random.default_rng(1)
+    x = np.linspace(-10, 10, 2001)
+    x = np.r_[x, x[::-1]]
+    v = 4 * np.tanh(x / 6) + rng.normal(0, noise, x.size)
+    rec = parse_recordings(_csv(x, v, fmt=fmt))
+    assert converter_step(rec.voltage_v) == pytest.approx(checks.printed_resolution(rec.voltage_v))
+    assert converter(Namespace(input_bits=None, input_lsb_v=None), rec) is None
+
+
+def test_a_converter_of_one_millivolt_printed_to_it_is_kept():
+    """A 1 mV step (13 bits on +-4.096 V), printed '%.3f': the last digit, and a converter."""
+    x, v, lsb = _codes(13, 4.096)
+    rec = parse_recordings(_csv(x, v, fmt=".3f"))
+    found = converter(Namespace(input_bits=None, input_lsb_v=None), rec)
+    assert found["input_lsb_v"] == pytest.approx(1e-3) and found["input_bits"] == 13   # +-2.2 V read

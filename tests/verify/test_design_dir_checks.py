@@ -88,6 +88,35 @@ def test_manifest_files_are_plain_vhd_names_inside_the_directory(copy_of, tmp_pa
     assert not (tmp_path / "ise").exists()
 
 
+@pytest.mark.parametrize("edit, why", [
+    (lambda man: man.update(model="../model.json"), "kept model '../model.json' is not a plain *.json"),
+    (lambda man: man.update(model="/etc/model.json"), "not a plain *.json"),
+    (lambda man: man.update(model=7), "field 'model' must be a file name"),
+    (lambda man: man["images"][0].update(hex="../image.hex"), "kept weight image '../image.hex' is not a plain"),
+    (lambda man: man["images"][0].update(hex="out.hex"), "leads out of"),
+    (lambda man: man["images"][0].update(hex="gone.hex"), "does not exist"),
+    (lambda man: man.update(images=[{"name": "a"}]), "field 'images' must be a list"),
+])
+def test_kept_model_and_images_are_confined_like_the_files(copy_of, tmp_path, cli, no_simulation, edit, why):
+    (tmp_path / "model.json").write_text("{}\n")
+    (tmp_path / "image.hex").write_text("0000\n")
+    d = copy_of("family", edit)
+    os.symlink(tmp_path / "image.hex", d / "out.hex")
+    with pytest.raises(FlannError, match="kept|field"):
+        read_manifest(d)
+    for argv in (["sim", d], ["synth", d, "--no-lint"]):
+        one_line(*cli(argv), why)
+
+
+def test_a_kept_image_named_after_any_recording_is_read(copy_of):
+    d = copy_of("family")
+    man = json.loads((d / "manifest.json").read_text())
+    (d / man["images"][0]["hex"]).rename(d / "image_sensor 1 (ünï).hex")
+    man["images"][0]["hex"] = "image_sensor 1 (ünï).hex"
+    (d / "manifest.json").write_text(json.dumps(man))
+    assert read_manifest(d)["images"][0]["hex"] == "image_sensor 1 (ünï).hex"
+
+
 # --- manifest widths ----------------------------------------------------------------------
 
 def test_every_generated_design_passes_the_width_checks(small_designs):

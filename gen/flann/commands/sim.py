@@ -13,7 +13,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ..argtypes import png_path
+from ..argtypes import bounded, png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_json, check_output_directory
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
@@ -59,7 +59,7 @@ def add_arguments(parser) -> None:
                              "temperature, and their difference (PNG)")
     parser.add_argument("--build", metavar="DIR", default=None,
                         help="keep generated HDL, logs and results here (default: a temporary directory)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the random stimuli (default %(default)s)")
+    parser.add_argument("--seed", type=bounded(int, 0, 2**32 - 1), default=1, help="seed of the random stimuli (default %(default)s)")
     parser.add_argument("--image", action="append", metavar="HEX", default=None,
                         help="a family design: a sensor's weight image (flann calibrate) to load through the "
                              "cfg port, each simulated (one alone, on a family without temperature: loaded over an "

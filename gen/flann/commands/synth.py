@@ -8,6 +8,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from ..argtypes import bounded
 from ..eda import ABC_MODES, NETLIST
 from ..errors import FlannError
 from ..implement import ice40, synth, timing
@@ -37,7 +38,7 @@ def add_arguments(p):
                    help="iCE40 only: simulate the placed-and-routed design (icebox_vlog + Verilator, Yosys's iCE40 "
                         "cell models) over every input code against the twin (needs the model: --model or the "
                         "manifest's)")
-    p.add_argument("--seed", type=int, default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
+    p.add_argument("--seed", type=bounded(int, 0, 2**31 - 1), default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")

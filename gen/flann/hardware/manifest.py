@@ -97,28 +97,55 @@ def read_manifest(directory) -> Manifest:
         raise FlannError(f"{path}: field 'files' must be a non-empty list of VHDL files in compile order")
     paths = []
     for f in files:
-        paths.append(_listed_file(path, directory, f))
+        paths.append(_listed_file(path, directory, f, "vhd", "listed file"))
         if paths.count(paths[-1]) > 1:
             raise FlannError(f"{path}: field 'files' lists {f!r} twice")
+    _kept_files(path, directory, data)
     return Manifest(directory, top, tuple(paths), data)
 
 
-_VHDL_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+-]*\.vhd")
+# VHDL names go to GHDL and ISE command lines; a kept model or image is named after the user's
+# recording (any characters but a directory separator)
+_NAMES = {"vhd": re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+-]*\.vhd"),
+          "json": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.json"),
+          "hex": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.hex")}
 
 
-def _listed_file(path: Path, directory: Path, name: str) -> Path:
-    """``directory/name`` for an entry of ``files``: a plain ``*.vhd`` name of a regular file in the
-    directory.  Every consumer hands these to GHDL, cocotb or ISE, so a path out of the directory
-    ('../x.csv', '/etc/passwd', a symlink leading out) or another kind of file is refused here."""
-    if not _VHDL_NAME.fullmatch(name):
-        raise FlannError(f"{path}: listed file {name!r} is not a plain *.vhd file name in {directory} "
+def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str, must_exist: bool = True) -> Path:
+    """``directory/name`` for a file the manifest names: a plain ``*.<suffix>`` name of a regular
+    file in the directory.  Consumers hand these to GHDL, cocotb, ISE or a JSON/hex reader, so a
+    path out of the directory ('../x.csv', '/etc/passwd', a symlink leading out) or another kind
+    of file is refused here."""
+    if not _NAMES[suffix].fullmatch(name):
+        raise FlannError(f"{path}: {what} {name!r} is not a plain *.{suffix} file name in {directory} "
                          "(no directory part, no '..')")
     p = directory / name
     if not p.is_file():
-        raise FlannError(f"{path}: listed file {name!r} does not exist in {directory}")
+        if must_exist or p.exists() or p.is_symlink():
+            raise FlannError(f"{path}: {what} {name!r} does not exist in {directory}"
+                             if not p.exists() else f"{path}: {what} {name!r} is not a regular file")
+        return p
     if Path(os.path.realpath(p)).parent != Path(os.path.realpath(directory)):
-        raise FlannError(f"{path}: listed file {name!r} leads out of {directory} (a symbolic link)")
+        raise FlannError(f"{path}: {what} {name!r} leads out of {directory} (a symbolic link)")
     return p
+
+
+def _kept_files(path: Path, directory: Path, data: dict) -> None:
+    """The model and weight images a design keeps beside its VHDL, confined like its files (a
+    missing one is the reader's to report: a design may be checked in without its model)."""
+    model = data.get("model")
+    if model is not None:
+        if not isinstance(model, str):
+            raise FlannError(f"{path}: field 'model' must be a file name, got {model!r}")
+        _listed_file(path, directory, model, "json", "kept model", must_exist=False)
+    images = data.get("images")
+    if images is None:
+        return
+    if not isinstance(images, list) or not all(isinstance(im, dict) and isinstance(im.get("name"), str)
+                                                and isinstance(im.get("hex"), str) for im in images):
+        raise FlannError(f"{path}: field 'images' must be a list of {{\"name\", \"hex\"}} objects")
+    for im in images:
+        _listed_file(path, directory, im["hex"], "hex", "kept weight image")
 
 
 __all__ = ["MANIFEST", "Manifest", "is_design", "read_manifest", "write_design"]

@@ -13,6 +13,10 @@ from typing import Mapping
 
 from ..errors import SensorError
 
+# the temperatures a sensor model is taken to (degC): absolute zero to a high-temperature
+# LVDT's rating with margin; the effects' reference temperatures and every simulated one
+TEMPERATURE_RANGE_C = (-273.15, 1000.0)
+
 
 @dataclass(frozen=True)
 class Param:
@@ -75,7 +79,7 @@ SPECS: dict[str, EffectSpec] = {
                "primary current *= 1 + coefficient_per_c * (T - reference_temperature_c)",
                (Param("coefficient_per_c", "1/degC", -0.001, 0.0, -0.5, 0.5,
                       "relative sensitivity change per degC"),
-                Param("reference_temperature_c", "degC", 20.0, 20.0, -273.15, 1e3,
+                Param("reference_temperature_c", "degC", 20.0, 20.0, *TEMPERATURE_RANGE_C,
                       "temperature at which the sensitivity is nominal"))),
         EffectSpec("adc_clipping", "output",
                "converter or amplifier rails: the output saturates at +-rail_v",
@@ -101,7 +105,7 @@ SPECS: dict[str, EffectSpec] = {
                "R_p, R_s *= 1 + copper_tempco_per_c dT;  Ip = V / (source_ohm + R_p + j w Lp(mu)); "
                "mu_r *= 1 + permeability_tempco_per_c dT;  v1 *= 1 + e/2, v2 *= 1 - e/2 with "
                "e = balance_drift_per_c dT;  dT = T - reference_temperature_c",
-               (Param("reference_temperature_c", "degC", 20.0, 20.0, -273.15, 1e3,
+               (Param("reference_temperature_c", "degC", 20.0, 20.0, *TEMPERATURE_RANGE_C,
                       "temperature of the sensor file's resistances and permeability"),
                 Param("copper_tempco_per_c", "1/degC", 0.00393, 0.0, -0.1, 0.1,
                       "winding resistance temperature coefficient (copper: 0.00393 at 20 degC)"),

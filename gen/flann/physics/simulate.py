@@ -35,6 +35,7 @@ import numpy as np
 from ..errors import FlannError
 from ..numeric.fixed import nearest_codes, signed_range
 from ..recordings import Recordings
+from .effect_params import TEMPERATURE_RANGE_C
 from .effects import EFFECTS, Context, Signal
 from .lvdt import demodulate_v, inductances_h
 from .sensor import Sensor
@@ -55,8 +56,10 @@ def _broadcast(value, shape, fill) -> np.ndarray | None:
 
 
 def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
-                      time_s=None) -> np.ndarray:
-    """Noiseless output (V) of ``s`` with all its enabled effects (see module docstring)."""
+                      time_s=None, physical: bool = False) -> np.ndarray:
+    """Noiseless output (V) of ``s`` with all its enabled effects (see module docstring);
+    ``physical``: refuse effects that turn a drive, winding or core factor non-positive (a
+    fit's trial parameters may pass through such values, a simulated bench may not)."""
     x = np.asarray(displacement_mm, dtype=float)
     ctx = Context(
         displacement_mm=x,
@@ -69,10 +72,29 @@ def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=
     for stage in ("position", "transformer"):
         for name in _ordered(s.effects, stage):
             sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
+    if physical:
+        _check_scales(s, sig, ctx.temperature_c, x.shape)
     sig = _transformer(s, sig)
     for name in _ordered(s.effects, "output"):
         sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
     return np.asarray(sig.output_v, dtype=float)
+
+
+_SCALES = ("drive_scale", "resistance_scale", "permeability_scale", "s1_scale", "s2_scale")
+
+
+def _check_scales(s: Sensor, sig: Signal, temperature_c, shape) -> None:
+    """The effects' factors on the drive, the windings and the core stay positive: linear
+    temperature coefficients taken far from their reference turn them negative, and the
+    transformer would then simulate a sensor no one can build."""
+    for field in _SCALES:
+        a = np.broadcast_to(np.asarray(getattr(sig, field), dtype=float), shape)
+        if a.size and not np.all(a > 0):
+            i = int(np.argmin(a))
+            at = "" if temperature_c is None else f" at {float(temperature_c.flat[i]):g} degC"
+            raise FlannError(f"{s.name}: its effects make the {field.replace('_', ' ')} {float(a.flat[i]):.3g}"
+                             f"{at}, not positive: the linear temperature and balance coefficients do not "
+                             "reach that far; simulate nearer their reference temperature")
 
 
 # Above this many distinct permeabilities (a temperature ramp) the inductances are
@@ -152,6 +174,13 @@ def adc_convert(s: Sensor, volts) -> np.ndarray:
     return nearest_codes(v, lsb, lo, hi) * lsb
 
 
+_RANGE_TEXT = f"{TEMPERATURE_RANGE_C[0]:g}..{TEMPERATURE_RANGE_C[1]:g} degC"
+
+
+def _in_range(t: float) -> bool:
+    return math.isfinite(t) and TEMPERATURE_RANGE_C[0] <= t <= TEMPERATURE_RANGE_C[1]
+
+
 def parse_temperature_profile(spec: str | float | None) -> Callable[[np.ndarray, float], np.ndarray]:
     """A function (time_s, duration_s) -> temperature_c from a text spec.
 
@@ -173,9 +202,10 @@ def parse_temperature_profile(spec: str | float | None) -> Callable[[np.ndarray,
     if kind not in want or len(nums) != want[kind] or not all(map(math.isfinite, nums)):
         raise FlannError(f"--temperature-profile {text!r}: expected const:T, ramp:T0:T1 or "
                          "sine:MEAN:AMPLITUDE:PERIOD_S")
-    if any(t < -273.15 for t in nums[:2]) or (kind == "sine" and nums[2] <= 0):
-        raise FlannError(f"--temperature-profile {text!r}: temperatures must be >= -273.15 "
-                         "degC and the period > 0")
+    reached = nums[:2] if kind != "sine" else [nums[0] - abs(nums[1]), nums[0] + abs(nums[1])]
+    if not all(_in_range(t) for t in reached) or (kind == "sine" and nums[2] <= 0):
+        raise FlannError(f"--temperature-profile {text!r}: temperatures must be within {_RANGE_TEXT} "
+                         "and the period > 0")
     if kind == "const":
         return lambda t, dur: np.full_like(t, nums[0])
     if kind == "ramp":
@@ -242,7 +272,7 @@ def simulate_recordings(s: Sensor, sweeps: int = 1, step_mm: float = 1.0, noise_
     y = np.empty(x.size)
     for start in range(0, x.size, _CHUNK):
         sl = slice(start, start + _CHUNK)
-        y[sl] = simulate_output_v(s, x[sl], direction=d[sl], temperature_c=temp[sl], time_s=t[sl])
+        y[sl] = simulate_output_v(s, x[sl], direction=d[sl], temperature_c=temp[sl], time_s=t[sl], physical=True)
         if progress and x.size > _CHUNK:
             print(f"simulate: {min(start + _CHUNK, x.size)}/{x.size} samples", file=sys.stderr)
     rng = np.random.default_rng(seed)
@@ -257,7 +287,7 @@ MAX_TEMPERATURES = 64
 
 
 def parse_temperatures(text: str) -> tuple[float, ...]:
-    """``"-20,0,25,50,80"`` -> (-20.0, 0.0, 25.0, 50.0, 80.0): distinct, >= -273.15 degC."""
+    """``"-20,0,25,50,80"`` -> (-20.0, 0.0, 25.0, 50.0, 80.0): distinct, within TEMPERATURE_RANGE_C."""
     try:
         temps = tuple(float(t) for t in str(text).split(",") if t.strip())
     except ValueError:
@@ -265,8 +295,8 @@ def parse_temperatures(text: str) -> tuple[float, ...]:
                          "e.g. -20,0,25,50,80") from None
     if not temps or len(temps) > MAX_TEMPERATURES:
         raise FlannError(f"--temperatures {text!r}: give 1 to {MAX_TEMPERATURES} temperatures")
-    if not all(math.isfinite(t) and t >= -273.15 for t in temps):
-        raise FlannError(f"--temperatures {text!r}: temperatures must be finite and >= -273.15 degC")
+    if not all(_in_range(t) for t in temps):
+        raise FlannError(f"--temperatures {text!r}: temperatures must be within {_RANGE_TEXT}")
     if len(set(temps)) != len(temps):
         raise FlannError(f"--temperatures {text!r}: a temperature is repeated")
     return temps

@@ -409,14 +409,24 @@ def _grid_step(u: np.ndarray, gaps: np.ndarray, k: int, res: float, tol: float) 
     return q
 
 
+# Above this many bits a grid at the printing's last digit is taken for the printing: a
+# converter whose step is a power of ten volts is a 1 mV step of a 12-bit converter on a
+# 2.048 V reference, not a 23-bit one of 1 µV (noisy readings of a long logger file printed
+# '%.6f' fill every microvolt and look like that)
+PRINTED_GRID_BITS = 16
+
+
 def converter_of(voltage_v) -> tuple[int, float] | None:
     """(bits, volts per code) of the converter the readings were taken with, from their grid:
-    the step, and the fewest two's-complement bits whose range holds every reading; None off-grid."""
+    the step, and the fewest two's-complement bits whose range holds every reading; None off-grid,
+    or when the grid is the printing's last digit at more than :data:`PRINTED_GRID_BITS`."""
     step = converter_step(voltage_v)
     if not step > 0:
         return None
     vmax = float(np.max(np.abs(np.asarray(voltage_v, float))))
     bits = int(np.ceil(np.log2(max(vmax / step, 1.0) + 1.0))) + 1
+    if bits > PRINTED_GRID_BITS and abs(step - printed_resolution(voltage_v)) < 1e-6 * step:
+        return None
     return (bits, step) if 4 <= bits <= 32 else None
 
 
