@@ -10,10 +10,10 @@ import pytest
 
 from flann.cli import main
 from flann.golden.model import load_model
-from flann.hardware.family.render import load_design
+from flann.hardware.family.render import design_hash, load_design
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.production.demo import bad_files, write_batch
-from flann.hardware.family.images import parse_hex
+from flann.hardware.family.images import header_fields, parse_hex
 from flann.recordings import read_recordings
 
 
@@ -69,6 +69,8 @@ def test_weight_image_reproduces_the_recording(batch):
         d = batch["out"] / p.stem
         words = parse_hex((d / "weights.hex").read_text())
         assert len(words) == fam.mem_depth
+        # the header names the design the image was calibrated for and its size, as sim --image checks them
+        assert header_fields((d / "weights.hex").read_text()) == (design_hash(batch["design"]), fam.mem_depth)
         twin = FlannFamilyTop(fam, words)
         rec = read_recordings(p)
         codes = np.clip(np.floor(rec.voltage_v / s.input_lsb_v + 0.5).astype(int), s.code_min, s.code_max)

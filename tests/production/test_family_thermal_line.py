@@ -18,7 +18,8 @@ import pytest
 from flann.cli import main
 from flann.golden.thermal_metrics import drift_ppm_fs_per_c
 from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
-from flann.hardware.family.images import parse_hex
+from flann.hardware.family.images import header_fields, parse_hex
+from flann.hardware.family.render import design_hash
 from flann.recordings import Recordings, write_recordings
 from flann.verify.design import from_directory
 
@@ -107,6 +108,7 @@ def test_calibrate_certificates_per_temperature(line):
         # the drift column is the hardware's: recompute it from the written image and the twin
         rec = recording(params, seed=list(SENSORS).index(name))
         words = parse_hex((out / name / "weights.hex").read_text())
+        assert header_fields((out / name / "weights.hex").read_text()) == (design_hash(line["design"]), len(words))
         codes = np.clip(np.floor(rec.voltage_v / spec.input_lsb_v + 0.5).astype(int), spec.code_min, spec.code_max)
         tcodes = np.floor(rec.temperature_c / spec.temp.lsb_c + 0.5).astype(int)
         hw = FlannFamilyThermalTop(spec, words).process(codes, tcodes).out_data * spec.output_lsb_mm

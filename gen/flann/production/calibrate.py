@@ -358,9 +358,8 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     """A passed sensor: its two-input model, its image (every order's memory in turn) and the
     certificate; a failed one: only the certificate."""
     model_json, mhash = chk["model"].to_json(), res.model_sha256
-    head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
-            f"model sha256 {mhash}", f"{fam.image_words} words x {images.DATA_BITS} bits, address 0 first: "
-            f"order j's memory at j x {fam.fam.mem_depth} (cfg_addr)"]
+    head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.image_words,
+                                    f"address 0 first: order j's memory at j x {fam.fam.mem_depth} (cfg_addr)")
     html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
@@ -407,8 +406,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
     model_json, mhash = model.to_json(), res.model_sha256
-    head = [f"flann {__version__} calibrate: sensor {res.sensor}", f"design sha256 {dhash}",
-            f"model sha256 {mhash}", f"{fam.mem_depth} words x {images.DATA_BITS} bits, address 0 first"]
+    head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.mem_depth)
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")

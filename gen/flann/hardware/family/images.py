@@ -54,6 +54,14 @@ _HEADER_DESIGN = re.compile(r"#\s*design sha256 ([0-9a-f]{64})\b")
 _HEADER_WORDS = re.compile(r"#\s*(\d+) words x (\d+) bits\b")
 
 
+def provenance_header(tool: str, sensor: str, design_sha256: str, model_sha256: str, words: int,
+                      layout: str = "address 0 first") -> list[str]:
+    """The ``#`` header lines of a calibrated image, as :func:`header_fields` reads them back:
+    who wrote it for which sensor, the design and model it belongs to, its size and layout."""
+    return [f"{tool}: sensor {sensor}", f"design sha256 {design_sha256}", f"model sha256 {model_sha256}",
+            f"{words} words x {DATA_BITS} bits, {layout}"]
+
+
 def header_fields(text: str) -> tuple[str | None, int | None]:
     """(design sha256, word count) an image's ``#`` header states (None where it states none)."""
     design = words = None
@@ -97,4 +105,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["hex_text", "header_fields", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["hex_text", "header_fields", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
