@@ -12,10 +12,14 @@ from pathlib import Path
 
 import pytest
 
+from dataclasses import replace
+
 from flann.eda import complete_pmux_cases, ghdl_to_verilog
+from flann.hardware.family.images import read_image
+from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.manifest import read_manifest
-from flann.verify.design import from_model
-from flann.verify.netlist import check_netlist
+from flann.verify.design import from_directory, from_model
+from flann.verify.netlist import check_netlist, compare, compile_netlist, mapped_netlist, run_netlist, sweep_of
 
 pytestmark = [pytest.mark.sim, pytest.mark.synth,
               pytest.mark.skipif(not all(shutil.which(t) for t in ("ghdl", "yosys", "verilator")),
@@ -35,6 +39,25 @@ def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
     (work / "raw.v").write_text(complete_pmux_cases(raw)[0])
     bad = check_netlist(design, tmp_path / "nl_raw", netlist=work / "raw.v")
     assert bad["codes_tested"] == 256 and bad["mismatches"] > 0
+
+
+def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, small_designs):
+    """The family's mapped netlist (weights in a RAMB4) takes a sensor's image through cfg_* and
+    then agrees with that sensor's twin on every code; loaded with the other sensor's image it
+    agrees with the other twin and not the first: the load, not the initial contents, decides."""
+    design = from_directory(small_designs["dir"] / "family")
+    r = check_netlist(design, tmp_path / "nl")
+    assert r["codes_tested"] == 256 and r["mismatches"] == 0, r
+    assert "RAMB4" in Path(r["netlist"]).read_text()
+    sweep = sweep_of(design)
+    kept = [read_image(design.directory / im["hex"]) for im in design.manifest["images"]]
+    assert len(kept) == 2 and kept[0] != kept[1] and list(sweep.image) == kept[-1]
+    exe = compile_netlist(mapped_netlist(design, tmp_path / "synth"), tmp_path / "verilator", sweep)
+    other = replace(sweep, image=tuple(kept[0]), process=FlannFamilyTop(design.spec, kept[0]).process)
+    (tmp_path / "other").mkdir()
+    got = run_netlist(exe, other, tmp_path / "other", shards=1)
+    assert compare(other, got)["mismatches"] == 0
+    assert compare(sweep, got)["mismatches"] > 0
 
 
 def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):

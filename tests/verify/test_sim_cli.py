@@ -53,10 +53,14 @@ def _is_png(path: Path) -> bool:
 @pytest.mark.parametrize("datapath", SIMULATED)
 def test_plot_is_written_for_every_datapath(designs, datapath, tmp_path, capsys, figures):
     png = tmp_path / "sim.png"
+    # the family design's mapped netlist too: its weight image loaded through the cfg port
+    netlist = ["--netlist"] if datapath == "family" else []
     rc = main(["sim", str(designs["dir"] / datapath), "--plot", str(png), "--json",
-               "--build", str(tmp_path / "b")])
+               "--build", str(tmp_path / "b"), *netlist])
     s = json.loads(capsys.readouterr().out)
-    assert rc == 0 and s["mismatches"] == 0
+    assert rc == 0 and s["mismatches"] == 0 and s["all_passed"]
+    if netlist:
+        assert s["netlist"]["codes_tested"] == 2 ** BITS and s["netlist"]["mismatches"] == 0
     assert _is_png(png)
     (axes,) = figures
     for ax in axes:

@@ -17,7 +17,7 @@ from ..hardware.registry import read_design
 from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
-from ..verify.netlist import DRIVER_TOP, check_synthesized, require_sweep_driver
+from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver
 from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
@@ -49,7 +49,7 @@ def add_arguments(p):
                    help="the model DIR was generated from, for the netlist check's twin (default: the model "
                         "DIR/manifest.json records)")
     p.add_argument("--no-netlist-check", action="store_true",
-                   help="do not simulate the mapped netlist; by default a fixed-point design's mapped netlist is "
+                   help="do not simulate the mapped netlist; by default a fixed-point or family design's mapped netlist is "
                         "simulated over every input code against the twin (Verilator), with --model or without "
                         "(the manifest's model), reported as 'netlist check' (JSON: netlist_check, null when not "
                         "run), and a disagreeing design is refused")
@@ -59,9 +59,9 @@ def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
     """The mapped netlist against its twin over every input code: (result, "") or (None, why
     it was not run); a design whose netlist disagrees is refused."""
     man, dp = read_design(args.directory)
-    if not dp.netlist:
-        return None, (f"no netlist sweep for a {dp.name} design (it drives the fixed-point {DRIVER_TOP} "
-                      "against its twin)")
+    if dp.netlist not in SWEEPS:
+        return None, (f"no netlist sweep for a {dp.name} design (it drives one-input tops: the "
+                      f"{', '.join(SWEEPS)} datapaths')")
     if args.model is None and not man.get("model"):
         print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
               file=sys.stderr)

@@ -150,7 +150,7 @@ class Datapath:
     why_no_ise: str = ""               # empty: flann ise writes a project for it
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
     derive_options: Callable | None = None  # (GenOptions, compared) -> keyword arguments of its derive
-    netlist: bool = False              # its mapped netlist can be simulated over every code (flann_top's ports)
+    netlist: str | None = None         # the sweep of its mapped netlist over every code (flann.verify.netlist.SWEEPS)
     summary: Callable | None = None    # manifest -> lines flann gen prints
     derive: Callable | None = None     # (FlannModel, **derive options) -> spec of a model with no design directory
     number_format: str = ""            # the arithmetic of its products and sum (what flann gen --format names)

@@ -23,7 +23,7 @@ from . import plots
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
-from .netlist import require_sweep_driver
+from .netlist import netlist_summary, require_sweep_driver
 from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
 
 # a two-input sweep over every voltage code at every temperature code up to this many samples;
@@ -115,7 +115,7 @@ def _two_images(design: Design, loaded: list, given: bool) -> list:
     return loaded
 
 
-def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
+def _family(design: Design, build_dir, *, seed=1, images=None, netlist=False, progress=None, **_) -> dict:
     loaded = _two_images(design, _images(design, images, design.spec.mem_depth), bool(images))
     images = [im for im, _words in loaded]
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
@@ -134,6 +134,9 @@ def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
                  design.manifest["output_lsb_mm"])
     s["images"] = [im["name"] for im in images]
     s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
+    if netlist:
+        s["netlist"], passed = netlist_summary(design, build_dir, progress)
+        s["all_passed"] = s["all_passed"] and passed
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
@@ -284,8 +287,10 @@ def simulate(design: Design, build_dir, **kw) -> dict:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
     if kw.get("netlist"):
         require_sweep_driver(dp, design.directory, "--netlist")
-    if kw.get("engine") == "verilator":   # the netlist of the sweep driver, compiled by Verilator
-        require_sweep_driver(dp, design.directory, "--engine verilator")
+    if kw.get("engine") == "verilator" and BENCHES[dp.bench] is not _fixed:
+        # GHDL's netlist compiled by Verilator stands in for the fixed-point sweep bench only
+        raise FlannError(f"--engine verilator: replaces the fixed-point datapath's VHDL sweep; {design.directory} "
+                         f"holds a {dp.name} design (its bench runs under GHDL)")
     if kw.get("images") and BENCHES[dp.bench] not in LOADS_IMAGES:
         raise FlannError(f"--image: {design.directory} is a {dp.name} design, its weights are built in "
                          "(weight images load into a family design's memory)")

@@ -7,6 +7,11 @@ whose cells ``flann synth`` counts) -> Verilator, compiled with Yosys's own Xili
 not model) and a C++ driver that steps through every input code -> every output compared with
 the twin in one pass.  Verilator, not Icarus: on the default design's mapped netlist Icarus runs
 about 1 code/s, Verilator a few hundred.
+
+A datapath names its sweep (``Datapath.netlist``, a key of :data:`SWEEPS`): the top the driver
+drives, the twin it is compared with, and for a family design the weight image the driver
+first loads through the cfg port (the last one the design keeps, over the memory's initial
+sensor, so that the load is what the sweep sees).
 """
 
 from __future__ import annotations
@@ -15,11 +20,15 @@ import shutil
 import subprocess
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from ..errors import FlannError
+from ..hardware.family.images import read_image
+from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.fixed.datapath import DATAPATH as FIXED
 from ..hardware.fixed.twin import FlannTop
 from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
@@ -29,8 +38,55 @@ from .design import Design
 from .shards import cores, count_lines, merge, read_results, split
 
 DRIVER = "netlist_main.cpp"
-DRIVER_TOP = FIXED.top      # the driver is written against this entity's ports (Vflann_top)
+DRIVER_TOP = FIXED.top      # the driver's ports: this entity's (and a family top's cfg_* besides)
 RAM_MODELS = "ramb4_sim.v"
+PREFIX = "Vdut"             # the Verilated model's class, whatever the top (the driver includes Vdut.h)
+
+
+@dataclass(frozen=True)
+class NetlistSweep:
+    """What the driver needs of a design: its top, widths and latency, the twin's outputs of a
+    code array, and the weight image it loads first (None: the weights are built in)."""
+
+    top: str
+    in_bits: int
+    out_bits: int
+    latency: int
+    process: Callable
+    image: tuple | None = None
+    cfg_addr_bits: int | None = None
+
+    @property
+    def codes(self) -> tuple[int, int]:
+        return -(1 << (self.in_bits - 1)), (1 << (self.in_bits - 1)) - 1
+
+
+def _fixed_sweep(design: Design) -> NetlistSweep:
+    man = design.manifest
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
+                        FlannTop(design.spec).process)
+
+
+def _family_sweep(design: Design) -> NetlistSweep:
+    man = design.manifest
+    kept = man.get("images") or []
+    if not kept:
+        raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
+                         "design keeps none (regenerate it with flann gen --family from the recordings)")
+    words = read_image(design.directory / kept[-1]["hex"])
+    if len(words) != design.spec.mem_depth:
+        raise FlannError(f"{design.directory / kept[-1]['hex']}: {len(words)} words, the design's memory holds "
+                         f"{design.spec.mem_depth}")
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
+                        FlannFamilyTop(design.spec, words).process, tuple(words), design.spec.addr_bits)
+
+
+SWEEPS = {"fixed": _fixed_sweep, "family": _family_sweep}
+
+
+def sweep_of(design: Design) -> NetlistSweep:
+    require_sweep_driver(design.datapath, design.directory, "the netlist sweep")
+    return SWEEPS[design.datapath.netlist](design)
 
 
 def yosys_datdir() -> Path:
@@ -60,7 +116,7 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     return work / NETLIST
 
 
-def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cells: bool = True,
+def compile_netlist(netlist: Path, build: Path, sweep: NetlistSweep, cells: bool = True,
                     models: list | None = None, defines: tuple = ()) -> Path:
     """Verilator model of ``netlist`` with the sweep driver (and the Xilinx cell models for a
     mapped netlist; GHDL's own Verilog has no cells; ``models`` replaces them for another
@@ -74,14 +130,17 @@ def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cel
     build.mkdir(parents=True)
     if models is None:
         models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
+    flags = f"-DIN_BITS={sweep.in_bits} -DOUT_BITS={sweep.out_bits}"
+    if sweep.image is not None:
+        flags += f" -DCFG_ADDR_BITS={sweep.cfg_addr_bits}"
     cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
-           "--top-module", DRIVER_TOP, "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
+           "--top-module", sweep.top, "--prefix", PREFIX, "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
            "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
-           "-CFLAGS", f"-DIN_BITS={in_bits} -DOUT_BITS={out_bits}"]
+           "-CFLAGS", flags]
     log = build / "verilator.log"
     with open(log, "w") as fh:
         r = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=build)
-    exe = build / "obj" / f"V{DRIVER_TOP}"
+    exe = build / "obj" / PREFIX
     if r.returncode != 0 or not exe.is_file():
         text = log.read_text(errors="replace")
         first = next((ln.strip() for ln in text.splitlines() if "%Error" in ln or "error:" in ln), f"see {log}")
@@ -89,11 +148,17 @@ def compile_netlist(netlist: Path, build: Path, in_bits: int, out_bits: int, cel
     return exe
 
 
-def run_netlist(exe: Path, lo: int, hi: int, build: Path, shards: int = 2, progress=None) -> dict:
-    """Run the compiled netlist over codes lo..hi in ``shards`` processes; arrays in code order."""
+def run_netlist(exe: Path, sweep: NetlistSweep, build: Path, shards: int = 2, progress=None) -> dict:
+    """Run the compiled netlist over every code of ``sweep`` in ``shards`` processes (each loads
+    the weight image first); arrays in code order."""
+    lo, hi = sweep.codes
     parts = split(lo, hi, max(1, shards))
     files = [Path(build) / f"netlist_{k}.txt" for k in range(len(parts))]
-    procs = [subprocess.Popen([str(exe), str(a), str(b), str(f)], stdout=subprocess.DEVNULL,
+    image = []
+    if sweep.image is not None:
+        (Path(build) / "netlist_image.txt").write_text("".join(f"{w:x}\n" for w in sweep.image))
+        image = [str(Path(build) / "netlist_image.txt")]
+    procs = [subprocess.Popen([str(exe), str(a), str(b), str(f), *image], stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, text=True) for (a, b), f in zip(parts, files)]
     t0 = time.monotonic()
     try:
@@ -111,12 +176,11 @@ def run_netlist(exe: Path, lo: int, hi: int, build: Path, shards: int = 2, progr
     return {**merge([read_results(f) for f in files]), "seconds": time.monotonic() - t0}
 
 
-def compare(design: Design, got: dict) -> dict:
+def compare(sweep: NetlistSweep, got: dict) -> dict:
     """Mismatches of the netlist's outputs against the twin (and missing codes)."""
-    man = design.manifest
-    lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1
-    out, sat = FlannTop(design.spec).process(got["codes"])
-    bad = (got["data"] != out) | (got["sat"] != sat) | (got["latency"] != man["latency_cycles"])
+    lo, hi = sweep.codes
+    out, sat = sweep.process(got["codes"])
+    bad = (got["data"] != out) | (got["sat"] != sat) | (got["latency"] != sweep.latency)
     missing = (hi - lo + 1) - int(np.unique(got["codes"]).size)
     first = [int(c) for c in got["codes"][bad][:5]]
     return {"codes_tested": int(got["codes"].size), "mismatches": int(np.count_nonzero(bad)) + missing,
@@ -128,16 +192,24 @@ def check_netlist(design: Design, build, netlist: Path | None = None, progress=N
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
+    sweep = sweep_of(design)
     if netlist is None:
         netlist = mapped_netlist(design, build / "synth", abc)
-    man = design.manifest
-    exe = compile_netlist(netlist, build / "verilator", man["input_bits"], man["output_bits"])
-    lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1
-    got = run_netlist(exe, lo, hi, build, shards=cores(), progress=progress)
-    res = compare(design, got)
+    exe = compile_netlist(netlist, build / "verilator", sweep)
+    got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
+    res = compare(sweep, got)
     res.update(simulator="verilator", seconds=time.monotonic() - t0, run_seconds=got["seconds"],
                netlist=str(netlist))
     return res
+
+
+def netlist_summary(design: Design, build_dir, progress=None) -> tuple[dict, bool]:
+    """``flann sim --netlist``: the mapped netlist's sweep as the summary reports it, and whether it
+    passed (every code, no mismatch)."""
+    nl = check_netlist(design, Path(build_dir) / "netlist", progress=progress("netlist") if progress else None)
+    entry = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"], "simulator": nl["simulator"],
+             "seconds": round(nl["seconds"], 1)}
+    return entry, nl["mismatches"] == 0 and nl["codes_tested"] > 0
 
 
 def check_rtl_netlist(design: Design, build, progress=None) -> dict:
@@ -147,21 +219,21 @@ def check_rtl_netlist(design: Design, build, progress=None) -> dict:
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
-    man = design.manifest
+    sweep = sweep_of(design)
     verilog = ghdl_to_verilog(read_manifest(design.directory), build / "ghdl_synth")
-    exe = compile_netlist(verilog, build / "verilator", man["input_bits"], man["output_bits"], cells=False)
+    exe = compile_netlist(verilog, build / "verilator", sweep, cells=False)
     t_build = time.monotonic() - t0
-    lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1
-    got = run_netlist(exe, lo, hi, build, shards=cores(), progress=progress)
+    lo, hi = sweep.codes
+    got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
     return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1)}
 
 
 def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> None:
-    """The netlist and post-route sweeps drive :data:`DRIVER_TOP`'s flat ports: refuse another
+    """The netlist and post-route sweeps drive one-input tops (:data:`SWEEPS`): refuse another
     datapath's design before any slow step."""
-    if not datapath.netlist:
-        raise FlannError(f"{flag}: the sweep driver drives {DRIVER_TOP}'s ports; {directory} holds a "
-                         f"{datapath.name} design")
+    if datapath.netlist not in SWEEPS:
+        raise FlannError(f"{flag}: the sweep driver drives one-input tops (the {', '.join(SWEEPS)} datapaths' "
+                         f"ports); {directory} holds a {datapath.name} design")
 
 
 def check_synthesized(design: Design, netlist: Path) -> dict:
@@ -170,5 +242,5 @@ def check_synthesized(design: Design, netlist: Path) -> dict:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["DRIVER_TOP", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["DRIVER_TOP", "NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

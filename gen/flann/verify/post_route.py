@@ -5,7 +5,8 @@ do: every LUT's truth table, every routing switch, the block-RAM contents) → `
 (IceStorm: the configured chip as Verilog, its block RAMs as ``SB_RAM40_4K``, ports named
 from the ``.pcf``) → Verilator with Yosys's iCE40 cell models (``<yosys datdir>/ice40/
 cells_sim.v``) and the same sweep driver as the Spartan-II netlist
-(:mod:`flann.verify.netlist`) → every input code compared with the twin in one pass.
+(:mod:`flann.verify.netlist`; a family design's weight image loaded first through its cfg port)
+→ every input code compared with the twin in one pass.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 from ..errors import FlannError
 from ..hardware.target import Ice40Part
 from .design import Design
-from .netlist import DRIVER_TOP, compare, compile_netlist, run_netlist, yosys_datdir
+from .netlist import compare, compile_netlist, run_netlist, sweep_of, yosys_datdir
 from .shards import cores
 
 # cells_sim.v gives some cell inputs default values, which Verilator does not parse
@@ -68,14 +69,12 @@ def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, buil
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
-    man = design.manifest
-    netlist = routed_verilog(Path(asc), Path(pcf), part, DRIVER_TOP, build / "post_route.v")
+    sweep = sweep_of(design)
+    netlist = routed_verilog(Path(asc), Path(pcf), part, sweep.top, build / "post_route.v")
     models = [yosys_datdir() / "ice40" / "cells_sim.v"]
-    exe = compile_netlist(netlist, build / "verilator_post_route", man["input_bits"], man["output_bits"],
-                          models=models, defines=DEFINES)
-    lo, hi = -(1 << (man["input_bits"] - 1)), (1 << (man["input_bits"] - 1)) - 1
-    got = run_netlist(exe, lo, hi, build, shards=cores(), progress=progress)
-    res = compare(design, got)
+    exe = compile_netlist(netlist, build / "verilator_post_route", sweep, models=models, defines=DEFINES)
+    got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
+    res = compare(sweep, got)
     res.update(simulator="icebox_vlog + Verilator (Yosys iCE40 cell models)", device=part.name,
                seconds=round(time.monotonic() - t0, 1))
     return res

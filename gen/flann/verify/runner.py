@@ -36,7 +36,7 @@ from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from . import plots
 from .design import Design
-from .netlist import check_netlist, check_rtl_netlist
+from .netlist import check_rtl_netlist, netlist_summary
 from .shards import count_lines, cores, merge, read_results, split
 
 # bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
@@ -389,10 +389,8 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
                                     "seconds": round(r.seconds, 1)} for r in results}
     all_ok = all(r.ok for r in results)
     if netlist:
-        nl = check_netlist(design, build_dir / "netlist", progress=progress("netlist") if progress else None)
-        summary["netlist"] = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"],
-                              "simulator": nl["simulator"], "seconds": round(nl["seconds"], 1)}
-        all_ok = all_ok and nl["mismatches"] == 0 and nl["codes_tested"] > 0
+        summary["netlist"], passed = netlist_summary(design, build_dir, progress)
+        all_ok = all_ok and passed
     summary["all_passed"] = all_ok
     summary["latency_cycles"] = man["latency_cycles"]
     summary["output_lsb_mm"] = man["output_lsb_mm"]

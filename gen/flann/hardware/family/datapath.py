@@ -81,7 +81,7 @@ DATAPATH = Datapath(
     generate=generate, rebuild=rebuild, twin=FlannFamilyTop, estimate=estimate, fields=FIELDS,
     why_no_explore="flann explore sizes one sensor's design from its model; a family design is sized by "
                    "its members (flann gen --family): explore one of them, e.g. DIR/init_model.json",
-    bench="family", stages="family_member", summary=summary, eval_spec=eval_spec,
+    bench="family", stages="family_member", netlist="family", summary=summary, eval_spec=eval_spec,
     number_format=FIXED.number_format,  # the fixed blocks, weights from a memory
 )
 

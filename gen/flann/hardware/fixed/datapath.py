@@ -65,7 +65,7 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="fixed point, widths from the error budget",
     generate=generate, rebuild=rebuild, twin=FlannTop, estimate=estimate, fields=FIELDS,
     derive_options=lambda options, compared=False: options.to_kwargs(),
-    bench="sweep", stages="fixed_point", explore="fixed_space", netlist=True, summary=summary, eval_spec=eval_spec,
+    bench="sweep", stages="fixed_point", explore="fixed_space", netlist="fixed", summary=summary, eval_spec=eval_spec,
     derive=derive_spec, number_format=render.DATAPATH, fuzz_share=0.8, fuzz_options=fuzz_options,
 )
 

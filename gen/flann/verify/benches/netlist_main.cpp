@@ -1,24 +1,49 @@
-// Verilator driver for the post-synthesis netlist of flann_top: every code from argv[1] to
-// argv[2], back to back, one line per sample ("code data sat latency") in argv[3], the same
-// format as the VHDL sweep harness.  IN_BITS / OUT_BITS come in as -D flags.
+// Verilator driver for the post-synthesis netlist of a one-input top (flann_top, or
+// flann_family_top with CFG_ADDR_BITS defined): every code from argv[1] to argv[2], back to
+// back, one line per sample ("code data sat latency") in argv[3], the same format as the VHDL
+// sweep harness.  A family top first takes its weight image through the cfg port: argv[4], one
+// hex word per line, address 0 first.  The model is built with --prefix Vdut; IN_BITS /
+// OUT_BITS (and CFG_ADDR_BITS) come in as -D flags.
 #include <cstdio>
 #include <cstdlib>
-#include "Vflann_top.h"
+#include "Vdut.h"
 #include "verilated.h"
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: %s CODE_LO CODE_HI OUT.txt\n", argv[0]);
+#ifdef CFG_ADDR_BITS
+  const int args = 5;
+#else
+  const int args = 4;
+#endif
+  if (argc != args) {
+    std::fprintf(stderr, "usage: %s CODE_LO CODE_HI OUT.txt%s\n", argv[0], args == 5 ? " IMAGE.txt" : "");
     return 2;
   }
   const long lo = std::atol(argv[1]), hi = std::atol(argv[2]);
   std::FILE* f = std::fopen(argv[3], "w");
   if (!f) return 2;
-  Vflann_top* t = new Vflann_top;
+  Vdut* t = new Vdut;
   auto tick = [t]() { t->clk = 0; t->eval(); t->clk = 1; t->eval(); };
-  t->clk = 0; t->rst = 1; t->in_valid = 0; t->in_data = 0; t->eval();
+  t->clk = 0; t->rst = 1; t->in_valid = 0; t->in_data = 0;
+#ifdef CFG_ADDR_BITS
+  t->cfg_we = 0; t->cfg_addr = 0; t->cfg_data = 0;
+#endif
+  t->eval();
   tick(); tick();
   t->rst = 0;
+#ifdef CFG_ADDR_BITS
+  std::FILE* img = std::fopen(argv[4], "r");
+  if (!img) return 2;
+  unsigned long word = 0;
+  for (unsigned long a = 0; std::fscanf(img, "%lx", &word) == 1; ++a) {
+    if (a >> CFG_ADDR_BITS) return 3;  // more words than the memory holds
+    t->cfg_we = 1; t->cfg_addr = a; t->cfg_data = static_cast<unsigned int>(word);
+    tick();
+  }
+  std::fclose(img);
+  t->cfg_we = 0;
+  tick();
+#endif
   const unsigned long long in_mask = (1ULL << IN_BITS) - 1;
   for (long c = lo; c <= hi; ++c) {
     t->in_data = static_cast<unsigned long long>(c) & in_mask;
