@@ -160,15 +160,20 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
     """
     if abc not in ABC_MODES:
         raise FlannError(f"abc mode {abc!r}: allowed {', '.join(ABC_MODES)}")
-    head = [f"read_verilog {verilog}"]
+    # synth_xilinx's coarse step with `memory -nowiden`: two ports written at addr & 0 and addr & 1
+    # (the family's weight memory) stay the two ports of one RAMB4_S16_S16, as XST maps them, not
+    # one wide port of two RAMB4_S16
+    head = [f"read_verilog {verilog}", f"synth_xilinx -family {FAMILY} -top {top} -run begin:coarse",
+            "techmap -map +/cmp2lut.v -map +/cmp2lcu.v -D LUT_WIDTH=4", "alumacc", "share", "opt",
+            "memory -nomap -nowiden", "opt_clean"]
     # the netlist the counts describe, for post-synthesis simulation (flann.verify.netlist)
     tail = ["check -assert", f"tee -q -o {stat} stat -json", f"write_verilog -noattr {NETLIST}",
             # last: flattening and dropping the cell library change nothing written above
             "flatten", "delete =A:blackbox", f"write_json {MAPPED_JSON}"]
     if abc == "full":
-        return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top}"] + tail)
+        return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top} -run map_memory:"] + tail)
     return "; ".join(head + [
-        f"synth_xilinx -family {FAMILY} -top {top} -run begin:map_luts",
+        f"synth_xilinx -family {FAMILY} -top {top} -run map_memory:map_luts",
         "opt_expr -mux_undef -noclkinv",
         "abc -fast -lut 4:6",  # LUT4 plus MUXF5/MUXF6 wide functions, as synth_xilinx maps xcv
         "clean",

@@ -32,7 +32,7 @@ def test_two_sensors_through_cfg_port(tmp_path):
         h.write_text(hex_text(chk["words"]))
         images.append({"name": p.stem, "hex": str(h)})
     res = runner.run_family_bench(hdl, images, tmp_path / "build")
-    assert res.tests == 3 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
+    assert res.tests == 4 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
     rec = res.records["family_every_code"]
     assert len(rec["codes"]) == 2 ** 8 and rec["mismatches"] == 0
 
@@ -52,7 +52,7 @@ def test_two_identical_sensors_verify(tmp_path):
         (tmp_path / f"{name}.hex").write_text(words)
         images.append({"name": name, "hex": str(tmp_path / f"{name}.hex")})
     res = runner.run_family_bench(hdl, images, tmp_path / "build")
-    assert res.tests == 3 and res.ok, f"failed: {res.failed_tests}"
+    assert res.tests == 4 and res.ok, f"failed: {res.failed_tests}"
     assert res.records["family_every_code"]["mismatches"] == 0
 
 

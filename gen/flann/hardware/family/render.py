@@ -71,10 +71,11 @@ def contexts(fam: FamilySpec, init_name: str, mem_entity: str = MEM) -> dict[str
     s = fam.spec
     base = fixed.contexts(s)
     words = FlannFamilyMem.encode(fam, s)
-    # the block RAM holds each word as two halves (low half at 2k, high half at 2k + 1)
+    # the block RAM holds each word as two halves (low half at 2k, high half at 2k + 1); the
+    # VHDL array is descending, so its aggregate lists the highest address first
     mem = dict(entity=mem_entity, depth=fam.mem_depth, half_words=2 * fam.mem_depth, data_bits=DATA_BITS,
-               half_bits=HALF_BITS, addr_bits=fam.addr_bits,
-               init_name=init_name, halves=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)])
+               half_bits=HALF_BITS, addr_bits=fam.addr_bits, init_name=init_name,
+               halves_high_first=[bits_literal(h, HALF_BITS, False) for h in bram_image(words)][::-1])
     n = base["flann_norm"]
     norm = dict(code_bits=n["code_bits"], phase_bits=n["phase_bits"], lin_bits=n["lin_bits"],
                 acc_v_bits=n["acc_v_bits"], lin_width=n["acc_l_bits"], guard_v=n["guard_v"],

@@ -76,6 +76,19 @@ class FamilyBench:
 
 
 @cocotb.test()
+async def family_initial_contents_are_the_first_member(dut):
+    """Before any load the memory holds what the design was generated with (the block RAM's INIT,
+    the first member): codes at both ends, the null and at random bit-exact vs that twin.  First
+    in this module: the tests share one simulation, and the later ones load other sensors."""
+    bench = FamilyBench(dut)
+    await bench.start()
+    s = bench.fam.spec
+    codes = [s.code_min, s.code_max, 0, *(bench.rng.randint(s.code_min, s.code_max) for _ in range(13))]
+    await bench.run_codes(codes)
+    assert bench.sb.checked == len(codes) and bench.sb.ok, f"{bench.sb.mismatches} mismatches vs the initial twin"
+
+
+@cocotb.test()
 async def family_two_sensors_every_code(dut):
     """Load sensor A then sensor B through cfg_*: every input code bit-exact vs that sensor's twin."""
     bench = FamilyBench(dut)
