@@ -168,6 +168,12 @@ def _main(argv: list[str] | None) -> int:
     except FlannError as exc:
         print(f"error: {one_line(exc)}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        # the file system refused what a command checks no further (a file where a build step
+        # makes its directory, a full disk): the path and the reason, as the shell says them
+        where = f"{exc.filename}: " if exc.filename is not None else ""
+        print(f"error: {one_line(where + (exc.strerror or str(exc)))}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

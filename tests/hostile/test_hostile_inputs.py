@@ -280,6 +280,11 @@ def p_manifest_model_outside(w):
     _edited_manifest(w, lambda m: m.update(model="../m.json"))
 
 
+def p_build_file(w):
+    (w / "bb").mkdir()
+    _write(w / "bb" / "family", "mine\n")
+
+
 def p_thermal_toml(w):
     shutil.copy(Path(__file__).resolve().parents[2] / "data" / "sensors" / "paper_lvdt_thermal.toml",
                 w / "thermal.toml")
@@ -480,6 +485,8 @@ CASES = [
                                                      "-260,25"), 2, "not positive", (), "p_thermal_toml"),
     Case("sim-seed-negative", "14", ("sim", "design", "--seed", "-1"), 2, "--seed"),
     Case("synth-seed-negative", "14", ("synth", "design", "--seed", "-1", "--no-lint"), 2, "--seed"),
+    Case("sim-build-holds-a-file-where-a-bench-builds", "own", ("sim", "fam", "--build", "bb"), 2,
+         "bb/family: Not a directory", ("bb/**",), "p_build_file"),
     Case("sim-kept-model-outside-dir", "1", ("sim", "edited"), 2, "kept model '../m.json'", (),
          "p_manifest_model_outside"),
 ]
