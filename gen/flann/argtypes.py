@@ -51,6 +51,10 @@ def bounded(kind: type = float, lo: float | None = None, hi: float | None = None
     return parse
 
 
+# a seed sim hands to the benches and, with --post-route, to nextpnr, which reads a C int
+TOOL_SEED = bounded(int, 0, 2**31 - 1)
+
+
 def terms_or_auto(lo: int, hi: int):
     """An argparse ``type`` for ``--terms``: ``auto`` or an integer in ``[lo, hi]`` (``hi``:
     :data:`flann.golden.model.MAX_TERMS`, passed in: this module stays free of numpy, which

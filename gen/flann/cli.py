@@ -171,7 +171,7 @@ def _main(argv: list[str] | None) -> int:
     except OSError as exc:
         # the file system refused what a command checks no further (a file where a build step
         # makes its directory, a full disk): the path and the reason, as the shell says them
-        where = f"{exc.filename}: " if exc.filename is not None else ""
+        where = "".join(f"{name}: " for name in (exc.filename, exc.filename2) if name is not None)
         print(f"error: {one_line(where + (exc.strerror or str(exc)))}", file=sys.stderr)
         return 2
 

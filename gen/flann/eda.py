@@ -151,7 +151,8 @@ MAPPED_JSON = "mapped.json"  # the same netlist flattened, for the timing estima
 
 
 def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.json") -> str:
-    """The Yosys script.  ``abc="full"`` is plain ``synth_xilinx -family xcv``.
+    """The Yosys script.  ``abc="full"`` is ``synth_xilinx -family xcv`` with its coarse step run
+    here, its memory pass with ``-nowiden`` (below).
 
     ``abc="fast"`` runs the same synth_xilinx steps but replaces its LUT-mapping ABC
     script (fraig, scorr, dch, mfs2: minutes to hours on wide multipliers) by ``abc -fast``;
@@ -181,7 +182,7 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
         "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=4",
         "xilinx_dffopt -lut4",
         "opt_lut_ins -tech xilinx",
-        f"synth_xilinx -family {FAMILY} -top {top} -run map_cells:",
+        f"synth_xilinx -family {FAMILY} -top {top} -run finalize:",
     ] + tail)
 
 

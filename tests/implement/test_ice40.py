@@ -96,7 +96,7 @@ def test_errors_are_one_line(small, tmp_path, capsys):
 
 @pytest.mark.parametrize("command", ["sim", "synth"])
 def test_post_route_of_another_datapath_is_refused_before_any_tool(small, tmp_path, capsys, command):
-    """The sweep driver drives the one-input tops' ports: a float18 design is refused in one line, by
+    """The netlist sweep drives the fixed and family tops: a float18 design is refused in one line, by
     both commands, before synthesis or a bench starts (no build directory is made)."""
     model, _hdl = small
     f18 = tmp_path / "f18"
@@ -107,7 +107,7 @@ def test_post_route_of_another_datapath_is_refused_before_any_tool(small, tmp_pa
                       "--model", str(model), "-o", str(tmp_path / "o")]}[command]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "the sweep driver drives one-input tops (the fixed, family datapaths' ports)" in err[0] and "float18" in err[0], err
+    assert len(err) == 1 and "the netlist sweep has a driver and twin for fixed and family designs only" in err[0] and "float18" in err[0], err
     assert not (tmp_path / "o").exists()
 
 

@@ -15,6 +15,7 @@ import pytest
 from dataclasses import replace
 
 from flann.eda import complete_pmux_cases, ghdl_to_verilog
+from flann.errors import FlannError
 from flann.hardware.family.images import read_image
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.manifest import read_manifest
@@ -60,6 +61,10 @@ def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, sm
         assert res["codes_tested"] == 256 and res["mismatches"] == 0, (name, res)
         if loaded is other:
             assert compare(sweep, got)["mismatches"] > 0
+    # an image cut short would leave the memory's initial sensor in place: the driver refuses it
+    (tmp_path / "short").mkdir()
+    with pytest.raises(FlannError, match=f"{len(kept[0]) - 1} hex words read, the memory takes {len(kept[0])}"):
+        run_netlist(exe, replace(sweep, image=tuple(kept[0][:-1])), tmp_path / "short", shards=1)
 
 
 def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):

@@ -13,7 +13,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ..argtypes import bounded, png_path
+from ..argtypes import TOOL_SEED, png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_json, check_output_directory
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
@@ -42,7 +42,8 @@ def add_arguments(parser) -> None:
                         help="with DIR: the model DIR was generated from (checked against the manifest's sha256)")
     parser.add_argument("--netlist", action="store_true",
                         help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
-                             "netlist over every input code (Verilator, Yosys's Xilinx cell models)")
+                             "netlist over every input code (Verilator, Yosys's Xilinx cell models); a family "
+                             "design's with the last weight image it keeps loaded through cfg_*")
     parser.add_argument("--post-route", action="store_true",
                         help="also place and route on an iCE40 (--post-route-device) and simulate the routed design "
                              "over every input code (icebox_vlog + Verilator, Yosys's iCE40 cell models)")
@@ -59,7 +60,8 @@ def add_arguments(parser) -> None:
                              "temperature, and their difference (PNG)")
     parser.add_argument("--build", metavar="DIR", default=None,
                         help="keep generated HDL, logs and results here (default: a temporary directory)")
-    parser.add_argument("--seed", type=bounded(int, 0, 2**32 - 1), default=1, help="seed of the random stimuli (default %(default)s)")
+    parser.add_argument("--seed", type=TOOL_SEED, default=1,
+                        help="seed of the random stimuli and of --post-route's placement (default %(default)s)")
     parser.add_argument("--image", action="append", metavar="HEX", default=None,
                         help="a family design: a sensor's weight image (flann calibrate) to load through the "
                              "cfg port, each simulated (one alone, on a family without temperature: loaded over an "

@@ -8,7 +8,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ..argtypes import bounded
+from ..argtypes import TOOL_SEED
 from ..eda import ABC_MODES, NETLIST
 from ..errors import FlannError
 from ..implement import ice40, synth, timing
@@ -38,7 +38,7 @@ def add_arguments(p):
                    help="iCE40 only: simulate the placed-and-routed design (icebox_vlog + Verilator, Yosys's iCE40 "
                         "cell models) over every input code against the twin (needs the model: --model or the "
                         "manifest's)")
-    p.add_argument("--seed", type=bounded(int, 0, 2**31 - 1), default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
+    p.add_argument("--seed", type=TOOL_SEED, default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
     p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
@@ -60,8 +60,7 @@ def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
     it was not run); a design whose netlist disagrees is refused."""
     man, dp = read_design(args.directory)
     if dp.netlist not in SWEEPS:
-        return None, (f"no netlist sweep for a {dp.name} design (it drives one-input tops: the "
-                      f"{', '.join(SWEEPS)} datapaths')")
+        return None, f"no netlist sweep for a {dp.name} design (it has a driver and twin for {' and '.join(SWEEPS)} designs)"
     if args.model is None and not man.get("model"):
         print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
               file=sys.stderr)

@@ -29,7 +29,6 @@ import numpy as np
 from ..errors import FlannError
 from ..hardware.family.images import read_image
 from ..hardware.family.twin import FlannFamilyTop
-from ..hardware.fixed.datapath import DATAPATH as FIXED
 from ..hardware.fixed.twin import FlannTop
 from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
 from ..hardware.manifest import read_manifest
@@ -38,7 +37,6 @@ from .design import Design
 from .shards import cores, count_lines, merge, read_results, split
 
 DRIVER = "netlist_main.cpp"
-DRIVER_TOP = FIXED.top      # the driver's ports: this entity's (and a family top's cfg_* besides)
 RAM_MODELS = "ramb4_sim.v"
 PREFIX = "Vdut"             # the Verilated model's class, whatever the top (the driver includes Vdut.h)
 
@@ -132,7 +130,7 @@ def compile_netlist(netlist: Path, build: Path, sweep: NetlistSweep, cells: bool
         models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
     flags = f"-DIN_BITS={sweep.in_bits} -DOUT_BITS={sweep.out_bits}"
     if sweep.image is not None:
-        flags += f" -DCFG_ADDR_BITS={sweep.cfg_addr_bits}"
+        flags += f" -DCFG_ADDR_BITS={sweep.cfg_addr_bits} -DCFG_WORDS={len(sweep.image)}"
     cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
            "--top-module", sweep.top, "--prefix", PREFIX, "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
            "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
@@ -232,8 +230,8 @@ def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> Non
     """The netlist and post-route sweeps drive one-input tops (:data:`SWEEPS`): refuse another
     datapath's design before any slow step."""
     if datapath.netlist not in SWEEPS:
-        raise FlannError(f"{flag}: the sweep driver drives one-input tops (the {', '.join(SWEEPS)} datapaths' "
-                         f"ports); {directory} holds a {datapath.name} design")
+        raise FlannError(f"{flag}: {directory} holds a {datapath.name} design, and the netlist sweep has a driver "
+                         f"and twin for {' and '.join(SWEEPS)} designs only")
 
 
 def check_synthesized(design: Design, netlist: Path) -> dict:
@@ -242,5 +240,5 @@ def check_synthesized(design: Design, netlist: Path) -> dict:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["DRIVER_TOP", "NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

@@ -2,8 +2,10 @@
 // flann_family_top with CFG_ADDR_BITS defined): every code from argv[1] to argv[2], back to
 // back, one line per sample ("code data sat latency") in argv[3], the same format as the VHDL
 // sweep harness.  A family top first takes its weight image through the cfg port: argv[4], one
-// hex word per line, address 0 first.  The model is built with --prefix Vdut; IN_BITS /
-// OUT_BITS (and CFG_ADDR_BITS) come in as -D flags.
+// hex word per line, address 0 first, exactly CFG_WORDS of them (a short or unreadable image
+// would leave the memory's initial sensor in place and still match a twin of it).  The model
+// is built with --prefix Vdut; IN_BITS / OUT_BITS (and CFG_ADDR_BITS, CFG_WORDS) come in as -D
+// flags.
 #include <cstdio>
 #include <cstdlib>
 #include "Vdut.h"
@@ -33,14 +35,21 @@ int main(int argc, char** argv) {
   t->rst = 0;
 #ifdef CFG_ADDR_BITS
   std::FILE* img = std::fopen(argv[4], "r");
-  if (!img) return 2;
-  unsigned long word = 0;
-  for (unsigned long a = 0; std::fscanf(img, "%lx", &word) == 1; ++a) {
-    if (a >> CFG_ADDR_BITS) return 3;  // more words than the memory holds
+  if (!img) {
+    std::fprintf(stderr, "cannot open the weight image %s\n", argv[4]);
+    return 2;
+  }
+  unsigned long word = 0, a = 0;
+  for (; a < CFG_WORDS && std::fscanf(img, " %lx", &word) == 1; ++a) {
     t->cfg_we = 1; t->cfg_addr = a; t->cfg_data = static_cast<unsigned int>(word);
     tick();
   }
+  const bool rest = std::fscanf(img, " %*s") != EOF;
   std::fclose(img);
+  if (a != CFG_WORDS || rest || (a - 1) >> CFG_ADDR_BITS) {
+    std::fprintf(stderr, "weight image %s: %lu hex words read, the memory takes %d\n", argv[4], a, CFG_WORDS);
+    return 3;
+  }
   t->cfg_we = 0;
   tick();
 #endif
