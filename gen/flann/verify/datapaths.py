@@ -16,13 +16,11 @@ from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
-from ..hardware.family.images import header_fields, parse_hex
-from ..hardware.family.render import design_hash
-from ..inputs import read_text
 from . import plots
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
+from .images import checked_image, kept_images
 from .netlist import netlist_summary, require_sweep_driver
 from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
 
@@ -64,36 +62,12 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-def _image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:
-    """(image, its words) read and checked against the design before anything is simulated: hex
-    words of the memory's width, as many as the design's image holds (``words``), and the design
-    and word count its header names (a weight image flann calibrate wrote says both)."""
-    text = read_text(image["hex"], FlannError, "a weight image (.hex)")
-    got = parse_hex(text, image["hex"])
-    named, stated = header_fields(text)
-    if stated is not None and stated != len(got):
-        raise FlannError(f"{image['hex']}: {len(got)} words, its header says {stated}: the image is cut "
-                         "short or was edited; write it again with flann calibrate")
-    if len(got) != words:
-        raise FlannError(f"{image['hex']}: {len(got)} words, {design.directory}'s weight image is {words} words "
-                         "(an image of another design?)")
-    if named is not None and named != (ours := design_hash(design.directory)):
-        raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[:12]}..., "
-                         f"{design.directory} is {ours[:12]}...): calibrate the sensor for this design "
-                         "(flann calibrate --design DIR)")
-    return image, got
-
-
 def _images(design: Design, images, words: int) -> list[tuple[dict, list[int]]]:
     """The weight images a family bench loads, ({name, hex}, words) each: those given (--image),
-    else the ones flann gen kept in the design; each checked by :func:`_image`, so a bad file is
+    else the ones flann gen kept in the design; each checked by :func:`~flann.verify.images.checked_image`, so a bad file is
     one line before the simulation, not a failed bench after it."""
-    images = list(images or _kept_images(design))
-    return [_image(design, im, words) for im in images]
-
-
-def _kept_images(design: Design) -> list[dict]:
-    return [{"name": im["name"], "hex": str(design.directory / im["hex"])} for im in design.manifest.get("images", [])]
+    images = list(images or kept_images(design))
+    return [checked_image(design, im, words) for im in images]
 
 
 def _two_images(design: Design, loaded: list, given: bool) -> list:
@@ -102,7 +76,7 @@ def _two_images(design: Design, loaded: list, given: bool) -> list:
     differs from it where the design keeps one)."""
     if given and len(loaded) == 1:
         (image, words), = loaded
-        kept = sorted(_images(design, _kept_images(design), len(words)), key=lambda k: k[1] == words)
+        kept = sorted(_images(design, kept_images(design), len(words)), key=lambda k: k[1] == words)
         if kept:
             # named by the design's folder: the summary shows it is the design's own, not one given
             im, first = kept[0]
@@ -221,7 +195,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     initial sensor, so the cfg port is what loads it), at every voltage code and the stated
     temperature codes: one run of the sweep harness per image."""
     spec, man = design.spec, design.manifest
-    loaded = _images(design, images or _kept_images(design)[-1:], spec.image_words)
+    loaded = _images(design, images or kept_images(design)[-1:], spec.image_words)
     if not loaded:
         raise FlannError(f"{design.directory}: the {design.datapath.name} bench loads a sensor weight image through "
                          "the cfg port; the design holds none: pass --image A.hex (written by flann calibrate)")

@@ -27,13 +27,13 @@ from typing import Callable
 import numpy as np
 
 from ..errors import FlannError
-from ..hardware.family.images import read_image
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.fixed.twin import FlannTop
 from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR
 from .design import Design
+from .images import checked_image, kept_images
 from .shards import cores, count_lines, merge, read_results, split
 
 DRIVER = "netlist_main.cpp"
@@ -67,14 +67,11 @@ def _fixed_sweep(design: Design) -> NetlistSweep:
 
 def _family_sweep(design: Design) -> NetlistSweep:
     man = design.manifest
-    kept = man.get("images") or []
+    kept = kept_images(design)
     if not kept:
         raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
                          "design keeps none (regenerate it with flann gen --family from the recordings)")
-    words = read_image(design.directory / kept[-1]["hex"])
-    if len(words) != design.spec.mem_depth:
-        raise FlannError(f"{design.directory / kept[-1]['hex']}: {len(words)} words, the design's memory holds "
-                         f"{design.spec.mem_depth}")
+    _, words = checked_image(design, kept[-1], design.spec.mem_depth)
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannFamilyTop(design.spec, words).process, tuple(words), design.spec.addr_bits)
 

@@ -1,0 +1,38 @@
+"""A family design's weight images as the benches and the netlist sweep load them: the ones the
+design keeps, and any image read and checked against the design before a slow step starts."""
+
+from __future__ import annotations
+
+from ..errors import FlannError
+from ..hardware.family.images import header_fields, parse_hex
+from ..hardware.family.render import design_hash
+from ..inputs import read_text
+from .design import Design
+
+
+def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:
+    """(image, its words) read and checked against the design before anything is simulated: hex
+    words of the memory's width, as many as the design's image holds (``words``), and the design
+    and word count its header names (a weight image flann calibrate wrote says both)."""
+    text = read_text(image["hex"], FlannError, "a weight image (.hex)")
+    got = parse_hex(text, image["hex"])
+    named, stated = header_fields(text)
+    if stated is not None and stated != len(got):
+        raise FlannError(f"{image['hex']}: {len(got)} words, its header says {stated}: the image is cut "
+                         "short or was edited; write it again with flann calibrate")
+    if len(got) != words:
+        raise FlannError(f"{image['hex']}: {len(got)} words, {design.directory}'s weight image is {words} words "
+                         "(an image of another design?)")
+    if named is not None and named != (ours := design_hash(design.directory)):
+        raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[:12]}..., "
+                         f"{design.directory} is {ours[:12]}...): calibrate the sensor for this design "
+                         "(flann calibrate --design DIR)")
+    return image, got
+
+
+def kept_images(design: Design) -> list[dict]:
+    """The weight images flann gen kept in the design, as {name, hex path}."""
+    return [{"name": im["name"], "hex": str(design.directory / im["hex"])} for im in design.manifest.get("images", [])]
+
+
+__all__ = ["checked_image", "kept_images"]
