@@ -121,10 +121,11 @@ def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str,
                          "(no directory part, no '..')")
     p = directory / name
     if not p.is_file():
-        if must_exist or p.exists() or p.is_symlink():
-            raise FlannError(f"{path}: {what} {name!r} does not exist in {directory}"
-                             if not p.exists() else f"{path}: {what} {name!r} is not a regular file")
-        return p
+        absent = not p.exists() and not p.is_symlink()   # a dangling link is there, and refused
+        if absent and not must_exist:
+            return p
+        raise FlannError(f"{path}: {what} {name!r} " + ("does not exist in " + str(directory) if not p.exists()
+                                                          else "is not a regular file"))
     if Path(os.path.realpath(p)).parent != Path(os.path.realpath(directory)):
         raise FlannError(f"{path}: {what} {name!r} leads out of {directory} (a symbolic link)")
     return p
