@@ -17,7 +17,8 @@ from flann.golden.thermal_train import fit_thermal
 from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
 from flann.hardware.thermal.twin import FlannThermalTop
-from flann.verify.datapaths import THERMAL_MAX_SAMPLES, simulate, thermal_temperature_codes
+from flann.verify.datapaths import simulate
+from flann.verify.temperatures import THERMAL_MAX_SAMPLES, thermal_temperature_codes
 from flann.verify.design import from_directory
 
 from test_thermal_twin import sensor_v

@@ -95,20 +95,21 @@ def test_errors_are_one_line(small, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("command", ["sim", "synth"])
-def test_post_route_of_another_datapath_is_refused_before_any_tool(small, tmp_path, capsys, command):
-    """The netlist sweep drives the fixed and family tops: a float18 design is refused in one line, by
-    both commands, before synthesis or a bench starts (no build directory is made)."""
-    model, _hdl = small
-    f18 = tmp_path / "f18"
-    assert main(["gen", str(model), "-o", str(f18), "--format", "float18"]) == 0
-    capsys.readouterr()
-    argv = {"sim": ["sim", str(f18), "--post-route", "--build", str(tmp_path / "b")],
-            "synth": ["synth", str(f18), "--device", "ice40-hx8k-ct256", "--post-route", "--no-lint",
-                      "--model", str(model), "-o", str(tmp_path / "o")]}[command]
+def test_post_route_of_a_design_without_a_twin_is_refused_before_any_tool(tmp_path, capsys, command):
+    """Every datapath flann gen writes has a netlist sweep; a design flann did not write (VHDL with
+    a hand-written manifest) has no twin: refused in one line by both commands, before synthesis
+    or a bench starts (no output or build directory is made)."""
+    plain = tmp_path / "plain"
+    shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", plain)
+    argv = {"sim": ["sim", str(plain), "--post-route", "--build", str(tmp_path / "b")],
+            "synth": ["synth", str(plain), "--device", "ice40-hx8k-ct256", "--post-route", "--no-lint",
+                      "-o", str(tmp_path / "o")]}[command]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "the netlist sweep has a driver and twin for fixed and family designs only" in err[0] and "float18" in err[0], err
-    assert not (tmp_path / "o").exists()
+    assert len(err) == 1 and err[0].startswith("error: "), err
+    assert {"sim": "no twin", "synth": "the netlist sweep has a driver and twin for fixed, float18, family, "
+                                      "thermal and family_thermal designs only"}[command] in err[0], err
+    assert not (tmp_path / "o").exists() and not (tmp_path / "b").exists()
 
 
 def test_every_table_part_has_its_package_in_the_chip_database():

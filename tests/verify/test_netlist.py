@@ -10,6 +10,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from dataclasses import replace
@@ -65,6 +66,25 @@ def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, sm
     (tmp_path / "short").mkdir()
     with pytest.raises(FlannError, match=f"{len(kept[0]) - 1} hex words read, the memory takes {len(kept[0])}"):
         run_netlist(exe, replace(sweep, image=tuple(kept[0][:-1])), tmp_path / "short", shards=1)
+
+
+@pytest.mark.parametrize("datapath", ["thermal", "family_thermal"])
+def test_two_input_netlist_follows_its_temperature_input(tmp_path, small_designs, datapath):
+    """A design with temperature: GHDL's netlist (as Yosys reads it) runs every voltage code at the
+    RTL sweep's temperature codes and agrees with the twin at each; against the twin one
+    temperature code up it disagrees, so in_temp is driven and read, not left at 0."""
+    design = from_directory(small_designs["dir"] / datapath)
+    sweep = sweep_of(design)
+    spec = design.spec
+    assert sweep.temps[0] == spec.temp_code_min and sweep.temps[-1] == spec.temp_code_max
+    verilog = ghdl_to_verilog(read_manifest(design.directory), tmp_path / "ghdl")
+    exe = compile_netlist(verilog, tmp_path / "verilator", sweep, cells=False)
+    got = run_netlist(exe, sweep, tmp_path, shards=2)
+    res = compare(sweep, got)
+    assert res["codes_tested"] == 256 * len(sweep.temps) == sweep.samples and res["mismatches"] == 0, res
+    assert sorted(set(got["temps"].tolist())) == list(sweep.temps)
+    up = replace(sweep, process=lambda c, t: sweep.process(c, np.minimum(t + 1, spec.temp_code_max)))
+    assert compare(up, got)["mismatches"] > 0
 
 
 def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):

@@ -33,7 +33,7 @@ from ..hardware.family_thermal.spec import FamilyThermalSpec, order_models
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.thermal.spec import ThermalSpec
 from ..hardware.thermal.twin import FlannThermalTop
-from ..verify.datapaths import family_thermal_temperature_codes, thermal_temperature_codes
+from ..verify.temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 
 STAGES = ("temperature", "correction", "interpolation", "orders", "horner", "output")
 STAGE_TEXT = {

@@ -151,7 +151,9 @@ def run(args) -> int:
             print(f"  bench {name:<11} {b['tests']} test(s) {secs}  {state}")
         if "netlist" in s:
             n = s["netlist"]
-            print(f"netlist (Yosys xcv)     {n['codes_tested']} codes, {n['mismatches']} mismatches "
+            what = (f"samples ({n['temperature_codes']} temperature codes)" if n.get("temperature_codes")
+                    else "codes")
+            print(f"netlist (Yosys xcv)     {n['codes_tested']} {what}, {n['mismatches']} mismatches "
                   f"({n['simulator']}, {n['seconds']:.0f} s)")
         if "post_route" in s:
             n = s["post_route"]

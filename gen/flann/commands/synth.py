@@ -17,7 +17,7 @@ from ..hardware.registry import read_design
 from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
-from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver
+from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver, sweep_datapaths
 from ..verify.post_route import checker
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
@@ -60,7 +60,7 @@ def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
     it was not run); a design whose netlist disagrees is refused."""
     man, dp = read_design(args.directory)
     if dp.netlist not in SWEEPS:
-        return None, f"no netlist sweep for a {dp.name} design (it has a driver and twin for {' and '.join(SWEEPS)} designs)"
+        return None, f"no netlist sweep for a {dp.name} design (it has a driver and twin for {sweep_datapaths()} designs)"
     if args.model is None and not man.get("model"):
         print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
               file=sys.stderr)
@@ -71,9 +71,9 @@ def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
     res = check_synthesized(design, netlist)
     if res["mismatches"]:
         raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res['mismatches']} of "
-                         f"{res['codes_tested']} input codes (first: {res['first_mismatches']}); not handing it on")
+                         f"{res['codes_tested']} samples (first: {res['first_mismatches']}); not handing it on")
     return {"codes": res["codes_tested"], "mismatches": res["mismatches"], "passed": not res["mismatches"],
-            "simulator": res["simulator"]}, ""
+            "simulator": res["simulator"], "temperature_codes": res["temperature_codes"]}, ""
 
 
 def post_route_check(directory, model):

@@ -198,7 +198,9 @@ class SynthReport:
                 lines.append(f"  DOES NOT MEET the design's clock {CLOCK_HZ / 1e6:g} MHz (estimate)")
         n = self.netlist_check
         if n is not None:
-            lines.append(f"  {'netlist check':<20} {n['codes']:>6} input codes simulated on the mapped netlist "
+            temps = n.get("temperature_codes")
+            what = f"samples (every input code x {temps} temperature codes)" if temps else "input codes"
+            lines.append(f"  {'netlist check':<20} {n['codes']:>6} {what} simulated on the mapped netlist "
                          f"({n['simulator']}), {n['mismatches']} mismatches with the twin: "
                          + ("passed" if n["passed"] else "FAILED"))
         elif self.netlist_not_run:

@@ -22,17 +22,8 @@ from .float18 import run_design
 from .benches import BENCH_DIR
 from .images import checked_image, kept_images
 from .netlist import netlist_summary, require_sweep_driver
+from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
-
-# a two-input sweep over every voltage code at every temperature code up to this many samples;
-# above it, every voltage code at THERMAL_TEMPS temperature codes (both ends of the code range,
-# both ends of the calibrated range, evenly spaced codes between)
-THERMAL_MAX_SAMPLES = 2_000_000
-THERMAL_TEMPS = 17
-# the family design with temperature: every voltage code at both ends of the temperature code range
-# and this many codes evenly spaced over the calibrated range (its ends included)
-FAMILY_THERMAL_TEMPS = 7
-
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
     man = design.manifest
@@ -89,7 +80,7 @@ def _two_images(design: Design, loaded: list, given: bool) -> list:
     return loaded
 
 
-def _family(design: Design, build_dir, *, seed=1, images=None, netlist=False, progress=None, **_) -> dict:
+def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
     loaded = _two_images(design, _images(design, images, design.spec.mem_depth), bool(images))
     images = [im for im, _words in loaded]
     res = run_family_bench(design.directory, images, build_dir, seed=seed)
@@ -108,23 +99,11 @@ def _family(design: Design, build_dir, *, seed=1, images=None, netlist=False, pr
                  design.manifest["output_lsb_mm"])
     s["images"] = [im["name"] for im in images]
     s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
-    if netlist:
-        s["netlist"], passed = netlist_summary(design, build_dir, progress)
-        s["all_passed"] = s["all_passed"] and passed
     return {"summary": s, "curve": curve, "spec": design.spec}
 
 
-def _fixed(design: Design, build_dir, *, seed=1, netlist=False, engine="auto", progress=None, **_) -> dict:
-    return simulate_fixed(design, build_dir, seed=seed, netlist=netlist, engine=engine, progress=progress)
-
-
-def thermal_temperature_codes(spec) -> tuple[list[int], bool]:
-    """(temperature codes the sweep runs, every code?)."""
-    every = list(range(spec.temp_code_min, spec.temp_code_max + 1))
-    if len(every) * (spec.code_max - spec.code_min + 1) <= THERMAL_MAX_SAMPLES:
-        return every, True
-    inner = np.linspace(spec.temp_lo, spec.temp_hi, THERMAL_TEMPS - 2).round().astype(int).tolist()
-    return sorted({spec.temp_code_min, spec.temp_code_max, *inner}), False
+def _fixed(design: Design, build_dir, *, seed=1, engine="auto", progress=None, **_) -> dict:
+    return simulate_fixed(design, build_dir, seed=seed, engine=engine, progress=progress)
 
 
 def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
@@ -181,13 +160,6 @@ def _sweep_rows(path: Path, samples: int):
     if rows.shape != (samples, 5):
         return None
     return rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3].astype(bool)
-
-
-def family_thermal_temperature_codes(spec) -> list[int]:
-    """The temperature codes the family-with-temperature sweep runs: both ends of the code range
-    (clamped), FAMILY_THERMAL_TEMPS evenly spaced codes over the calibrated range (its ends included)."""
-    inner = np.linspace(spec.temp_lo, spec.temp_hi, FAMILY_THERMAL_TEMPS).round().astype(int).tolist()
-    return sorted({spec.temp_code_min, spec.temp_code_max, *inner})
 
 
 def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
@@ -254,12 +226,13 @@ BENCHES = {"sweep": _fixed, "thermal_sweep": _thermal, "f18_top": _float18, "fam
 LOADS_IMAGES = (_family, _family_thermal)   # the benches that load weight images (--image)
 
 
-def simulate(design: Design, build_dir, **kw) -> dict:
-    """Verify ``design`` with its datapath's bench (flann sim)."""
+def simulate(design: Design, build_dir, *, netlist: bool = False, **kw) -> dict:
+    """Verify ``design`` with its datapath's bench (flann sim); with ``netlist``, then its mapped
+    netlist over every code (the sweep of :data:`flann.verify.netlist.SWEEPS` it names)."""
     dp = design.datapath
     if dp.bench is None:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
-    if kw.get("netlist"):
+    if netlist:
         require_sweep_driver(dp, design.directory, "--netlist")
     if kw.get("engine") == "verilator" and BENCHES[dp.bench] is not _fixed:
         # GHDL's netlist compiled by Verilator stands in for the fixed-point sweep bench only
@@ -268,7 +241,12 @@ def simulate(design: Design, build_dir, **kw) -> dict:
     if kw.get("images") and BENCHES[dp.bench] not in LOADS_IMAGES:
         raise FlannError(f"--image: {design.directory} is a {dp.name} design, its weights are built in "
                          "(weight images load into a family design's memory)")
-    return BENCHES[dp.bench](design, build_dir, **kw)
+    res = BENCHES[dp.bench](design, build_dir, **kw)
+    if netlist:
+        s = res["summary"]
+        s["netlist"], passed = netlist_summary(design, build_dir, kw.get("progress"))
+        s["all_passed"] = s["all_passed"] and passed
+    return res
 
 
 __all__ = ["simulate", "BENCHES"]

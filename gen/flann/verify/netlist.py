@@ -9,9 +9,10 @@ the twin in one pass.  Verilator, not Icarus: on the default design's mapped net
 about 1 code/s, Verilator a few hundred.
 
 A datapath names its sweep (``Datapath.netlist``, a key of :data:`SWEEPS`): the top the driver
-drives, the twin it is compared with, and for a family design the weight image the driver
-first loads through the cfg port (the last one the design keeps, over the memory's initial
-sensor, so that the load is what the sweep sees).
+drives, the twin it is compared with, for a design with temperature the temperature codes each
+voltage code runs at (those of its RTL sweep, :mod:`flann.verify.temperatures`), and for a
+family design the weight image the driver first loads through the cfg port (the last one the
+design keeps, over the memory's initial sensor, so that the load is what the sweep sees).
 """
 
 from __future__ import annotations
@@ -28,13 +29,17 @@ import numpy as np
 
 from ..errors import FlannError
 from ..hardware.family.twin import FlannFamilyTop
+from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.fixed.twin import FlannTop
+from ..hardware.float18.spec import FlannF18Top
+from ..hardware.thermal.twin import FlannThermalTop
 from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR
 from .design import Design
 from .images import checked_image, kept_images
 from .shards import cores, count_lines, merge, read_results, split
+from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 
 DRIVER = "netlist_main.cpp"
 RAM_MODELS = "ramb4_sim.v"
@@ -44,7 +49,9 @@ PREFIX = "Vdut"             # the Verilated model's class, whatever the top (the
 @dataclass(frozen=True)
 class NetlistSweep:
     """What the driver needs of a design: its top, widths and latency, the twin's outputs of a
-    code array, and the weight image it loads first (None: the weights are built in)."""
+    code array (and a temperature code array), the temperature codes every voltage code runs at
+    (None: the top has no temperature input) and the weight image it loads first (None: the
+    weights are built in)."""
 
     top: str
     in_bits: int
@@ -53,10 +60,21 @@ class NetlistSweep:
     process: Callable
     image: tuple | None = None
     cfg_addr_bits: int | None = None
+    temps: tuple | None = None
+    temp_bits: int | None = None
 
     @property
     def codes(self) -> tuple[int, int]:
         return -(1 << (self.in_bits - 1)), (1 << (self.in_bits - 1)) - 1
+
+    @property
+    def samples(self) -> int:
+        lo, hi = self.codes
+        return (hi - lo + 1) * (len(self.temps) if self.temps is not None else 1)
+
+    def expected(self, got: dict):
+        """The twin's (out_data, out_sat) at the samples the driver ran."""
+        return self.process(got["codes"]) if self.temps is None else self.process(got["codes"], got["temps"])
 
 
 def _fixed_sweep(design: Design) -> NetlistSweep:
@@ -65,18 +83,49 @@ def _fixed_sweep(design: Design) -> NetlistSweep:
                         FlannTop(design.spec).process)
 
 
-def _family_sweep(design: Design) -> NetlistSweep:
+def _float18_sweep(design: Design) -> NetlistSweep:
     man = design.manifest
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
+                        FlannF18Top(design.spec).process)
+
+
+def _last_image(design: Design, words: int) -> list[int]:
     kept = kept_images(design)
     if not kept:
         raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
                          "design keeps none (regenerate it with flann gen --family from the recordings)")
-    _, words = checked_image(design, kept[-1], design.spec.mem_depth)
+    return checked_image(design, kept[-1], words)[1]
+
+
+def _family_sweep(design: Design) -> NetlistSweep:
+    man = design.manifest
+    words = _last_image(design, design.spec.mem_depth)
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannFamilyTop(design.spec, words).process, tuple(words), design.spec.addr_bits)
 
 
-SWEEPS = {"fixed": _fixed_sweep, "family": _family_sweep}
+# every temperature code while a sweep stays below this many samples (the mapped netlist runs
+# some thousands of samples a second on a core); above it, the RTL sweep's spread of codes
+NETLIST_MAX_SAMPLES = 150_000
+
+
+def _thermal_sweep(design: Design) -> NetlistSweep:
+    man, spec = design.manifest, design.spec
+    temps, _ = thermal_temperature_codes(spec, NETLIST_MAX_SAMPLES)
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
+                        FlannThermalTop(spec).process, temps=tuple(temps), temp_bits=spec.temp_bits)
+
+
+def _family_thermal_sweep(design: Design) -> NetlistSweep:
+    man, spec = design.manifest, design.spec
+    words = _last_image(design, spec.image_words)
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
+                        FlannFamilyThermalTop(spec, words).process, tuple(words), spec.cfg_addr_bits,
+                        tuple(family_thermal_temperature_codes(spec)), spec.temp_bits)
+
+
+SWEEPS = {"fixed": _fixed_sweep, "float18": _float18_sweep, "family": _family_sweep, "thermal": _thermal_sweep,
+          "family_thermal": _family_thermal_sweep}
 
 
 def sweep_of(design: Design) -> NetlistSweep:
@@ -126,6 +175,8 @@ def compile_netlist(netlist: Path, build: Path, sweep: NetlistSweep, cells: bool
     if models is None:
         models = [str(yosys_datdir() / "xilinx" / "cells_sim.v"), str(BENCH_DIR / RAM_MODELS)] if cells else []
     flags = f"-DIN_BITS={sweep.in_bits} -DOUT_BITS={sweep.out_bits}"
+    if sweep.temps is not None:
+        flags += f" -DTEMP_BITS={sweep.temp_bits}"
     if sweep.image is not None:
         flags += f" -DCFG_ADDR_BITS={sweep.cfg_addr_bits} -DCFG_WORDS={len(sweep.image)}"
     cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
@@ -145,22 +196,26 @@ def compile_netlist(netlist: Path, build: Path, sweep: NetlistSweep, cells: bool
 
 def run_netlist(exe: Path, sweep: NetlistSweep, build: Path, shards: int = 2, progress=None) -> dict:
     """Run the compiled netlist over every code of ``sweep`` in ``shards`` processes (each loads
-    the weight image first); arrays in code order."""
+    the weight image first; a shard runs its codes at every temperature code); arrays in code
+    order within each shard."""
     lo, hi = sweep.codes
     parts = split(lo, hi, max(1, shards))
     files = [Path(build) / f"netlist_{k}.txt" for k in range(len(parts))]
-    image = []
+    extra = []
+    if sweep.temps is not None:
+        (Path(build) / "netlist_temps.txt").write_text("".join(f"{t}\n" for t in sweep.temps))
+        extra.append(str(Path(build) / "netlist_temps.txt"))
     if sweep.image is not None:
         (Path(build) / "netlist_image.txt").write_text("".join(f"{w:x}\n" for w in sweep.image))
-        image = [str(Path(build) / "netlist_image.txt")]
-    procs = [subprocess.Popen([str(exe), str(a), str(b), str(f), *image], stdout=subprocess.DEVNULL,
+        extra.append(str(Path(build) / "netlist_image.txt"))
+    procs = [subprocess.Popen([str(exe), str(a), str(b), str(f), *extra], stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, text=True) for (a, b), f in zip(parts, files)]
     t0 = time.monotonic()
     try:
         while any(p.poll() is None for p in procs):
             time.sleep(0.5)
             if progress:
-                progress(sum(count_lines(f) for f in files), hi - lo + 1, time.monotonic() - t0)
+                progress(sum(count_lines(f) for f in files), sweep.samples, time.monotonic() - t0)
     finally:
         for p in procs:
             if p.poll() is None:
@@ -168,18 +223,20 @@ def run_netlist(exe: Path, sweep: NetlistSweep, build: Path, shards: int = 2, pr
     bad = [p for p in procs if p.returncode != 0]
     if bad:
         raise FlannError(f"netlist simulation failed: {(bad[0].stderr.read() or '').strip() or bad[0].returncode}")
-    return {**merge([read_results(f) for f in files]), "seconds": time.monotonic() - t0}
+    return {**merge([read_results(f, sweep.temps is not None) for f in files]), "seconds": time.monotonic() - t0}
 
 
 def compare(sweep: NetlistSweep, got: dict) -> dict:
-    """Mismatches of the netlist's outputs against the twin (and missing codes)."""
-    lo, hi = sweep.codes
-    out, sat = sweep.process(got["codes"])
-    bad = (got["data"] != out) | (got["sat"] != sat) | (got["latency"] != sweep.latency)
-    missing = (hi - lo + 1) - int(np.unique(got["codes"]).size)
-    first = [int(c) for c in got["codes"][bad][:5]]
+    """Mismatches of the netlist's outputs against the twin (and missing samples)."""
+    out, sat = sweep.expected(got)
+    # the driver prints out_data as signed; a float18 code is a bit pattern
+    mask = (1 << sweep.out_bits) - 1
+    bad = ((got["data"] & mask) != (out & mask)) | (got["sat"] != sat) | (got["latency"] != sweep.latency)
+    ran = np.column_stack([got["codes"]] + ([got["temps"]] if sweep.temps is not None else []))
+    missing = sweep.samples - int(np.unique(ran, axis=0).shape[0])
+    first = ran[bad][:5].tolist() if sweep.temps is not None else [int(c) for c in got["codes"][bad][:5]]
     return {"codes_tested": int(got["codes"].size), "mismatches": int(np.count_nonzero(bad)) + missing,
-            "first_mismatches": first}
+            "first_mismatches": first, "temperature_codes": None if sweep.temps is None else len(sweep.temps)}
 
 
 def check_netlist(design: Design, build, netlist: Path | None = None, progress=None, abc: str = "full") -> dict:
@@ -203,7 +260,7 @@ def netlist_summary(design: Design, build_dir, progress=None) -> tuple[dict, boo
     passed (every code, no mismatch)."""
     nl = check_netlist(design, Path(build_dir) / "netlist", progress=progress("netlist") if progress else None)
     entry = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"], "simulator": nl["simulator"],
-             "seconds": round(nl["seconds"], 1)}
+             "temperature_codes": nl["temperature_codes"], "seconds": round(nl["seconds"], 1)}
     return entry, nl["mismatches"] == 0 and nl["codes_tested"] > 0
 
 
@@ -223,12 +280,18 @@ def check_rtl_netlist(design: Design, build, progress=None) -> dict:
     return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1)}
 
 
+def sweep_datapaths() -> str:
+    """The datapaths the netlist sweep drives, as a sentence lists them."""
+    names = list(SWEEPS)
+    return f"{', '.join(names[:-1])} and {names[-1]}"
+
+
 def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> None:
-    """The netlist and post-route sweeps drive one-input tops (:data:`SWEEPS`): refuse another
+    """The netlist and post-route sweeps drive the tops of :data:`SWEEPS`: refuse another
     datapath's design before any slow step."""
     if datapath.netlist not in SWEEPS:
         raise FlannError(f"{flag}: {directory} holds a {datapath.name} design, and the netlist sweep has a driver "
-                         f"and twin for {' and '.join(SWEEPS)} designs only")
+                         f"and twin for {sweep_datapaths()} designs only")
 
 
 def check_synthesized(design: Design, netlist: Path) -> dict:
@@ -237,5 +300,5 @@ def check_synthesized(design: Design, netlist: Path) -> dict:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "sweep_datapaths", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

@@ -92,7 +92,7 @@ def checker(design: Design, refuse: bool = False):
         res = check_post_route(design, asc, pcf, part, Path(work) / "post_route")
         if refuse and res["mismatches"]:
             raise FlannError(f"the routed design of {design.directory} on {part.name} disagrees with its twin on "
-                             f"{res['mismatches']} of {res['codes_tested']} input codes (first: "
+                             f"{res['mismatches']} of {res['codes_tested']} samples (first: "
                              f"{res['first_mismatches']}); no bitstream written")
         return {k: res[k] for k in SUMMARY_KEYS}
 

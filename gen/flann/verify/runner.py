@@ -36,7 +36,7 @@ from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from . import plots
 from .design import Design
-from .netlist import check_rtl_netlist, netlist_summary
+from .netlist import check_rtl_netlist
 from .shards import count_lines, cores, merge, read_results, split
 
 # bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
@@ -351,11 +351,11 @@ def simulator_name(about: dict) -> str:
     return f"GHDL, {backend}" if backend else "GHDL"
 
 
-def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), netlist: bool = False,
-             engine: str = "auto", progress=None) -> dict:
+def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), engine: str = "auto",
+             progress=None) -> dict:
     """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
-    GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches,
-    optionally the post-synthesis netlist; returns {"summary", "curve", "spec"} (summary =
+    GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches;
+    returns {"summary", "curve", "spec"} (summary =
     `flann sim --json`)."""
     build_dir = Path(build_dir)
     spec, man = design.spec, design.manifest
@@ -387,11 +387,7 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
             results.append(run_bench(design, b, build_dir, seed=seed))
     summary["benches"] = {r.bench: {"tests": r.tests, "failures": r.failures, "failed": r.failed_tests,
                                     "seconds": round(r.seconds, 1)} for r in results}
-    all_ok = all(r.ok for r in results)
-    if netlist:
-        summary["netlist"], passed = netlist_summary(design, build_dir, progress)
-        all_ok = all_ok and passed
-    summary["all_passed"] = all_ok
+    summary["all_passed"] = all(r.ok for r in results)
     summary["latency_cycles"] = man["latency_cycles"]
     summary["output_lsb_mm"] = man["output_lsb_mm"]
     summary["model_sha256"] = man["model_sha256"]

@@ -29,16 +29,21 @@ def count_lines(path: Path) -> int:
         return 0
 
 
-def read_results(path) -> dict:
-    """A shard's lines "code data sat latency" as arrays (VHDL harness and netlist driver alike)."""
-    rows = np.loadtxt(path, dtype=np.int64, ndmin=2) if Path(path).is_file() else np.zeros((0, 4), np.int64)
+def read_results(path, temps: bool = False) -> dict:
+    """A shard's lines "code data sat latency" as arrays (VHDL harness and netlist driver alike);
+    with ``temps``, a fifth column: the temperature code (``temps``)."""
+    cols = 5 if temps else 4
+    rows = np.loadtxt(path, dtype=np.int64, ndmin=2) if Path(path).is_file() else np.zeros((0, cols), np.int64)
     if rows.size == 0:
-        rows = np.zeros((0, 4), dtype=np.int64)
-    return {"codes": rows[:, 0], "data": rows[:, 1], "sat": rows[:, 2].astype(bool), "latency": rows[:, 3]}
+        rows = np.zeros((0, cols), dtype=np.int64)
+    got = {"codes": rows[:, 0], "data": rows[:, 1], "sat": rows[:, 2].astype(bool), "latency": rows[:, 3]}
+    if temps:
+        got["temps"] = rows[:, 4]
+    return got
 
 
 def merge(parts: list[dict]) -> dict:
-    return {k: np.concatenate([p[k] for p in parts]) for k in ("codes", "data", "sat", "latency")}
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
 def terminal_progress(label: str):
