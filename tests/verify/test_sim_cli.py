@@ -82,6 +82,27 @@ def test_plot_is_written_for_every_datapath(designs, datapath, tmp_path, capsys,
         assert any("degC" in label for ax in axes[:-1] for label, _x, _y in ax["lines"])
 
 
+@pytest.mark.parametrize("datapath", [d for d in SIMULATED if d != "family"])
+def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, datapath, tmp_path, capsys,
+                                                                      monkeypatch):
+    """--netlist is not dropped by any datapath's bench: after the bench, the design's own netlist
+    sweep runs (the family's runs for real above; the sweeps themselves are checked by flann synth
+    in tests/hardware/test_datapath_matrix.py), and a failed sweep fails the run."""
+    from flann.verify import datapaths
+    calls = []
+
+    def sweep(design, build_dir, progress=None):
+        calls.append(design.datapath.name)
+        return {"codes_tested": 256, "mismatches": 1, "simulator": "stub", "temperature_codes": None,
+                "seconds": 0.0}, False
+
+    monkeypatch.setattr(datapaths, "netlist_summary", sweep)
+    rc = main(["sim", str(designs["dir"] / datapath), "--json", "--netlist", "--build", str(tmp_path / "b")])
+    s = json.loads(capsys.readouterr().out)
+    assert calls == [datapath] and s["netlist"]["mismatches"] == 1
+    assert rc == 1 and not s["all_passed"] and s["mismatches"] == 0
+
+
 def test_float18_plot_draws_no_lsb_bound(designs, tmp_path, capsys, figures):
     """The float18 design states no error bound: its difference panel (mm) has no +-1 lines."""
     png = tmp_path / "f18.png"
