@@ -34,7 +34,7 @@ try:   # Ctrl-C while the interpreter imports this module: one line too, not a t
 
     from . import __version__
     from .argtypes import finite_float
-    from .errors import FlannError, one_line
+    from .errors import FlannError, Terminated, one_line
     from .fileio import guarding_inputs
 except KeyboardInterrupt:
     sys.stderr.write("error: interrupted\n")
@@ -92,11 +92,6 @@ def _one_line_warnings() -> None:
         print(f"warning: {one_line(message)}", file=sys.stderr)
 
     warnings.showwarning = show
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM (``timeout``, a job scheduler, systemd): unwound as Ctrl-C is, so temporary
-    directories, half-written files and a batch's summary are dealt with the same way."""
 
 
 def main(argv: list[str] | None = None) -> int:

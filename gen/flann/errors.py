@@ -11,6 +11,11 @@ def one_line(text) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``timeout``, a job scheduler, systemd): unwound as Ctrl-C is, so temporary
+    directories, half-written files and a batch's summary are dealt with the same way."""
+
+
 class FlannError(Exception):
     """Bad input from the user: reported as one line, exit code 2."""
 

@@ -1,11 +1,11 @@
 """A batch over a process pool that stops promptly on Ctrl-C and keeps what was done.
 
 Only ``jobs`` items are ever in flight (no queue of submitted work that would run on after
-an interrupt).  While the batch runs, Ctrl-C only sets a flag (the workers ignore SIGINT:
-the terminal sends it to the whole process group), so no KeyboardInterrupt can land in the
-middle of recording a result: the parent submits nothing more, lets the items already
-running finish (each writes its output whole or not at all), and returns what finished
-with ``interrupted`` set, so the caller can still write its summary before exiting 130.
+an interrupt).  While the batch runs, Ctrl-C and SIGTERM only set a flag (the workers ignore
+SIGINT: the terminal sends it to the whole process group), so no KeyboardInterrupt can land in
+the middle of recording a result: the parent submits nothing more, lets the items already
+running finish (each writes its output whole or not at all), and returns the signal that
+stopped it, so the caller can still write its summary before exiting 130 (143: SIGTERM).
 """
 
 from __future__ import annotations
@@ -26,19 +26,22 @@ def _worker_init() -> None:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
-def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[object, object], None]) -> bool:
+def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[object, object], None]) -> int:
     """Call ``fn(item)`` for every item (in this process when ``jobs == 1``) and
-    ``on_result(item, result)`` as each finishes; True if Ctrl-C stopped the batch early."""
+    ``on_result(item, result)`` as each finishes; the signal that stopped the batch early
+    (SIGINT, SIGTERM), else 0."""
     items = list(items)
     stop = []
 
-    def on_sigint(signum, frame) -> None:
+    def on_signal(signum, frame) -> None:
         stop.append(signum)
 
-    try:
-        previous = signal.signal(signal.SIGINT, on_sigint)
-    except ValueError:   # not the main thread: Ctrl-C keeps its default meaning
-        previous = None
+    previous = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            previous[sig] = signal.signal(sig, on_signal)
+        except ValueError:   # not the main thread: the signals keep their meaning
+            break
     try:
         if jobs <= 1 or len(items) <= 1:
             for item in items:
@@ -48,9 +51,9 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
         else:
             _pool(fn, items, jobs, on_result, stop)
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
-    return bool(stop)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return stop[0] if stop else 0
 
 
 def _pool(fn, items, jobs, on_result, stop) -> None:

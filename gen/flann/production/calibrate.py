@@ -31,6 +31,7 @@ import hashlib
 import io
 import math
 import os
+import signal
 import sys
 import time
 import warnings
@@ -44,7 +45,7 @@ import numpy as np
 from .. import __version__
 from ..diagnose import diagnose
 from ..diagnose.data import reduce_points
-from ..errors import FlannError
+from ..errors import FlannError, Terminated
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm
 from ..golden.metrics import raw_output_mm
@@ -509,16 +510,19 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
-    interrupted = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record)
+    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record)
     if progress:
         sys.stderr.write("\n")
     for i in todo:
         if i not in results:
             results[i] = Result(sensor=sensor_name(paths[i]), recording=str(paths[i]), status="interrupted",
-                                reason="not calibrated: the batch was interrupted (Ctrl-C)")
+                                reason="not calibrated: the batch was interrupted "
+                                       f"({'SIGTERM' if stopped_by == signal.SIGTERM else 'Ctrl-C'})")
     ordered = [results[i] for i in range(len(paths))]
     write_summary(summary_path(out_dir), ordered)
-    if interrupted:
+    if stopped_by == signal.SIGTERM:
+        raise Terminated
+    if stopped_by:
         raise KeyboardInterrupt
     return ordered
 
