@@ -46,6 +46,17 @@ def test_default_design_handshake_reset_saturation(default_design):
     assert r.tests == 3 and r.ok, f"failed: {r.failed_tests}"
 
 
+def test_top_bench_with_the_clamp_at_the_converter_ends(tmp_path_factory):
+    """A design without the clamp (--no-clamp: the clamp codes are the converter's end codes)
+    has no code beyond its range edges: the top bench's saturation test runs with none, where
+    it drove -129 (out of the 8-bit port's range) and failed a good design."""
+    d = tmp_path_factory.mktemp("noclamp")
+    design = from_model(MODEL, d, {**DEFAULT, "input_bits": 8, "clamp": False})
+    assert (design.spec.clamp_lo, design.spec.clamp_hi) == (design.spec.code_min, design.spec.code_max)
+    r = run_bench(design, "top", d / "build", extra={"handshake_samples": 12})
+    assert r.tests == 3 and r.ok, f"failed: {r.failed_tests}"
+
+
 @pytest.mark.parametrize("block", ["norm", "expansion", "multiplier", "adder"])
 def test_default_design_each_block_vs_twin(default_design, block):
     design, d = default_design

@@ -65,8 +65,9 @@ async def top_out_of_range_saturates(dut):
     s = bench.spec
     below = sorted({s.code_min, s.code_min + 1, s.clamp_lo - 1, (s.code_min + s.clamp_lo) // 2})
     above = sorted({s.clamp_hi + 1, (s.clamp_hi + s.code_max) // 2, s.code_max - 1, s.code_max})
-    below = [c for c in below if c < s.clamp_lo]
-    above = [c for c in above if c > s.clamp_hi]
+    # a clamp at the converter's end code leaves nothing beyond it on that side
+    below = [c for c in below if s.code_min <= c < s.clamp_lo]
+    above = [c for c in above if s.clamp_hi < c <= s.code_max]
     edges = [s.clamp_lo, s.clamp_hi]
     await bench.run_codes(edges + below + above)
     await bench.drain()
