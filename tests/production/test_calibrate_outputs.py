@@ -188,3 +188,23 @@ def test_a_recording_at_the_summarys_path_is_refused_before_any_work(line, tmp_p
     err = capsys.readouterr().err
     assert rc == 2 and "is the batch summary this run writes" in err and len(err.strip().splitlines()) == 1
     assert sorted(p.name for p in out.iterdir()) == ["summary.csv"]
+
+
+def test_the_family_costs_accuracy_flag_reaches_the_summary_and_the_console(line, tmp_path, capsys,
+                                                                          monkeypatch):
+    """The flag of a sensor whose hardware error exceeds its own design's reach by more than
+    REACH_FACTOR was on the certificate only: it is now a summary column (with the reach beside
+    it) and a warning line.  The factor is moved so that the same sensor is flagged, then not."""
+    from flann.production import calibrate as production
+    for factor, flagged in ((1e-3, True), (1e6, False)):
+        monkeypatch.setattr(production, "REACH_FACTOR", factor)
+        out = tmp_path / f"cal{factor:g}"
+        capsys.readouterr()
+        rc, rows = _calibrate(line, out, line["rec"]["s1"], "--tolerance-mm", "0.5")
+        err = capsys.readouterr().err
+        (row,) = rows
+        assert rc == 0 and float(row["own_design_max_error_mm"]) > 0
+        assert ("the family design costs it accuracy" in row["warnings"]) is flagged, row["warnings"]
+        assert ("warning: s1: hardware max error" in err) is flagged, err
+        html = (out / "s1" / "certificate.html").read_text()
+        assert ("the family design costs it accuracy" in html) is flagged

@@ -86,3 +86,16 @@ def test_a_converter_of_one_millivolt_printed_to_it_is_kept():
     rec = parse_recordings(_csv(x, v, fmt=".3f"))
     found = converter(Namespace(input_bits=None, input_lsb_v=None), rec)
     assert found["input_lsb_v"] == pytest.approx(1e-3) and found["input_bits"] == 13   # +-2.2 V read
+
+
+@pytest.mark.parametrize("noise", [1e-5, 3e-4])
+def test_a_straight_sensor_at_even_steps_is_no_converter(noise):
+    """A straight sensor read at evenly spaced positions gives evenly spaced readings, each off
+    that spacing by its noise: no converter (it was taken for a 6-bit one of 25 mV), while the
+    same readings quantised by a 12-bit converter are found at its step."""
+    rng = np.random.default_rng(3)
+    x = np.linspace(-5, 5, 41)
+    v = np.round((0.1 * x + 1e-5 * x ** 3 + rng.normal(0, noise, x.size)) * 1e6) / 1e6
+    assert checks.converter_of(v) is None
+    lsb = 2.0 / 4096
+    assert checks.converter_of(np.round(v / lsb) * lsb) == (12, pytest.approx(lsb))

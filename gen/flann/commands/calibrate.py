@@ -61,6 +61,9 @@ def run(args) -> int:
         print(f"error: {r.sensor}: {r.reason}", file=sys.stderr)
     for r in failed:
         print(f"FAIL: {r.sensor}: {r.reason}", file=sys.stderr)
+    for r in results:
+        if r.costs_accuracy:
+            print(f"warning: {r.sensor}: {r.costs_accuracy}", file=sys.stderr)
     passed = len(results) - len(rejected) - len(failed)
     print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
           f"{len(rejected)} rejected; summary {summary_path(args.out)}")

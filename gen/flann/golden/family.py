@@ -18,6 +18,7 @@ temperature normalisation, the family's voltage normalisation and ridge).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,6 +98,11 @@ def shared_terms(tried, table, own_rms, steady) -> int:
     terms = next((t for t in tried if accurate(t) and steady(t)), None)
     if terms is None:
         terms = next((t for t in reversed(tried) if steady(t)), tried[-1])
+        worst = max(held[terms] / rms if rms > 0 else np.inf for held, rms in zip(table, own_rms))
+        warnings.warn(f"no shared term count keeps every member's held-out RMS within {FAMILY_SHARE:g} x its "
+                      f"own design's (tried {', '.join(map(str, tried))} terms): {terms} terms, the most "
+                      f"accurate with steady weights, leave the worst member at {worst:.2f} x its own",
+                      stacklevel=2)
     return terms
 
 

@@ -84,7 +84,10 @@ SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit"
                   "drift_ppm_fs_per_c",
                   # what the verdict judged: its range and its max error there (max_error_mm
                   # stays the whole recording's; max_error_pct_fs is over judged_over)
-                  "judged_over", "judged_max_error_mm")
+                  "judged_over", "judged_max_error_mm",
+                  # the sensor's own design's reach (its own train --terms auto at the design's
+                  # converter; a one-input family), and every warning of the sensor's calibration
+                  "own_design_max_error_mm", "warnings")
 
 
 @dataclass
@@ -106,6 +109,8 @@ class Result:
     model_sha256: str = ""
     written: bool = False   # OUTDIR/<sensor>/ was written by this run (_write_sensor)
     drift_ppm_fs_per_c: float | None = None  # a family design with temperature
+    own_reach_mm: float | None = None   # what the sensor's own design reaches (a one-input family)
+    costs_accuracy: str = ""   # the warning when the family design costs this sensor accuracy
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -119,7 +124,8 @@ class Result:
                 "max_error_mm": f(self.max_error_mm), "ratio_to_limit": f(self.ratio_to_limit, 4),
                 "limit_mm": f(self.limit_mm), "raw_max_error_mm": f(self.raw_max_error_mm),
                 "twin_vs_float_lsb": f(self.twin_vs_float_lsb, 4), "recording": self.recording,
-                **self.verdict_cells(), "drift_ppm_fs_per_c": f(self.drift_ppm_fs_per_c, 4)}
+                **self.verdict_cells(), "drift_ppm_fs_per_c": f(self.drift_ppm_fs_per_c, 4),
+                "own_design_max_error_mm": f(self.own_reach_mm), "warnings": "; ".join(self.warnings)}
 
     def verdict_cells(self) -> dict:
         """The verdict and traceability columns (a row without a verdict was never judged:
@@ -286,11 +292,13 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         res.model_sha256 = text_sha256(chk["model"].to_json())
         reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
                                         cost=lambda m: fixed_point_cost(m, (fam.spec.input_bits, fam.spec.input_lsb_v)))
+        res.own_reach_mm = reach
         if res.max_error_mm > REACH_FACTOR * reach:
-            res.warnings.append(
+            res.costs_accuracy = (
                 f"hardware max error {res.max_error_mm:.4g} mm is {res.max_error_mm / reach:.2f} x what this "
                 f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms; flagged above "
                 f"{REACH_FACTOR:g} x): the family design costs it accuracy")
+            res.warnings.append(res.costs_accuracy)
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
         findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
         res.diagnosis = diagnosis_cell(named, groups)

@@ -349,11 +349,21 @@ def converter_step(voltage_v, max_divisor: int = 64, tol: float = 0.02) -> float
         q = span / round(span * k / g0)
         frac = rel / q
         if np.max(np.abs(frac - np.round(frac))) <= tol:
-            return q
+            return q if _on_grid(rel, q, res, u) else 0.0
         q = _grid_step(u, gaps, k, res, tol)
         if q > 0:
-            return q
+            return q if _on_grid(rel, q, res, u) else 0.0
     return 0.0
+
+
+def _on_grid(rel: np.ndarray, q: float, res: float, u: np.ndarray) -> bool:
+    """Converter codes times a step are on the grid to the printing's rounding (a few of the
+    printed digit; nine significant digits without one), not to a share of the step: readings
+    of a straight sensor at evenly spaced positions are evenly spaced too, each off that grid
+    by its noise (0.1 V/mm at 0.25 mm steps, 10 uV noise: a '6-bit, 25 mV converter')."""
+    off = rel - q * np.round(rel / q)
+    off -= np.median(off)
+    return float(np.max(np.abs(off))) <= 2.0 * res + 4e-9 * float(np.max(np.abs(u)))
 
 
 def _grid_step(u: np.ndarray, gaps: np.ndarray, k: int, res: float, tol: float) -> float:
