@@ -41,6 +41,47 @@ def test_one_wrong_reading_is_left_out_with_one_warning(tmp_path, capsys):
     assert b.training["positions_used"] == 21 and b.training["readings_used"] == 21
 
 
+def _two_sweeps(glitch=None, offset=0.0):
+    """Two sweeps each way of a tanh sensor, 12-bit converter, a direction column; ``glitch``:
+    (row, volts) replaces one reading; ``offset``: added to the second pair of sweeps (another
+    sensor's file joined on)."""
+    rng = np.random.default_rng(1)
+    xs, lsb = np.arange(-20, 20.001, 0.25), 10 / 4096
+    rows = []
+    for k in range(2):
+        for d, q in ((1, xs), (-1, xs[::-1])):
+            v = np.round((4.2 * np.tanh(0.045 * q) + rng.normal(0, 0.0015, q.size) + k * offset) / lsb) * lsb
+            rows += [[a, b, d] for a, b in zip(q, v)]
+    if glitch is not None:
+        rows[glitch[0]][1] = glitch[1]
+    return ["displacement_mm,voltage_v,direction"] + [f"{a:.3f},{b:.6f},{d:+d}" for a, b, d in rows]
+
+
+def test_a_glitch_among_repeated_sweeps_is_left_out_not_refused(tmp_path, capsys):
+    """One reading of 0.9 V among -2.14 V (two sweeps each way, a direction column) was refused
+    as a repeat that differs ('give each sweep its direction', which it had): it is a gross
+    outlier, left out with one warning, and the model and the converter are those without it.
+    Without the outlier screen (--terms N) it is still refused, and so are two files joined."""
+    clean, glitched = _two_sweeps(), _two_sweeps(glitch=(30, 0.9))
+    a, b = tmp_path / "clean.csv", tmp_path / "glitch.csv"
+    a.write_text("\n".join(clean[:31] + clean[32:]) + "\n")   # the glitch's row left out by hand
+    b.write_text("\n".join(glitched) + "\n")
+    assert run(["train", a, "-o", tmp_path / "a.json"], capsys)[0] == 0
+    rc, _, err = run(["train", b, "-o", tmp_path / "b.json"], capsys)
+    warned = [line for line in err.splitlines() if line.startswith("warning:")]
+    assert rc == 0 and len(warned) == 1 and "line 32 (" in warned[0], err
+    ma, mb = load_model(tmp_path / "a.json"), load_model(tmp_path / "b.json")
+    v = np.linspace(-3.5, 3.5, 2001)
+    assert np.max(np.abs(ma.predict(v) - mb.predict(v))) < 1e-6
+    assert mb.training["converter"]["input_bits"] == 12
+    rc, _, err = run(["train", b, "-o", tmp_path / "c.json", "--terms", "5"], capsys)
+    assert rc == 2 and "lines 32 and 354" in err and "appears twice" in err
+    joined = tmp_path / "joined.csv"
+    joined.write_text("\n".join(_two_sweeps(offset=0.2)) + "\n")
+    rc, _, err = run(["train", joined, "-o", tmp_path / "d.json"], capsys)
+    assert rc == 2 and "appears twice" in err, err
+
+
 def test_many_wrong_readings_are_refused(tmp_path, capsys):
     rng = np.random.default_rng(1)
     x = np.tile(np.linspace(-10.0, 10.0, 200), 2)

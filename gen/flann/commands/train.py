@@ -13,7 +13,7 @@ from ..argtypes import bounded, checked, terms_or_auto
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.model import MAX_TERMS
-from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers
+from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers, screens
 from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
@@ -148,6 +148,8 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     rec, record, outlier_text = _screen(rec, step_v)
     if outlier_text:
         warnings.warn(outlier_text)
+        # a glitch is on no converter's grid: the grid is the readings' without it
+        conv = converter(args, rec)
     provenance.update(record)
     if args.input_bits is not None:
         # the user's converter, by gen's own rule, before any fit: one it cannot carry would
@@ -206,7 +208,8 @@ def run(args) -> int:
     hint = compensation_hint(rec)
     if hint:   # before the checks: a multi-temperature recording may not pass them as one
         print(hint, file=sys.stderr)
-    rec = prepare_for_fit(rec, trim=args.trim)
+    # --terms auto screens gross outliers: a glitch among repeated readings is left to it
+    rec = prepare_for_fit(rec, trim=args.trim, lone_glitches=args.terms == "auto" and screens(rec.displacement_mm))
     explicit = None
     if (args.input_offset_v is None) != (args.input_scale_v is None):
         raise FlannError("--input-offset-v and --input-scale-v must be given together")

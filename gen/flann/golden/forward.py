@@ -350,12 +350,18 @@ MAX_SCREEN_POSITIONS = 5000   # a logger's continuous positions: the screen is s
 MIN_SCREEN_POSITIONS = 20
 
 
+def screens(x) -> bool:
+    """Whether :func:`screen_outliers` judges a recording at positions ``x``: enough distinct
+    positions for a smooth fit, not a logger's continuous ones."""
+    npos = np.unique(np.asarray(x, float)).size
+    return MIN_SCREEN_POSITIONS <= npos <= MAX_SCREEN_POSITIONS
+
+
 def screen_outliers(x, v, direction=None, step_v: float = 0.0) -> Screen | None:
     """Gross outliers against the cross-validated forward fit (:func:`robust_forward`);
     None when the recording has too few or too many distinct positions to judge them this way.
     Raises :class:`OutlierShareError` above ``MAX_OUTLIER_SHARE``."""
-    npos = np.unique(np.asarray(x, float)).size
-    if npos > MAX_SCREEN_POSITIONS or npos < MIN_SCREEN_POSITIONS:
+    if not screens(x):
         return None
     ff = robust_forward(x, v, direction, step_v)
     return Screen(ff.keep, tuple(ff.outliers), ff.noise_v, ff.noise_from, int(ff.positions.x.size))

@@ -224,7 +224,7 @@ def repeat_noise_v(displacement_mm, voltage_v, direction=None) -> tuple[float, i
 
 
 def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 0.01,
-                     inferred: bool = False) -> None:
+                     inferred: bool = False, lone_glitches: bool = False) -> None:
     """Repeated readings (same position and direction: dwells, repeated sweeps) are data.
 
     A repeat is refused only when it differs from the median of the other readings there by
@@ -233,6 +233,10 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
     ``MIN_REPEAT_PAIRS`` of them and they agree no worse than neighbouring positions do (the
     point-to-point estimate on the first reading of each position; sweeps further apart
     than that have drifted), else from that point-to-point estimate.  The message names the lines and the difference in noise units.
+
+    ``lone_glitches``: the caller screens gross outliers (``flann train --terms auto``), so a
+    repeat off by itself, where the other readings there agree with the neighbouring
+    positions, is left to that screen (which names it and leaves it out) instead of refused.
     """
     direction = rec.direction if rec.direction is not None else np.zeros(len(rec))
     sigma, pairs = repeat_noise_v(rec.displacement_mm, rec.voltage_v, direction)
@@ -253,6 +257,8 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
         if len(rows) < 2:
             continue
         vv = rec.voltage_v[rows]
+        if lone_glitches and _lone_glitches(rec, direction, d, x, vv, tol):
+            continue
         for j, i in enumerate(rows):
             others = np.delete(np.arange(len(rows)), j)
             ref = float(np.median(vv[others]))
@@ -272,7 +278,24 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
                 f"{where} with different voltages ({rec.voltage_v[first_row]:.6g} V, "
                 f"{rec.voltage_v[this_row]:.6g} V): {which} (noise {sigma:.3g} V {source}; "
                 f"repeats may differ by {tol:.3g} V): a glitch, or two files joined? "
-                "give each sweep its direction (+1/-1)")
+                + ("give each sweep its direction (+1/-1)" if rec.direction is None or inferred else
+                   "flann train --terms auto leaves an isolated glitch out; flann diagnose shows where"))
+
+
+def _lone_glitches(rec: Recordings, direction: np.ndarray, d: float, x: float, vv: np.ndarray,
+                   tol: float) -> bool:
+    """The readings ``vv`` at position ``x`` (direction ``d``) disagree only through glitches:
+    fewer than half of them are off the line through the neighbouring positions' medians,
+    and the rest agree with it."""
+    same = direction == d
+    xs, vs = rec.displacement_mm[same], rec.voltage_v[same]
+    below, above = np.unique(xs[xs < x]), np.unique(xs[xs > x])
+    if below.size == 0 or above.size == 0:
+        return False   # at an end: no line through neighbours on both sides
+    xl, xh = float(below[-1]), float(above[0])
+    vl, vh = float(np.median(vs[xs == xl])), float(np.median(vs[xs == xh]))
+    off = np.abs(vv - (vl + (vh - vl) * (x - xl) / (xh - xl))) > tol
+    return 0 < int(off.sum()) < 0.5 * vv.size + 0.5 * (vv.size == 2)
 
 
 def _several_temperatures(rec: Recordings, a: int, b: int, x: float, which: str) -> None:
@@ -488,9 +511,10 @@ def sweep_direction(displacement_mm) -> np.ndarray | None:
 
 
 def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None = None,
-                    can_trim: bool = True) -> Recordings:
+                    can_trim: bool = True, lone_glitches: bool = False) -> Recordings:
     """Validate recordings for fitting an inverse model; with ``trim`` keep the monotonic span
-    (``can_trim``: the command has a ``--trim`` to advise; without, the span is named instead).
+    (``can_trim``: the command has a ``--trim`` to advise; without, the span is named instead;
+    ``lone_glitches``: the caller screens outliers, :func:`check_duplicates`).
 
     Without a direction column, sweeps are told apart by the file order (:func:`sweep_direction`)
     for the checks: the same position on the way up and on the way back is not a repeat.
@@ -503,7 +527,7 @@ def prepare_for_fit(rec: Recordings, trim: bool = False, noise_v: float | None =
     inferred = rec.direction is None and (d := sweep_direction(rec.displacement_mm)) is not None
     if inferred:
         rec = replace(rec, direction=d)
-    check_duplicates(rec, inferred=inferred)
+    check_duplicates(rec, inferred=inferred, lone_glitches=lone_glitches)
     span = monotonic_span(rec, noise_v=noise_v)
     if span.foldback:
         if not span.trimmable:
