@@ -135,3 +135,17 @@ def test_four_sweeps_train_and_their_repeats_give_the_noise(tmp_path, capsys):
     assert t["readings_used"] == 1200 and t["positions_used"] == 300
     assert "repeated readings" in t["noise_from"] and 6e-4 < t["noise_v"] < 1.1e-3
     assert t["converter"]["input_bits"] == 14
+
+
+def test_four_positions_are_too_few_for_auto(tmp_path, capsys):
+    """Four positions went to a 2-fold direct fit that held out the two interior positions, near
+    the null: 0.026 mm held out for a model 1.6 mm off at the ends (worse than none).  Auto now
+    takes five or more (the spline's); four are refused in one line naming --terms."""
+    x = np.linspace(-10, 10, 4)
+    rows = [f"{a:.3f},{0.2 * a - 0.0003 * a ** 3:.5f}" for a in x]
+    rc, _, err = run(["train", write(tmp_path / "few4.csv", rows), "-o", tmp_path / "m.json"], capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "4 distinct positions" in err and "--terms 1" in err
+    assert not (tmp_path / "m.json").exists()
+    x = np.linspace(-10, 10, 5)
+    rows = [f"{a:.3f},{0.2 * a - 0.0003 * a ** 3:.5f}" for a in x]
+    assert run(["train", write(tmp_path / "few5.csv", rows), "-o", tmp_path / "m5.json"], capsys)[0] == 0

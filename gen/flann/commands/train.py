@@ -17,7 +17,7 @@ from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, sc
 from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
-from ..golden.inverse import fit_default
+from ..golden.inverse import MIN_POSITIONS, fit_default
 from ..hardware.adc import ADC_BITS, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
@@ -138,9 +138,12 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     said = []
     check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
     positions = int(np.unique(rec.displacement_mm).size)
-    if positions < 4:
+    if positions < MIN_POSITIONS:
+        # four: two folds each hold out one interior position, near the null, where a line shrunk
+        # by the ridge is still right: 0.026 mm held out for a model 1.6 mm off at the ends
         raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
-                         "(its cross-validation needs at least 4): give --terms 1 (a line) or --terms 2")
+                         f"(the spline through them and its check by leaving each out need at least "
+                         f"{MIN_POSITIONS}): give --terms 1 (a line) or --terms 2")
     conv = converter(args, rec)
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)
