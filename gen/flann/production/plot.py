@@ -84,6 +84,19 @@ def _scale(lo: float, hi: float, p0: float, p1: float):
     return lambda v: p0 + (np.asarray(v, dtype=float) - lo) * k
 
 
+# the data's extremes stay this share of the axis inside the frame: a last point at a tick's
+# value drawn on the frame line is hidden by it (a certificate's worst error at its stroke's end)
+PAD = 0.02
+
+
+def _axis(lo: float, hi: float, p0: float, p1: float, n: int = 5):
+    """(ticks, scale) of an axis over [lo, hi] drawn from px ``p0`` to ``p1``: round ticks, and
+    the data kept PAD of the axis clear of the frame where a tick would put it on it."""
+    ticks = nice_ticks(lo, hi, n)
+    pad = PAD * (ticks[-1] - ticks[0])
+    return ticks, _scale(min(ticks[0], lo - pad), max(ticks[-1], hi + pad), p0, p1)
+
+
 def _points(px: np.ndarray, py: np.ndarray) -> str:
     return " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px, py))
 
@@ -92,8 +105,7 @@ def _panel(top: float, title: str, ylabel: str, lines, sx, bands=()) -> Panel:
     """lines: (x, values, colour, dash, width); the y range covers them all (and 0); bands:
     (x_lo, x_hi, y_lo, y_hi, colour) in data units, shaded."""
     ys = np.concatenate([np.asarray(v, float) for _, v, *_ in lines] + [np.zeros(1)])
-    yt = nice_ticks(float(np.min(ys)), float(np.max(ys)))
-    sy = _scale(yt[0], yt[-1], top + PANEL_H, top)
+    yt, sy = _axis(float(np.min(ys)), float(np.max(ys)), top + PANEL_H, top)
     step = yt[1] - yt[0] if len(yt) > 1 else 1.0
     series = tuple(Series(_points(sx(x), sy(v)), c, d, w) for x, v, c, d, w in lines)
     z = float(sy(0.0))
@@ -124,8 +136,7 @@ def error_plot_svg(chk: dict, sensor: str, tolerance_mm: float | None = None,
     x = np.asarray(chk["rec"].displacement_mm, dtype=float)
     o = np.argsort(x, kind="stable")
     x = x[o]
-    xt = nice_ticks(float(x[0]), float(x[-1]), 8)
-    sx = _scale(xt[0], xt[-1], LEFT, WIDTH - RIGHT)
+    xt, sx = _axis(float(x[0]), float(x[-1]), LEFT, WIDTH - RIGHT, 8)
     lim = np.asarray(chk["limit_mm"], float)[o]
     raw = _panel(TOP, f"{sensor}: raw sensor (error from its least-squares line)", "raw error (mm)",
                  [(x, chk["raw_err_mm"][o], COLOURS["raw"], "", 1.0)], sx)
@@ -163,8 +174,7 @@ def error_plot_temperatures_svg(chk: dict, sensor: str, tolerance_mm: float | No
     legend names them), the tolerance band given one, as an <svg>."""
     x_all = np.asarray(chk["rec"].displacement_mm, dtype=float)
     labels, temps = chk["labels"], chk["temperatures_c"]
-    xt = nice_ticks(float(np.min(x_all)), float(np.max(x_all)), 8)
-    sx = _scale(xt[0], xt[-1], LEFT, WIDTH - RIGHT)
+    xt, sx = _axis(float(np.min(x_all)), float(np.max(x_all)), LEFT, WIDTH - RIGHT, 8)
     raw_lines, hw_lines, legend = [], [], []
     for g, temp in enumerate(temps):
         rows = np.flatnonzero(labels == g)
