@@ -92,6 +92,12 @@ def test_command_on_datapath(designs, datapath, command):
         assert r.returncode == 0, r.stderr
     if command == "synth" and not why:   # every top flann gen writes has a netlist sweep
         assert "0 mismatches with the twin: passed" in r.stdout, r.stdout
+    if command == "ise" and not why:
+        # the README's wiring step names the ports the datapath adds to the common interface
+        extra = (json.loads((designs["dir"] / datapath / "manifest.json").read_text()).get("cfg_port") or {})
+        readme = (designs["dir"] / f"ise_{datapath}" / "README.txt").read_text()
+        for name in extra.get("ports", {}):
+            assert name in readme.split("This design adds", 1)[-1].split("\n", 1)[0], (name, readme)
 
 
 @pytest.mark.sim

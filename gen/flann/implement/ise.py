@@ -251,6 +251,9 @@ def write_ise(directory, device: str | None = None, out_dir="ise", clock_mhz: fl
         cycles_per_sample=man.data.get("cycles_per_sample"), latency=man.data.get("latency_cycles"),
         core_name=f"flann:lvdt:{man.top}:{__version__}", input_bits=man.data["input_bits"],
         output_bits=man.data["output_bits"],
+        # the ports a datapath adds to the common interface: the board must wire them too
+        extra_ports=[p.name for p in _extra_ports(man.data)],
+        cfg_timing=(man.data.get("cfg_port") or {}).get("timing"),
         pin_notes=f"implement/templates/ucf_pins/{pins_kind}_notes.j2",
         pin_lines=f"implement/templates/ucf_pins/{pins_kind}_lines.j2",
     )
