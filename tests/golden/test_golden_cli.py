@@ -126,7 +126,8 @@ def test_predict_clamps_outside_the_trained_range_like_the_hardware(tmp_path, ca
     assert code == 0 and "2 of 3 voltages outside" in err and "clamped" in err
     assert out.read_text() == "voltage_v,predicted_mm,clamped\n3,4.5,1\n-7,-3.5,1\n1,2.5,0\n"
     code, _, err = run(["predict", hand_model(tmp_path), data, "-o", out, "--extrapolate"], capsys)
-    assert out.read_text() == "voltage_v,predicted_mm\n3,6.5,\n-7,-13.5,\n1,2.5,\n".replace(",\n", "\n")
+    # evaluated outside the range, and each row says so
+    assert out.read_text() == "voltage_v,predicted_mm,extrapolated\n3,6.5,1\n-7,-13.5,1\n1,2.5,0\n"
 
 
 def test_predict_without_displacement_column(tmp_path, capsys):

@@ -3,7 +3,8 @@
 Outside the trained voltage range the model is not extrapolated: like the hardware (which
 clamps the ADC code to the trained range), the voltage is clamped to the nearest end of the
 range and the row is flagged (``clamped`` = 1).  ``--extrapolate`` evaluates the expansion
-there instead (the trigonometric terms are periodic: the result is rarely meaningful).
+there instead (the trigonometric terms are periodic: the result is rarely meaningful), and the
+row is flagged ``extrapolated`` = 1: every row says whether it is a figure of the trained range.
 """
 
 from __future__ import annotations
@@ -76,13 +77,14 @@ def run(args) -> int:
         cols["displacement_mm"] = rec.displacement_mm
     if args.extrapolate:
         cols["predicted_mm"] = _predict_unclamped(model, rec.voltage_v, temp)
-        flags = None
+        flag, flags = "extrapolated", outside_range(model, rec.voltage_v, temp)
     else:
         cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v, temp)
+        flag = "clamped"
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
-    w.writerow(list(cols) + (["clamped"] if flags is not None else []))
+    w.writerow([*cols, flag])
     for i, row in enumerate(zip(*cols.values())):
-        w.writerow([f"{c:.9g}" for c in row] + ([int(flags[i])] if flags is not None else []))
+        w.writerow([f"{c:.9g}" for c in row] + [int(flags[i])])
     atomic_write_text(args.output, out.getvalue())
     return 0
