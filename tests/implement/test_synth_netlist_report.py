@@ -81,3 +81,11 @@ def test_help_says_the_check_runs_without_model(capsys):
     # the old help said the netlist is simulated only when --model is given
     assert "then simulated" not in text
     assert "manifest" in text and "netlist_check" in text
+
+
+def test_output_directory_on_a_spartan_ii_part_is_refused(capsys, tmp_path):
+    """-o names an iCE40 bitstream's directory; on a Spartan-II part it was silently ignored
+    (a 90 s synthesis later, no files): refused in one line before any tool runs."""
+    rc, out, err = _run(capsys, GOOD, "--no-lint", "-o", tmp_path / "out")
+    assert rc == 2 and err.strip().startswith("error: -o ") and len(err.strip().splitlines()) == 1
+    assert "iCE40" in err and not (tmp_path / "out").exists()

@@ -23,6 +23,9 @@ from ..verify.post_route import checker
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
 
+ICE40_OUT = "ice40"   # the bitstream directory without -o
+
+
 def add_arguments(p):
     p.add_argument("directory", metavar="DIR", help="generated design: DIR/manifest.json and its VHDL files")
     p.add_argument(
@@ -31,9 +34,9 @@ def add_arguments(p):
         f"else {DEFAULT_PART}; devices " + ", ".join(d.name for d in DEVICES) + "); or an iCE40 part for real "
         "place and route, timing and a bitstream (" + ", ".join(p.name for p in ICE40_PARTS) + ")",
     )
-    p.add_argument("-o", "--output", metavar="OUT", default="ice40",
-                   help="iCE40 only: directory for the bitstream (.bin), example pins (.pcf), .asc and reports "
-                        "(default %(default)s/)")
+    p.add_argument("-o", "--output", metavar="OUT", default=None,
+                   help=f"iCE40 only: directory for the bitstream (.bin), example pins (.pcf), .asc and reports "
+                        f"(default {ICE40_OUT}/)")
     p.add_argument("--post-route", action="store_true",
                    help="iCE40 only: simulate the placed-and-routed design (icebox_vlog + Verilator, Yosys's iCE40 "
                         "cell models) over every input code against the twin (needs the model: --model or the "
@@ -92,7 +95,7 @@ def run_ice40(args) -> int:
         synth.check_lint(read_manifest(args.directory).files, args.vsg_config, start=args.directory)
     check = post_route_check(args.directory, args.model) if args.post_route else None
     with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
-        report = ice40.implement(args.directory, args.device, args.output, work=Path(args.work or tmp),
+        report = ice40.implement(args.directory, args.device, args.output or ICE40_OUT, work=Path(args.work or tmp),
                                  seed=args.seed, progress=not args.json, post_route=check)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
@@ -110,6 +113,9 @@ def run(args) -> int:
     if args.post_route:
         raise FlannError(f"--post-route needs an iCE40 part (--device {DEFAULT_ICE40_PART}): the Spartan-II is not "
                          "placed and routed here (its mapped netlist is simulated unless --no-netlist-check)")
+    if args.output is not None:
+        raise FlannError(f"-o {args.output}: a Spartan-II synthesis writes no files (its figures are printed; "
+                         "--work DIR keeps the netlist and logs); -o names the bitstream directory of an iCE40 part")
     if args.device is not None:
         parse_part(args.device)  # refuse a bad part before any slow step
     if args.work and Path(args.work).exists() and not Path(args.work).is_dir():
