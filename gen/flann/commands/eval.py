@@ -53,7 +53,7 @@ def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm
         raise FlannError(f"--full-scale-mm must be > 0, got {fs_mm:g}")
     if len(rec) < 2:
         raise FlannError(f"{rec.source}: need at least 2 rows to evaluate, got {len(rec)}")
-    fs = full_scale_mm(rec.displacement_mm) if fs_mm is None else float(fs_mm)
+    fs = full_scale_mm(rec.displacement_mm, rec.source) if fs_mm is None else float(fs_mm)
     x = rec.displacement_mm
     # outside the trained range the voltage is clamped, as the hardware does
     predicted = predict_clamped(model, rec.voltage_v, rec.temperature_c)[0]

@@ -34,12 +34,15 @@ def full_scale_of_span(lo_mm: float, hi_mm: float) -> float:
     return 0.5 * (float(hi_mm) - float(lo_mm))
 
 
-def full_scale_mm(displacement_mm) -> float:
-    """The full scale of the displacements' span (:func:`full_scale_of_span`)."""
+def full_scale_mm(displacement_mm, source: str = "") -> float:
+    """The full scale of the displacements' span (:func:`full_scale_of_span`); ``source`` names
+    the recording in the refusal."""
     x = np.asarray(displacement_mm, dtype=float)
     fs = full_scale_of_span(np.min(x), np.max(x)) if x.size else 0.0
     if not fs > 0:
-        raise FlannError("displacement_mm spans no range: full scale is 0, % FS is undefined")
+        where = f"{source}: " if source else ""
+        raise FlannError(f"{where}displacement_mm spans no range (every reading at one position): full scale is "
+                         "0, % FS is undefined: eval needs readings over a stroke")
     return fs
 
 
