@@ -88,13 +88,14 @@ def run(args) -> int:
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
+    # a design eval cannot judge is refused before any warning about the recording
+    spec = design_spec(args.model, args.design) if args.design else None
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
                        temperature_c=rec.temperature_c)
     warn_outside_stroke(model, rec)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     errors = res.pop("_errors", None)
     if args.design:
-        spec = design_spec(args.model, args.design)
         hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
                                adc=design_adc(args.design))
         pts = hw.pop("_points")
