@@ -43,9 +43,12 @@ def _float18(design: Design, build_dir, *, seed=1, **_) -> dict:
     inside = ~r["sat"]
     err = float(np.abs(hdl_mm - ref)[inside].max()) if inside.any() else 0.0
     ok = not r["bench_failed"] and r["mismatches"] == 0 and r["latency"] == [design.manifest["latency_cycles"]]
-    benches = {"float18_top": {"tests": 1, "failures": int(r["bench_failed"]), "failed": [], "seconds": None}}
+    secs = r["seconds"]
+    benches = {"float18_top": {"tests": 1, "failures": int(r["bench_failed"]), "failed": [],
+                               "seconds": round(secs, 1)}}
     s = _summary(design, int(codes.size), r["mismatches"], err, benches, ok)
-    s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
+    s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1,
+                  "codes_per_s": round(codes.size / secs, 1) if secs > 0 else None}
     # the float18 design states no error bound (its spec has no error analysis): no bound line
     curve = plots.curve([{"title": None, "series": [plots.series("", codes, hdl_mm, ref)]}],
                         ref=plots.GOLDEN, simulator="GHDL", unit_mm=True,

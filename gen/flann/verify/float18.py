@@ -77,7 +77,7 @@ def run_files(fspec, man: dict, files, build_dir: Path, codes=None, seed: int = 
         stages["all_equal"] = stages["missing"] == 0 and not any(stages[k] for k in ("terms", "products", "sums"))
     return {"codes": hcodes, "out": hout, "sat": hsat, "twin_out": out[k], "twin_sat": sat[k],
             "mismatches": mism, "latency": got["latency"], "bench_failed": failed,
-            "manifest": man, "spec": fspec, "stages": stages}
+            "manifest": man, "spec": fspec, "stages": stages, "seconds": res.seconds}
 
 
 __all__ = ["run_top", "run_design", "run_files"]
