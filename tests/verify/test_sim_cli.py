@@ -98,9 +98,12 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
 
     monkeypatch.setattr(datapaths, "netlist_summary", sweep)
     rc = main(["sim", str(designs["dir"] / datapath), "--json", "--netlist", "--build", str(tmp_path / "b")])
-    s = json.loads(capsys.readouterr().out)
+    out, err = capsys.readouterr()
+    s = json.loads(out)
     assert calls == [datapath] and s["netlist"]["mismatches"] == 1
     assert rc == 1 and not s["all_passed"] and s["mismatches"] == 0
+    # with --json too, stderr says why in one line (the JSON on stdout stays parseable)
+    assert err.strip().splitlines()[-1] == "error: co-simulation failed (mapped netlist: 1 mismatches)", err
 
 
 def test_float18_plot_draws_no_lsb_bound(designs, tmp_path, capsys, figures):

@@ -163,12 +163,17 @@ def run(args) -> int:
             print(f"plot: {args.plot}")
     if args.plot and not plotted:
         print(f"{args.plot}: not written, the simulation gave no outputs to plot", file=sys.stderr)
+    # on stderr with --json too: a script sees why beside the exit code, its JSON stays clean
     if s.get("post_route", {}).get("mismatches"):
-        if not args.json:
-            print("error: the placed-and-routed design disagrees with its twin", file=sys.stderr)
+        print("error: the placed-and-routed design disagrees with its twin", file=sys.stderr)
         return 1
     if not s["all_passed"] or s["mismatches"]:
-        if not args.json:
-            print("error: co-simulation failed (see the bench lines above)", file=sys.stderr)
+        why = [f"bench {name}: {', '.join(b['failed']) or 'failed'}" for name, b in s.get("benches", {}).items()
+               if b.get("failures")]
+        if s["mismatches"]:
+            why.append(f"{s['mismatches']} mismatches with the twin")
+        if (s.get("netlist") or {}).get("mismatches"):
+            why.append(f"mapped netlist: {s['netlist']['mismatches']} mismatches")
+        print(f"error: co-simulation failed ({'; '.join(why) or 'see the summary'})", file=sys.stderr)
         return 1
     return 0
