@@ -383,10 +383,12 @@ def _on_grid(rel: np.ndarray, q: float, res: float, u: np.ndarray) -> bool:
     """Converter codes times a step are on the grid to the printing's rounding (a few of the
     printed digit; nine significant digits without one), not to a share of the step: readings
     of a straight sensor at evenly spaced positions are evenly spaced too, each off that grid
-    by its noise (0.1 V/mm at 0.25 mm steps, 10 uV noise: a '6-bit, 25 mV converter')."""
+    by its noise (0.1 V/mm at 0.25 mm steps, 10 uV noise: a '6-bit, 25 mV converter').  Nine
+    significant digits round a reading by up to 5e-9 of it, while the printed digit (``res``)
+    is that of the smallest readings: the allowance is 2e-8 of the largest."""
     off = rel - q * np.round(rel / q)
     off -= np.median(off)
-    return float(np.max(np.abs(off))) <= 2.0 * res + 4e-9 * float(np.max(np.abs(u)))
+    return float(np.max(np.abs(off))) <= 2.0 * res + 2e-8 * float(np.max(np.abs(u)))
 
 
 def _grid_step(u: np.ndarray, gaps: np.ndarray, k: int, res: float, tol: float) -> float:
