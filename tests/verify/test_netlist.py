@@ -68,12 +68,12 @@ def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, sm
         run_netlist(exe, replace(sweep, image=tuple(kept[0][:-1])), tmp_path / "short", shards=1)
 
 
-@pytest.mark.parametrize("datapath", ["thermal", "family_thermal"])
-def test_two_input_netlist_follows_its_temperature_input(tmp_path, small_designs, datapath):
+def test_two_input_netlist_follows_its_temperature_input(tmp_path, small_designs):
     """A design with temperature: GHDL's netlist (as Yosys reads it) runs every voltage code at the
     RTL sweep's temperature codes and agrees with the twin at each; against the twin one
-    temperature code up it disagrees, so in_temp is driven and read, not left at 0."""
-    design = from_directory(small_designs["dir"] / datapath)
+    temperature code up it disagrees, so in_temp is driven and read, not left at 0 (the family
+    with temperature's mapped netlist: flann synth in tests/hardware/test_datapath_matrix.py)."""
+    design = from_directory(small_designs["dir"] / "thermal")
     sweep = sweep_of(design)
     spec = design.spec
     assert sweep.temps[0] == spec.temp_code_min and sweep.temps[-1] == spec.temp_code_max

@@ -85,9 +85,10 @@ def test_plot_is_written_for_every_datapath(designs, datapath, tmp_path, capsys,
 @pytest.mark.parametrize("datapath", [d for d in SIMULATED if d != "family"])
 def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, datapath, tmp_path, capsys,
                                                                       monkeypatch):
-    """--netlist is not dropped by any datapath's bench: after the bench, the design's own netlist
-    sweep runs (the family's runs for real above; the sweeps themselves are checked by flann synth
-    in tests/hardware/test_datapath_matrix.py), and a failed sweep fails the run."""
+    """--netlist is not dropped by any datapath: after the bench (stood in for here: each runs for
+    real in the tests above), the design's own netlist sweep runs (stood in for too: the family's
+    runs for real above, and the sweeps themselves are checked by flann synth in
+    tests/hardware/test_datapath_matrix.py), and a failed sweep fails the run."""
     from flann.verify import datapaths
     calls = []
 
@@ -96,7 +97,11 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
         return {"codes_tested": 256, "mismatches": 1, "simulator": "stub", "temperature_codes": None,
                 "seconds": 0.0}, False
 
+    def bench(design, build_dir, **_):
+        return {"summary": datapaths._summary(design, 256, 0, None, {}, True), "curve": None, "spec": design.spec}
+
     monkeypatch.setattr(datapaths, "netlist_summary", sweep)
+    monkeypatch.setitem(datapaths.BENCHES, DATAPATHS[datapath].bench, bench)
     rc = main(["sim", str(designs["dir"] / datapath), "--json", "--netlist", "--build", str(tmp_path / "b")])
     out, err = capsys.readouterr()
     s = json.loads(out)
