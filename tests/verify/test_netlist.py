@@ -51,6 +51,9 @@ def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, sm
     sweep = sweep_of(design)
     kept = [read_image(design.directory / im["hex"]) for im in design.manifest["images"]]
     assert len(kept) == 2 and kept[0] != kept[1] and list(sweep.image) == kept[-1]
+    # an image given (flann sim --image) is the one loaded
+    given = design.manifest["images"][0]
+    assert list(sweep_of(design, {"name": "given", "hex": design.directory / given["hex"]}).image) == kept[0]
     netlist = mapped_netlist(design, tmp_path / "synth")
     assert "RAMB4" in netlist.read_text()   # the weights in a block RAM, not in logic
     exe = compile_netlist(netlist, tmp_path / "verilator", sweep)

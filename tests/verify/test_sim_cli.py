@@ -92,8 +92,8 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
     from flann.verify import datapaths
     calls = []
 
-    def sweep(design, build_dir, progress=None):
-        calls.append(design.datapath.name)
+    def sweep(design, build_dir, progress=None, image=None):
+        calls.append((design.datapath.name, image and Path(image["hex"]).name))
         return {"codes_tested": 256, "mismatches": 1, "simulator": "stub", "temperature_codes": None,
                 "seconds": 0.0}, False
 
@@ -101,11 +101,17 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
         return {"summary": datapaths._summary(design, 256, 0, None, {}, True), "curve": None, "spec": design.spec}
 
     monkeypatch.setattr(datapaths, "netlist_summary", sweep)
+    if datapaths.BENCHES[DATAPATHS[datapath].bench] in datapaths.LOADS_IMAGES:
+        monkeypatch.setattr(datapaths, "LOADS_IMAGES", (*datapaths.LOADS_IMAGES, bench))
     monkeypatch.setitem(datapaths.BENCHES, DATAPATHS[datapath].bench, bench)
-    rc = main(["sim", str(designs["dir"] / datapath), "--json", "--netlist", "--build", str(tmp_path / "b")])
+    d = designs["dir"] / datapath
+    # a family design's netlist computes with the image given, as its bench ends
+    image = json.loads((d / "manifest.json").read_text())["images"][0]["hex"] if "family" in datapath else None
+    rc = main(["sim", str(d), "--json", "--netlist", "--build", str(tmp_path / "b"),
+               *(["--image", str(d / image)] if image else [])])
     out, err = capsys.readouterr()
     s = json.loads(out)
-    assert calls == [datapath] and s["netlist"]["mismatches"] == 1
+    assert calls == [(datapath, image)] and s["netlist"]["mismatches"] == 1
     assert rc == 1 and not s["all_passed"] and s["mismatches"] == 0
     # with --json too, stderr says why in one line (the JSON on stdout stays parseable)
     assert err.strip().splitlines()[-1] == "error: co-simulation failed (mapped netlist: 1 mismatches)", err

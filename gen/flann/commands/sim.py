@@ -43,7 +43,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--netlist", action="store_true",
                         help="also synthesise (GHDL + Yosys synth_xilinx -family xcv) and simulate the mapped "
                              "netlist over every input code (Verilator, Yosys's Xilinx cell models); a family "
-                             "design's with the last weight image it keeps loaded through cfg_*")
+                             "design's with the last --image (else the last weight image it keeps) loaded through "
+                             "cfg_*; a design with temperature at its sweep's temperature codes")
     parser.add_argument("--post-route", action="store_true",
                         help="also place and route on an iCE40 (--post-route-device) and simulate the routed design "
                              "over every input code (icebox_vlog + Verilator, Yosys's iCE40 cell models)")
@@ -105,8 +106,10 @@ def run(args) -> int:
                        progress=terminal_progress, images=images or None)
         s = res["summary"]
         if args.post_route:
+            # a family design's routed netlist computes with the last image given, as its bench ends
+            check = checker(design, image=images[-1] if images else None)
             rep = ice40.implement(design.directory, args.post_route_device, build / "ice40", work=build / "ice40_work",
-                                  seed=args.seed, progress=not args.json, post_route=checker(design))
+                                  seed=args.seed, progress=not args.json, post_route=check)
             s["post_route"] = {**rep.post_route, "device": rep.part.name, "fmax_mhz": rep.fmax_mhz,
                                "timing_met": rep.timing_met}
         plotted = bool(args.plot and res["curve"] is not None)

@@ -247,7 +247,10 @@ def simulate(design: Design, build_dir, *, netlist: bool = False, **kw) -> dict:
     res = BENCHES[dp.bench](design, build_dir, **kw)
     if netlist:
         s = res["summary"]
-        s["netlist"], passed = netlist_summary(design, build_dir, kw.get("progress"))
+        # a family design's netlist computes with the last image given (--image), as its bench ends
+        given = kw.get("images")
+        s["netlist"], passed = netlist_summary(design, build_dir, kw.get("progress"),
+                                               image=given[-1] if given else None)
         s["all_passed"] = s["all_passed"] and passed
     return res
 

@@ -77,19 +77,23 @@ class NetlistSweep:
         return self.process(got["codes"]) if self.temps is None else self.process(got["codes"], got["temps"])
 
 
-def _fixed_sweep(design: Design) -> NetlistSweep:
+def _fixed_sweep(design: Design, image=None) -> NetlistSweep:
     man = design.manifest
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannTop(design.spec).process)
 
 
-def _float18_sweep(design: Design) -> NetlistSweep:
+def _float18_sweep(design: Design, image=None) -> NetlistSweep:
     man = design.manifest
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannF18Top(design.spec).process)
 
 
-def _last_image(design: Design, words: int) -> list[int]:
+def _loaded_image(design: Design, words: int, image: dict | None) -> list[int]:
+    """The words the driver loads: ``image`` ({name, hex}: one the user gave), else the last image
+    the design keeps."""
+    if image is not None:
+        return checked_image(design, image, words)[1]
     kept = kept_images(design)
     if not kept:
         raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
@@ -97,9 +101,9 @@ def _last_image(design: Design, words: int) -> list[int]:
     return checked_image(design, kept[-1], words)[1]
 
 
-def _family_sweep(design: Design) -> NetlistSweep:
+def _family_sweep(design: Design, image=None) -> NetlistSweep:
     man = design.manifest
-    words = _last_image(design, design.spec.mem_depth)
+    words = _loaded_image(design, design.spec.mem_depth, image)
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannFamilyTop(design.spec, words).process, tuple(words), design.spec.addr_bits)
 
@@ -109,16 +113,16 @@ def _family_sweep(design: Design) -> NetlistSweep:
 NETLIST_MAX_SAMPLES = 150_000
 
 
-def _thermal_sweep(design: Design) -> NetlistSweep:
+def _thermal_sweep(design: Design, image=None) -> NetlistSweep:
     man, spec = design.manifest, design.spec
     temps, _ = thermal_temperature_codes(spec, NETLIST_MAX_SAMPLES)
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannThermalTop(spec).process, temps=tuple(temps), temp_bits=spec.temp_bits)
 
 
-def _family_thermal_sweep(design: Design) -> NetlistSweep:
+def _family_thermal_sweep(design: Design, image=None) -> NetlistSweep:
     man, spec = design.manifest, design.spec
-    words = _last_image(design, spec.image_words)
+    words = _loaded_image(design, spec.image_words, image)
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
                         FlannFamilyThermalTop(spec, words).process, tuple(words), spec.cfg_addr_bits,
                         tuple(family_thermal_temperature_codes(spec)), spec.temp_bits)
@@ -128,9 +132,9 @@ SWEEPS = {"fixed": _fixed_sweep, "float18": _float18_sweep, "family": _family_sw
           "family_thermal": _family_thermal_sweep}
 
 
-def sweep_of(design: Design) -> NetlistSweep:
+def sweep_of(design: Design, image: dict | None = None) -> NetlistSweep:
     require_sweep_driver(design.datapath, design.directory, "the netlist sweep")
-    return SWEEPS[design.datapath.netlist](design)
+    return SWEEPS[design.datapath.netlist](design, image)
 
 
 def yosys_datdir() -> Path:
@@ -239,12 +243,13 @@ def compare(sweep: NetlistSweep, got: dict) -> dict:
             "first_mismatches": first, "temperature_codes": None if sweep.temps is None else len(sweep.temps)}
 
 
-def check_netlist(design: Design, build, netlist: Path | None = None, progress=None, abc: str = "full") -> dict:
+def check_netlist(design: Design, build, netlist: Path | None = None, progress=None, abc: str = "full",
+                  image: dict | None = None) -> dict:
     """Every input code through the mapped netlist (synthesised here unless ``netlist`` is given)."""
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
-    sweep = sweep_of(design)
+    sweep = sweep_of(design, image)
     if netlist is None:
         netlist = mapped_netlist(design, build / "synth", abc)
     exe = compile_netlist(netlist, build / "verilator", sweep)
@@ -255,10 +260,11 @@ def check_netlist(design: Design, build, netlist: Path | None = None, progress=N
     return res
 
 
-def netlist_summary(design: Design, build_dir, progress=None) -> tuple[dict, bool]:
+def netlist_summary(design: Design, build_dir, progress=None, image: dict | None = None) -> tuple[dict, bool]:
     """``flann sim --netlist``: the mapped netlist's sweep as the summary reports it, and whether it
     passed (every code, no mismatch)."""
-    nl = check_netlist(design, Path(build_dir) / "netlist", progress=progress("netlist") if progress else None)
+    nl = check_netlist(design, Path(build_dir) / "netlist", progress=progress("netlist") if progress else None,
+                       image=image)
     entry = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"], "simulator": nl["simulator"],
              "temperature_codes": nl["temperature_codes"], "seconds": round(nl["seconds"], 1)}
     return entry, nl["mismatches"] == 0 and nl["codes_tested"] > 0

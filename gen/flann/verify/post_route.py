@@ -64,12 +64,14 @@ def routed_verilog(asc: Path, pcf: Path, part: Ice40Part, top: str, out: Path) -
     return out
 
 
-def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, build, progress=None) -> dict:
-    """Every input code through the routed design; returns {"codes_tested", "mismatches", ...}."""
+def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, build, progress=None,
+                     image: dict | None = None) -> dict:
+    """Every input code through the routed design (a family design loaded with ``image``, else
+    its last kept one); returns {"codes_tested", "mismatches", ...}."""
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
-    sweep = sweep_of(design)
+    sweep = sweep_of(design, image)
     netlist = routed_verilog(Path(asc), Path(pcf), part, sweep.top, build / "post_route.v")
     models = [yosys_datdir() / "ice40" / "cells_sim.v"]
     exe = compile_netlist(netlist, build / "verilator_post_route", sweep, models=models, defines=DEFINES)
@@ -83,13 +85,13 @@ def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, buil
 SUMMARY_KEYS = ("codes_tested", "mismatches", "first_mismatches", "simulator", "seconds")
 
 
-def checker(design: Design, refuse: bool = False):
+def checker(design: Design, refuse: bool = False, image: dict | None = None):
     """The post-route check as :func:`flann.implement.ice40.implement` calls it: (asc, pcf, part,
     work) → summary.  ``refuse``: a routed design that disagrees with its twin raises (nothing
-    is written then) instead of being reported."""
+    is written then) instead of being reported; ``image``: a family design's weight image to load."""
 
     def check(asc, pcf, part, work) -> dict:
-        res = check_post_route(design, asc, pcf, part, Path(work) / "post_route")
+        res = check_post_route(design, asc, pcf, part, Path(work) / "post_route", image=image)
         if refuse and res["mismatches"]:
             raise FlannError(f"the routed design of {design.directory} on {part.name} disagrees with its twin on "
                              f"{res['mismatches']} of {res['codes_tested']} samples (first: "
