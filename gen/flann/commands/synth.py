@@ -52,8 +52,9 @@ def add_arguments(p):
                    help="the model DIR was generated from, for the netlist check's twin (default: the model "
                         "DIR/manifest.json records)")
     p.add_argument("--no-netlist-check", action="store_true",
-                   help="do not simulate the mapped netlist; by default a fixed-point or family design's mapped netlist is "
-                        "simulated over every input code against the twin (Verilator), with --model or without "
+                   help="do not simulate the mapped netlist; by default the mapped netlist of a design flann gen "
+                        "wrote is simulated over every input code (a design with temperature: at its sweep's "
+                        "temperature codes) against the twin (Verilator), with --model or without "
                         "(the manifest's model), reported as 'netlist check' (JSON: netlist_check, null when not "
                         "run), and a disagreeing design is refused")
 

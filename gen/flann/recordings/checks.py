@@ -285,8 +285,8 @@ def check_duplicates(rec: Recordings, k_sigma: float = 8.0, floor_frac: float = 
 def _lone_glitches(rec: Recordings, direction: np.ndarray, d: float, x: float, vv: np.ndarray,
                    tol: float) -> bool:
     """The readings ``vv`` at position ``x`` (direction ``d``) disagree only through glitches:
-    fewer than half of them are off the line through the neighbouring positions' medians,
-    and the rest agree with it."""
+    fewer than half of them (one of two) are off the line through the neighbouring positions'
+    medians, and the rest agree with it."""
     same = direction == d
     xs, vs = rec.displacement_mm[same], rec.voltage_v[same]
     below, above = np.unique(xs[xs < x]), np.unique(xs[xs > x])
@@ -294,8 +294,8 @@ def _lone_glitches(rec: Recordings, direction: np.ndarray, d: float, x: float, v
         return False   # at an end: no line through neighbours on both sides
     xl, xh = float(below[-1]), float(above[0])
     vl, vh = float(np.median(vs[xs == xl])), float(np.median(vs[xs == xh]))
-    off = np.abs(vv - (vl + (vh - vl) * (x - xl) / (xh - xl))) > tol
-    return 0 < int(off.sum()) < 0.5 * vv.size + 0.5 * (vv.size == 2)
+    off = int(np.count_nonzero(np.abs(vv - (vl + (vh - vl) * (x - xl) / (xh - xl))) > tol))
+    return off == 1 if vv.size == 2 else 0 < off < vv.size / 2
 
 
 def _several_temperatures(rec: Recordings, a: int, b: int, x: float, which: str) -> None:

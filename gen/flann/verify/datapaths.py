@@ -25,6 +25,7 @@ from .netlist import netlist_summary, require_sweep_driver
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
 
+
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
     man = design.manifest
     return {"codes_tested": codes, "mismatches": mismatches,

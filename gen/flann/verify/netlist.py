@@ -77,16 +77,18 @@ class NetlistSweep:
         return self.process(got["codes"]) if self.temps is None else self.process(got["codes"], got["temps"])
 
 
-def _fixed_sweep(design: Design, image=None) -> NetlistSweep:
+def _sweep(design: Design, process: Callable, **more) -> NetlistSweep:
+    """The sweep of ``design``'s top as its manifest states it, compared with ``process``."""
     man = design.manifest
-    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
-                        FlannTop(design.spec).process)
+    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"], process, **more)
+
+
+def _fixed_sweep(design: Design, image=None) -> NetlistSweep:
+    return _sweep(design, FlannTop(design.spec).process)
 
 
 def _float18_sweep(design: Design, image=None) -> NetlistSweep:
-    man = design.manifest
-    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
-                        FlannF18Top(design.spec).process)
+    return _sweep(design, FlannF18Top(design.spec).process)
 
 
 def _loaded_image(design: Design, words: int, image: dict | None) -> list[int]:
@@ -102,10 +104,9 @@ def _loaded_image(design: Design, words: int, image: dict | None) -> list[int]:
 
 
 def _family_sweep(design: Design, image=None) -> NetlistSweep:
-    man = design.manifest
     words = _loaded_image(design, design.spec.mem_depth, image)
-    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
-                        FlannFamilyTop(design.spec, words).process, tuple(words), design.spec.addr_bits)
+    return _sweep(design, FlannFamilyTop(design.spec, words).process, image=tuple(words),
+                  cfg_addr_bits=design.spec.addr_bits)
 
 
 # every temperature code while a sweep stays below this many samples (the mapped netlist runs
@@ -114,18 +115,17 @@ NETLIST_MAX_SAMPLES = 150_000
 
 
 def _thermal_sweep(design: Design, image=None) -> NetlistSweep:
-    man, spec = design.manifest, design.spec
+    spec = design.spec
     temps, _ = thermal_temperature_codes(spec, NETLIST_MAX_SAMPLES)
-    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
-                        FlannThermalTop(spec).process, temps=tuple(temps), temp_bits=spec.temp_bits)
+    return _sweep(design, FlannThermalTop(spec).process, temps=tuple(temps), temp_bits=spec.temp_bits)
 
 
 def _family_thermal_sweep(design: Design, image=None) -> NetlistSweep:
-    man, spec = design.manifest, design.spec
+    spec = design.spec
     words = _loaded_image(design, spec.image_words, image)
-    return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"],
-                        FlannFamilyThermalTop(spec, words).process, tuple(words), spec.cfg_addr_bits,
-                        tuple(family_thermal_temperature_codes(spec)), spec.temp_bits)
+    return _sweep(design, FlannFamilyThermalTop(spec, words).process, image=tuple(words),
+                  cfg_addr_bits=spec.cfg_addr_bits, temps=tuple(family_thermal_temperature_codes(spec)),
+                  temp_bits=spec.temp_bits)
 
 
 SWEEPS = {"fixed": _fixed_sweep, "float18": _float18_sweep, "family": _family_sweep, "thermal": _thermal_sweep,
