@@ -40,8 +40,8 @@ def thermal():
 
 def test_shape_is_the_curve_not_the_term(thermal):
     sd = thermal.shape_description
-    # the curve beside the named effects is within a few mV of the calibrated simulation;
-    # the shape term itself took volts back off a doubled gain
+    # the curve beside the named effects is within a few mV of the calibrated simulation
+    # (the shape term once took volts back off a doubled gain)
     assert sd["terms"] > 0
     assert sd["rms_v"] < 0.005 and sd["peak_v"] < 0.01
     assert sd["rms_v"] < thermal.ideal_rms

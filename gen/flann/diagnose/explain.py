@@ -73,11 +73,11 @@ def explain(name: str, params: dict, contrib: np.ndarray, x: np.ndarray,
         drift, note = f"{k * 100:+.3g} %/degC", ""
         seen = _drift_of_output(contrib, y, temperature, p.get("reference_temperature_c"))
         if seen is not None and abs(seen - k) > 0.1 * abs(k):
-            # the coefficient scales the fitted simulation, whose gain can trade with the
-            # shape term: the drift of what was recorded is the number to act on
+            # the coefficient scales the fitted simulation, not the shape term or the other
+            # effects beside it: the drift of what was recorded is the number to act on
             drift = f"{seen * 100:+.3g} %/degC of the recorded output"
             note = (f"; coefficient_per_c ({k * 100:+.3g} %/degC) is relative to the fitted "
-                    "simulation, whose gain trades with the shape term")
+                    "simulation alone")
         return (f"the residual follows the recorded temperature{trange} rather than the "
                 f"displacement, scaling with the output itself (up to {_mv(big)} where the "
                 f"output is largest): the sensitivity drifts by {drift} (primary copper "
