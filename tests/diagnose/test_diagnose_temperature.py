@@ -1,7 +1,7 @@
 """A formula sensor recorded at three temperatures, whose curve the simulation cannot follow
 exactly: what the report says about its shape (the fitted curve with the named effects off
-against the calibrated ideal simulation, never the shape term's own size, which can be volts
-when the fit trades gain for shape), and no rail named where the readings still rise."""
+against the calibrated ideal simulation, never the shape term's own size), and no rail named
+where the readings still rise."""
 
 import re
 

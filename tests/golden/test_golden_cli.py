@@ -107,6 +107,26 @@ def hand_model(tmp_path):
     return p
 
 
+def test_readings_past_the_range_by_the_training_noise_are_flagged_not_warned(tmp_path, capsys):
+    # a curve-fitted model's range ends at the curve's ends; the noisiest end readings of its
+    # own training file pass them: 2.03 V is 1.5 sigma of 20 mV past 2 V, 2.2 V is 10 sigma
+    m = json.loads(hand_model(tmp_path).read_text())
+    m["training"] = {"noise_v": 0.02}
+    model = tmp_path / "noisy.json"
+    model.write_text(json.dumps(m))
+    data = tmp_path / "v.csv"
+    out = tmp_path / "p.csv"
+    data.write_text("voltage_v\n2.03\n-2.05\n1\n")
+    code, _, err = run(["predict", model, data, "-o", out], capsys)
+    assert code == 0 and err == ""
+    assert [r["clamped"] for r in csv.DictReader(out.open())] == ["1", "1", "0"]
+    data.write_text("voltage_v\n2.03\n2.2\n1\n")
+    code, _, err = run(["predict", model, data, "-o", out], capsys)
+    assert code == 0 and "1 of 3 voltages outside" in err
+    assert "1 more past its ends by less than 4x the training noise" in err
+    assert [r["clamped"] for r in csv.DictReader(out.open())] == ["1", "1", "0"]
+
+
 def test_predict_writes_every_row(tmp_path, capsys):
     data = write_csv(tmp_path / "r.csv", [-4.0, 0.0, 4.0], [-2.0, 0.0, 1.0])
     out = tmp_path / "p.csv"

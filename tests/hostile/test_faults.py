@@ -4,6 +4,7 @@ calibrate batch, Ctrl-C during start-up and during a calibrate pool."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -165,6 +166,11 @@ def test_ctrl_c_during_start_up_is_one_line(delay, tmp_path):
     if err.startswith("Fatal Python error: init_import_site"):
         # the interrupt reached the interpreter while it imported its own site module, before
         # the first line of flann or of the console script ran: nothing of ours to catch it
+        return
+    frames = re.findall(r'File "([^"]+)"', err)
+    if frames and set(frames) == {str(FLANN)} and err.rstrip().endswith("KeyboardInterrupt"):
+        # the same before the package's first line: the console script pip wrote was still
+        # importing it (no frame of ours), and no code of ours had run to catch it
         return
     assert "Traceback" not in err, err
     if p.returncode == -signal.SIGINT:   # before Python installed its handler: killed silently

@@ -36,18 +36,40 @@ def outside_range(model, voltage_v, temperature_c=None) -> np.ndarray:
     return model.clamp(voltage_v, temperature_c)[2]
 
 
+# A model fitted to a forward curve ends its range at the curve's ends, which the noisiest
+# readings at the stroke's ends pass by up to a few sigma: those are the stroke's ends, not
+# voltages the model never saw, so they are flagged in the output but not warned about.
+NOISE_SIGMAS = 4.0
+
+
+def _past_the_noise(model, voltage_v, temperature_c, outside: np.ndarray) -> np.ndarray:
+    noise = model.training.get("noise_v") if isinstance(model.training, dict) else None
+    if not isinstance(noise, (int, float)) or not noise > 0:
+        return outside
+    v = np.asarray(voltage_v, dtype=float)
+    lo, hi = sorted(model.voltage_range_v)
+    # a reading outside only through its temperature keeps its flag
+    near = (v >= lo - NOISE_SIGMAS * noise) & (v <= hi + NOISE_SIGMAS * noise)
+    inside_t = ~outside_range(model, np.clip(v, lo, hi), temperature_c)
+    return outside & ~(near & inside_t)
+
+
 def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
                        temperature_c=None) -> None:
     outside = outside_range(model, voltage_v, temperature_c)
-    if outside.any():
+    far = _past_the_noise(model, voltage_v, temperature_c, outside)
+    if far.any():
         lo, hi = sorted(model.voltage_range_v)
         what = "extrapolated" if extrapolated else "clamped to the range as the hardware does (column clamped = 1)"
         where, items = f"[{lo:g}, {hi:g}] V", "voltages"
         if is_thermal(model):
             tlo, thi = sorted(model.temperature_range_c)
             where, items = where + f" or calibrated temperatures [{tlo:g}, {thi:g}] degC", "readings"
-        warnings.warn(f"{source}: {int(outside.sum())} of {outside.size} {items} outside the "
-                      f"model's trained range {where}: {what}", stacklevel=2)
+        near = int(outside.sum() - far.sum())
+        also = (f" ({near} more past its ends by less than {NOISE_SIGMAS:g}x the training noise)"
+                if near else "")
+        warnings.warn(f"{source}: {int(far.sum())} of {far.size} {items} outside the "
+                      f"model's trained range {where}{also}: {what}", stacklevel=2)
 
 
 def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, np.ndarray]:
