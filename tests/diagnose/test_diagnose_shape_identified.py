@@ -60,3 +60,27 @@ def test_backlash_is_read_at_its_size_beside_shape_terms(tmp_path, seed):
     assert [e["name"] for e in r["effects"]] == ["backlash"]
     db = r["effects"][0]["params"]["deadband_mm"]
     assert abs(db["value"] - 0.03) < 0.004 and db["stderr"] < 0.004, db
+
+
+def test_halves_of_unequal_gain_are_not_read_as_large_cancelling_effects(tmp_path):
+    # 5.18 V tanh(x / 13.84 mm), the + half 1.14 % stronger than the - half, 0.5 mV offset,
+    # 0.5 mV noise, 14 bits over +-8.192 V, -20..20 mm every 0.05 mm out and back.  With the
+    # shape modes moved by a zero shift the selection named a 24 % imbalance, a -0.61 V
+    # offset and a -0.94 mm shift that cancel (the reading at 0 mm is 0.5 mV)
+    rng = np.random.default_rng(1001)
+    lsb = 16.384 / 2 ** 14
+    xf = np.round(np.arange(-20, 20.0001, 0.05), 4)
+    x = np.r_[xf, xf[::-1]]
+    v = 5.177 * np.tanh(x / 13.84) * (1 + 0.0114 * np.sign(x)) + 0.00055 + rng.normal(0, 5e-4, x.size)
+    v = np.clip(np.round(v / lsb), -2 ** 13, 2 ** 13 - 1) * lsb
+    d = np.r_[np.ones(xf.size), -np.ones(xf.size)]
+    rec = tmp_path / "halves.csv"
+    rec.write_text("displacement_mm,voltage_v,direction\n"
+                   + "".join(f"{a:.4f},{b:.6f},{int(c)}\n" for a, b, c in zip(x, v, d)))
+    out = tmp_path / "d.json"
+    assert main(["diagnose", str(rec), "--quiet", "--json", str(out)]) == 0
+    r = json.loads(out.read_text())
+    sizes = {e["name"]: {k: p["value"] for k, p in e["params"].items()} for e in r["effects"]}
+    assert abs(sizes.get("null_offset", {}).get("offset_v", 0.0)) < 0.01, sizes
+    assert abs(sizes.get("zero_shift", {}).get("shift_mm", 0.0)) < 0.1, sizes
+    assert abs(sizes.get("secondary_imbalance", {}).get("imbalance_fraction", 0.0)) < 0.05, sizes

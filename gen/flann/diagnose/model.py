@@ -147,14 +147,20 @@ class OddBasis:
         """Columns of the basis matrix (coefficients of the shape term)."""
         return self.k * (1 if self.warp is None else 2)
 
-    def evaluate(self, core_mm: np.ndarray) -> np.ndarray:
-        """(n, ncols) basis matrix at the core positions."""
-        raw = self._raw(core_mm)
-        return raw if self._share is None else raw - self._known_at(core_mm) @ self._share
+    def evaluate(self, core_mm: np.ndarray, shift_mm: float = 0.0) -> np.ndarray:
+        """(n, ncols) basis matrix at the core positions, the terms moved by a zero shift.
 
-    def _known_at(self, core_mm: np.ndarray) -> np.ndarray:
+        The shares taken out are of the functions as the fit has them: the simulated output
+        moved by the shift (the simulation applies it), the shape modes where they are (the
+        fit evaluates them at the unshifted positions), so the span is the fit's own."""
+        raw = self._raw(np.asarray(core_mm, float) - shift_mm)
+        return raw if self._share is None else raw - self._known_at(core_mm, shift_mm) @ self._share
+
+    def _known_at(self, core_mm: np.ndarray, shift_mm: float = 0.0) -> np.ndarray:
         grid, rows = self.known
-        return np.stack([np.interp(np.asarray(core_mm, float), grid, r) for r in rows], 1)
+        u = np.asarray(core_mm, float)
+        at = [u - shift_mm] + [u] * (len(rows) - 1)   # the output row first, then the modes
+        return np.stack([np.interp(a, grid, r) for a, r in zip(at, rows)], 1)
 
     def _raw(self, core_mm: np.ndarray) -> np.ndarray:
         u = np.asarray(core_mm, float)[:, None]
@@ -369,11 +375,8 @@ class PhysicsFamily:
                                    temperature_c=temp, time_s=time)
             u = core / self._half_range()
             y = y + curvature * u ** 2 * (y - y0)
-        # a zero shift moves the magnetic centre: the geometry's modes and the shape term
-        # (whose shares of those modes are taken out at the same positions) move with it
-        shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
         if self.shape is not None:
-            modes = self._modes_at(idx, core - shift)
+            modes = self._modes_at(idx, core)
             if origin != self.origin0:
                 y = y - gain * (origin - self.origin0) * self.scale * modes[0]
             if shape is not None:
@@ -385,10 +388,11 @@ class PhysicsFamily:
         hi = eff.get("adc_clipping", {}).get("rail_high_v", math.inf)
         lo = eff.get("adc_clipping", {}).get("rail_low_v", -math.inf)
         if basis is not None:
-            # the origin's own change inside a fit (~1e-3 mm) would only move the shape by
-            # a negligible amount; keeping it fixed lets every evaluation reuse one
-            # factorisation of the basis
-            B, pinv = self._basis_at(basis, idx, core - shift)
+            # the shape follows a zero shift (it may be large); the origin's own change
+            # inside a fit (~1e-3 mm) would only move it by a negligible amount, and keeping
+            # it fixed lets every evaluation reuse one factorisation of the basis
+            shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
+            B, pinv = self._basis_at(basis, idx, core, shift)
             if coef is None:
                 if target is None:
                     coef = np.zeros(basis.ncols)
@@ -405,12 +409,12 @@ class PhysicsFamily:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
-    def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray):
+    def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray, shift: float = 0.0):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
         inside a fit the basis moves only with a zero shift, so the finite-difference
         steps of every other parameter reuse one factorisation (a least-squares solve per
         evaluation was most of the diagnosis' time on 2,000 points)."""
-        key = ("disc", basis.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        key = ("disc", basis.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()), shift)
         hit = self._shape_cache.get(key)
         if hit is None:
             # bounded in bytes too: an entry (basis and pseudo-inverse) is 2 n K floats, and
@@ -418,7 +422,7 @@ class PhysicsFamily:
             held = sum(2 * v[0].nbytes for k, v in self._shape_cache.items() if k[0] == "disc")
             if len(self._shape_cache) > 400 or held > CACHE_BYTES:
                 self._shape_cache.clear()
-            B = basis.evaluate(core)
+            B = basis.evaluate(core, shift)
             store: list = []
 
             def pinv():
