@@ -2,10 +2,13 @@
 
 Only ``jobs`` items are ever in flight (no queue of submitted work that would run on after
 an interrupt).  While the batch runs, Ctrl-C and SIGTERM only set a flag (the workers ignore
-SIGINT: the terminal sends it to the whole process group), so no KeyboardInterrupt can land in
-the middle of recording a result: the parent submits nothing more, lets the items already
-running finish (each writes its output whole or not at all), and returns the signal that
-stopped it, so the caller can still write its summary before exiting 130 (143: SIGTERM).
+both: a terminal sends SIGINT, and ``timeout`` or a job scheduler SIGTERM, to the whole process
+group), so no KeyboardInterrupt can land in the middle of recording a result: the parent
+submits nothing more, lets the items already running finish (each writes its output whole or
+not at all), and returns the signal that stopped it, so the caller can still write its
+summary before exiting 130 (143: SIGTERM).  A worker that dies all the same (SIGKILL, the
+system out of memory) loses only the items it had in flight: each is reported through
+``on_lost`` and the batch goes on in a new pool.
 """
 
 from __future__ import annotations
@@ -13,23 +16,26 @@ from __future__ import annotations
 import os
 import signal
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Callable, Iterable
 
 POLL_S = 0.1   # how often the parent looks at the Ctrl-C flag while workers run
+LOST = ("its worker process died before it finished (killed, or the system ran out of "
+        "memory); run it again")
 
 
 def _worker_init() -> None:
+    # the parent decides when the batch stops; a worker finishes the item it holds
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    # a forked worker inherits flann's SIGTERM handler; the parent unwinds the batch, a worker
-    # told to stop just stops
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
-def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[object, object], None]) -> int:
+def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[object, object], None],
+              on_lost: Callable[[object, str], None] | None = None) -> int:
     """Call ``fn(item)`` for every item (in this process when ``jobs == 1``) and
-    ``on_result(item, result)`` as each finishes; the signal that stopped the batch early
-    (SIGINT, SIGTERM), else 0."""
+    ``on_result(item, result)`` as each finishes, ``on_lost(item, why)`` for an item whose
+    worker died; the signal that stopped the batch early (SIGINT, SIGTERM), else 0."""
     items = list(items)
     stop = []
 
@@ -49,18 +55,25 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
                     break
                 on_result(item, fn(item))
         else:
-            _pool(fn, items, jobs, on_result, stop)
+            _pool(fn, items, jobs, on_result, on_lost, stop)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return stop[0] if stop else 0
 
 
-def _pool(fn, items, jobs, on_result, stop) -> None:
+def _pool(fn, items, jobs, on_result, on_lost, stop) -> None:
     pending = iter(items)
     end = object()
+    more = True
+    while more and not stop:
+        more = _one_pool(fn, pending, end, min(jobs, len(items)), on_result, on_lost, stop)
+
+
+def _one_pool(fn, pending, end, jobs, on_result, on_lost, stop) -> bool:
+    """Run items from ``pending`` until they end or a signal; True when the pool broke first."""
     running: dict = {}
-    with ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=_worker_init) as pool:
+    with ProcessPoolExecutor(max_workers=jobs, initializer=_worker_init) as pool:
         def fill() -> None:
             while not stop and len(running) < jobs:
                 item = next(pending, end)
@@ -68,12 +81,26 @@ def _pool(fn, items, jobs, on_result, stop) -> None:
                     return
                 running[pool.submit(fn, item)] = item
 
-        fill()
-        while running:
-            done, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
-            for fut in done:
-                on_result(running.pop(fut), fut.result())
+        try:
             fill()
+            while running:
+                done, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    item = running.pop(fut)
+                    try:
+                        res = fut.result()
+                    except BrokenProcessPool:
+                        running[fut] = item
+                        raise
+                    on_result(item, res)
+                fill()
+        except BrokenProcessPool:
+            for item in running.values():
+                if on_lost is None:
+                    raise
+                on_lost(item, LOST)
+            return True
+    return False
 
 
 __all__ = ["run_batch"]

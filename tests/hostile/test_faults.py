@@ -108,31 +108,42 @@ def test_write_error_in_a_calibrate_batch_fails_that_sensor_and_goes_on(world, c
     assert "s0,failed" in summary and "s1,ok" in summary, summary
 
 
-@pytest.mark.parametrize("jobs, sig", [(1, signal.SIGINT), (2, signal.SIGINT), (1, signal.SIGTERM)])
-def test_ctrl_c_stops_a_calibrate_pool_promptly_and_writes_the_summary(world, jobs, sig):
-    """Ctrl-C (the terminal signals the whole process group) and SIGTERM (``timeout``, a job
-    scheduler: flann's process alone) stop the batch the same way: the summary is written, with
-    the sensors not calibrated as interrupted rows, so no earlier run's summary is left beside
-    this run's sensor folders."""
+@pytest.mark.parametrize("jobs, sig, group", [(1, signal.SIGINT, True), (2, signal.SIGINT, True),
+                                              (1, signal.SIGTERM, False), (2, signal.SIGTERM, True)])
+def test_ctrl_c_stops_a_calibrate_pool_promptly_and_writes_the_summary(world, jobs, sig, group):
+    """Ctrl-C (the terminal signals the whole process group) and SIGTERM (to flann's process
+    alone, or to its group as ``timeout`` and job schedulers send it) stop the batch the same
+    way: the summary is written, with the sensors not calibrated as interrupted rows, and an
+    earlier run's folders of those sensors are gone, so no old certificate or summary is left
+    beside this run's."""
     import time
 
     recs = []
     for k in range(12):
         shutil.copy(world / ("s0.csv" if k % 2 else "s1.csv"), world / f"r{k:02d}.csv")
         recs.append(f"r{k:02d}.csv")
+        old = world / "out" / f"r{k:02d}"   # an earlier run's folder (a sensor folder is replaced whole)
+        old.mkdir(parents=True)
+        (old / "certificate.html").write_text("PASS (an earlier run)")
+        (old / "earlier_run").write_text("")
+
+    def written():
+        return [d for d in (world / "out").glob("*")
+                if d.is_dir() and not d.name.startswith(".") and not (d / "earlier_run").exists()]
+
     p = subprocess.Popen([str(FLANN), "calibrate", *recs, "-o", "out", "--design", "fam", "-j", str(jobs),
                           "--diagnosis-points", "40"], stderr=subprocess.PIPE, stdout=subprocess.PIPE,
                          text=True, start_new_session=True, cwd=world, preexec_fn=as_on_a_terminal)
-    # the state we interrupt in: the first sensor's folder is in place
+    # the state we interrupt in: the first sensor's folder of this run is in place
     deadline = time.monotonic() + 120
-    while not any(d.is_dir() and not d.name.startswith(".") for d in (world / "out").glob("*")):
+    while not written():
         assert p.poll() is None and time.monotonic() < deadline, p.communicate()
         time.sleep(0.02)
-    if sig == signal.SIGINT:
-        os.killpg(p.pid, signal.SIGINT)   # what Ctrl-C on a terminal does: the whole process group
+    if group:
+        os.killpg(p.pid, sig)   # what Ctrl-C on a terminal and `timeout` do: the whole process group
     else:
-        os.kill(p.pid, signal.SIGTERM)
-    at_interrupt = sum(1 for d in (world / "out").glob("*") if d.is_dir() and not d.name.startswith("."))
+        os.kill(p.pid, sig)
+    at_interrupt = len(written())
     out, err = p.communicate(timeout=60)
     assert p.returncode == 128 + sig, err
     assert "Traceback" not in err
@@ -257,3 +268,21 @@ def test_sigterm_is_one_line_and_leaves_nothing(tmp_path):
     assert p.returncode == 128 + signal.SIGTERM, (p.returncode, err)
     assert err.strip().splitlines() == ["error: terminated"], err
     assert not (tmp_path / "m.json").exists() and list(tmp.iterdir()) == []
+
+
+def _square_or_die(item):
+    if item == 3:
+        os.kill(os.getpid(), signal.SIGKILL)   # the system's out-of-memory killer, say
+    return item * item
+
+
+def test_a_worker_that_dies_loses_only_its_items_and_the_batch_goes_on():
+    from flann.pool import run_batch
+
+    done, lost = {}, {}
+    stopped = run_batch(_square_or_die, range(8), 2, done.__setitem__, lost.__setitem__)
+    assert stopped == 0
+    assert 3 in lost and "worker process died" in lost[3]
+    # every item is accounted for once: the ones in flight with 3 are lost, the rest done
+    assert sorted([*done, *lost]) == list(range(8)) and not set(done) & set(lost)
+    assert all(done[i] == i * i for i in done) and len(lost) <= 2

@@ -515,14 +515,22 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if progress:
             _progress(len(results), len(paths), failed, t0)
 
+    def lost(item, why: str) -> None:
+        res = Result(sensor=sensor_name(item[1]), recording=str(item[1]), design_sha256=dhash)
+        res.fail(why)
+        res.verdict = rejected(spec, res.reason)
+        record(item, res)
+
     one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
-    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record)
+    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record, lost)
     if progress:
         sys.stderr.write("\n")
     for i in todo:
         if i not in results:
+            # not calibrated by this run: an earlier run's certificate must not stand beside it
+            remove_output_directory(child(out_dir, sensor_name(paths[i])), _is_sensor_output)
             results[i] = Result(sensor=sensor_name(paths[i]), recording=str(paths[i]), status="interrupted",
                                 reason="not calibrated: the batch was interrupted "
                                        f"({'SIGTERM' if stopped_by == signal.SIGTERM else 'Ctrl-C'})")
