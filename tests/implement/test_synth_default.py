@@ -57,3 +57,6 @@ def test_default_design_fits_its_documented_device_and_xc2s30_as_the_readme_says
     # block RAMs), not from the tool under test, and the tool's own pick of the smallest part
     assert rep["luts"] <= 12 * 18 * 4 and rep["brams"] <= 6
     assert rep["smallest_device"] == "xc2s30-pq208-5"
+    # the ISE handoff, which has only the estimate, does not refuse the part synth measured
+    assert main(["ise", str(d), "-o", str(tmp_path / "ise"), "--device", rep["smallest_device"]]) == 0, \
+        capsys.readouterr().err

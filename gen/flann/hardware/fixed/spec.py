@@ -949,8 +949,10 @@ def estimate_resources(spec: Spec) -> dict:
     luts = L * (mult + expansion) + norm + adder + 30
     # the normaliser's accumulators and its output registers
     ffs = L * (2 * P + 3 * T + spec.product_fmt.width + W) + 2 * norm + spec.acc_fmt.width + 40
-    # each lane reads its own copy
-    tables = [spec.value_fmt.width] + ([spec.slope_fmt.width] if spec.interp and not spec.shared_table else [])
+    # each lane reads its own copy; a bit no entry sets is no memory bit (synthesis drops it:
+    # sin below pi/2 never reaches the value format's integer bit)
+    value_bits = bits_needed(0, max(spec.value_rom), signed=False) if spec.value_rom else spec.value_fmt.width
+    tables = [value_bits] + ([spec.slope_fmt.width] if spec.interp and not spec.shared_table else [])
     brams = L * table_brams(A, tables)
     if spec.steps * W > 2048:  # small weight ROMs go to LUTs
         brams += L * math.ceil(spec.steps * W / BRAM_BITS)
