@@ -231,9 +231,10 @@ def test_one_image_on_a_family_is_loaded_over_one_the_design_keeps(small_designs
     monkeypatch.setattr(datapaths, "run_family_bench", bench)
     given = _calibrated(d, read_image(d / kept[0]["hex"]), tmp_path / "weights.hex")
     one_line(*cli(["sim", d, "--image", given]), "stopped before the bench")
-    # the given image second, over the kept image that differs from it
+    # the given image second, over the kept image that differs from it; calibrate names every
+    # image weights.hex, so the folder names the sensor
     assert seen == [[{"name": f"family/{kept[1]['name']}", "hex": str(d.resolve() / kept[1]["hex"])},
-                     {"name": "weights", "hex": str(given.resolve())}]]
+                     {"name": f"{tmp_path.name}/weights", "hex": str(given.resolve())}]]
 
 
 @pytest.mark.sim
@@ -245,4 +246,6 @@ def test_one_image_on_a_family_simulates(small_designs, tmp_path, cli):
     rc, out, err = cli(["sim", d, "--image", given, "--json", "--build", tmp_path / "b"])
     s = json.loads(out)
     assert rc == 0 and s["all_passed"] and s["mismatches"] == 0, err
-    assert s["images"] == [f"family/{kept[0]['name']}", "weights"] and s["codes_tested"] == 2 * 2 ** 8
+    # calibrate names every image weights.hex: the folder names the sensor
+    assert s["images"] == [f"family/{kept[0]['name']}", f"{tmp_path.name}/weights"]
+    assert s["codes_tested"] == 2 * 2 ** 8

@@ -16,6 +16,7 @@ from pathlib import Path
 from ..argtypes import TOOL_SEED, png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_json, check_output_directory
+from ..hardware.family.images import IMAGE_FILE
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
 from ..implement import ice40
 from ..verify.design import is_design_dir, open_design
@@ -73,11 +74,14 @@ def add_arguments(parser) -> None:
 
 
 def image_names(paths) -> list[dict]:
-    """{name, hex} per --image: the file's stem, or its folder and stem where stems repeat
-    (flann calibrate writes every sensor's weights.hex in the sensor's own folder)."""
+    """{name, hex} per --image: the file's stem, or its folder and stem where stems repeat or
+    the stem is calibrate's (it writes every sensor's image under one name, in the sensor's
+    own folder: the folder names the sensor)."""
     files = [Path(h).resolve() for h in paths]
     stems = [f.stem for f in files]
-    names = [f"{f.parent.name}/{f.stem}" if stems.count(f.stem) > 1 else f.stem for f in files]
+    generic = Path(IMAGE_FILE).stem
+    names = [f"{f.parent.name}/{f.stem}" if stems.count(f.stem) > 1 or f.stem == generic else f.stem
+             for f in files]
     names = [str(f) if names.count(n) > 1 else n for f, n in zip(files, names)]
     if len(set(names)) < len(names):
         twice = next(n for n in names if names.count(n) > 1)
