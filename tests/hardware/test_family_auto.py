@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from flann.cli import main
 from flann.golden.family import FAMILY_SHARE, family_terms
@@ -45,3 +46,20 @@ def test_gen_family_terms_auto_says_what_sharing_costs(tmp_path, capsys):
     terms = man["family"]["terms"]
     lines = [line for line in out.splitlines() if "own design" in line]
     assert len(lines) == 2 and all(f"in the family {terms} terms" in line for line in lines)
+
+
+@pytest.mark.parametrize("terms", ["auto", "7"])
+def test_a_member_the_family_cannot_take_is_named(tmp_path, capsys, terms):
+    # a recording of three rows among two good ones: the refusal says which file, whether it
+    # fails its own training (auto) or the family's common converter (--terms N)
+    paths = []
+    for k, (amp, asym) in enumerate([(3.0, 0.02), (3.1, -0.01)]):
+        paths.append(tmp_path / f"m{k}.csv")
+        write_recordings(paths[-1], s_curve_rec(amp, asym, k))
+    short = tmp_path / "short_one.csv"
+    short.write_text("displacement_mm,voltage_v\n-10,-2.10\n-9.9,-2.095\n-9.8,-2.09\n")
+    rc = main(["gen", "--family", *map(str, paths), str(short), "--terms", terms, "-o", str(tmp_path / "d"),
+               "--input-bits", "14", "--input-lsb-v", "0.001"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and err[0].startswith("error: short_one: "), err
+    assert not (tmp_path / "d").exists()

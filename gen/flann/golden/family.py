@@ -67,8 +67,11 @@ def family_terms(members, *, norm: str, ridge: float, margin: float = 0.5,
     own = []
     for name, v, x in members:
         # judged at the ridges the family trains with (its weights must fit one memory)
-        model, choice = fit_auto(v, x, norms=(norm,), ridges=tuple(r for r in AUTO_RIDGES if r >= ridge),
-                                 cost=cost)
+        try:
+            model, choice = fit_auto(v, x, norms=(norm,), ridges=tuple(r for r in AUTO_RIDGES if r >= ridge),
+                                     cost=cost)
+        except FlannError as exc:
+            raise FlannError(f"{name}: {exc}") from None
         fp = model.training.get("fixed_point") or {}
         own.append((name, v, x, choice, fp.get("cost")))
     top = max(c.terms for _n, _v, _x, c, _c in own)

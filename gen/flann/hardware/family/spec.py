@@ -250,6 +250,8 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
         raise SpecError("the family design always clamps (the clamp range is a per-sensor value)")
     N = max(m.terms for m in models)
     models = [_padded(m, N) for m in models]
+    # a member that cannot take the common formats is named: the options are the family's
+    labels = list(names) if len(names) == len(models) else [f"member {k + 1}" for k in range(len(models))]
     # common input code: every member's voltage range + margin
     vmax = max(max(abs(v) for v in m.voltage_range_v) for m in models)
     if input_lsb_v is None:
@@ -275,7 +277,7 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
                   weight_frac_bits=weight_frac_bits, product_frac_bits=product_frac_bits)
     if any(v is None for v in forced.values()):
         o = GenOptions.of(None, **{k: v for k, v in common.items() if k != "check_device"})
-        big = [_quiet(derive_blocks, _scaled(m, 1 + mu), o) for m in models]
+        big = [_member(n, _quiet, derive_blocks, _scaled(m, 1 + mu), o) for n, m in zip(labels, models)]
         picks = dict(phase_bits=max(b.normaliser.phase_bits for b in big),
                      table_addr_bits=max(b.expansion.table_addr_bits for b in big),
                      term_frac_bits=max(b.expansion.term_fmt.frac_bits for b in big),
@@ -283,7 +285,7 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
                      product_frac_bits=max(b.multiplier.product_fmt.frac_bits for b in big))
         forced = {k: (picks[k] if v is None else v) for k, v in forced.items()}
     options = {**{k: v for k, v in common.items() if k != "check_device"}, **forced, "output_bits": output_bits}
-    blocks = [derive_blocks(m, GenOptions.of(None, **options)) for m in models]
+    blocks = [_member(n, derive_blocks, m, GenOptions.of(None, **options)) for n, m in zip(labels, models)]
     specs = [assemble(b, device=device, check_device=False) for b in blocks]
 
     b0 = blocks[0]
@@ -303,6 +305,15 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
     if check_device:
         check_fits(fam.spec, fam.spec.device.split("-")[0])
     return fam
+
+
+def _member(name: str, fn, *args):
+    try:
+        return fn(*args)
+    except FitError:
+        raise
+    except SpecError as exc:
+        raise SpecError(f"{name}: {exc}") from None
 
 
 def _envelope(b: Blocks, s: Spec, *, weight_bound: int, lin_width: int, lin_bound: int, acc_bound: int,
