@@ -63,3 +63,13 @@ def test_a_member_the_family_cannot_take_is_named(tmp_path, capsys, terms):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and err[0].startswith("error: short_one: "), err
     assert not (tmp_path / "d").exists()
+
+
+def test_members_are_named_as_calibrate_names_the_sensors(tmp_path):
+    from flann.hardware.family.build import member_names
+
+    # a file name with a space becomes calibrate's folder name; a model calibrate wrote is
+    # named by its sensor's folder, not "1_model", "2_model"
+    assert member_names(["line rec/sensor 1.csv", "b/s2.csv"]) == ["sensor_1", "s2"]
+    assert member_names(["cal/sensor_1/model.json", "cal/sensor_2/model.json"]) == ["sensor_1", "sensor_2"]
+    assert member_names(["a/x.csv", "b/x.csv"]) == ["1_x", "2_x"]

@@ -172,7 +172,7 @@ def test_calibrated_models_make_the_same_images(line):
                  "--temp-bits", "8", "--temp-lsb-c", "1"]) == 0
     man = json.loads((again / "manifest.json").read_text())
     assert man["datapath"] == "family_thermal"
-    # every file is model.json: the members are told apart by their place
-    for k, n in enumerate(SENSORS):
-        assert parse_hex((again / f"image_{k + 1}_model.hex").read_text()) == \
+    # every file is model.json: the members are named by their sensors' folders
+    for n in SENSORS:
+        assert parse_hex((again / f"image_{n}.hex").read_text()) == \
             parse_hex((out / n / "weights.hex").read_text())

@@ -373,7 +373,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
         if res.verdict.passed:
-            (tmp / "model.json").write_text(model_json, newline="")
+            (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(chk["words"], head), newline="")
     res.written = True
 
@@ -420,7 +420,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
         if res.verdict.passed:
-            (tmp / "model.json").write_text(model_json, newline="")
+            (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(words, head), newline="")
             (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
             (tmp / "weights.bmm").write_text(images.bmm_text(fam, head), newline="")

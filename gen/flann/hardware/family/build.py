@@ -15,6 +15,8 @@ from ...golden.train import fit_lstsq
 from ..fixed.cost import fixed_point_cost
 from ..options import default
 from ...recordings import prepare_for_fit, read_recordings
+from ...fileio import safe_name
+from .images import MODEL_FILE
 from .render import write
 from .spec import DEFAULT_MARGIN, derive_family
 
@@ -100,15 +102,23 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     if bad:
         raise FlannError(f"{len(bad)} of {len(sources)} family members cannot be used "
                          "(nothing written): " + "; ".join(bad))
-    names = [Path(p).stem for p in sources]
+    names = member_names(sources)
     fam = derive_family(models, names=names, margin=margin, **options)
-    unique = dict(zip(names, models))
-    if len(unique) < len(names):  # members with one file name: told apart by their place
-        unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
-    man = write(fam, out_dir, fam.spec.model, init_name=names[0], members=unique)
+    man = write(fam, out_dir, fam.spec.model, init_name=names[0], members=dict(zip(names, models)))
     if choices:
         man = {**man, "terms_chosen": [vars(c) for c in choices]}
     return man
 
 
-__all__ = ["check_terms", "generate_family", "MIN_TERMS", "train_model", "load_member", "read_csvs", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]
+def member_names(sources) -> list[str]:
+    """Each member's name as flann calibrate names the sensor (the file's stem, made safe for a
+    file name); a model calibrate wrote by its sensor's folder; members of one name told apart
+    by their place."""
+    paths = [Path(p) for p in sources]
+    names = [safe_name(p.parent.name if p.name == MODEL_FILE and p.parent.name else p.stem) for p in paths]
+    if len(set(names)) < len(names):
+        names = [f"{k + 1}_{n}" for k, n in enumerate(names)]
+    return names
+
+
+__all__ = ["check_terms", "member_names", "generate_family", "MIN_TERMS", "train_model", "load_member", "read_csvs", "DEFAULT_TERMS", "FIXED_TERMS", "NORMALISATION"]

@@ -25,7 +25,9 @@ from .render import image_text
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
-IMAGE_FILE = "weights.hex"   # flann calibrate's name for every sensor's image, in its own folder
+# flann calibrate's names for every sensor's image and model, in the sensor's own folder
+IMAGE_FILE = "weights.hex"
+MODEL_FILE = "model.json"
 MEM_DIGITS = HALF_BITS // 4
 
 
@@ -106,4 +108,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["IMAGE_FILE", "hex_text", "header_fields", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["IMAGE_FILE", "MODEL_FILE", "hex_text", "header_fields", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]

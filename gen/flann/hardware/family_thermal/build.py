@@ -18,7 +18,7 @@ from ...golden.model import text_sha256
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
 from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
-from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, check_terms, read_csvs
+from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, check_terms, member_names, read_csvs
 from ..family.spec import DEFAULT_MARGIN
 from ..options import default
 from .render import write
@@ -171,7 +171,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     if bad:
         raise FlannError(f"{len(bad)} of {len(sources)} family members cannot be used (nothing written): "
                          + "; ".join(bad))
-    names = [Path(p).stem for p in sources]
+    names = member_names(sources)
     models = [m for m, _ in loaded]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -180,8 +180,6 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
         except SpecError as exc:
             raise FlannError(f"--family: {exc}") from None
     unique = dict(zip(names, models))
-    if len(unique) < len(names):
-        unique = {f"{k + 1}_{n}": m for k, (n, m) in enumerate(zip(names, models))}
     init_text = loaded[0][1]
     sha = text_sha256(init_text)
     man = write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
