@@ -141,6 +141,7 @@ class ThermalCv:
     sq_errors: np.ndarray       # held-out squared error of every judged point, fixed order
     max_coefficient: float      # largest |coefficient| fitted on all the judged points
     weight_sum: float           # sum of |coefficient| fitted on all the judged points
+    at_positions: int = 0       # how many of sq_errors (the first) are the position folds'
 
     @property
     def mse(self) -> float:
@@ -153,6 +154,13 @@ class ThermalCv:
     @property
     def max_mm(self) -> float:
         return float(np.sqrt(np.max(self.sq_errors)))
+
+    @property
+    def position_rms_mm(self) -> float:
+        """Held-out RMS over the position folds alone: how well the terms follow the curve at
+        the calibrated temperatures (a held-out temperature's error is the temperature
+        orders', much the same at any term count)."""
+        return float(np.sqrt(np.mean(self.sq_errors[:self.at_positions]))) if self.at_positions else self.rms_mm
 
     @property
     def coefficients(self) -> int:
@@ -210,6 +218,7 @@ def _cv(x, folds: _Folds, inputs: _Inputs, terms, norm, ridge) -> ThermalCv:
         train[held] = False
         coef = solve_lstsq(full[train], x[train], ridge)
         errs.append((full[held] @ coef - x[held]) ** 2)
+    at_positions = sum(e.size for e in errs)
     usable = terms[:folds.n_temperatures - 1]   # orders the remaining temperatures determine
     for held, v_fold in zip(folds.temperature, inputs.v_n_without):
         part = thermal_design(v_fold, t_n, usable)
@@ -219,7 +228,7 @@ def _cv(x, folds: _Folds, inputs: _Inputs, terms, norm, ridge) -> ThermalCv:
         errs.append((part[held] @ coef - x[held]) ** 2)
     coef = solve_lstsq(full, x, ridge)
     return ThermalCv(tuple(terms), norm, ridge, np.concatenate(errs), float(np.max(np.abs(coef))),
-                     float(np.sum(np.abs(coef))))
+                     float(np.sum(np.abs(coef))), at_positions)
 
 
 def _paired_se(r: ThermalCv, ref: ThermalCv) -> float:
