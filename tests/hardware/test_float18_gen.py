@@ -72,6 +72,12 @@ def test_fixed_only_option_is_an_error_and_writes_nothing(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+def test_a_wider_converter_is_told_how_to_feed_its_top_12_bits(tmp_path):
+    with pytest.raises(SpecError, match=r"top 12 bits \(--input-bits 12 --input-lsb-v 0\.004\)"):
+        run_gen(_args(DEFAULT, "-o", tmp_path / "x", "--input-bits", "14", "--input-lsb-v", "0.001"))
+    assert not (tmp_path / "x").exists()
+
+
 def test_flann_gen_format_float18_cli(tmp_path, capsys):
     from flann.cli import main
 

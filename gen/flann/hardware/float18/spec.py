@@ -146,8 +146,11 @@ def derive_f18_spec(model: FlannModel, **options) -> F18Spec:
     fmt = FLOAT18
     Tf = front.term_fmt.frac_bits
     if front.input_bits > fmt.sig_bits:
+        drop = front.input_bits - fmt.sig_bits
         raise SpecError(f"input_bits = {front.input_bits}: float18 holds input codes exactly only up to "
-                        f"{fmt.sig_bits} bits")
+                        f"{fmt.sig_bits} bits: feed it the converter's top {fmt.sig_bits} bits (--input-bits "
+                        f"{fmt.sig_bits} --input-lsb-v {front.input_lsb_v * 2 ** drop:.6g}) or generate the "
+                        "fixed-point design")
     if front.term_fmt.width < front.input_bits:
         raise SpecError(f"term width {front.term_fmt.width} < input_bits {front.input_bits}: the code "
                         "cannot share the term converter")
