@@ -170,11 +170,12 @@ def yosys_script(verilog: str, top: str, abc: str = "full", stat: str = "stat.js
     # the netlist the counts describe, flattened, for post-synthesis simulation (flann.verify.
     # netlist): its vectors split into one net per bit, since a vector feeding back into itself
     # through cells (a carry chain) is a loop to Verilator, which then mis-simulated a thermal
-    # design's clamp (563 of 8192 samples; Icarus and the split netlist agree with the twin)
+    # design's clamp (563 of 8192 samples; Icarus and the split netlist agree with the twin);
+    # wires nothing reads go first (a constant table's, split, is a line Verilator refuses)
     tail = ["check -assert", f"tee -q -o {stat} stat -json",
             # flattening and dropping the cell library change nothing counted above
             "flatten", "delete =A:blackbox", f"write_json {MAPPED_JSON}",
-            "splitnets", f"write_verilog -noattr {NETLIST}"]
+            "opt_clean -purge", "splitnets", f"write_verilog -noattr {NETLIST}"]
     if abc == "full":
         return "; ".join(head + [f"synth_xilinx -family {FAMILY} -top {top} -run map_memory:"] + tail)
     return "; ".join(head + [

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from flann.cli import main
 pytestmark = [pytest.mark.synth,
               pytest.mark.skipif(not all(shutil.which(t) for t in ("ghdl", "yosys", "verilator")),
                                  reason="ghdl, yosys and verilator are required")]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _recording(path):
@@ -49,3 +51,16 @@ def test_thermal_clamp_netlist_is_checked_as_it_is(tmp_path, capsys):
     assert main(["synth", str(design), "--json", "--no-lint"]) == 0, capsys.readouterr().err
     rep = json.loads(capsys.readouterr().out)
     assert rep["netlist_check"]["mismatches"] == 0 and rep["netlist_check"]["codes"] == 256 * 32
+
+
+def test_a_large_table_netlist_compiles(tmp_path, capsys):
+    # split into bits, the 1024-word sine table's constant wire was one assignment of 14,336
+    # nets on one line, more than Verilator's preprocessor takes (40,000 tokens): unused after
+    # mapping, it is dropped before the split
+    design = tmp_path / "t10"
+    assert main(["gen", str(ROOT / "data" / "default_model.json"), "-o", str(design), "--input-bits", "8",
+                 "--table-addr-bits", "10"]) == 0
+    capsys.readouterr()
+    assert main(["synth", str(design), "--json", "--no-lint", "--abc", "fast"]) == 0, capsys.readouterr().err
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["netlist_check"]["mismatches"] == 0 and rep["netlist_check"]["codes"] == 256
