@@ -86,13 +86,8 @@ def _one_pool(fn, pending, end, jobs, on_result, on_lost, stop) -> bool:
             while running:
                 done, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
                 for fut in done:
-                    item = running.pop(fut)
-                    try:
-                        res = fut.result()
-                    except BrokenProcessPool:
-                        running[fut] = item
-                        raise
-                    on_result(item, res)
+                    res = fut.result()   # a broken pool raises here, the item still in running
+                    on_result(running.pop(fut), res)
                 fill()
         except BrokenProcessPool:
             for item in running.values():

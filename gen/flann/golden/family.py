@@ -132,21 +132,21 @@ def family_thermal_terms(members, *, orders: int, temperature_norm: tuple[float,
         choice, _best, _good = thermal_train.select_thermal(run.results, x)
         # compared over the position folds: with three temperatures the held-out middle one's
         # error (the temperature orders') swamped the terms', and 19 terms passed for 41
-        own.append((name, v, t, x, choice, choice.position_rms_mm))
+        own.append((name, v, t, x, choice))
         table.append({r.terms[0]: r.position_rms_mm for r in run.results if r.ridge == ridge})
-    top = max(c.terms[0] for *_m, c, _rms in own)
+    top = max(c.terms[0] for *_m, c in own)
     tried = [n for n in THERMAL_TERMS if n <= top and all(n in held for held in table)]
     if not tried:
         raise FlannError("--terms auto: the members' recordings are too few points for a common term count")
 
     def steady(n):
         fits = [thermal_train.fit_thermal(v, t, x, (n,) * orders, norm=norm, ridge=ridge, correct_input=False,
-                                          temperature_norm=temperature_norm) for _n, v, t, x, _c, _r in own]
+                                          temperature_norm=temperature_norm) for _n, v, t, x, _c in own]
         return all(_steady([(m.bias[j], m.weights[j]) for m in fits], margin) for j in range(orders))
 
-    terms = shared_terms(tried, table, [rms for *_m, rms in own], steady)
-    out = [MemberChoice(name, c.terms[0], c.ridge, rms, None, held[terms])
-           for (name, _v, _t, _x, c, rms), held in zip(own, table)]
+    terms = shared_terms(tried, table, [c.position_rms_mm for *_m, c in own], steady)
+    out = [MemberChoice(name, c.terms[0], c.ridge, c.position_rms_mm, None, held[terms])
+           for (name, _v, _t, _x, c), held in zip(own, table)]
     return terms, out
 
 

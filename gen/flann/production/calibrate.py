@@ -485,20 +485,25 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     results: dict[int, Result] = {}
     seen: dict[str, int] = {}
     todo = []
+
+    def refused(path, why: str) -> Result:
+        """A rejected row with the reason and no certificate: the batch goes on."""
+        res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
+        res.fail(why)
+        res.verdict = rejected(spec, res.reason)
+        return res
+
     for i, p in enumerate(paths):
         name = sensor_name(p)
         # these cannot have a folder of their own (it is the summary's name, or the folder of
-        # an earlier recording, also on a file system that ignores case): a rejected row with
-        # the reason and no certificate; the batch goes on
+        # an earlier recording, also on a file system that ignores case)
         clash = (f"sensor name {name!r} is the batch summary's file name; rename the recording"
                  if name.casefold() == SUMMARY else
                  f"sensor name {name!r} already used by {paths[seen[name.casefold()]]} (one folder "
                  "per name, letter case ignored); rename this recording"
                  if name.casefold() in seen else "")
         if clash:
-            results[i] = Result(sensor=name, recording=str(p), design_sha256=dhash)
-            results[i].fail(clash)
-            results[i].verdict = rejected(spec, results[i].reason)
+            results[i] = refused(p, clash)
         else:
             seen[name.casefold()] = i
             todo.append(i)
@@ -515,16 +520,11 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if progress:
             _progress(len(results), len(paths), failed, t0)
 
-    def lost(item, why: str) -> None:
-        res = Result(sensor=sensor_name(item[1]), recording=str(item[1]), design_sha256=dhash)
-        res.fail(why)
-        res.verdict = rejected(spec, res.reason)
-        record(item, res)
-
     one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
-    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record, lost)
+    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record,
+                           lambda item, why: record(item, refused(item[1], why)))
     if progress:
         sys.stderr.write("\n")
     for i in todo:

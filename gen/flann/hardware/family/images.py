@@ -25,10 +25,10 @@ from .render import image_text
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
 
 HEX_DIGITS = DATA_BITS // 4
+MEM_DIGITS = HALF_BITS // 4
 # flann calibrate's names for every sensor's image and model, in the sensor's own folder
 IMAGE_FILE = "weights.hex"
 MODEL_FILE = "model.json"
-MEM_DIGITS = HALF_BITS // 4
 
 
 def hex_text(words, header: list[str] = ()) -> str:

@@ -179,10 +179,9 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
             spec = derive_family_thermal(models, temp, names=names, margin=margin, **options)
         except SpecError as exc:
             raise FlannError(f"--family: {exc}") from None
-    unique = dict(zip(names, models))
     init_text = loaded[0][1]
     sha = text_sha256(init_text)
-    man = write(spec, out_dir, init_text, sha, init_name=names[0], members=unique)
+    man = write(spec, out_dir, init_text, sha, init_name=names[0], members=dict(zip(names, models)))
     if choices:
         man = {**man, "terms_chosen": [vars(c) for _p, c in choices]}
     return man
