@@ -18,6 +18,7 @@ from flann.hardware.fixed.render import ENTITIES
 from flann.hardware.registry import DATAPATHS, read_design
 from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.datapaths import simulate
+from flann.verify.shards import cores
 from flann.verify.temperatures import THERMAL_MAX_SAMPLES, thermal_temperature_codes
 from flann.verify.design import from_directory
 
@@ -225,3 +226,30 @@ def test_synth_reads_a_two_level_hierarchy_stat():
     text = ('{\n   "modules": {\n   },\n       flann_t0_adder                1\n       flann_t1_seq   1\n'
             '      "design": {\n         "num_cells_by_type": {\n            "LUT4": 12\n         }\n      }\n}\n')
     assert json.loads(_stat_json(text))["design"]["num_cells_by_type"] == {"LUT4": 12}
+
+
+@pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
+def test_the_sweep_runs_in_shards_of_temperature_codes_and_a_fault_in_one_fails_the_whole(design, tmp_path):
+    """Every (voltage, temperature) code through shards of whole temperature codes, one per core,
+    progress to the last sample; then the same design with its upper temperature clamp one code
+    low: only the last shard's codes differ from the twin, and the joined result fails."""
+    seen = []
+    out = simulate(from_directory(design["dir"]), tmp_path / "b",
+                   progress=lambda label: (lambda done, total, secs: seen.append((label, done, total))))
+    s = out["summary"]
+    assert s["all_passed"] and s["mismatches"] == 0 and s["codes_tested"] == 256 * 32, s
+    assert s["sweep"]["shards"] == min(cores(), 32)
+    assert seen[-1] == ("sweep", 256 * 32, 256 * 32)
+    assert out["curve"] is not None
+    bad = tmp_path / "bad"
+    shutil.copytree(design["dir"], bad)
+    top = bad / "flann_thermal_top.vhd"
+    hi = from_directory(design["dir"]).spec.temp_code_max
+    text = top.read_text()
+    line = next(ln for ln in text.splitlines() if "constant temp_hi_c" in ln)
+    assert line.endswith('"01101";')                          # 13, the fixture's upper clamp code
+    top.write_text(text.replace(line, line.replace('"01101"', '"01100"')))
+    s = simulate(from_directory(bad), tmp_path / "b2")["summary"]
+    assert not s["all_passed"] and s["codes_tested"] == 256 * 32
+    assert 0 < s["mismatches"] <= 256 * (hi - 12), s

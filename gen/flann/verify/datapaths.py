@@ -23,7 +23,7 @@ from .benches import BENCH_DIR
 from .images import checked_image, kept_images
 from .netlist import netlist_summary, require_sweep_driver
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
-from .runner import ghdl_backend, run_cocotb, run_family_bench, simulate as simulate_fixed, throughput
+from .runner import ghdl_backend, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
 
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
@@ -110,7 +110,7 @@ def _fixed(design: Design, build_dir, *, seed=1, engine="auto", progress=None, *
     return simulate_fixed(design, build_dir, seed=seed, engine=engine, progress=progress)
 
 
-def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
+def _thermal(design: Design, build_dir, *, seed=1, codes=None, progress=None, **_) -> dict:
     """``codes``: (lo, hi), a narrower voltage code range than every code (tests of wide inputs)."""
     spec, man = design.spec, design.manifest
     temps, every = thermal_temperature_codes(spec)
@@ -118,18 +118,17 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     build_dir = Path(build_dir).resolve()
     samples = len(temps) * (code_hi - code_lo + 1)
     backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
-    work = build_dir / "thermal_sweep"
-    temps_file, out_file = build_dir / "thermal_temps.txt", build_dir / "thermal_sweep.txt"
+    out_file = build_dir / "thermal_sweep.txt"
     build_dir.mkdir(parents=True, exist_ok=True)
-    temps_file.write_text("".join(f"{t}\n" for t in temps))
-    sweep = {"file": str(out_file), "code_lo": code_lo, "code_hi": code_hi, "temps": temps}
+    sweep = {"file": str(out_file), "code_lo": code_lo, "code_hi": code_hi}
     params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
-              "code_lo_g": code_lo, "code_hi_g": code_hi, "temps_file_g": str(temps_file),
-              "out_file_g": str(out_file)}
+              "code_lo_g": code_lo, "code_hi_g": code_hi}
     # the one sweep harness, with a temperature loop for a two-input design
-    res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
-                     "test_thermal_sweep", work, {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
-                     name="thermal_sweep", parameters=params, seed=seed, backend=backend)
+    res = sweep_temperatures([*design.files, BENCH_DIR / "flann_sweep.vhd"], "test_thermal_sweep",
+                             build_dir / "thermal_sweep", {"model": str(design.model), "manifest": dict(man),
+                                                           "sweep": sweep},
+                             params, temps, name="thermal_sweep", seed=seed, backend=backend,
+                             progress=progress("sweep") if progress else None)
     rec = res.records.get("thermal_sweep", {})
     benches = {"thermal_sweep": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
                                  "seconds": round(res.seconds, 1)}}
@@ -140,7 +139,7 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     s["temperature_codes"] = "every" if every else temps
     s["temperature_codes_tested"] = len(temps)
     s["voltage_codes_tested"] = code_hi - code_lo + 1
-    s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
+    s["sweep"] = _sweep_about(backend, res, samples=samples)
     curve = None
     got = _sweep_rows(out_file, len(temps) * (code_hi - code_lo + 1))
     if got is not None:
@@ -155,6 +154,13 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, **_) -> dict:
     return {"summary": s, "curve": curve, "spec": spec}
 
 
+def _sweep_about(backend: str, *runs, samples: int) -> dict:
+    """The summary's ``sweep`` entry of two-input sweeps (one run per image, each of ``samples``)."""
+    secs = sum(r.seconds for r in runs)
+    return {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": max(r.shards for r in runs),
+            "seconds": round(secs, 1), "codes_per_s": round(samples * len(runs) / secs, 1) if secs > 0 else None}
+
+
 def _sweep_rows(path: Path, samples: int):
     """A two-input sweep's output file as (voltage codes, temperature codes, out, sat), or None
     when the harness did not write every sample (the bench has failed and says why)."""
@@ -166,7 +172,7 @@ def _sweep_rows(path: Path, samples: int):
     return rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3].astype(bool)
 
 
-def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
+def _family_thermal(design: Design, build_dir, *, seed=1, images=None, progress=None, **_) -> dict:
     """Each sensor's image given (--image), else the design's last member (not the memories'
     initial sensor, so the cfg port is what loads it), at every voltage code and the stated
     temperature codes: one run of the sweep harness per image."""
@@ -180,24 +186,22 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     samples = len(temps) * (spec.code_max - spec.code_min + 1)
     backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
     build_dir.mkdir(parents=True, exist_ok=True)
-    temps_file = build_dir / "family_thermal_temps.txt"
-    temps_file.write_text("".join(f"{t}\n" for t in temps))
     bench = {"tests": 0, "failures": 0, "failed": [], "seconds": 0.0}
-    total, mismatches, ok, per_image, groups = 0, 0, True, {}, []
+    total, mismatches, ok, per_image, groups, runs = 0, 0, True, {}, [], []
     for k, (image, words) in enumerate(loaded):
         tag = f"family_thermal_sweep_{k}" if len(loaded) > 1 else "family_thermal_sweep"
         out_file, image_file = build_dir / f"{tag}.txt", build_dir / f"{tag}_image.txt"
         image_file.write_text("".join(f"{a} {w >> 16} {w & 0xFFFF}\n" for a, w in enumerate(words)))
-        sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "temps": temps,
-                 "words": words}
+        sweep = {"file": str(out_file), "code_lo": spec.code_min, "code_hi": spec.code_max, "words": words}
         params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
                   "addr_bits_g": spec.cfg_addr_bits, "code_lo_g": spec.code_min, "code_hi_g": spec.code_max,
-                  "image_file_g": str(image_file), "temps_file_g": str(temps_file), "out_file_g": str(out_file)}
+                  "image_file_g": str(image_file)}
         # the one sweep harness, its image loaded through the cfg port first
-        res = run_cocotb([*design.files, BENCH_DIR / "flann_sweep.vhd"], "flann_sweep",
-                         "test_family_thermal_sweep", build_dir / tag,
-                         {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
-                         name="family_thermal_sweep", parameters=params, seed=seed, backend=backend)
+        res = sweep_temperatures([*design.files, BENCH_DIR / "flann_sweep.vhd"], "test_family_thermal_sweep",
+                                 build_dir / tag, {"model": str(design.model), "manifest": dict(man), "sweep": sweep},
+                                 params, temps, name="family_thermal_sweep", seed=seed, backend=backend,
+                                 progress=progress(image["name"]) if progress else None)
+        runs.append(res)
         rec = res.records.get("family_thermal_sweep", {})
         bench["tests"] += res.tests
         bench["failures"] += res.failures
@@ -219,7 +223,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, **_) -> d
     s["temperature_codes"] = temps
     s["temperature_codes_tested"] = len(temps)
     s["voltage_codes_tested"] = spec.code_max - spec.code_min + 1
-    s["sweep"] = {"engine": "ghdl", "backend": f"ghdl-{backend}", "shards": 1, "codes_per_s": None}
+    s["sweep"] = _sweep_about(backend, *runs, samples=samples)
     curve = plots.two_input(groups, temps, spec.temp_lsb_c, ref=plots.TWIN, simulator=f"GHDL, {backend}",
                             calibrated=(spec.temp_lo, spec.temp_hi)) if groups else None
     return {"summary": s, "curve": curve, "spec": spec}

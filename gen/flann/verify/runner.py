@@ -79,6 +79,7 @@ class BenchResult:
     records: dict = field(default_factory=dict)
     failed_tests: list = field(default_factory=list)
     test_seconds: dict = field(default_factory=dict)  # cocotb's wall time per test (results.xml)
+    shards: int = 1  # simulations run side by side
 
     @property
     def ok(self) -> bool:
@@ -224,7 +225,8 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
     ``codes``: None = every input code; (lo, hi) = that range; a list or array = those codes
     (handed to the harness in a file).  Returns {"bench": BenchResult, "codes", "data", "sat",
     "latency" (arrays in the order simulated), "backend", "shards", "seconds", "build_seconds"}.
-    ``progress(done, total, elapsed_s)`` is called about twice a second while the shards run.
+    ``progress(done, total, elapsed_s)`` is called about twice a second while the shards run, and
+    once when they have.
     """
     man = design.manifest
     half = 1 << (man["input_bits"] - 1)
@@ -257,33 +259,88 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
         s.update(name=f"sweep_{k}", file=str(build_dir / f"sweep_{k}.txt"))
         (build_dir / f"bench_config_{k}.json").write_text(
             json.dumps({**_bench_config(design), "records_dir": str(records), "shard": s}))
-    results: list = [None] * len(shard_cfg)
+    def params(s: dict) -> dict:
+        p = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2,
+             "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
+        return {**p, "codes_file_g": s["codes_file"]} if "codes_file" in s else p
 
-    def one(k: int) -> None:
-        s = shard_cfg[k]
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2,
-                  "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
-        if "codes_file" in s:
-            params["codes_file_g"] = s["codes_file"]
-        results[k] = _test(build_dir, "flann_sweep", "test_sweep", backend, build_dir / f"bench_config_{k}.json",
-                           str(k), params, [], None, 1)
-
-    threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(shard_cfg))]
-    t1 = time.monotonic()
-    for t in threads:
-        t.start()
     files = [Path(s["file"]) for s in shard_cfg]
-    while any(t.is_alive() for t in threads):
-        for t in threads:
-            t.join(0.5)
-            break
-        if progress:
-            progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    t1 = time.monotonic()
+    results = _run_shards(build_dir, "test_sweep", backend,
+                          [(build_dir / f"bench_config_{k}.json", params(s)) for k, s in enumerate(shard_cfg)],
+                          1, files, total, progress)
     seconds = time.monotonic() - t1
-    bench = _result("sweep", [r for r in results if r is not None], records, time.monotonic() - t0)
+    bench = _result("sweep", results, records, time.monotonic() - t0)
     got = merge([read_results(f) for f in files])
     return {"bench": bench, **got, "backend": backend, "shards": len(shard_cfg), "seconds": seconds,
             "build_seconds": t_build}
+
+
+def _run_shards(build_dir: Path, module: str, backend: str, shards: list[tuple[Path, dict]], seed: int,
+                files: list[Path], total: int, progress) -> list[Path]:
+    """The built sweep harness run once per shard ((bench configuration, generics) each), side by
+    side; ``progress(done, total, elapsed_s)`` about twice a second from the lines in ``files``.
+    Returns the shards' results files."""
+    results: list = [None] * len(shards)
+
+    def one(k: int) -> None:
+        results[k] = _test(build_dir, "flann_sweep", module, backend, shards[k][0], str(k), shards[k][1], [], None,
+                           seed)
+
+    threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(shards))]
+    t1 = time.monotonic()
+    for t in threads:
+        t.start()
+    while any(t.is_alive() for t in threads):
+        next(t for t in threads if t.is_alive()).join(0.5)
+        if progress:
+            progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    if progress:  # the last figure, whatever the timing: a terminal's line ends at done
+        progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    return [r for r in results if r is not None]
+
+
+def sweep_temperatures(sources, module: str, build_dir, config: dict, parameters: dict, temps, *, name: str,
+                       seed: int = 1, backend: str | None = None, progress=None) -> BenchResult:
+    """A two-input design's sweep harness (every voltage code of ``config["sweep"]`` at each code of
+    ``temps``) in shards of whole temperature codes, one per core, built once; the shards' lines
+    joined in order into ``config["sweep"]["file"]``, their records ``name`` into one (samples and
+    mismatches summed, the largest ``max_err_lsb``, every latency seen).  A shard without its
+    record leaves the result without one: the bench has failed and its log says why."""
+    build_dir = Path(build_dir).resolve()
+    if build_dir.exists():
+        shutil.rmtree(build_dir)
+    t0 = time.monotonic()
+    backend = build(sources, "flann_sweep", build_dir, backend)
+    sweep_cfg = config["sweep"]
+    chunks = [c for c in np.array_split(np.asarray(temps, dtype=np.int64), min(cores(), len(temps))) if c.size]
+    shards, files = [], []
+    for k, chunk in enumerate(chunks):
+        temps_file, out_file = build_dir / f"temps_{k}.txt", build_dir / f"sweep_{k}.txt"
+        temps_file.write_text("".join(f"{int(t)}\n" for t in chunk))
+        cfg = {**config, "seed": seed, "records_dir": str(build_dir / f"records_{k}"),
+               "sweep": {**sweep_cfg, "file": str(out_file), "temps": [int(t) for t in chunk]}}
+        cfg_path = build_dir / f"bench_config_{k}.json"
+        cfg_path.write_text(json.dumps(cfg))
+        shards.append((cfg_path, {**parameters, "temps_file_g": str(temps_file), "out_file_g": str(out_file)}))
+        files.append(out_file)
+    total = len(temps) * (sweep_cfg["code_hi"] - sweep_cfg["code_lo"] + 1)
+    results = _run_shards(build_dir, module, backend, shards, seed, files, total, progress)
+    with open(sweep_cfg["file"], "wb") as joined:
+        for f in files:
+            if f.is_file():
+                joined.write(f.read_bytes())
+    parts = [_result(name, [r], build_dir / f"records_{k}", 0.0) for k, r in enumerate(results)]
+    res = BenchResult(name, sum(p.tests for p in parts), sum(p.failures for p in parts),
+                      time.monotonic() - t0, {}, [t for p in parts for t in p.failed_tests], shards=len(chunks))
+    recs = [p.records.get(name) for p in parts]
+    if len(recs) == len(chunks) and all(recs):
+        merged = {"samples": sum(r["samples"] for r in recs), "mismatches": sum(r["mismatches"] for r in recs),
+                  "latency": sorted({lat for r in recs for lat in r["latency"]})}
+        if all("max_err_lsb" in r for r in recs):
+            merged["max_err_lsb"] = max(r["max_err_lsb"] for r in recs)
+        res.records[name] = merged
+    return res
 
 
 ENGINES = ("auto", "ghdl", "verilator")
@@ -395,5 +452,5 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
-__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "simulate", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "simulate", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]
