@@ -13,7 +13,8 @@ from ..argtypes import bounded, checked, terms_or_auto
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
 from ..golden.model import MAX_TERMS
-from ..golden.forward import MAX_OUTLIER_SHARE, OUTLIER_K, OutlierShareError, screen_outliers, screens
+from ..golden.forward import screens
+from ..golden.screen import screen_recording
 from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
@@ -79,33 +80,6 @@ def converter(args, rec) -> dict | None:
             "from": "the recording's converter grid"}
 
 
-def _screen(rec, step_v: float) -> tuple[object, dict, str]:
-    """Gross outliers left out (one warning line), or refused above the stated share."""
-    try:
-        sc = screen_outliers(rec.displacement_mm, rec.voltage_v, rec.direction, step_v)
-    except OutlierShareError as exc:
-        raise FlannError(
-            f"{rec.source}: {exc.n_out} of {exc.n} readings are more than {OUTLIER_K:g} noise units "
-            f"from the smooth fit of the others (more than {100 * MAX_OUTLIER_SHARE:g} % are refused): "
-            f"worst {rec.line_of(exc.row)}, {exc.units:.3g} noise units (noise {exc.sigma:.3g} V); "
-            "not isolated glitches: look at the recording (flann diagnose)") from None
-    if sc is None:   # too few or too many positions to judge outliers: every reading is used
-        return rec, {"positions_used": int(np.unique(rec.displacement_mm).size), "readings_used": len(rec),
-                     "outliers_checked": False}, ""
-    record = {"positions_used": sc.positions, "readings_used": int(sc.keep.sum()),
-              "noise_v": float(f"{sc.noise_v:.4g}"), "noise_from": sc.noise_from}
-    said = ""
-    if sc.outliers:
-        record["outliers_left_out"] = [{"line": rec.line_of(i), "noise_units": round(u, 1)}
-                                       for i, u in sc.outliers]
-        listed = ", ".join(f"{rec.line_of(i)} ({u:.3g} noise units)" for i, u in sc.outliers[:5])
-        more = f" and {len(sc.outliers) - 5} more" if len(sc.outliers) > 5 else ""
-        said = (f"{rec.source}: left out {len(sc.outliers)} gross outlier reading(s) of {len(rec)}: "
-                f"{listed}{more} (noise {sc.noise_v:.3g} V, {sc.noise_from})")
-        rec = rec.subset(sc.keep)
-    return rec, record, said
-
-
 def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
     """'; held-out ...' from the same cross-validation as auto (printed, not stored)."""
     if explicit is not None or len(rec) < 4:
@@ -148,7 +122,7 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)
     _stage(f"{len(rec)} readings at {positions} positions: screening for gross outliers")
-    rec, record, outlier_text = _screen(rec, step_v)
+    rec, record, outlier_text = screen_recording(rec, step_v)
     if outlier_text:
         warnings.warn(outlier_text)
         # a glitch is on no converter's grid: the grid is the readings' without it

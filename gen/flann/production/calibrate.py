@@ -55,10 +55,11 @@ from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.family.build import RIDGE, train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
-from ..hardware.family.spec import FamilySpec, FitError, member_spec
+from ..hardware.family.spec import FamilySpec, FitError, member_spec, outside_input
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..physics.sensor import load_sensor
 from ..pool import run_batch
+from ..golden.screen import ready_for_fit
 from ..recordings import Recordings, read_recordings
 from ..hardware.family import images
 from .certificate import render_certificate, render_certificate_thermal, render_rejection
@@ -278,6 +279,12 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             rec = seen["rec"] = read_recordings(path)
+            why = outside_input(fam, rec.voltage_v)
+            if why:   # before the screen: readings beyond the converter are not glitches
+                raise FitError(why)
+            rec, said = ready_for_fit(rec)
+            if said:   # the glitch is the reading's, not the sensor's: neither fitted nor judged
+                warnings.warn(said)
             chk = check_sensor(rec, fam)
         res.warnings += [str(w.message) for w in caught]
         res.twin_vs_float_lsb = chk["twin_err_lsb"]
@@ -366,7 +373,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
                           extra: dict) -> None:
     """A passed sensor: its two-input model, its image (every order's memory in turn) and the
     certificate; a failed one: only the certificate."""
-    model_json, mhash = chk["model"].to_json(), res.model_sha256
+    model_json, mhash = chk["model"].to_json(), _kept_model_sha(res)
     head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.image_words,
                                     f"address 0 first: order j's memory at j x {fam.fam.mem_depth} (cfg_addr)")
     html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
@@ -405,6 +412,14 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
         res.warnings.append(f"no certificate written: {exc}")
 
 
+def _kept_model_sha(res: Result) -> str:
+    """The model's sha256 where its model.json is kept (a passed sensor); a failed sensor's
+    row and certificate name none, as they hold no model."""
+    if not res.verdict.passed:
+        res.model_sha256 = ""
+    return res.model_sha256
+
+
 def _is_sensor_output(directory: Path) -> bool:
     return (directory / "certificate.html").is_file()
 
@@ -414,7 +429,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     """A passed sensor: its model, weight images and certificate; a failed one: only the
     certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
-    model_json, mhash = model.to_json(), res.model_sha256
+    model_json, mhash = model.to_json(), _kept_model_sha(res)
     head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.mem_depth)
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:

@@ -6,11 +6,14 @@ flow, also used by ``flann calibrate``); a model.json is used as it is.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 from ...errors import FlannError
 from ...golden.model import MAX_TERMS, FlannModel, load_model
 from ...golden.family import family_terms
+from ...golden.forward import screens
+from ...golden.screen import ready_for_fit
 from ...golden.train import fit_lstsq
 from ..fixed.cost import fixed_point_cost
 from ..options import default
@@ -28,8 +31,9 @@ RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in a
 
 
 def train_model(rec, terms: int = FIXED_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
-    """Least-squares FLANN of ``terms`` terms on validated recordings."""
-    rec = prepare_for_fit(rec, can_trim=False)
+    """Least-squares FLANN of ``terms`` terms on recordings ready for the fit
+    (:func:`flann.golden.screen.ready_for_fit`: a glitch among repeats is the screen's)."""
+    rec = prepare_for_fit(rec, can_trim=False, lone_glitches=screens(rec.displacement_mm))
     info = {"data_file": Path(rec.source).name, "data_sha256": rec.sha256, **(training or {})}
     return fit_lstsq(rec.voltage_v, rec.displacement_mm, terms, norm=NORMALISATION, ridge=ridge, training=info)
 
@@ -47,18 +51,31 @@ def read_csvs(sources) -> dict:
     return out
 
 
-def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, read: dict | None = None):
-    """(terms, per-member choices) for the recordings among ``sources`` (``read``: their
-    :func:`read_csvs`), chosen like ``flann train --terms auto`` at the design's converter
+def ready_members(sources, read: dict) -> dict:
+    """{place in ``sources``: the recordings ready for a fit} of the CSVs in ``read`` (their
+    :func:`read_csvs`): validated and gross outliers left out, each with one warning line
+    (:func:`flann.golden.screen.ready_for_fit`); one that is not ready is left out here and
+    reported with every other bad member when the members are loaded."""
+    out = {}
+    for k, raw in read.items():
+        try:
+            rec, said = ready_for_fit(raw)
+        except FlannError:
+            continue
+        if said:
+            warnings.warn(said, stacklevel=2)
+        out[k] = rec
+    return out
+
+
+def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, ready: dict | None = None):
+    """(terms, per-member choices) for the recordings among ``sources`` (``ready``: their
+    :func:`ready_members`), chosen like ``flann train --terms auto`` at the design's converter
     (:func:`flann.golden.family.family_terms`); (None, []) when every member is a model.json
     (their terms are used as they are)."""
-    members = []
-    for k, raw in (read_csvs(sources) if read is None else read).items():
-        try:
-            rec = prepare_for_fit(raw, can_trim=False)
-        except FlannError:
-            continue   # reported with every other bad member when the members are loaded
-        members.append((Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm))
+    if ready is None:
+        ready = ready_members(sources, read_csvs(sources))
+    members = [(Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm) for k, rec in ready.items()]
     if not members:
         return None, []
     adc = (options.get("input_bits", default("input_bits")), options.get("input_lsb_v"))
@@ -67,13 +84,13 @@ def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, read: dic
 
 
 def load_member(path, terms: int = FIXED_TERMS, rec=None) -> FlannModel:
-    """A model.json as it is, or a recordings CSV (``rec``: already read) trained with
-    ``terms`` terms."""
+    """A model.json as it is, or a recordings CSV (``rec``: already ready for the fit,
+    :func:`ready_members`) trained with ``terms`` terms."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         return load_model(path)
     if path.suffix.lower() == ".csv":
-        return train_model(read_recordings(path) if rec is None else rec, terms)
+        return train_model(ready_for_fit(read_recordings(path))[0] if rec is None else rec, terms)
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
 
@@ -88,15 +105,15 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    choices, read = [], read_csvs(sources)
+    choices, ready = [], ready_members(sources, read_csvs(sources))
     if terms == "auto":
-        terms, choices = auto_terms(sources, options, margin, read)
+        terms, choices = auto_terms(sources, options, margin, ready)
         terms = FIXED_TERMS if terms is None else max(MIN_TERMS, terms)
     check_terms(terms)
     models, bad = [], []
     for k, p in enumerate(sources):   # every member is tried: the user learns of all bad files at once
         try:
-            models.append(load_member(p, terms, read.get(k)))
+            models.append(load_member(p, terms, ready.get(k)))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:

@@ -56,6 +56,8 @@ def bram_image(words) -> list[int]:
     mask = (1 << HALF_BITS) - 1
     return [h for w in words for h in (int(w) & mask, (int(w) >> HALF_BITS) & mask)]
 DEFAULT_MARGIN = 0.5
+# readings at one extreme value, this many or more, are a clipped output, not a sensor's end
+CLIPPED_READINGS = 3
 # a later sensor may lie beyond the members' envelope by this many times the members' own
 # spread: the offset constant k0 (bias + linear term at code 0) follows the sensor's null
 # asymmetry, which a few members sample poorly (tests/hardware/test_family_headroom.py: three
@@ -378,16 +380,32 @@ def clamp_codes(voltage_range_v, lsb: float, code_min: int, code_max: int) -> tu
     return int(lo), int(hi)
 
 
+def outside_input(fam: FamilySpec, voltage_v) -> str:
+    """'' when the voltages ``voltage_v`` (readings, or a model's range) lie inside the design's
+    input codes, else why not; readings piled up at their extreme are named as clipped."""
+    f, v = fam.spec, np.asarray(voltage_v, dtype=float).ravel()
+    lo, hi = float(v.min()), float(v.max())
+    in_lo, in_hi = f.code_min * f.input_lsb_v, f.code_max * f.input_lsb_v
+    if in_lo <= lo and hi <= in_hi:
+        return ""
+    why = f"voltage range {lo:.6g}..{hi:.6g} V exceeds the design's input {in_lo:.6g}..{in_hi:.6g} V"
+    piled = max((int(np.count_nonzero(v == e)), e) for e in (lo, hi))
+    if piled[0] >= CLIPPED_READINGS:
+        why += (f" ({piled[0]} readings at {piled[1]:.6g} V: the output is clipped at the converter's rail, "
+                "a sensor of more gain than the family's)")
+    return why
+
+
 def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> Spec:
     """One sensor's values under the family formats; FitError names what does not fit."""
     f = fam.spec
     if not isinstance(model, FlannModel):
         raise SpecError("model must be a FlannModel")
     model = _padded(model, fam.terms)
+    why = outside_input(fam, model.voltage_range_v)
+    if why:
+        raise FitError(why)
     lo, hi = sorted(model.voltage_range_v)
-    if lo < f.code_min * f.input_lsb_v or hi > f.code_max * f.input_lsb_v:
-        raise FitError(f"voltage range {lo:.4g}..{hi:.4g} V exceeds the design's input "
-                       f"{f.code_min * f.input_lsb_v:.4g}..{f.code_max * f.input_lsb_v:.4g} V")
     try:
         s = _quiet(derive_spec, model, **fam.options, model_sha256=model_sha256, check_device=False)
     except SpecError as exc:
