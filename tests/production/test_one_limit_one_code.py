@@ -107,6 +107,30 @@ def test_limit_is_half_a_code_bin_and_clips_to_the_trained_range(family):
     np.testing.assert_allclose(physical_limit_mm(model, inside, lsb / 4) * 4, want, rtol=1e-3)
 
 
+def test_the_limit_at_an_end_takes_no_slope_from_beyond_the_trained_range(family):
+    """At the ends the bin is the one that ends there: a model's continuation past its range is
+    pinned by no data (a FLANN's can be flat where the sensor is not), so a model that differs
+    from another only beyond the range has the same limit everywhere."""
+    fam = load_design(family["design"])
+    model = check_sensor(read_recordings(family["paths"][2]), fam)["model"]
+    lsb = fam.spec.input_lsb_v
+    vlo, vhi = sorted(model.voltage_range_v)
+
+    class WildBeyond:
+        voltage_range_v = model.voltage_range_v
+
+        @staticmethod
+        def predict(v):
+            v = np.asarray(v, dtype=float)
+            return model.predict(v) + 1e3 * (np.maximum(v - vhi, 0) + np.minimum(v - vlo, 0))
+
+    ends = np.array([vhi, vhi - lsb / 4, vlo, vlo + lsb / 4, vhi + 1.0])
+    np.testing.assert_allclose(physical_limit_mm(WildBeyond, ends, lsb), physical_limit_mm(model, ends, lsb),
+                               rtol=1e-12)
+    at_top = 0.5 * abs(model.predict(vhi) - model.predict(vhi - lsb))
+    assert physical_limit_mm(model, [vhi], lsb)[0] == pytest.approx(at_top, rel=1e-12)
+
+
 @pytest.fixture(scope="module")
 def thermal_family(tmp_path_factory):
     d = tmp_path_factory.mktemp("one_limit_thermal")

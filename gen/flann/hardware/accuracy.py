@@ -86,26 +86,28 @@ def physical_limit_mm(model, voltage_v, lsb_v: float, temperature_c=None) -> np.
     ``ratio_to_limit`` of ``flann eval --design`` and of the production certificate is the max
     error over the largest of these, worst over the stroke.
 
-    Readings are clipped to the model's trained voltage range (temperatures to its calibrated
-    range) first: the model is the only knowledge of the slope and is a fit only there (a
-    trigonometric sum far beyond it has a slope no sensor has), and the designs clamp their
-    codes to that range, so a reading beyond it gets the slope at the range's end.  The bin
-    around a reading at the end reaches half an LSB past it: a smooth fit's continuation over
-    that distance is its slope at the end, where the limit is usually largest; clipping the
-    bin instead would take the slope half an LSB inside (1 % lower at the flat end of an
-    S-curve read with 8 bits).
+    The bin is kept inside the model's trained voltage range (temperatures are clipped to its
+    calibrated range): the model is the only knowledge of the slope and is a fit only there,
+    and the designs clamp their codes to that range.  A reading within half an LSB of an end,
+    or beyond it, gets the bin that ends at the range's end.  A bin reaching past the end
+    took the fit's continuation, which no data pins: a FLANN fitted to a curve's inverse has
+    a slope there no sensor has (an erf sensor read with 10 bits: 0.92 mm at the end for one
+    model of the same recording, 0.17 mm for another, 0.107 mm from the sensor's formula);
+    inside, the slope is taken half an LSB in (1 % lower at the flat end of an S-curve read
+    with 8 bits).
 
     ``model`` is anything with ``predict`` and ``voltage_range_v`` (a benchmark's true sensor
     too); ``lsb_v`` is the converter's LSB (the full ADC's when the design drops low bits)."""
-    h = 0.5 * lsb_v
-    v = np.clip(np.asarray(voltage_v, dtype=float), *sorted(model.voltage_range_v))
+    lo, hi = sorted(model.voltage_range_v)
+    h = min(0.5 * lsb_v, 0.5 * (hi - lo))   # a range narrower than an LSB: the slope across it
+    v = np.clip(np.asarray(voltage_v, dtype=float), lo + h, hi - h)
     if temperature_c is None:
         dx = model.predict(v + h) - model.predict(v - h)
     else:
         t = np.clip(np.broadcast_to(np.asarray(temperature_c, dtype=float), v.shape),
                     *sorted(model.temperature_range_c))
         dx = model.predict(v + h, t) - model.predict(v - h, t)
-    return 0.5 * np.abs(dx)
+    return 0.5 * np.abs(dx) * (lsb_v / (2 * h))
 
 
 def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, float] | None = None) -> dict:
