@@ -61,6 +61,8 @@ def test_calibrate_fits_and_judges_without_the_outlier(line, capsys):
                "--design", str(d / "design"), "-j", "1"])
     rows = _rows(d / "out" / "summary.csv")
     assert rc == 0, rows
+    said = [ln for ln in capsys.readouterr().err.splitlines() if "gross outlier" in ln]
+    assert len(said) == 1 and said[0].startswith("warning: glitched: ") and f"line {line['line']}" in said[0]
     clean, glitched = rows["clean"], rows["glitched"]
     assert glitched["status"] == "ok" and f"line {line['line']}" in glitched["warnings"]
     assert "gross outlier" not in clean["warnings"]

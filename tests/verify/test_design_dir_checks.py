@@ -51,7 +51,7 @@ def no_simulation(monkeypatch):
     """Fail the test if a bench or a synthesis starts (each refusal comes before them)."""
     def started(*_a, **_kw):
         raise AssertionError("a slow step started")
-    for name in ("simulate_fixed", "run_cocotb", "run_family_bench", "run_design"):
+    for name in ("simulate_fixed", "sweep_temperatures", "run_family_bench", "run_design"):
         monkeypatch.setattr(datapaths, name, started)
     monkeypatch.setattr("flann.implement.synth.synthesize", started)
 

@@ -179,3 +179,18 @@ def test_verilator_engine_is_refused_where_it_cannot_run(designs, name, cli):
     one line before any simulation (it ran GHDL instead, saying nothing)."""
     rc, out, err = cli(["sim", designs["dir"] / name, "--engine", "verilator"])
     assert rc == 2 and out == "" and err.startswith("error: --engine verilator") and len(err.strip().splitlines()) == 1
+
+
+def test_throughput_is_said_to_be_at_the_nominal_clock(designs, tmp_path, capsys):
+    """sim runs no timing analysis: its samples/s is at the clock the design is written for (a
+    float18 design does not reach it on a Spartan-II), and both the text and the JSON say so."""
+    summary = tmp_path / "s.json"
+    assert main(["sim", str(designs["dir"] / "float18"), "--summary-json", str(summary)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("samples/s at"))
+    s = json.loads(summary.read_text())
+    assert s["clock_nominal"] is True and s["clock_checked_by"] == "flann synth"
+    # the names outside scripts read are kept
+    assert s["samples_per_s"] == s["samples_per_s_at_50mhz"] and s["clock_hz"] == 50e6
+    assert line.split()[:5] == ["samples/s", "at", "50", "MHz", f"{s['samples_per_s']:.0f}"]
+    assert line.endswith(" at the design's nominal clock, not a timing result (flann synth estimates the "
+                         "design's Fmax)")

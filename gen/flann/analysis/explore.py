@@ -96,8 +96,8 @@ def _measure(row: Row, design_dir: Path, device: str, work: Path | None, abc: st
     d = rep.to_dict()
     row.luts, row.ffs, row.brams = d["luts"], d["ffs"], d["brams"]
     row.fits, row.smallest_device = d["fits"], d["smallest_device"]
-    if d["warnings"]:
-        row.note = (row.note + "; " if row.note else "") + f"{len(d['warnings'])} yosys warning(s)"
+    if d["yosys_warnings"]:
+        row.note = (row.note + "; " if row.note else "") + f"{len(d['yosys_warnings'])} yosys warning(s)"
 
 
 DEFAULT_LANES, DEFAULT_STYLES = (1, 2, 4), ("lut", "shiftadd")

@@ -65,13 +65,15 @@ class ThermalTraceResult:
     curves: dict = field(repr=False, default_factory=dict)
     hdl: dict | None = None
     fmt: str = "thermal"
+    beyond_limits: int = 0   # samples left out: the float model beyond the output limits there
     stage_text: dict = field(repr=False, default_factory=lambda: dict(STAGE_TEXT))
 
     def to_dict(self) -> dict:
         d = {"format": self.fmt, "points": self.n_points, "voltage_codes": self.voltage_codes,
              "temperature_codes": self.temperature_codes, "total": self.total, "stages": self.stages,
              "orders": self.orders, "dominant": self.dominant,
-             "identity_residual_mm": self.identity_residual_mm, "output_lsb_mm": self.output_lsb_mm}
+             "identity_residual_mm": self.identity_residual_mm, "output_lsb_mm": self.output_lsb_mm,
+             "beyond_limits": self.beyond_limits}
         if self.hdl is not None:
             d["hdl"] = self.hdl
         return d
@@ -91,6 +93,9 @@ class ThermalTraceResult:
         d = self.dominant
         lines.append(f"dominant stage: {d['stage']} ({self.stage_text[d['stage']]}, {d['share']:.0%} of the error "
                      f"variance)")
+        if self.beyond_limits:
+            lines.append(f"{self.beyond_limits} samples not traced: pairs where the float model leaves the calibrated "
+                         "displacements, which the output holds at its limits")
         if self.hdl is not None:
             h = self.hdl
             lines.append(f"HDL (GHDL, {h['top']}): {h['codes']} samples simulated, {h['mismatches']} mismatches "
@@ -119,6 +124,12 @@ def trace_thermal(spec: ThermalSpec) -> ThermalTraceResult:
     vc = _voltage_codes(spec)
     c = np.tile(vc, len(temps))
     tau = np.repeat(np.asarray(temps, dtype=np.int64), vc.size)
+    # pairs the sensor never gave, where the float model leaves the calibrated displacements:
+    # the output saturates there by design, not by an arithmetic stage (counted, not traced)
+    lo, hi = spec.output_limits_mm
+    x_float = spec.float_model(c, tau)
+    inside = (x_float >= lo) & (x_float <= hi)
+    c, tau = c[inside], tau[inside]
     tr = FlannThermalTop(spec).trace(c, tau)
     h = spec.input_lsb_v / 2.0 ** spec.fine_bits          # the order datapaths' grid (V)
     kq = q / 2.0 ** spec.inner_bits                       # the orders' LSB (mm)
@@ -165,7 +176,8 @@ def trace_thermal(spec: ThermalSpec) -> ThermalTraceResult:
     return ThermalTraceResult(n_points=int(c.size), voltage_codes=int(vc.size), temperature_codes=temps,
                               total=total, stages=stages, orders=orders,
                               dominant={"stage": dom, "share": stages[dom]["share"]},
-                              identity_residual_mm=resid, output_lsb_mm=q, volts=v, curves=curves)
+                              identity_residual_mm=resid, output_lsb_mm=q, volts=v, curves=curves,
+                              beyond_limits=int(np.count_nonzero(~inside)))
 
 
 # the family design with temperature (flann_family_thermal_top): t_n is exact (tau - mid over a

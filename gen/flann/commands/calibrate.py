@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 
 from ..argtypes import bounded
+from ..errors import one_line
 from ..production.calibrate import DIAGNOSIS_POINTS, calibrate_batch, summary_path
 from ..production.spec import build_spec
 from ..production.traceability import Station
@@ -61,9 +62,9 @@ def run(args) -> int:
         print(f"error: {r.sensor}: {r.reason}", file=sys.stderr)
     for r in failed:
         print(f"FAIL: {r.sensor}: {r.reason}", file=sys.stderr)
-    for r in results:
-        if r.costs_accuracy:
-            print(f"warning: {r.sensor}: {r.costs_accuracy}", file=sys.stderr)
+    for r in results:   # every warning of the row's `warnings` column, one line each
+        for w in r.warnings:
+            print(f"warning: {r.sensor}: {one_line(w)}", file=sys.stderr)
     passed = len(results) - len(rejected) - len(failed)
     print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
           f"{len(rejected)} rejected; summary {summary_path(args.out)}")

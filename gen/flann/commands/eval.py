@@ -80,6 +80,15 @@ def warn_outside_stroke(model, rec) -> None:
                       "the figures include them", stacklevel=2)
 
 
+def hardware_vs_float(hw: dict) -> str:
+    """Both |hardware - float| figures, each saying what it includes: at the readings (the ADC's
+    quantisation of the voltages too) and at their ADC codes (the datapath alone, what flann sim
+    measures over every code)."""
+    return (f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm at the readings "
+            f"(ADC quantisation included), {hw['max_abs_hardware_minus_float_at_codes_mm']:.4g} mm at the "
+            "readings' ADC codes")
+
+
 def run(args) -> int:
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
@@ -143,8 +152,7 @@ def run(args) -> int:
                    "dropped)" if hw["dropped_low_bits"] else "")
         temp = (f", {hw['temp_bits']}-bit temperature x {hw['temp_lsb_c']:g} degC" if "temp_bits" in hw else "")
         print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, output LSB "
-              f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; "
-              f"|hardware - float| <= {hw['max_abs_hardware_minus_float_mm']:.4g} mm")
+              f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; {hardware_vs_float(hw)}")
         if "weight_image" in hw:
             print(f"hardware weight memories: {hw['weight_image']}")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "

@@ -28,9 +28,12 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    # the part the design was generated for unless another is asked for, as flann synth does
-    args.device = args.device or ise.design_device(args.directory)
+    # the part the design was generated for unless another is asked for, as flann synth does;
+    # read first either way: the design's files are inputs no output may replace
+    generated_for = ise.design_device(args.directory)
+    args.device = args.device or generated_for
     parse_part(args.device)  # refuse a bad part before synthesis
+    ise.check_output(args.output)  # and an output directory it may not replace
     ise.check_directory_fits(args.directory, args.device, force=args.force)
     clock = args.clock_mhz
     if not args.no_timing_check:

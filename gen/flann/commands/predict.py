@@ -5,6 +5,8 @@ clamps the ADC code to the trained range), the voltage is clamped to the nearest
 range and the row is flagged (``clamped`` = 1).  ``--extrapolate`` evaluates the expansion
 there instead (the trigonometric terms are periodic: the result is rarely meaningful), and the
 row is flagged ``extrapolated`` = 1: every row says whether it is a figure of the trained range.
+A two-input model's displacement is also held at its calibrated limits (a voltage and a
+temperature each inside its range, but a pair the sensor never gave), flagged the same way.
 """
 
 from __future__ import annotations
@@ -76,7 +78,12 @@ def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, n
     """(displacement mm, clamped flags): the voltage (and a two-input model's temperature)
     clamped to the trained range first."""
     v, t, outside = model.clamp(voltage_v, temperature_c)
-    return (model.predict(v, t) if is_thermal(model) else model.predict(v)), outside
+    if not is_thermal(model):
+        return model.predict(v), outside
+    # a (voltage, temperature) pair inside both ranges the sensor never gave: held at the
+    # calibrated displacement limits, as the hardware's output is
+    x, beyond = model.saturate(model.predict(v, t))
+    return x, outside | beyond
 
 
 def _predict_unclamped(model, voltage_v, temperature_c):
@@ -103,6 +110,12 @@ def run(args) -> int:
     else:
         cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v, temp)
         flag = "clamped"
+        held = flags & ~outside_range(model, rec.voltage_v, temp)
+        if held.any():
+            lo, hi = model.output_limits_mm()
+            warnings.warn(f"{rec.source}: {int(held.sum())} of {held.size} readings inside the calibrated voltages "
+                          f"and temperatures give a displacement beyond the calibrated {lo:.6g}..{hi:.6g} mm (a pair "
+                          "the sensor never gave): held there as the hardware does (column clamped = 1)")
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     w.writerow([*cols, flag])

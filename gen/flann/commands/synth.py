@@ -11,10 +11,10 @@ from pathlib import Path
 from ..argtypes import TOOL_SEED
 from ..eda import ABC_MODES, NETLIST
 from ..errors import FlannError
-from ..implement import ice40, synth, timing
+from ..implement import ice40, synth
 from ..hardware.manifest import read_manifest
 from ..hardware.registry import read_design
-from ..hardware.target import (CLOCK_HZ, DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
+from ..hardware.target import (DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..verify.design import from_directory
 from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver, sweep_datapaths
@@ -59,16 +59,19 @@ def add_arguments(p):
                         "run), and a disagreeing design is refused")
 
 
-def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
-    """The mapped netlist against its twin over every input code: (result, "") or (None, why
-    it was not run); a design whose netlist disagrees is refused."""
+def _check_netlist(args, netlist: Path) -> dict:
+    """The mapped netlist against its twin over every input code, as the report's netlist_*
+    fields: the result, or why it was not run (and a warning when the user can supply what
+    is missing); a design whose netlist disagrees is refused."""
+    if args.no_netlist_check:
+        return {"netlist_not_run": "--no-netlist-check"}
     man, dp = read_design(args.directory)
     if dp.netlist not in SWEEPS:
-        return None, f"no netlist sweep for a {dp.name} design (it has a driver and twin for {sweep_datapaths()} designs)"
+        return {"netlist_not_run": f"no netlist sweep for a {dp.name} design (it has a driver and twin for "
+                                   f"{sweep_datapaths()} designs)"}
     if args.model is None and not man.get("model"):
-        print("warning: netlist not simulated: pass --model MODEL.json (the twin is built from the model)",
-              file=sys.stderr)
-        return None, "no model (pass --model MODEL.json)"
+        return {"netlist_not_run": "no model (pass --model MODEL.json)",
+                "netlist_warning": "netlist not simulated: pass --model MODEL.json (the twin is built from the model)"}
     design = from_directory(args.directory, args.model)
     if not args.json:
         print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
@@ -76,8 +79,9 @@ def _check_netlist(args, netlist: Path) -> tuple[dict | None, str]:
     if res["mismatches"]:
         raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res['mismatches']} of "
                          f"{res['codes_tested']} samples (first: {res['first_mismatches']}); not handing it on")
-    return {"codes": res["codes_tested"], "mismatches": res["mismatches"], "passed": not res["mismatches"],
-            "simulator": res["simulator"], "temperature_codes": res["temperature_codes"]}, ""
+    return {"netlist_check": {"codes": res["codes_tested"], "mismatches": res["mismatches"],
+                              "passed": not res["mismatches"], "simulator": res["simulator"],
+                              "temperature_codes": res["temperature_codes"]}}
 
 
 def post_route_check(directory, model):
@@ -102,9 +106,8 @@ def run_ice40(args) -> int:
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(report.table())
-    if not report.timing_met:
-        print(f"warning: {report.top} on {report.part.name}: nextpnr's Fmax {report.fmax_mhz or 0:.1f} MHz is below "
-              f"the design's clock {report.clock_mhz:g} MHz", file=sys.stderr)
+    for w in report.all_warnings():   # the JSON's "warnings" too
+        print(f"warning: {w}", file=sys.stderr)
     return 0
 
 
@@ -128,19 +131,13 @@ def run(args) -> int:
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
         work = Path(args.work) if args.work else Path(tmp)
         report = synth.synthesize(args.directory, args.device, work=work, progress=not args.json, abc=args.abc)
-        check, why = ((None, "--no-netlist-check") if args.no_netlist_check
-                      else _check_netlist(args, work / NETLIST))
-        report = dataclasses.replace(report, netlist_check=check, netlist_not_run=why)
+        report = dataclasses.replace(report, **_check_netlist(args, work / NETLIST))
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(report.table())
-        for w in report.warnings:
-            print(f"warning: yosys: {w}", file=sys.stderr)
-    if report.timing and not report.timing.meets(CLOCK_HZ):
-        print(f"warning: {report.top} is estimated at {report.timing.fmax_mhz:.1f} MHz on {report.part.name}, "
-              f"below the design's clock {CLOCK_HZ / 1e6:g} MHz: run it at most at "
-              f"{timing.safe_clock_mhz(report.timing):g} MHz (flann ise writes that PERIOD)", file=sys.stderr)
+    for w in report.all_warnings():   # the JSON's "warnings" too
+        print(f"warning: {w}", file=sys.stderr)
     if not report.fits:
         print(f"error: {synth.not_fit_message(report)}", file=sys.stderr)
         return 2

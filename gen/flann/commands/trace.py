@@ -9,6 +9,7 @@ Fig. 6(b)); ``--at CSV`` also lists the error at the recordings' input voltages.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 import tempfile
@@ -62,9 +63,26 @@ def _design_dir(args):
     return from_directory(args.model, args.design_model)
 
 
+def traced(design) -> str:
+    """A design's trace as its label names it: the datapath, and for a family design the member
+    whose weights fill the memory (the first member's, its init_model, unless --model names
+    another model)."""
+    name, man = design.datapath.name, design.manifest
+    init = man.get("init_model")
+    if not init:
+        return name
+    if Path(design.model) != (design.directory / init).resolve():
+        return f"{name}: {Path(design.model).name}'s weights in the memory (--model)"
+    images = man.get("images") or []
+    first = images[0].get("name") if images and isinstance(images[0], dict) else None
+    who = f"member {first}" if first else "its first member"
+    return f"{name}: {who}, the memory's initial weights from {init}"
+
+
 def run(args) -> int:
     design = _design_dir(args)
     model = None if design else load_model(args.model)  # a design's datapath says whether it has stages
+    label = None   # a design's: what was traced (traced())
     args.format = args.format or FORMATS[0]
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:
@@ -72,6 +90,8 @@ def run(args) -> int:
         if args.at and design.datapath.stages in TWO_INPUT_STAGE_MODELS:
             raise FlannError(f"{args.model}: --at lists the error at one-input voltages; a two-input "
                              "design's error at recordings is flann eval MODEL REC --design DIR")
+        # the label names the datapath and, for a family, its member; the JSON keeps the number format
+        label = traced(design)
         results = {args.format: trace_design(design)}
     else:
         results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
@@ -92,15 +112,17 @@ def run(args) -> int:
             plot_compare(results, args.plot, points, title=f"hardware − golden: {args.model}",
                          points_label=f"inputs of {Path(args.at).name}" if args.at else "")
         else:
-            plot_trace(results[args.format], args.plot, title=f"flann trace {args.model} ({args.format})")
+            plot_trace(results[args.format], args.plot, title=f"flann trace {args.model} ({label or args.format})")
     if args.json:
         out = {f: r.to_dict() for f, r in results.items()} if args.compare else results[args.format].to_dict()
+        if not args.compare:   # a model's trace is of the datapath of its number format
+            out.update(datapath=design.datapath.name if design else args.format, traced=label or args.format)
         if points:
             out = {"trace": out, "at": points}
         print(json.dumps(out, indent=2))
         return 0
     for f, r in results.items():
-        print(r.text())
+        print((dataclasses.replace(r, fmt=label) if design else r).text())
         print()
     if points:
         print(f"at the input voltages of {args.at} (nearest input code):")

@@ -41,6 +41,9 @@ from .model import MAX_TERMS, FlannModel, ModelFile, evaluate, expand
 
 FORMAT = "flann-thermal-model/1"
 INPUTS = ("voltage_v", "temperature_c")
+# the output saturates this share of the calibrated displacement span beyond each end of it
+# (about the fit's own error at the stroke's ends)
+OUTPUT_MARGIN = 0.01
 
 
 def power_columns(t_n, orders: int) -> np.ndarray:
@@ -134,6 +137,21 @@ class ThermalModel(ModelFile):
         v_n, t_n = self.normalise(voltage_v, temperature_c)
         coef = np.concatenate([[b, *w] for w, b in zip(self.weights, self.bias)])
         return thermal_design(v_n, t_n, self.terms) @ coef
+
+    def output_limits_mm(self) -> tuple[float, float]:
+        """(lo, hi) mm: the calibrated displacement range widened by ``OUTPUT_MARGIN`` of its span.
+        The clamp of voltage and temperature is one rectangle, but at each temperature the sensor
+        covers only part of the voltages: a pair it never gives evaluates the polynomial in t_n
+        outside the calibration (45 mm on a +-25 mm sensor), so the output saturates here."""
+        lo, hi = sorted(float(x) for x in self.displacement_range_mm)
+        margin = OUTPUT_MARGIN * (hi - lo)
+        return lo - margin, hi + margin
+
+    def saturate(self, displacement_mm) -> tuple[np.ndarray, np.ndarray]:
+        """(displacement held within :meth:`output_limits_mm`, flags where it was)."""
+        x = np.asarray(displacement_mm, dtype=float)
+        lo, hi = self.output_limits_mm()
+        return np.clip(x, lo, hi), (x < lo) | (x > hi)
 
     def clamp(self, voltage_v, temperature_c) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(voltage, temperature, outside flags): both clamped to the calibrated ranges, as

@@ -134,6 +134,14 @@ class Ice40Report:
     def timing_met(self) -> bool:
         return self.fmax_mhz is not None and self.fmax_mhz >= self.clock_mhz
 
+    def all_warnings(self) -> list[str]:
+        """Every warning of this run, as flann synth prints them and its JSON lists them."""
+        out = list(self.warnings)
+        if not self.timing_met:
+            out.append(f"{self.top} on {self.part.name}: nextpnr's Fmax {self.fmax_mhz or 0:.1f} MHz is below "
+                       f"the design's clock {self.clock_mhz:g} MHz")
+        return out
+
     @property
     def bitstream(self) -> str:
         return str(Path(self.output) / f"{self.top}.bin")
@@ -162,7 +170,7 @@ class Ice40Report:
             "top": self.top,
             "cells": dict(sorted(self.cells.items())),
             "seconds": round(self.seconds, 1),
-            "warnings": list(self.warnings),
+            "warnings": self.all_warnings(),
             "flow": (f"ghdl --synth --std=93c --out=verilog | yosys synth_ice40 | nextpnr-ice40 --{self.part.nextpnr} "
                      f"--package {self.part.package} --freq {self.clock_mhz:g} | icepack"),
         }

@@ -35,7 +35,7 @@ from pathlib import Path
 from .. import __version__
 from ..hardware.target import CLOCK_HZ, Part, parse_part
 from ..errors import FlannError
-from ..fileio import atomic_directory
+from ..fileio import atomic_directory, check_output_directory
 from ..textgen import template
 from ..hardware.registry import read_design
 from .synth import Resources, manifest_device, not_fit_message, shortfall, smallest_fit, synthesize
@@ -220,6 +220,12 @@ def check_directory_fits(directory, device: str, force: bool = False) -> None:
     check_fits(man, dp, parse_part(device), force, warn=False)
 
 
+def check_output(out_dir) -> None:
+    """Refuse now, in one line, an output directory :func:`write_ise` would refuse only after
+    its checks and warnings (a user's directory, the design's own)."""
+    check_output_directory(out_dir, _is_ise_project, "flann ISE project")
+
+
 def check_clock_mhz(clock_mhz: float) -> None:
     if not (0 < clock_mhz <= 200):
         raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
@@ -230,6 +236,7 @@ def write_ise(directory, device: str | None = None, out_dir="ise", clock_mhz: fl
     """Write the ISE 10.1 handoff for a generated design (``device``: default the part its
     manifest records); returns the files written."""
     man, dp = read_design(directory)
+    check_output(out_dir)
     part = parse_part(device if device is not None else manifest_device(man))
     check_fits(man, dp, part, force)
     check_clock_mhz(clock_mhz)
@@ -307,5 +314,5 @@ def summary(files: list[str], out_dir, part: Part | str) -> str:
             f"with ISE 10.1 (see README.txt)")
 
 
-__all__ = ["write_ise", "design_device", "check_directory_fits", "pin_map", "top_ports", "design_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN",
-           "INPUT_PINS", "OUTPUT_PINS"]
+__all__ = ["write_ise", "design_device", "check_directory_fits", "check_output", "pin_map", "top_ports",
+           "design_ports", "Port", "summary", "CLOCK_PIN", "RESET_PIN", "INPUT_PINS", "OUTPUT_PINS"]

@@ -122,6 +122,7 @@ class SynthReport:
     # or None with why it was not run
     netlist_check: dict | None = None
     netlist_not_run: str = ""
+    netlist_warning: str = ""   # why the netlist check could not run, when the user should act on it
 
     @property
     def fits(self) -> bool:
@@ -130,6 +131,17 @@ class SynthReport:
     @property
     def smallest(self) -> Part | None:
         return smallest_fit(self.resources, self.part)
+
+    def all_warnings(self) -> list[str]:
+        """Every warning of this synthesis, as flann synth prints them and its JSON lists them."""
+        out = [f"yosys: {w}" for w in self.warnings]
+        if self.netlist_warning:
+            out.append(self.netlist_warning)
+        if self.timing and not self.timing.meets(CLOCK_HZ):
+            out.append(f"{self.top} is estimated at {self.timing.fmax_mhz:.1f} MHz on {self.part.name}, below the "
+                       f"design's clock {CLOCK_HZ / 1e6:g} MHz: run it at most at "
+                       f"{spartan2_timing.safe_clock_mhz(self.timing):g} MHz (flann ise writes that PERIOD)")
+        return out
 
     def to_dict(self) -> dict:
         r, d = self.resources, self.part.device
@@ -162,7 +174,8 @@ class SynthReport:
             "netlist_check": self.netlist_check,
             "cells": r.cells,
             "entities": self.entities,
-            "warnings": list(self.warnings),
+            "warnings": self.all_warnings(),
+            "yosys_warnings": list(self.warnings),
             "flow": f"ghdl --synth --std=93c --out=verilog | yosys synth_xilinx -family {FAMILY}"
                     + (" (abc -fast)" if self.abc == "fast" else ""),
         }
@@ -205,8 +218,10 @@ class SynthReport:
                          + ("passed" if n["passed"] else "FAILED"))
         elif self.netlist_not_run:
             lines.append(f"  {'netlist check':<20} not run: {self.netlist_not_run}")
-        if self.fits:
-            lines.append(f"  fits {self.part.name}")
+        if self.fits:   # then the part itself bounds the smallest that fits
+            smallest = self.smallest.name
+            lines.append(f"  fits {self.part.name}; smallest device that fits: "
+                         + ("this one" if smallest == self.part.name else smallest))
         else:
             lines.append(f"  DOES NOT FIT {self.part.name}: {'; '.join(shortfall(r, self.part))}")
         return "\n".join(lines)

@@ -189,6 +189,23 @@ def check_sensor(rec, fam: FamilySpec) -> dict:
             "limit_mm": limit, "rec": rec}
 
 
+def polarity_warning(rec, fam: FamilySpec) -> str:
+    """'' when the sensor's output rises with displacement as the design's sensor's does, else
+    why not: the weights invert either slope, so a reversed output calibrates and measures
+    right, but on a line that builds one kind of sensor it is a wiring fault (secondaries or
+    the excitation swapped) that a replaced unit would not share."""
+    m = fam.spec.model
+    lo, hi = sorted(m.voltage_range_v)
+    x_lo, x_hi = m.predict(np.array([lo, hi]))
+    design_rises = bool(x_hi > x_lo)   # x(v) rises where v(x) does
+    rises = float(np.polyfit(rec.displacement_mm, rec.voltage_v, 1)[0]) > 0
+    if rises == design_rises:
+        return ""
+    return (f"the output {'rises' if rises else 'falls'} with displacement where the design's sensor's "
+            f"{'rises' if design_rises else 'falls'}: a reversed output (secondaries or excitation swapped?); "
+            "calibrated as it is")
+
+
 def diagnosis_sample(rec, points: int | None) -> tuple[Recordings, str]:
     """The recording the diagnosis sees, and one sentence saying how it was reduced: at most
     about ``points`` means, as ``flann diagnose --max-points`` takes them
@@ -306,6 +323,9 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                 f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms; flagged above "
                 f"{REACH_FACTOR:g} x): the family design costs it accuracy")
             res.warnings.append(res.costs_accuracy)
+        reversed_output = polarity_warning(rec, fam)
+        if reversed_output:
+            res.warnings.append(reversed_output)
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
         findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
         res.diagnosis = diagnosis_cell(named, groups)

@@ -158,14 +158,17 @@ def manifest(fspec, files: list[str]) -> dict:
     }
 
 
+def derive(model_path_or_model, **options):
+    """The F18Spec of a model (a FlannModel, or a model.json path: its hash recorded)."""
+    if isinstance(model_path_or_model, FlannModel):
+        return derive_f18_spec(model_path_or_model, **options)
+    path = Path(model_path_or_model)
+    return derive_f18_spec(load_model(path), model_sha256=model_sha256(path), **options)
+
+
 def generate(model_path_or_model, out_dir, **options) -> dict:
     """`flann gen --format float18`: derive, render, write VHDL + manifest.json atomically."""
-    if isinstance(model_path_or_model, FlannModel):
-        fspec = derive_f18_spec(model_path_or_model, **options)
-    else:
-        path = Path(model_path_or_model)
-        fspec = derive_f18_spec(load_model(path), model_sha256=model_sha256(path), **options)
-    return write(fspec, out_dir, model_text(model_path_or_model))
+    return write(derive(model_path_or_model, **options), out_dir, model_text(model_path_or_model))
 
 
 def write(fspec, out_dir, model: str | None = None) -> dict:
@@ -174,5 +177,5 @@ def write(fspec, out_dir, model: str | None = None) -> dict:
     return write_design({**texts, MODEL_FILE: model if model is not None else fspec.model.to_json()}, man, out_dir)
 
 
-__all__ = ["BLOCKS", "block_context", "render_block", "render_blocks", "render_design", "generate",
+__all__ = ["BLOCKS", "block_context", "render_block", "render_blocks", "render_design", "derive", "generate",
            "write", "manifest", "TOP", "CVT", "DATAPATH"]

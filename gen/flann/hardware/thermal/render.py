@@ -67,7 +67,9 @@ def contexts(spec: ThermalSpec) -> dict:
         node_min=bits_literal(-(1 << (node_bits - 1)), node_w),
         inner_bits=s.inner_bits,
         round_bits=round_bits,
-        out_max=bits_literal(s.out_fmt.max_int, round_bits), out_min=bits_literal(s.out_fmt.min_int, round_bits),
+        # the calibrated displacement limits (spec.output_limit_codes), within the output format
+        out_max=bits_literal(s.out_hi, round_bits), out_min=bits_literal(s.out_lo, round_bits),
+        out_max_mm=f"{s.out_hi * s.output_lsb_mm:.6g}", out_min_mm=f"{s.out_lo * s.output_lsb_mm:.6g}",
     )
 
 

@@ -7,7 +7,8 @@ Datapath (one sample = an ADC code ``in_data`` and a temperature code ``in_temp`
     in_data --clamp--> c --(c G + O), one rounding--> c' = node + frac  (grid lsb/2^E, FR more bits)
     node, node + 1 --one-input datapath of order j (hardware/fixed, output LSB q / 2^K)--> a_j, b_j
     f_j = a_j + (b_j - a_j) frac          (linear interpolation between two grid codes)
-    f_0 + t_n (f_1 + t_n f_2) --Horner, rounding at each multiply--> round to q, saturate
+    f_0 + t_n (f_1 + t_n f_2) --Horner, rounding at each multiply--> round to q,
+        saturate at the calibrated displacement limits (out_lo, out_hi), out_sat there
 
 Every one-input block is :mod:`flann.hardware.fixed` unchanged (its spec sized by its own
 error budget for the order's FLANN on the fine grid); the temperature terms and the cross
@@ -37,6 +38,18 @@ design, a quarter of the larger of the output step per input code and the model'
 RMS error, on the 1-2-5 series, or coarser when the interpolation's curvature error needs it; ``ThermalSpec.analysis`` lists every bound.  The slopes are taken
 numerically from the float model over the calibrated voltage and temperature ranges.
 The VHDL is rendered by :mod:`.render` (``flann_thermal_top``).
+
+Output limits.  The input clamp is one rectangle (calibrated voltages x calibrated
+temperatures), but at each temperature the sensor covers only part of the voltage range: a
+(voltage, temperature) pair the sensor never gives (the top of the voltage range at the
+temperature whose span is smallest) evaluates the polynomial in t_n outside the calibration,
+and the model extrapolates there (45 mm on a +-25 mm sensor).  So the output is saturated at
+the calibrated displacement range (the model's ``displacement_range_mm``, the positions it
+was trained on) widened by ``flann.golden.thermal.OUTPUT_MARGIN`` of its span on each side (the fit's own error at
+the stroke's ends), rounded outward to the output LSB: ``out_lo``, ``out_hi``
+(:func:`output_limit_codes`), and ``out_sat`` is raised there.  ``float_reference`` is the
+float model saturated at the same limits (in mm: the codes x q), so |hardware - reference|
+keeps its bound (a saturation is 1-Lipschitz) and a saturated output equals its reference.
 """
 
 from __future__ import annotations
@@ -60,6 +73,11 @@ MAX_INPUT_BITS = 24
 # Share of the 0.5-LSB pre-rounding budget per source (output LSBs).
 SHARE = {"orders": 0.2, "horner": 0.05, "curvature": 0.1, "fraction": 0.05, "gain": 0.05,
          "temperature": 0.05}
+def output_limit_codes(model: ThermalModel, q: float) -> tuple[int, int]:
+    """(out_lo, out_hi): the model's output limits (:meth:`ThermalModel.output_limits_mm`) in
+    output LSBs q, rounded outward."""
+    lo, hi = model.output_limits_mm()
+    return math.floor(lo / q + 1e-9), math.ceil(hi / q - 1e-9)
 
 
 @dataclass(frozen=True)
@@ -85,6 +103,8 @@ class ThermalSpec(InputCodes, TempCodes):
     inner_bits: int                # K: order outputs in q / 2^K
     output_lsb_mm: float           # q
     out_fmt: FixedFormat
+    out_lo: int                    # the output saturates at these codes (output_limit_codes)
+    out_hi: int
     orders: tuple[Spec, ...] = field(repr=False)
     analysis: dict = field(default_factory=dict, compare=False)
 
@@ -123,14 +143,25 @@ class ThermalSpec(InputCodes, TempCodes):
             "g_frac_bits": self.g_frac_bits, "gain_int": list(self.gain_int),
             "offset_int": list(self.offset_int), "inner_bits": self.inner_bits,
             "output_lsb_mm": self.output_lsb_mm, "output": self.out_fmt.describe(),
+            "output_limit_codes": [self.out_lo, self.out_hi],
             "orders": [o.to_dict() for o in self.orders],
         }
 
-    def float_reference(self, codes, temp_codes) -> np.ndarray:
-        """The float model (mm) at the clamped voltage and temperature codes."""
+    @property
+    def output_limits_mm(self) -> tuple[float, float]:
+        """The output's saturation limits (mm): out_lo and out_hi times the output LSB."""
+        return self.out_lo * self.output_lsb_mm, self.out_hi * self.output_lsb_mm
+
+    def float_model(self, codes, temp_codes) -> np.ndarray:
+        """The float model (mm) at the clamped voltage and temperature codes, not saturated."""
         c = np.clip(np.asarray(codes, dtype=np.int64), self.clamp_lo, self.clamp_hi)
         t = np.clip(np.asarray(temp_codes, dtype=np.int64), self.temp_lo, self.temp_hi)
         return self.model.predict(c * self.input_lsb_v, t * self.temp_lsb_c)
+
+    def float_reference(self, codes, temp_codes) -> np.ndarray:
+        """The float model (mm) at the clamped voltage and temperature codes, saturated at the
+        output limits as the hardware's output is (where it saturates, the reference is the limit)."""
+        return np.clip(self.float_model(codes, temp_codes), *self.output_limits_mm)
 
 
 def _order_model(model: ThermalModel, j: int, vrange) -> FlannModel:
@@ -296,7 +327,8 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
     fr, fg, ft, k, t_scale_int, t_offset_int, shift, gain_int, offset_int, specs = parts
     p = model.orders
     ymax = float(np.max(np.abs(model.displacement_range_mm))) * 1.05
-    out_bits = bits_needed(-math.ceil(ymax / q), math.ceil(ymax / q))
+    out_lo, out_hi = output_limit_codes(model, q)
+    out_bits = bits_needed(min(-math.ceil(ymax / q), out_lo), max(math.ceil(ymax / q), out_hi))
     analysis = {
         "slope_mm_per_v": slope_v, "slope_mm_per_t_n": slope_t,
         "curvature_mm_per_v2": curve_v,
@@ -310,6 +342,7 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
     specs = _smaller_tables(specs, k, rest)
     analysis["orders_lsb"] = _orders_lsb(specs, k)
     analysis["pre_rounding_lsb"] = rest + analysis["orders_lsb"]
+    analysis["output_limits_mm"] = [out_lo * q, out_hi * q]
     if q != asked:
         analysis["output_lsb_raised_from_mm"] = asked
         analysis["output_lsb_raised_because"] = why
@@ -318,7 +351,8 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
                        fine_bits=fine, interp_bits=fr, t_frac_bits=ft, t_scale_int=t_scale_int,
                        t_offset_int=t_offset_int, t_shift=shift, g_frac_bits=fg,
                        gain_int=gain_int, offset_int=offset_int, inner_bits=k, output_lsb_mm=q,
-                       out_fmt=FixedFormat(out_bits, out_bits, signed=True), orders=specs,
+                       out_fmt=FixedFormat(out_bits, out_bits, signed=True), out_lo=out_lo, out_hi=out_hi,
+                       orders=specs,
                        analysis=analysis)
 
 
@@ -373,4 +407,4 @@ def corrected_codes_float(spec: ThermalSpec, codes, temp_codes) -> np.ndarray:
     return v / spec.input_lsb_v * 2 ** spec.fine_bits
 
 
-__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float", "top_widths"]
+__all__ = ["ThermalSpec", "derive_thermal_spec", "corrected_codes_float", "top_widths", "output_limit_codes"]

@@ -2,7 +2,7 @@
 
 ``FlannThermalTop(spec).process(in_data, in_temp)`` returns the output ports ``out_data`` (in
 output LSBs) and ``out_sat`` (an input outside the calibrated codes, clamped, or the output
-saturated), plus the internal stages in :class:`ThermalTrace`.  The order datapaths are
+saturated at the calibrated displacement limits ``spec.out_lo``/``spec.out_hi``), plus the internal stages in :class:`ThermalTrace`.  The order datapaths are
 :class:`flann.hardware.fixed.twin.FlannTop`, unchanged.  The entity is the rendered top's (:mod:`.render`).
 """
 
@@ -70,7 +70,10 @@ class FlannThermalTop:
         acc = parts[-1]
         for part in reversed(parts[:-1]):
             acc = round_shift(acc * t_n, s.t_frac_bits) + part
-        out, clipped = s.out_fmt.saturate(round_shift(acc, s.inner_bits))
+        # saturate at the calibrated displacement limits (within the output format)
+        rounded = round_shift(acc, s.inner_bits)
+        out = np.clip(rounded, s.out_lo, s.out_hi)
+        clipped = out != rounded
         return ThermalTrace(t_n, gain, fine, tuple(parts), acc, out, sat | clipped)
 
     def process(self, in_data, in_temp) -> TopOut:
@@ -86,7 +89,8 @@ class FlannThermalTop:
 
     def error_vs_float(self, temp_codes=None, codes=None) -> dict:
         """max |twin - float| (output LSBs) over every voltage code (default) at each of
-        ``temp_codes`` (default: every temperature code); output clipping is not an error."""
+        ``temp_codes`` (default: every temperature code); the float reference is saturated at the
+        output limits as the hardware is, so a saturated output is compared with its limit."""
         s = self.spec
         codes = self.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
         temp_codes = self.all_temp_codes() if temp_codes is None else temp_codes
@@ -94,7 +98,7 @@ class FlannThermalTop:
         for tau in np.asarray(temp_codes, dtype=np.int64):
             out, sat = self.process(codes, tau)
             ref = s.float_reference(codes, tau) / s.output_lsb_mm
-            ok = ~(sat & (np.abs(ref) > s.out_fmt.max_int))
+            ok = ~(sat & ((ref > s.out_hi) | (ref < s.out_lo)))   # never, with ref saturated
             if ok.any():
                 worst = max(worst, float(np.max(np.abs(out - ref)[ok])))
         return {"max_err_lsb": worst, "max_err_mm": worst * s.output_lsb_mm,
