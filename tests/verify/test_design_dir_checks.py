@@ -233,7 +233,8 @@ def test_one_image_on_a_family_is_loaded_over_one_the_design_keeps(small_designs
     one_line(*cli(["sim", d, "--image", given]), "stopped before the bench")
     # the given image second, over the kept image that differs from it; calibrate names every
     # image weights.hex, so the folder names the sensor
-    assert seen == [[{"name": f"family/{kept[1]['name']}", "hex": str(d.resolve() / kept[1]["hex"])},
+    assert seen == [[{"name": f"family/{kept[1]['name']}", "hex": str(d.resolve() / kept[1]["hex"]),
+                      "model": str(d.resolve() / kept[1]["model"])},
                      {"name": f"{tmp_path.name}/weights", "hex": str(given.resolve())}]]
 
 

@@ -14,13 +14,14 @@ import numpy as np
 
 from ..errors import FlannError
 from ..numeric.float18 import FLOAT18
+from ..hardware.family.spec import member_spec
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from . import plots
 from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
-from .images import checked_image, kept_images
+from .images import checked_image, image_model, kept_images
 from .netlist import netlist_summary, require_sweep_driver
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 from .runner import ghdl_backend, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
@@ -99,11 +100,29 @@ def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
     codes = len(rec.get("codes", [])) * len(rec.get("outputs", {}))
     benches = {"family": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
                           "seconds": round(res.seconds, 1)}}
-    s = _summary(design, codes, rec.get("mismatches"), None, benches, res.ok and bool(rec),
-                 design.manifest["output_lsb_mm"])
+    per_image = {im["name"]: _image_error_mm(design, im, words) for im, words in loaded}
+    known = [e for e in per_image.values() if e is not None]
+    s = _summary(design, codes, rec.get("mismatches"), max(known) if known else None, benches,
+                 res.ok and bool(rec), design.manifest["output_lsb_mm"])
     s["images"] = [im["name"] for im in images]
+    # the HDL equals the twin (mismatches): the twin against the model each image was made from
+    s["image_max_err_mm"] = {n: None if e is None else round(e, 6) for n, e in per_image.items()}
     s["sweep"] = {"engine": "ghdl", "backend": "ghdl", "shards": 1, "codes_per_s": None}
     return {"summary": s, "curve": curve, "spec": design.spec}
+
+
+def _image_error_mm(design: Design, image: dict, words: list[int]) -> float | None:
+    """max |twin - float model| (mm) over every input code of the design holding ``image``,
+    against the model it was made from (:func:`~flann.verify.images.image_model`; None when
+    that is not known), as the fixed datapath's sweep measures it."""
+    model = image_model(image)
+    if model is None:
+        return None
+    fam = design.spec
+    codes = np.arange(fam.spec.code_min, fam.spec.code_max + 1, dtype=np.int64)
+    out = FlannFamilyTop(fam, words).process(codes)[0]
+    ref = member_spec(fam, model).float_reference(codes)
+    return float(np.max(np.abs(out * fam.spec.output_lsb_mm - ref)))
 
 
 def _fixed(design: Design, build_dir, *, seed=1, engine="auto", progress=None, **_) -> dict:

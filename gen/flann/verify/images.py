@@ -3,8 +3,11 @@ design keeps, and any image read and checked against the design before a slow st
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ..errors import FlannError
-from ..hardware.family.images import header_fields, parse_hex
+from ..golden.model import FlannModel, load_model, text_sha256
+from ..hardware.family.images import MODEL_FILE, header_fields, header_model_sha256, parse_hex
 from ..hardware.family.render import design_hash
 from ..inputs import read_text
 from .design import Design
@@ -31,8 +34,24 @@ def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[i
 
 
 def kept_images(design: Design) -> list[dict]:
-    """The weight images flann gen kept in the design, as {name, hex path}."""
-    return [{"name": im["name"], "hex": str(design.directory / im["hex"])} for im in design.manifest.get("images", [])]
+    """The weight images flann gen kept in the design, as {name, hex path[, model path]}."""
+    return [{"name": im["name"], "hex": str(design.directory / im["hex"]),
+             **({"model": str(design.directory / im["model"])} if im.get("model") else {})}
+            for im in design.manifest.get("images", [])]
 
 
-__all__ = ["checked_image", "kept_images"]
+def image_model(image: dict) -> FlannModel | None:
+    """The float model an image was made from, or None when it cannot be told: the one the
+    design keeps beside it, else the ``model.json`` flann calibrate wrote beside it when its
+    sha256 is the one the image's header names (another file there is not the image's)."""
+    if image.get("model"):
+        return load_model(image["model"])
+    beside = Path(image["hex"]).parent / MODEL_FILE
+    if not beside.is_file():
+        return None
+    named = header_model_sha256(read_text(image["hex"], FlannError, "a weight image (.hex)"))
+    text = read_text(beside, FlannError, "a model (.json)")
+    return load_model(beside) if named is not None and named == text_sha256(text) else None
+
+
+__all__ = ["checked_image", "kept_images", "image_model"]

@@ -55,6 +55,7 @@ def parse_hex(text: str, source: str = "<hex>") -> list[int]:
 # the provenance lines of the ``#`` header flann calibrate writes: the design, the word count
 _HEADER_DESIGN = re.compile(r"#\s*design sha256 ([0-9a-f]{64})\b")
 _HEADER_WORDS = re.compile(r"#\s*(\d+) words x (\d+) bits\b")
+_HEADER_MODEL = re.compile(r"#\s*model sha256 ([0-9a-f]{64})\b")
 
 
 def provenance_header(tool: str, sensor: str, design_sha256: str, model_sha256: str, words: int,
@@ -76,6 +77,12 @@ def header_fields(text: str) -> tuple[str | None, int | None]:
         if words is None and (m := _HEADER_WORDS.match(line)):
             words = int(m.group(1))
     return design, words
+
+
+def header_model_sha256(text: str) -> str | None:
+    """The sha256 of the model.json an image's ``#`` header names (None where it names none)."""
+    found = (_HEADER_MODEL.match(ln.strip()) for ln in text.splitlines() if ln.strip().startswith("#"))
+    return next((m.group(1) for m in found if m), None)
 
 
 def read_image(path) -> list[int]:
@@ -108,4 +115,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["IMAGE_FILE", "MODEL_FILE", "hex_text", "header_fields", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["IMAGE_FILE", "MODEL_FILE", "hex_text", "header_fields", "header_model_sha256", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]

@@ -156,10 +156,13 @@ def write(fam: FamilySpec, out_dir, init_model: FlannModel, init_name: str = "",
     {name: FlannModel}), so `flann sim DIR` can load two sensors through the cfg port."""
     texts = render(fam, init_name)
     man = manifest(fam, list(texts))
+    members = members or {}
     images = {f"image_{name}.hex": image_text(FlannFamilyMem.encode(fam, member_spec(fam, m)))
-              for name, m in (members or {}).items()}
-    man["images"] = [{"name": n[len("image_"):-len(".hex")], "hex": n} for n in images]
-    return write_design({**texts, INIT_MODEL: init_model.to_json(), **images}, man, out_dir)
+              for name, m in members.items()}
+    # each image's model beside it: flann sim measures the hardware against it
+    models = {f"model_{name}.json": m.to_json() for name, m in members.items()}
+    man["images"] = [{"name": name, "hex": f"image_{name}.hex", "model": f"model_{name}.json"} for name in members]
+    return write_design({**texts, INIT_MODEL: init_model.to_json(), **images, **models}, man, out_dir)
 
 
 def read_manifest(out_dir) -> dict:
