@@ -113,6 +113,12 @@ class Result:
     own_reach_mm: float | None = None   # what the sensor's own design reaches (a one-input family)
     costs_accuracy: str = ""   # the warning when the family design costs this sensor accuracy
 
+    @property
+    def kept_model_sha256(self) -> str:
+        """The model's sha256 where its model.json is kept (a passed sensor); a failed or
+        rejected sensor's row and certificate name none, as its folder holds no model."""
+        return self.model_sha256 if self.verdict is not None and self.verdict.passed else ""
+
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
         self.status = "failed"
@@ -140,7 +146,7 @@ class Result:
                 "max_error_pct_fs": "" if v is None or v.max_error_pct_fs is None
                 else f"{v.max_error_pct_fs:.4g}",
                 "diagnosis": self.diagnosis, "design_sha256": self.design_sha256,
-                "model_sha256": self.model_sha256,
+                "model_sha256": self.kept_model_sha256,
                 "calibrated_at": t.calibrated_at if t is not None else "",
                 "station": t.station if t is not None else "",
                 "operator": t.operator if t is not None else "",
@@ -393,7 +399,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
                           extra: dict) -> None:
     """A passed sensor: its two-input model, its image (every order's memory in turn) and the
     certificate; a failed one: only the certificate."""
-    model_json, mhash = chk["model"].to_json(), _kept_model_sha(res)
+    model_json, mhash = chk["model"].to_json(), res.kept_model_sha256
     head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.image_words,
                                     f"address 0 first: order j's memory at j x {fam.fam.mem_depth} (cfg_addr)")
     html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
@@ -410,7 +416,6 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
     says so (when even that cannot be written, the summary row still does)."""
     res.fail(reason)
     res.verdict = rejected(spec, res.reason)
-    res.model_sha256 = ""
     # figures measured before the rejection describe no calibration the row stands for
     res.max_error_mm = res.limit_mm = res.ratio_to_limit = res.raw_max_error_mm = None
     res.twin_vs_float_lsb = res.drift_ppm_fs_per_c = None
@@ -432,14 +437,6 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
         res.warnings.append(f"no certificate written: {exc}")
 
 
-def _kept_model_sha(res: Result) -> str:
-    """The model's sha256 where its model.json is kept (a passed sensor); a failed sensor's
-    row and certificate name none, as they hold no model."""
-    if not res.verdict.passed:
-        res.model_sha256 = ""
-    return res.model_sha256
-
-
 def _is_sensor_output(directory: Path) -> bool:
     return (directory / "certificate.html").is_file()
 
@@ -449,7 +446,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     """A passed sensor: its model, weight images and certificate; a failed one: only the
     certificate (no weights a loader could pick up)."""
     model, words = chk["model"], chk["words"]
-    model_json, mhash = model.to_json(), _kept_model_sha(res)
+    model_json, mhash = model.to_json(), res.kept_model_sha256
     head = images.provenance_header(f"flann {__version__} calibrate", res.sensor, dhash, mhash, fam.mem_depth)
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:

@@ -24,7 +24,7 @@ from .benches import BENCH_DIR
 from .images import checked_image, image_model, kept_images
 from .netlist import netlist_summary, require_sweep_driver
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
-from .runner import ghdl_backend, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
+from .runner import backend_for, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
 
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
@@ -136,7 +136,7 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, progress=None, **
     code_lo, code_hi = (spec.code_min, spec.code_max) if codes is None else codes
     build_dir = Path(build_dir).resolve()
     samples = len(temps) * (code_hi - code_lo + 1)
-    backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
+    backend = backend_for(samples * man["cycles_per_sample"])
     out_file = build_dir / "thermal_sweep.txt"
     build_dir.mkdir(parents=True, exist_ok=True)
     sweep = {"file": str(out_file), "code_lo": code_lo, "code_hi": code_hi}
@@ -203,7 +203,7 @@ def _family_thermal(design: Design, build_dir, *, seed=1, images=None, progress=
     temps = family_thermal_temperature_codes(spec)
     build_dir = Path(build_dir).resolve()
     samples = len(temps) * (spec.code_max - spec.code_min + 1)
-    backend = ghdl_backend() if samples * man["cycles_per_sample"] > 2_000_000 else "mcode"
+    backend = backend_for(samples * man["cycles_per_sample"])
     build_dir.mkdir(parents=True, exist_ok=True)
     bench = {"tests": 0, "failures": 0, "failed": [], "seconds": 0.0}
     total, mismatches, ok, per_image, groups, runs = 0, 0, True, {}, [], []

@@ -116,6 +116,15 @@ def _runner(backend: str):
     return r
 
 
+# LLVM spends ~10 s more than mcode compiling and runs ~2.6x faster: worth it for long runs only
+LLVM_CYCLES = 2_000_000
+
+
+def backend_for(cycles: int) -> str:
+    """The GHDL backend for a simulation of ``cycles`` clock cycles in all."""
+    return ghdl_backend() if cycles > LLVM_CYCLES else "mcode"
+
+
 def build(sources, toplevel: str, build_dir, backend: str | None = None) -> str:
     """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used
     (default mcode: the cocotb benches are short, and mcode compiles in a second)."""
@@ -137,10 +146,14 @@ def _first_error(log: Path) -> str:
     return next((ln.strip() for ln in text.splitlines() if "error" in ln.lower()), f"see {log}")
 
 
+def _results_file(build_dir: Path, tag: str) -> Path:
+    return build_dir / f"results_{tag}.xml"
+
+
 def _test(build_dir: Path, toplevel: str, module: str, backend: str, cfg_path: Path, tag: str,
           parameters: dict, plusargs: list, testcase: str | None, seed: int) -> Path:
     """Run one simulation of a built design; returns its results file (never raises on failure)."""
-    results = build_dir / f"results_{tag}.xml"
+    results = _results_file(build_dir, tag)
     try:
         _runner(backend).test(
             test_module=f"{BENCH_PACKAGE}.{module}", hdl_toplevel=toplevel, hdl_toplevel_lang="vhdl",
@@ -243,8 +256,7 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
         shutil.rmtree(build_dir)
     records = build_dir / "records"
     t0 = time.monotonic()
-    # LLVM spends ~10 s more than mcode compiling and runs ~2.6x faster: worth it for long runs only
-    backend = backend or (ghdl_backend() if total * man["cycles_per_sample"] > 2_000_000 else "mcode")
+    backend = backend or backend_for(total * man["cycles_per_sample"])
     backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
     t_build = time.monotonic() - t0
     shard_cfg = []
@@ -280,8 +292,9 @@ def _run_shards(build_dir: Path, module: str, backend: str, shards: list[tuple[P
                 files: list[Path], total: int, progress) -> list[Path]:
     """The built sweep harness run once per shard ((bench configuration, generics) each), side by
     side; ``progress(done, total, elapsed_s)`` about twice a second from the lines in ``files``.
-    Returns the shards' results files."""
-    results: list = [None] * len(shards)
+    Returns the shards' results files, one per shard in order (a shard that wrote none is
+    counted failed when they are read)."""
+    results = [_results_file(build_dir, str(k)) for k in range(len(shards))]
 
     def one(k: int) -> None:
         results[k] = _test(build_dir, "flann_sweep", module, backend, shards[k][0], str(k), shards[k][1], [], None,
@@ -297,7 +310,7 @@ def _run_shards(build_dir: Path, module: str, backend: str, shards: list[tuple[P
             progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
     if progress:  # the last figure, whatever the timing: a terminal's line ends at done
         progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
-    return [r for r in results if r is not None]
+    return results
 
 
 def sweep_temperatures(sources, module: str, build_dir, config: dict, parameters: dict, temps, *, name: str,
@@ -452,5 +465,5 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
-__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "simulate", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "backend_for", "simulate", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]

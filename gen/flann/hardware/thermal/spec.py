@@ -45,8 +45,8 @@ temperatures), but at each temperature the sensor covers only part of the voltag
 temperature whose span is smallest) evaluates the polynomial in t_n outside the calibration,
 and the model extrapolates there (45 mm on a +-25 mm sensor).  So the output is saturated at
 the calibrated displacement range (the model's ``displacement_range_mm``, the positions it
-was trained on) widened by ``flann.golden.thermal.OUTPUT_MARGIN`` of its span on each side (the fit's own error at
-the stroke's ends), rounded outward to the output LSB: ``out_lo``, ``out_hi``
+was trained on) widened by ``flann.golden.thermal.OUTPUT_MARGIN`` of its span on each side
+(the fit's own error at the stroke's ends), rounded outward to the output LSB: ``out_lo``, ``out_hi``
 (:func:`output_limit_codes`), and ``out_sat`` is raised there.  ``float_reference`` is the
 float model saturated at the same limits (in mm: the codes x q), so |hardware - reference|
 keeps its bound (a saturation is 1-Lipschitz) and a saturated output equals its reference.
