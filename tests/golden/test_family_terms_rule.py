@@ -10,7 +10,7 @@ import pytest
 from scipy.special import erf
 
 from flann.golden.family import FAMILY_SHARE, _steady, family_terms, shared_terms
-from flann.hardware.family.build import NORMALISATION, RIDGE
+from flann.hardware.family.build import NORMALISATION
 
 
 def test_the_fewest_accurate_steady_count_is_taken_without_a_warning():
@@ -50,6 +50,7 @@ def test_members_with_a_bias_near_zero_are_steady():
                                                                             (1.03, 0.0)])]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        terms, choices = family_terms(members, norm=NORMALISATION, ridge=RIDGE)
+        terms, _ridge, choices = family_terms(members, norm=NORMALISATION)
     assert terms > 11
     assert all(c.family_rms_mm <= FAMILY_SHARE * c.own_rms_mm for c in choices), choices
+    assert all(c.family_max_mm <= FAMILY_SHARE * c.own_max_mm for c in choices), choices

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.golden.family import FAMILY_SHARE, family_terms
+from flann.golden.family import FAMILY_RIDGES, FAMILY_SHARE, family_terms
 from flann.golden.train import fit_auto
 from flann.recordings import Recordings, write_recordings
 
@@ -22,15 +22,17 @@ def s_curve_rec(amp, asym, seed, steps=150, lsb=2 * 3.6 / 2 ** 14):
 
 def test_family_terms_keep_every_member_near_its_own_design():
     recs = [s_curve_rec(3.0, 0.02, 1), s_curve_rec(3.1, -0.01, 2)]
-    terms, choices = family_terms([(str(i), r.voltage_v, r.displacement_mm) for i, r in enumerate(recs)],
-                                  norm="half", ridge=1e-6)
+    terms, ridge, choices = family_terms([(str(i), r.voltage_v, r.displacement_mm) for i, r in enumerate(recs)],
+                                         norm="half")
     assert 2 <= terms <= max(c.own_terms for c in choices)
+    assert ridge in FAMILY_RIDGES
     for c, r in zip(choices, recs):
         # the member's own choice is what train --terms auto takes with the family's normalisation
         _m, own = fit_auto(r.voltage_v, r.displacement_mm, norms=("half",),
-                           ridges=tuple(x for x in (1e-6, 1e-4, 1e-2, 1e-1, 1.0)))
+                           ridges=(1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1e-1, 1.0))
         assert c.own_terms == own.terms
         assert c.family_rms_mm <= FAMILY_SHARE * c.own_rms_mm
+        assert c.family_max_mm <= FAMILY_SHARE * c.own_max_mm
 
 
 def test_gen_family_terms_auto_says_what_sharing_costs(tmp_path, capsys):

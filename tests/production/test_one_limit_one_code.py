@@ -18,7 +18,8 @@ from flann.hardware.accuracy import (adc_codes, design_adc, design_spec, hardwar
 from flann.hardware.family.render import load_design
 from flann.hardware.registry import FAMILY_THERMAL, datapath, read_design
 from flann.numeric.fixed import nearest_codes
-from flann.production.calibrate import RIDGES, check_sensor
+from flann.golden.family import ridge_ladder
+from flann.production.calibrate import check_sensor
 from flann.production.spec import ProductionSpec
 from flann.production.thermal import check_sensor_thermal
 from flann.production.verdict import judge
@@ -149,7 +150,7 @@ def test_thermal_certificate_limit_is_evals_limit(thermal_family, capsys):
     assert dp is FAMILY_THERMAL
     spec, _ = dp.rebuild(dp.model_path(thermal_family["design"], man), man, thermal_family["design"])
     rec_path = thermal_family["paths"][1]
-    chk = check_sensor_thermal(read_recordings(rec_path), spec, RIDGES)
+    chk = check_sensor_thermal(read_recordings(rec_path), spec, ridge_ladder(spec.fam.ridge))
     model_path = thermal_family["dir"] / "t1_model.json"
     model_path.write_text(chk["model"].to_json())
     hw, pts = eval_hardware(capsys, model_path, rec_path, thermal_family["design"])

@@ -3,11 +3,12 @@
 Each member's recordings are put through the same selection as ``--terms auto`` (held-out
 error by cross-validation, the cheapest buildable candidate as good as the best), restricted
 to the family datapath's normalisation.  The shared design must serve the worst member: it
-takes the fewest terms at which every member's held-out RMS (at the family's ridge) is within
-``FAMILY_SHARE`` of its own choice's and whose weights are steady from member to member
-(:func:`_steady`), at most the largest of the members' own term counts.  :func:`family_terms` also says what
-sharing costs each member: its own choice (terms, held-out RMS, fixed-point cost) next to
-its held-out RMS at the family's terms.
+takes the fewest terms, and at those the largest of :data:`FAMILY_RIDGES` (the smallest
+weights), at which every member's held-out RMS and max error are within ``FAMILY_SHARE`` of
+its own choice's and whose weights are steady from member to member (:func:`_steady`), at
+most the largest of the members' own term counts.  :func:`family_terms` also says what
+sharing costs each member: its own choice (terms, held-out RMS and max, fixed-point cost)
+next to its held-out figures at the family's terms and ridge.
 
 :func:`family_thermal_terms` is the same rule for a family with temperature (x = sum_j t_n^j
 f_j(v), one term count shared by every order and member): each member's own choice is
@@ -27,8 +28,21 @@ from ..errors import FlannError
 from . import thermal_train
 from .train import AUTO_RIDGES, AUTO_TERMS, cross_validate, fit_auto, fit_lstsq
 
-# the family's terms keep every member's held-out RMS within this factor of its own design's
+# the family's terms keep every member's held-out RMS and max error within this factor of its
+# own design's
 FAMILY_SHARE = 1.2
+# The ridges a family design may train its members with, largest (smallest weights) first.  A
+# fixed 1e-6 bent the ends: on 20 S-curve sensors 41 terms reached 1.2-1.7 x each member's own
+# max error where 25 terms at 1e-10 reach 1.0-1.1 with weights of at most 10 (bench/family_reach.py).
+FAMILY_RIDGES = (1e-6, 1e-8, 1e-10)
+DEFAULT_RIDGE = FAMILY_RIDGES[0]    # --terms N, and designs whose manifest names no ridge
+# calibrate tries the design's ridge first, then these larger ones until a sensor's weights fit
+CALIBRATE_RIDGES = (*sorted(FAMILY_RIDGES), 1e-5, 1e-4, 1e-3)
+
+
+def ridge_ladder(ridge: float) -> tuple[float, ...]:
+    """The ridges calibrate tries for a design trained at ``ridge``: that one, then larger."""
+    return (ridge, *(r for r in CALIBRATE_RIDGES if r > ridge))
 
 
 @dataclass(frozen=True)
@@ -39,6 +53,8 @@ class MemberChoice:
     own_rms_mm: float
     own_cost: float | None          # LUT4 equivalents of its own design (None: not costed)
     family_rms_mm: float | None = None
+    own_max_mm: float | None = None     # held-out max error (None: judged by RMS alone)
+    family_max_mm: float | None = None
 
 
 def _steady(models, margin: float) -> bool:
@@ -60,57 +76,69 @@ def _steady(models, margin: float) -> bool:
     return True
 
 
-def family_terms(members, *, norm: str, ridge: float, margin: float = 0.5,
-                 cost=None) -> tuple[int, list[MemberChoice]]:
-    """(terms, per-member choices) for ``members``: (name, voltage_v, displacement_mm) tuples.
+def family_terms(members, *, norm: str, ridges=FAMILY_RIDGES, margin: float = 0.5,
+                 cost=None) -> tuple[int, float, list[MemberChoice]]:
+    """(terms, ridge, per-member choices) for ``members``: (name, voltage_v, displacement_mm) tuples.
 
     ``cost(model)`` as for :func:`flann.golden.train.fit_auto` (the design at the user's
-    converter).  The family's held-out RMS of each member is the same cross-validation at the
-    family's terms, normalisation and ridge (what :func:`fit_lstsq` will be given).
+    converter).  The family's held-out figures of each member are the same cross-validation at
+    the family's terms, normalisation and each of ``ridges`` (what :func:`fit_lstsq` will be
+    given).
     """
+    ridges = tuple(sorted(ridges, reverse=True))
     own = []
     for name, v, x in members:
-        # judged at the ridges the family trains with (its weights must fit one memory)
+        # judged at the ridges the family may train with (its weights must fit one memory)
         try:
-            model, choice = fit_auto(v, x, norms=(norm,), ridges=tuple(r for r in AUTO_RIDGES if r >= ridge),
+            model, choice = fit_auto(v, x, norms=(norm,), ridges=tuple(r for r in AUTO_RIDGES if r >= ridges[-1]),
                                      cost=cost)
         except FlannError as exc:
             raise FlannError(f"{name}: {exc}") from None
         fp = model.training.get("fixed_point") or {}
         own.append((name, v, x, choice, fp.get("cost")))
     top = max(c.terms for _n, _v, _x, c, _c in own)
-    tried = [t for t in AUTO_TERMS if t <= top]
-    table = [{r.terms: r.rms_mm for r in cross_validate(v, x, tried, (norm,), (ridge,))}
+    counts = [t for t in AUTO_TERMS if t <= top]
+    tried = [(t, r) for t in counts for r in ridges]
+    table = [{(r.terms, r.ridge): (r.rms_mm, r.max_mm) for r in cross_validate(v, x, counts, (norm,), ridges)}
              for _n, v, x, _c, _cost in own]
 
-    def steady(t):
+    def steady(key):
+        t, ridge = key
         fits = [fit_lstsq(v, x, t, norm=norm, ridge=ridge) for _n, v, x, _c, _cost in own]
         return _steady([(m.bias, m.weights) for m in fits], margin)
 
-    terms = shared_terms(tried, table, [c.rms_mm for _n, _v, _x, c, _cost in own], steady)
-    out = [MemberChoice(name, c.terms, c.ridge, c.rms_mm, own_cost, rms[terms])
-           for (name, v, x, c, own_cost), rms in zip(own, table)]
-    return terms, out
+    key = shared_terms(tried, table, [(c.rms_mm, c.max_mm) for _n, _v, _x, c, _cost in own], steady,
+                       describe=lambda k: f"{k[0]} terms at ridge {k[1]:g}")
+    out = [MemberChoice(name, c.terms, c.ridge, c.rms_mm, own_cost, held[key][0], c.max_mm, held[key][1])
+           for (name, v, x, c, own_cost), held in zip(own, table)]
+    return key[0], key[1], out
 
 
-def shared_terms(tried, table, own_rms, steady) -> int:
-    """The family's rule: of the term counts ``tried`` (ascending, up to the members' largest
-    own count), the fewest that keep every member's held-out RMS (``table[k][terms]``, member
-    k) within ``FAMILY_SHARE`` of its own choice's (``own_rms[k]``) and whose weights are
-    ``steady(terms)`` (fewer terms: smaller, steadier weights, so sensors like the members fit
-    the memory too); if none is both, the most accurate steady one, else the largest."""
-    def accurate(t):
-        return all(held[t] <= FAMILY_SHARE * rms for held, rms in zip(table, own_rms))
+def shared_terms(tried, table, own, steady, describe=lambda t: f"{t} terms"):
+    """The family's rule: of the candidates ``tried`` (in order of preference: fewer terms,
+    then smaller weights; up to the members' largest own count), the first that keeps every
+    member's held-out figures (``table[k][candidate]``, member k: one number or a tuple, RMS
+    then max) within ``FAMILY_SHARE`` of its own choice's (``own[k]``, the same figures) and
+    whose weights are ``steady(candidate)`` (fewer terms: smaller, steadier weights, so sensors
+    like the members fit the memory too); if none is both, the last steady one (the most
+    terms), else the last."""
+    def within(held, mine):
+        return bool(np.all(np.atleast_1d(held) <= FAMILY_SHARE * np.atleast_1d(mine)))
 
-    terms = next((t for t in tried if accurate(t) and steady(t)), None)
-    if terms is None:
-        terms = next((t for t in reversed(tried) if steady(t)), tried[-1])
-        worst = max(held[terms] / rms if rms > 0 else np.inf for held, rms in zip(table, own_rms))
-        warnings.warn(f"no shared term count keeps every member's held-out RMS within {FAMILY_SHARE:g} x its "
-                      f"own design's (tried {', '.join(map(str, tried))} terms): {terms} terms, the most "
-                      f"accurate with steady weights, leave the worst member at {worst:.2f} x its own",
+    def worst(held, mine):
+        held, mine = np.atleast_1d(held), np.atleast_1d(mine)
+        return float(max(h / m if m > 0 else np.inf for h, m in zip(held, mine)))
+
+    found = next((c for c in tried if all(within(held[c], mine) for held, mine in zip(table, own))
+                  and steady(c)), None)
+    if found is None:
+        found = next((c for c in reversed(tried) if steady(c)), tried[-1])
+        ratio = max(worst(held[found], mine) for held, mine in zip(table, own))
+        warnings.warn(f"no shared term count keeps every member's held-out error within {FAMILY_SHARE:g} x its "
+                      f"own design's ({len(tried)} candidates tried): {describe(found)}, the most "
+                      f"accurate with steady weights, leave the worst member at {ratio:.2f} x its own",
                       stacklevel=2)
-    return terms
+    return found
 
 
 # the family design's temperature orders take these expansion sizes (the design needs >= 2)
@@ -154,7 +182,8 @@ def family_thermal_terms(members, *, orders: int, temperature_norm: tuple[float,
     return terms, out
 
 
-__all__ = ["MemberChoice", "family_terms", "family_thermal_terms", "shared_terms", "THERMAL_TERMS"]
+__all__ = ["CALIBRATE_RIDGES", "DEFAULT_RIDGE", "FAMILY_RIDGES", "MemberChoice", "family_terms",
+           "family_thermal_terms", "ridge_ladder", "shared_terms", "THERMAL_TERMS"]
 
 
 # a member whose error in the family design exceeds its own design's by more than this is

@@ -47,12 +47,12 @@ from ..diagnose import diagnose
 from ..diagnose.data import reduce_points
 from ..errors import FlannError, Terminated
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
-from ..golden.family import REACH_FACTOR, own_reach_mm
+from ..golden.family import REACH_FACTOR, own_reach_mm, ridge_ladder
 from ..golden.metrics import raw_output_mm
 from ..golden.model import text_sha256
 from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
-from ..hardware.family.build import RIDGE, train_model
+from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
 from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
 from ..hardware.family.spec import FamilySpec, FitError, member_spec, outside_input
@@ -68,7 +68,6 @@ from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
 from .verdict import FAIL, PASS, Verdict, judge, rejected, require_positions, uncertainty
 
-RIDGES = (RIDGE, 1e-5, 1e-4, 1e-3)  # the family's own ridge first, then more until the weights fit
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
 # nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
 # sensors tried (docs/production.md); fewer points save little, the fits dominate.
@@ -158,9 +157,10 @@ class Result:
 
 
 def train_for_design(rec, fam: FamilySpec):
-    """(model, member spec): the least ridge whose weights fit the design's formats."""
+    """(model, member spec): the least ridge, from the design's own up, whose weights fit the
+    design's formats."""
     last = None
-    for ridge in RIDGES:
+    for ridge in ridge_ladder(fam.ridge):
         model = train_model(rec, fam.terms, ridge)
         try:
             return model, member_spec(fam, model, text_sha256(model.to_json()))
@@ -360,7 +360,7 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
             if rec.temperature_c is None:
                 raise FlannError(f"{path}: no temperature_c column; the design compensates temperature "
                                  f"({fam.orders} orders): calibrate at {fam.orders} or more temperatures")
-            chk = check_sensor_thermal(rec, fam, RIDGES)
+            chk = check_sensor_thermal(rec, fam, ridge_ladder(fam.fam.ridge))
         res.warnings += [str(w.message) for w in caught]
         err, x = chk["hw_err_mm"], np.asarray(rec.displacement_mm, dtype=float)
         res.twin_vs_float_lsb = chk["twin_err_lsb"]
@@ -590,5 +590,5 @@ def write_summary(path, results) -> None:
 
 
 __all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
-           "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS", "RIDGES",
+           "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS",
            "DIAGNOSIS_POINTS"]

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ...errors import FlannError
 from ...golden.model import MAX_TERMS, FlannModel, load_model
-from ...golden.family import family_terms
+from ...golden.family import DEFAULT_RIDGE, family_terms
 from ...golden.forward import screens
 from ...golden.screen import ready_for_fit
 from ...golden.train import fit_lstsq
@@ -27,10 +27,9 @@ DEFAULT_TERMS = "auto"  # chosen for the worst member, like train --terms auto (
 MIN_TERMS = 2    # a family's weight memory holds the term v and at least one harmonic
 FIXED_TERMS = 15  # a CSV's terms when --terms auto has no recordings to choose from, and calibrate's fallback
 NORMALISATION = "half"  # v_n in [-0.5, 0.5]: the periodic terms need not join the two ends
-RIDGE = 1e-6  # keeps the weights (and so the memory word) small at no cost in accuracy
 
 
-def train_model(rec, terms: int = FIXED_TERMS, ridge: float = RIDGE, training: dict | None = None) -> FlannModel:
+def train_model(rec, terms: int = FIXED_TERMS, ridge: float = DEFAULT_RIDGE, training: dict | None = None) -> FlannModel:
     """Least-squares FLANN of ``terms`` terms on recordings ready for the fit
     (:func:`flann.golden.screen.ready_for_fit`: a glitch among repeats is the screen's)."""
     rec = prepare_for_fit(rec, can_trim=False, lone_glitches=screens(rec.displacement_mm))
@@ -69,28 +68,27 @@ def ready_members(sources, read: dict) -> dict:
 
 
 def auto_terms(sources, options: dict, margin: float = DEFAULT_MARGIN, ready: dict | None = None):
-    """(terms, per-member choices) for the recordings among ``sources`` (``ready``: their
+    """(terms, ridge, per-member choices) for the recordings among ``sources`` (``ready``: their
     :func:`ready_members`), chosen like ``flann train --terms auto`` at the design's converter
-    (:func:`flann.golden.family.family_terms`); (None, []) when every member is a model.json
-    (their terms are used as they are)."""
+    (:func:`flann.golden.family.family_terms`); (None, the default ridge, []) when every member
+    is a model.json (their terms are used as they are)."""
     if ready is None:
         ready = ready_members(sources, read_csvs(sources))
     members = [(Path(sources[k]).stem, rec.voltage_v, rec.displacement_mm) for k, rec in ready.items()]
     if not members:
-        return None, []
+        return None, DEFAULT_RIDGE, []
     adc = (options.get("input_bits", default("input_bits")), options.get("input_lsb_v"))
-    return family_terms(members, norm=NORMALISATION, ridge=RIDGE, margin=margin,
-                        cost=lambda m: fixed_point_cost(m, adc))
+    return family_terms(members, norm=NORMALISATION, margin=margin, cost=lambda m: fixed_point_cost(m, adc))
 
 
-def load_member(path, terms: int = FIXED_TERMS, rec=None) -> FlannModel:
+def load_member(path, terms: int = FIXED_TERMS, rec=None, ridge: float = DEFAULT_RIDGE) -> FlannModel:
     """A model.json as it is, or a recordings CSV (``rec``: already ready for the fit,
-    :func:`ready_members`) trained with ``terms`` terms."""
+    :func:`ready_members`) trained with ``terms`` terms at ``ridge``."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         return load_model(path)
     if path.suffix.lower() == ".csv":
-        return train_model(ready_for_fit(read_recordings(path))[0] if rec is None else rec, terms)
+        return train_model(ready_for_fit(read_recordings(path))[0] if rec is None else rec, terms, ridge)
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
 
@@ -105,22 +103,22 @@ def generate_family(sources, out_dir, *, terms: int | str = DEFAULT_TERMS, margi
     """Size one design for every source and write it (nothing written if any step fails)."""
     if not sources:
         raise FlannError("--family needs at least one recordings CSV or model.json")
-    choices, ready = [], ready_members(sources, read_csvs(sources))
+    choices, ready, ridge = [], ready_members(sources, read_csvs(sources)), DEFAULT_RIDGE
     if terms == "auto":
-        terms, choices = auto_terms(sources, options, margin, ready)
+        terms, ridge, choices = auto_terms(sources, options, margin, ready)
         terms = FIXED_TERMS if terms is None else max(MIN_TERMS, terms)
     check_terms(terms)
     models, bad = [], []
     for k, p in enumerate(sources):   # every member is tried: the user learns of all bad files at once
         try:
-            models.append(load_member(p, terms, ready.get(k)))
+            models.append(load_member(p, terms, ready.get(k), ridge))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
         raise FlannError(f"{len(bad)} of {len(sources)} family members cannot be used "
                          "(nothing written): " + "; ".join(bad))
     names = member_names(sources)
-    fam = derive_family(models, names=names, margin=margin, **options)
+    fam = derive_family(models, names=names, margin=margin, ridge=ridge, **options)
     man = write(fam, out_dir, fam.spec.model, init_name=names[0], members=dict(zip(names, models)))
     if choices:
         man = {**man, "terms_chosen": [vars(c) for c in choices]}

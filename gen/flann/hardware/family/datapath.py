@@ -6,7 +6,7 @@ import warnings
 
 from ...errors import FlannError, SpecError
 from ...golden.model import load_model
-from ..datapath import Datapath, Field, _int, _num
+from ..datapath import NUMBER, Datapath, Field, _int, _num
 from ..fixed.datapath import DATAPATH as FIXED
 from ..options import GenOptions
 from . import render
@@ -49,7 +49,8 @@ def estimate(man: dict) -> dict:
 def summary(man: dict) -> list[str]:
     fam = man["family"]
     mem = fam["memory"]
-    return [f"  family of {len(fam['members'])} sensor(s), margin {fam['margin']:g}, {fam['terms']} terms",
+    ridge = f", ridge {fam['ridge']:g}" if "ridge" in fam else ""
+    return [f"  family of {len(fam['members'])} sensor(s), margin {fam['margin']:g}, {fam['terms']} terms{ridge}",
             f"  {man['input_bits']}-bit input x {man['input_lsb_v']} V -> {man['output_bits']}-bit output x "
             f"{man['output_lsb_mm']} mm; {man['cycles_per_sample']} cycles/sample",
             f"  weight memory {mem['used_words']} of {mem['depth']} x {mem['data_bits']}-bit words "
@@ -60,15 +61,26 @@ def summary(man: dict) -> list[str]:
 def choice_lines(man: dict) -> list[str]:
     """One line per member of ``--terms auto``: its own design against its share of the family's."""
     terms = man["family"]["terms"]
-    return [f"  {c['name']}: own design {c['own_terms']} terms (held-out RMS {c['own_rms_mm']:.4g} mm"
+
+    def held(c, who):
+        rms, top = c[f"{who}_rms_mm"], c.get(f"{who}_max_mm")
+        return f"held-out RMS {rms:.4g} mm" + ("" if top is None else f", max {top:.4g} mm")
+
+    def ratio(c):
+        said = f"{c['family_rms_mm'] / c['own_rms_mm']:.2f}x"
+        if c.get("own_max_mm") and c.get("family_max_mm") is not None:
+            said += f", {c['family_max_mm'] / c['own_max_mm']:.2f}x"
+        return said
+    return [f"  {c['name']}: own design {c['own_terms']} terms ({held(c, 'own')}"
             + (f", {c['own_cost']:.0f} LUT4-eq." if c["own_cost"] is not None else "")
-            + f"); in the family {terms} terms, held-out RMS {c['family_rms_mm']:.4g} mm "
-            f"({c['family_rms_mm'] / c['own_rms_mm']:.2f}x its own)" for c in man.get("terms_chosen", [])]
+            + f"); in the family {terms} terms, {held(c, 'family')} ({ratio(c)} its own)"
+            for c in man.get("terms_chosen", [])]
 
 
 FIELDS = (
     _num("output_lsb_mm", 0), Field("family", (dict,)), _num("family.margin", 0),
     Field("family.members", (list,)), Field("family.options", (dict,)), _int("family.terms", 2),
+    Field("family.ridge", NUMBER, 0, optional=True),
     Field("family.widths", (dict,)),
     *(_int(f"family.widths.{k}") for k in ("weight_bits", "lin_width", "lin_bits", "product_bits", "acc_bits")),
     Field("images", (list,), optional=True), Field("family.memory", (dict,)), _int("family.memory.depth"), _int("family.memory.addr_bits"),

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...errors import SpecError
+from ...golden.family import DEFAULT_RIDGE
 from ...golden.model import FlannModel
 from ...numeric.fixed import bits_needed, nearest_codes
 from ..fixed.latency import norm_latency
@@ -103,6 +104,7 @@ class FamilySpec:
     margin: float
     options: dict = field(compare=False)  # FORCED options, as every member is derived
     members: tuple = ()  # names the design was sized from
+    ridge: float = DEFAULT_RIDGE  # the members' weights are trained with this ridge (calibrate: first)
 
     # -- shape ----------------------------------------------------------------------------
     @property
@@ -180,6 +182,7 @@ class FamilySpec:
         s = self.spec
         return {
             "margin": self.margin,
+            "ridge": self.ridge,
             "members": list(self.members),
             "options": dict(self.options),
             "terms": self.terms,
@@ -231,6 +234,7 @@ def _scaled(model: FlannModel, k: float) -> FlannModel:
 
 
 def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT_MARGIN,
+                  ridge: float = DEFAULT_RIDGE,
                   input_bits: int = default("input_bits"), input_lsb_v: float | None = None,
                   output_bits: int | None = None, output_lsb_mm: float | None = None,
                   device: str = default("device"), mult_style: str = default("mult_style"),
@@ -300,7 +304,7 @@ def derive_family(models: list[FlannModel], *, names=(), margin: float = DEFAULT
                                     lin_bound=lin_bound,
                                     acc_bound=acc_bound_for(lin_bound, [wmax] * specs[0].steps,
                                                             b0.expansion.term_max, shift)),
-                     margin=mu, options=options, members=tuple(names))
+                     margin=mu, options=options, members=tuple(names), ridge=float(ridge))
     _check_memory(fam)
     for s in specs:  # every member fits by construction; keep the check honest
         member_spec(fam, s.model)
@@ -357,6 +361,7 @@ def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
         w = d["widths"]
         margin = float(d["margin"])
         terms = int(d["terms"])
+        ridge = float(d.get("ridge", DEFAULT_RIDGE))
     except (KeyError, TypeError, ValueError) as exc:
         raise SpecError(f"manifest 'family' entry is incomplete ({exc})") from None
     try:
@@ -368,7 +373,7 @@ def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
                          lin_width=int(w["lin_width"]), lin_bound=top["lin_bits"], acc_bound=top["acc_bits"])
     except (KeyError, TypeError, ValueError) as exc:
         raise SpecError(f"manifest 'family' entry is incomplete ({exc})") from None
-    fam = FamilySpec(spec=spec, margin=margin, options=options, members=tuple(d.get("members", ())))
+    fam = FamilySpec(spec=spec, margin=margin, options=options, members=tuple(d.get("members", ())), ridge=ridge)
     _check_memory(fam)
     return fam
 

@@ -13,12 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import FlannError, SpecError
-from ...golden.family import family_thermal_terms
+from ...golden.family import DEFAULT_RIDGE, family_thermal_terms
 from ...golden.model import text_sha256
 from ...golden.thermal import FORMAT, ThermalModel, load_any_model, temperature_groups
 from ...golden.thermal_train import fit_thermal
 from ...recordings import prepare_for_fit, read_recordings
-from ..family.build import FIXED_TERMS, NORMALISATION, RIDGE, check_terms, member_names, read_csvs
+from ..family.build import FIXED_TERMS, NORMALISATION, check_terms, member_names, read_csvs
 from ..family.spec import DEFAULT_MARGIN
 from ..options import default
 from .render import write
@@ -62,7 +62,7 @@ def _prepared(rec):
             cat([p.displacement_mm for p in parts]))
 
 
-def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = RIDGE,
+def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = DEFAULT_RIDGE,
                training: dict | None = None) -> ThermalModel:
     """x = sum_j t_n^j f_j(v) by least squares on every reading, t_n the design's."""
     temps = calibration_temperatures(rec)
@@ -94,7 +94,7 @@ def auto_terms(sources, temp: TempNorm, orders: int, margin: float, read: dict |
     if not members:
         return None, []
     terms, choices = family_thermal_terms(members, orders=orders, temperature_norm=(temp.offset_c, temp.scale_c),
-                                          norm=NORMALISATION, ridge=RIDGE, margin=margin)
+                                          norm=NORMALISATION, ridge=DEFAULT_RIDGE, margin=margin)
     return terms, list(zip(where, choices))
 
 
