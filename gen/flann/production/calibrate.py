@@ -169,6 +169,21 @@ def train_for_design(rec, fam: FamilySpec):
     raise last
 
 
+def reach_flag(rec, fam: FamilySpec, max_error_mm: float) -> tuple[float, str | None]:
+    """(what the sensor's own design reaches on its recording, the flag or None): its own
+    ``--terms auto`` fit at the design's converter, asked at the voltages that converter hands
+    on (as the hardware is), against the hardware's ``max_error_mm``."""
+    s = fam.spec
+    reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
+                                    cost=lambda m: fixed_point_cost(m, (s.input_bits, s.input_lsb_v)),
+                                    received=lambda v: adc_codes(s, v) * s.input_lsb_v)
+    if max_error_mm <= REACH_FACTOR * reach:
+        return reach, None
+    return reach, (f"hardware max error {max_error_mm:.4g} mm is {max_error_mm / reach:.2f} x what this "
+                   f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms, at the design's "
+                   f"{s.input_bits}-bit input; flagged above {REACH_FACTOR:g} x): the family design costs it accuracy")
+
+
 def check_sensor(rec, fam: FamilySpec) -> dict:
     """Train, quantise and check one sensor's recordings against the family design's twin."""
     require_positions(rec.displacement_mm, fam.terms)
@@ -320,14 +335,8 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
         res.model_sha256 = text_sha256(chk["model"].to_json())
-        reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
-                                        cost=lambda m: fixed_point_cost(m, (fam.spec.input_bits, fam.spec.input_lsb_v)))
-        res.own_reach_mm = reach
-        if res.max_error_mm > REACH_FACTOR * reach:
-            res.costs_accuracy = (
-                f"hardware max error {res.max_error_mm:.4g} mm is {res.max_error_mm / reach:.2f} x what this "
-                f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms; flagged above "
-                f"{REACH_FACTOR:g} x): the family design costs it accuracy")
+        res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm)
+        if res.costs_accuracy:
             res.warnings.append(res.costs_accuracy)
         reversed_output = polarity_warning(rec, fam)
         if reversed_output:
@@ -589,6 +598,6 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
+__all__ = ["reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
            "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS",
            "DIAGNOSIS_POINTS"]
