@@ -1,4 +1,5 @@
-"""The family design's default (--terms auto) and its headroom for sensors not in the gen set."""
+"""The family design's default (--terms auto: terms and ridge) and its headroom for sensors not in
+the gen set."""
 
 import contextlib
 import io
@@ -10,7 +11,9 @@ import pytest
 
 from flann.cli import main
 from flann.hardware.family.datapath import rebuild
-from flann.production.calibrate import check_sensor, train_for_design
+from flann.golden.family import DEFAULT_RIDGE, FAMILY_RIDGES, ridge_ladder
+from flann.hardware.family.render import load_design
+from flann.production.calibrate import check_sensor, reach_flag, train_for_design
 from flann.recordings import Recordings, read_recordings, write_recordings
 
 LSB = 2 * 3.6 / 2 ** 14
@@ -26,14 +29,13 @@ def s_curve_rec(amp, asym, w_mm, rng, steps=300):
     return Recordings(displacement_mm=xs, voltage_v=v, direction=np.sign(np.gradient(xs)))
 
 
-@pytest.fixture(scope="module")
-def family(tmp_path_factory):
-    """Three members drawn with +-3 % asymmetry, the design sized by flann gen's defaults."""
-    d = tmp_path_factory.mktemp("headroom")
-    rng = np.random.default_rng(2)
+def sized(d, seed: int, stem: str) -> tuple[list, str]:
+    """Three members drawn with +-3 % asymmetry (``stem``0.csv ...), a design sized from them
+    by flann gen's defaults in d/design: (their paths, what gen printed)."""
+    rng = np.random.default_rng(seed)
     paths = []
     for k in range(3):
-        paths.append(d / f"m{k}.csv")
+        paths.append(d / f"{stem}{k}.csv")
         write_recordings(paths[-1], s_curve_rec(rng.uniform(2.9, 3.2), rng.uniform(-0.03, 0.03),
                                                 7.0 * rng.uniform(0.95, 1.05), rng))
     out = io.StringIO()
@@ -41,9 +43,16 @@ def family(tmp_path_factory):
         rc = main(["gen", "--family", *map(str, paths), "-o", str(d / "design"), "--input-bits", "14",
                    "--input-lsb-v", repr(LSB)])
     assert rc == 0
+    return paths, out.getvalue()
+
+
+@pytest.fixture(scope="module")
+def family(tmp_path_factory):
+    d = tmp_path_factory.mktemp("headroom")
+    _paths, said = sized(d, 2, "m")
     man = json.loads((d / "design" / "manifest.json").read_text())
     fam, _ = rebuild(d / "design" / "init_model.json", man)
-    return d, man, fam, out.getvalue()
+    return d, man, fam, said
 
 
 def test_default_terms_are_chosen_like_train_auto(family):
@@ -85,3 +94,45 @@ def test_a_sensor_far_outside_the_family_is_still_refused(family, tmp_path, caps
     rc = main(["calibrate", str(p), "-o", str(tmp_path / "cal"), "--design", str(d / "design")])
     assert rc != 0
     assert "exceeds the design's input" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def design(tmp_path_factory):
+    """Three members whose design, at a fixed ridge of 1e-6, took 41 terms and left the first
+    flagged by calibrate at 1.53 x what its own design reaches: the ends of the stroke bent."""
+    tmp = tmp_path_factory.mktemp("family_ridge")
+    paths, _said = sized(tmp, 7, "s")
+    return tmp / "design", paths
+
+
+def test_the_design_names_its_ridge_and_its_members_are_not_flagged(design):
+    out, paths = design
+    man = json.loads((out / "manifest.json").read_text())
+    ridge = man["family"]["ridge"]
+    assert ridge in FAMILY_RIDGES
+    fam = load_design(out)
+    assert fam.ridge == ridge
+    for p in paths:
+        rec = read_recordings(p)
+        chk = check_sensor(rec, fam)
+        assert chk["model"].training["ridge"] == ridge      # calibrate trains at the design's ridge
+        hw = float(np.max(np.abs(chk["hw_err_mm"])))
+        own, flag = reach_flag(rec, fam, hw)
+        assert flag is None, (p.name, hw / own)
+
+
+def test_a_design_without_a_ridge_is_read_at_the_one_it_was_trained_with(design):
+    out, _paths = design
+    written = (out / "manifest.json").read_text()
+    man = json.loads(written)
+    del man["family"]["ridge"]
+    (out / "manifest.json").write_text(json.dumps(man))
+    try:
+        assert load_design(out).ridge == DEFAULT_RIDGE
+    finally:
+        (out / "manifest.json").write_text(written)
+
+
+def test_calibrate_tries_the_design_ridge_then_larger_ones():
+    assert ridge_ladder(1e-10) == (1e-10, 1e-8, 1e-6, 1e-5, 1e-4, 1e-3)
+    assert ridge_ladder(DEFAULT_RIDGE) == (1e-6, 1e-5, 1e-4, 1e-3)
