@@ -211,18 +211,18 @@ def test_family_terms_auto_compares_what_each_design_reaches_between_positions()
     norm_t = (25.0, 55.0)
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
-        family, choices = family_thermal_terms(
+        family, ridge, choices = family_thermal_terms(
             [(str(k), r.voltage_v, r.temperature_c, r.displacement_mm) for k, r in enumerate(recs)],
-            orders=3, temperature_norm=norm_t, norm="half", ridge=1e-6)
+            orders=3, temperature_norm=norm_t, norm="half")
     fresh = _tanh_sensor(*sensors[0], (-20, 25, 80), 0.033, 9, noise=0.0)
 
-    def between_positions(terms):
+    def between_positions(terms, at):
         m = fit_thermal(recs[0].voltage_v, recs[0].temperature_c, recs[0].displacement_mm, (terms,) * 3,
-                        norm="half", ridge=1e-6, correct_input=False, temperature_norm=norm_t)
+                        norm="half", ridge=at, correct_input=False, temperature_norm=norm_t)
         return float(np.sqrt(np.mean((m.predict(fresh.voltage_v, fresh.temperature_c) - fresh.displacement_mm) ** 2)))
 
     c = choices[0]
-    own, shared = between_positions(c.own_terms), between_positions(family)
+    own, shared = between_positions(c.own_terms, c.own_ridge), between_positions(family, ridge)
     # the figures gen prints are what the designs reach (the noise adds a little to both)
     assert own <= c.own_rms_mm <= 1.5 * own, (c, own)
     assert shared <= c.family_rms_mm <= 1.5 * shared, (c, shared)

@@ -146,40 +146,42 @@ THERMAL_TERMS = tuple(n for n in thermal_train.AUTO_TERMS if n >= 2)
 
 
 def family_thermal_terms(members, *, orders: int, temperature_norm: tuple[float, float], norm: str,
-                         ridge: float, margin: float = 0.5) -> tuple[int, list[MemberChoice]]:
-    """(terms per temperature order, per-member choices) for ``members``: (name, voltage_v,
-    temperature_c, displacement_mm) tuples, fitted as x = sum_j t_n^j f_j(v) with ``orders``
-    orders, t_n = (T - offset) / scale for ``temperature_norm`` (the design's), the voltage
-    normalisation ``norm`` and no input correction.  A member's own choice is
-    :func:`flann.golden.thermal_train.select_thermal` over the ridges >= ``ridge``; the
-    family's count is :func:`shared_terms` of the held-out RMS at ``ridge``."""
-    ridges = tuple(r for r in thermal_train.AUTO_RIDGES if r >= ridge) or (ridge,)
-    if ridge not in ridges:
-        ridges = (*ridges, ridge)
+                         ridges=FAMILY_RIDGES, margin: float = 0.5) -> tuple[int, float, list[MemberChoice]]:
+    """(terms per temperature order, ridge, per-member choices) for ``members``: (name,
+    voltage_v, temperature_c, displacement_mm) tuples, fitted as x = sum_j t_n^j f_j(v) with
+    ``orders`` orders, t_n = (T - offset) / scale for ``temperature_norm`` (the design's), the
+    voltage normalisation ``norm`` and no input correction.  A member's own choice is
+    :func:`flann.golden.thermal_train.select_thermal` over the ridges down to the least of
+    ``ridges``; the family's count and ridge are :func:`shared_terms` of the held-out RMS at
+    each of ``ridges``."""
+    ridges = tuple(sorted(ridges, reverse=True))
+    own_ridges = tuple(sorted({*(r for r in thermal_train.AUTO_RIDGES if r >= ridges[-1]), *ridges}))
     own, table = [], []
     for name, v, t, x in members:
         run = thermal_train.cross_validate_thermal(v, t, x, orders=orders, terms=THERMAL_TERMS, norms=(norm,),
-                                                   ridges=ridges, temperature_norm=temperature_norm,
+                                                   ridges=own_ridges, temperature_norm=temperature_norm,
                                                    correct_input=False, source=name)
         choice, _best, _good = thermal_train.select_thermal(run.results, x)
         # compared over the position folds: with three temperatures the held-out middle one's
         # error (the temperature orders') swamped the terms', and 19 terms passed for 41
         own.append((name, v, t, x, choice))
-        table.append({r.terms[0]: r.position_rms_mm for r in run.results if r.ridge == ridge})
+        table.append({(r.terms[0], r.ridge): r.position_rms_mm for r in run.results if r.ridge in ridges})
     top = max(c.terms[0] for *_m, c in own)
-    tried = [n for n in THERMAL_TERMS if n <= top and all(n in held for held in table)]
+    tried = [(n, r) for n in THERMAL_TERMS if n <= top for r in ridges if all((n, r) in held for held in table)]
     if not tried:
         raise FlannError("--terms auto: the members' recordings are too few points for a common term count")
 
-    def steady(n):
+    def steady(key):
+        n, ridge = key
         fits = [thermal_train.fit_thermal(v, t, x, (n,) * orders, norm=norm, ridge=ridge, correct_input=False,
                                           temperature_norm=temperature_norm) for _n, v, t, x, _c in own]
         return all(_steady([(m.bias[j], m.weights[j]) for m in fits], margin) for j in range(orders))
 
-    terms = shared_terms(tried, table, [c.position_rms_mm for *_m, c in own], steady)
-    out = [MemberChoice(name, c.terms[0], c.ridge, c.position_rms_mm, None, held[terms])
+    key = shared_terms(tried, table, [c.position_rms_mm for *_m, c in own], steady,
+                       describe=lambda k: f"{k[0]} terms at ridge {k[1]:g}")
+    out = [MemberChoice(name, c.terms[0], c.ridge, c.position_rms_mm, None, held[key])
            for (name, _v, _t, _x, c), held in zip(own, table)]
-    return terms, out
+    return key[0], key[1], out
 
 
 __all__ = ["CALIBRATE_RIDGES", "DEFAULT_RIDGE", "FAMILY_RIDGES", "MemberChoice", "family_terms",

@@ -79,9 +79,10 @@ def fit_sensor(rec, temp: TempNorm, terms: int, orders: int, ridge: float = DEFA
 
 
 def auto_terms(sources, temp: TempNorm, orders: int, margin: float, read: dict | None = None):
-    """(terms, [(index in ``sources``, its choice)]) for the recordings among ``sources``
+    """(terms, ridge, [(index in ``sources``, its choice)]) for the recordings among ``sources``
     (``read``: their :func:`~flann.hardware.family.build.read_csvs`;
-    :func:`flann.golden.family.family_thermal_terms`); (None, []) when none is one."""
+    :func:`flann.golden.family.family_thermal_terms`); (None, the default ridge, []) when none
+    is one."""
     members, where = [], []
     for k, rec in (read_csvs(sources) if read is None else read).items():
         try:
@@ -92,10 +93,11 @@ def auto_terms(sources, temp: TempNorm, orders: int, margin: float, read: dict |
         except FlannError:
             continue
     if not members:
-        return None, []
-    terms, choices = family_thermal_terms(members, orders=orders, temperature_norm=(temp.offset_c, temp.scale_c),
-                                          norm=NORMALISATION, ridge=DEFAULT_RIDGE, margin=margin)
-    return terms, list(zip(where, choices))
+        return None, DEFAULT_RIDGE, []
+    terms, ridge, choices = family_thermal_terms(members, orders=orders,
+                                                 temperature_norm=(temp.offset_c, temp.scale_c),
+                                                 norm=NORMALISATION, margin=margin)
+    return terms, ridge, list(zip(where, choices))
 
 
 def _range_of(sources, read: dict) -> tuple[float, float]:
@@ -123,9 +125,9 @@ def _range_of(sources, read: dict) -> tuple[float, float]:
 
 
 def load_member(path, temp: TempNorm, terms: int, orders: int,
-                training: dict | None = None, rec=None) -> tuple[ThermalModel, str]:
+                training: dict | None = None, rec=None, ridge: float = DEFAULT_RIDGE) -> tuple[ThermalModel, str]:
     """(model, model file text): a two-input model.json as it is, or a recordings CSV
-    (``rec``: already read) trained."""
+    (``rec``: already read) trained at ``ridge``."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         m = load_any_model(path)
@@ -134,7 +136,7 @@ def load_member(path, temp: TempNorm, terms: int, orders: int,
                              f"({FORMAT}) or recordings at several temperatures")
         return m, path.read_bytes().decode("utf-8")
     if path.suffix.lower() == ".csv":
-        m = fit_sensor(read_recordings(path) if rec is None else rec, temp, terms, orders, training=training)
+        m = fit_sensor(read_recordings(path) if rec is None else rec, temp, terms, orders, ridge, training=training)
         return m, m.to_json()
     raise FlannError(f"{path}: a family member is a recordings .csv or a model .json")
 
@@ -153,9 +155,9 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
         temp = temp_norm(_range_of(sources, read), temp_bits, temp_lsb_c)
     except SpecError as exc:
         raise FlannError(str(exc)) from None
-    choices = []
+    choices, ridge = [], DEFAULT_RIDGE
     if terms == "auto":
-        terms, choices = auto_terms(sources, temp, orders, margin, read)
+        terms, ridge, choices = auto_terms(sources, temp, orders, margin, read)
         terms = FIXED_TERMS if terms is None else terms
     terms = int(terms)
     # each trained member's model records what sharing the count costs it
@@ -165,7 +167,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     loaded, bad = [], []
     for k, p in enumerate(sources):
         try:
-            loaded.append(load_member(p, temp, terms, orders, chosen.get(k), read.get(k)))
+            loaded.append(load_member(p, temp, terms, orders, chosen.get(k), read.get(k), ridge))
         except FlannError as exc:
             bad.append(str(exc))
     if bad:
@@ -176,7 +178,7 @@ def generate_family_thermal(sources, out_dir, *, terms=DEFAULT_TERMS, margin: fl
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            spec = derive_family_thermal(models, temp, names=names, margin=margin, **options)
+            spec = derive_family_thermal(models, temp, names=names, margin=margin, ridge=ridge, **options)
         except SpecError as exc:
             raise FlannError(f"--family: {exc}") from None
     init_text = loaded[0][1]

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...errors import SpecError
+from ...golden.family import DEFAULT_RIDGE
 from ...golden.model import FlannModel
 from ...golden.thermal import ThermalModel
 from ...numeric.fixed import FixedFormat, bits_needed, nearest_codes, signed_range
@@ -227,7 +228,7 @@ def check_member(spec: FamilyThermalSpec, model: ThermalModel) -> list:
 
 def derive_family_thermal(models: list[ThermalModel], temp: TempNorm, *, names=(), margin: float = DEFAULT_MARGIN,
                           output_lsb_mm: float | None = None, output_bits: int | None = None,
-                          **options) -> FamilyThermalSpec:
+                          ridge: float = DEFAULT_RIDGE, **options) -> FamilyThermalSpec:
     """Size one design for every sensor (every order of every sensor is a member of the
     family the orders share); the first sensor initialises the memories."""
     if not models:
@@ -242,7 +243,7 @@ def derive_family_thermal(models: list[ThermalModel], temp: TempNorm, *, names=(
     K = inner_bits(P)
     members = [m for p in per for m in p]
     fam = derive_family(members, names=tuple(f"{n}.t{j}" for n in names for j in range(P)), margin=margin,
-                        output_lsb_mm=output_lsb_mm / (1 << K), **options, check_device=False)
+                        ridge=ridge, output_lsb_mm=output_lsb_mm / (1 << K), **options, check_device=False)
     s = fam.spec
     if output_bits is None:
         ymax = 0.0
