@@ -120,23 +120,29 @@ def shared_terms(tried, table, own, steady, describe=lambda t: f"{t} terms"):
     member's held-out figures (``table[k][candidate]``, member k: one number or a tuple, RMS
     then max) within ``FAMILY_SHARE`` of its own choice's (``own[k]``, the same figures) and
     whose weights are ``steady(candidate)`` (fewer terms: smaller, steadier weights, so sensors
-    like the members fit the memory too); if none is both, the last steady one (the most
-    terms), else the last."""
-    def within(held, mine):
-        return bool(np.all(np.atleast_1d(held) <= FAMILY_SHARE * np.atleast_1d(mine)))
+    like the members fit the memory too); if none is both, the steady one whose worst member
+    is nearest its own (the first of equals), said in a warning, else the last."""
+    calm: dict = {}
 
-    def worst(held, mine):
-        held, mine = np.atleast_1d(held), np.atleast_1d(mine)
-        return float(max(h / m if m > 0 else np.inf for h, m in zip(held, mine)))
+    def is_steady(c):
+        if c not in calm:
+            calm[c] = steady(c)
+        return calm[c]
 
-    found = next((c for c in tried if all(within(held[c], mine) for held, mine in zip(table, own))
-                  and steady(c)), None)
+    def within(c):
+        return all(np.all(np.atleast_1d(held[c]) <= FAMILY_SHARE * np.atleast_1d(mine))
+                   for held, mine in zip(table, own))
+
+    def worst(c):
+        return max(float(h / m) if m > 0 else np.inf for held, mine in zip(table, own)
+                   for h, m in zip(np.atleast_1d(held[c]), np.atleast_1d(mine)))
+
+    found = next((c for c in tried if within(c) and is_steady(c)), None)
     if found is None:
-        found = next((c for c in reversed(tried) if steady(c)), tried[-1])
-        ratio = max(worst(held[found], mine) for held, mine in zip(table, own))
+        found = min((c for c in tried if is_steady(c)), key=worst, default=tried[-1])
         warnings.warn(f"no shared term count keeps every member's held-out error within {FAMILY_SHARE:g} x its "
                       f"own design's ({len(tried)} candidates tried): {describe(found)}, the most "
-                      f"accurate with steady weights, leave the worst member at {ratio:.2f} x its own",
+                      f"accurate with steady weights, leave the worst member at {worst(found):.2f} x its own",
                       stacklevel=2)
     return found
 
