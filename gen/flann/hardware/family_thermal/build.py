@@ -94,11 +94,9 @@ def auto_terms(sources, temp: TempNorm, orders: int, margin: float, read: dict |
             continue
     if not members:
         return None, DEFAULT_RIDGE, []
-    # one ridge: the smaller ones chose 19 terms for bench/thermal_line.py, a netlist that the
-    # Verilator sweep of flann synth cannot simulate (docs/temperature.md, "Not done yet")
     terms, ridge, choices = family_thermal_terms(members, orders=orders,
                                                  temperature_norm=(temp.offset_c, temp.scale_c),
-                                                 norm=NORMALISATION, ridges=(DEFAULT_RIDGE,), margin=margin)
+                                                 norm=NORMALISATION, margin=margin)
     return terms, ridge, list(zip(where, choices))
 
 
