@@ -27,6 +27,7 @@ sys.unraisablehook = _unraisable
 
 try:   # Ctrl-C while the interpreter imports this module: one line too, not a traceback
     import argparse
+    import copy
     import importlib
     import os
     import signal
@@ -71,7 +72,57 @@ class _Parser(argparse.ArgumentParser):
         self.register("type", float, finite_float)   # no flag takes NaN or infinity
 
     def error(self, message: str):
+        if _Parser._trying:
+            raise _NotThisReading(message)
         self.exit(2, f"error: {self.prog}: {one_line(message)} (see {self.prog} --help)\n")
+
+    _trying = 0   # > 0 while a reading of --json WORD is tried (an error then tries the other)
+
+    def parse_known_args(self, args=None, namespace=None):
+        """``--json WORD``: WORD is the JSON file, unless the command then misses an input WORD
+        would be: ``flann eval --json model.json rec.csv`` reads model.json and prints the JSON
+        (``--json=FILE`` always names the file).  When neither reading parses whole, the error
+        said is the second's if the first failed, else the first's (unrecognized arguments)."""
+        args = list(sys.argv[1:] if args is None else args)
+        action = self._option_string_actions.get("--json")
+        other = _json_word_as_positional(args) if action is not None and action.nargs == "?" else None
+        if other is None:
+            return super().parse_known_args(args, namespace)
+        said = args   # the reading whose error is said when neither parses whole
+        for reading in (args, other):
+            _Parser._trying += 1
+            try:
+                ns, extra = super().parse_known_args(list(reading), copy.copy(namespace))
+            except _NotThisReading:
+                if reading is args:   # WORD as the file fails: the other reading's error says why
+                    said = other
+                continue
+            finally:
+                _Parser._trying -= 1
+            if not extra:
+                return ns, extra
+        return super().parse_known_args(said, namespace)
+
+
+class _NotThisReading(Exception):
+    pass
+
+
+def _json_word_as_positional(args: list[str]) -> list[str] | None:
+    """``args`` with every ``--json WORD`` read as a bare ``--json`` before the word WORD (None
+    when there is no such pair): the other reading of the command line."""
+    out, changed = [], False
+    for k, a in enumerate(args):
+        if a == "--":
+            out += args[k:]
+            break
+        nxt = args[k + 1] if k + 1 < len(args) else None
+        if a == "--json" and nxt is not None and nxt != "-" and not nxt.startswith("-"):
+            out.append("--json=-")   # flann.commands.common.JSON_STDOUT: the JSON on stdout
+            changed = True
+        else:
+            out.append(a)
+    return out if changed else None
 
 
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:

@@ -10,15 +10,16 @@ from ..errors import one_line
 from ..production.calibrate import DIAGNOSIS_POINTS, calibrate_batch, summary_path
 from ..production.spec import build_spec
 from ..production.traceability import Station
+from .common import add_common, quiet
 
 HELP = "calibrate sensors for a family design: weight images and certificates"
 
 
 def add_arguments(p) -> None:
     p.add_argument("recordings", nargs="+", metavar="REC.csv", help="one recordings CSV per sensor (name = file stem)")
-    p.add_argument("-o", "--out", required=True, metavar="OUTDIR", help="OUTDIR/<sensor>/ and OUTDIR/summary.csv")
     p.add_argument("--design", required=True, metavar="DIR", help="family design from `flann gen --family`")
-    p.add_argument("-j", "--jobs", type=int, default=None, metavar="N", help="parallel workers (default: all cores)")
+    add_common(p, output=dict(help="OUTDIR/<sensor>/ and OUTDIR/summary.csv", metavar="OUTDIR", required=True,
+                              legacy_out=True), jobs="sensors calibrated")
     p.add_argument("--sensor", metavar="TOML", default=None,
                    help="nominal sensor description for the diagnosis (geometry known: faster)")
     p.add_argument("--diagnosis-points", type=int, default=DIAGNOSIS_POINTS, metavar="N",
@@ -54,8 +55,9 @@ def run(args) -> int:
                       fail_on_effects=args.fail_on_effect)
     station = Station(station=args.station, operator=args.operator, fixture=args.fixture,
                       temperature_c=args.temperature_c, serial_column=args.serial_column)
-    results = calibrate_batch(args.recordings, args.out, args.design, jobs=args.jobs, sensor_toml=args.sensor,
-                              diagnosis_points=args.diagnosis_points, spec=spec, station=station)
+    results = calibrate_batch(args.recordings, args.output, args.design, jobs=args.jobs, sensor_toml=args.sensor,
+                              diagnosis_points=args.diagnosis_points, spec=spec, station=station,
+                              progress=False if quiet(args) else None)
     rejected = [r for r in results if r.verdict is None or r.verdict.rejected]
     failed = [r for r in results if r.status != "ok" and r not in rejected]
     for r in rejected:
@@ -67,5 +69,5 @@ def run(args) -> int:
             print(f"warning: {r.sensor}: {one_line(w)}", file=sys.stderr)
     passed = len(results) - len(rejected) - len(failed)
     print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
-          f"{len(rejected)} rejected; summary {summary_path(args.out)}")
+          f"{len(rejected)} rejected; summary {summary_path(args.output)}")
     return 2 if rejected else 1 if failed else 0

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 from ..argtypes import bounded, png_path
@@ -11,9 +10,9 @@ from ..diagnose.data import MAX_POINTS
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
 from ..errors import FlannError
-from ..fileio import atomic_write_json
 from ..physics.sensor import load_sensor
 from ..recordings import read_recordings
+from .common import add_common, emit_json, json_to_stdout, json_word_as_input, on_terminal
 
 HELP = "locate and name the physics missing between simulation and recordings"
 
@@ -25,8 +24,6 @@ def add_arguments(p) -> None:
                    help="sensor description (flann-sensor/1); its geometry is then taken as "
                         "known and only gain and origin are calibrated (default: the paper's "
                         "LVDT with geometry calibrated to the recordings)")
-    p.add_argument("--json", nargs="?", const="-", metavar="OUT.json",
-                   help="write the diagnosis as JSON (to stdout when no file is given)")
     p.add_argument("--plot", metavar="OUT.png", type=png_path, help="residuals before/after, mismatch shaded")
     p.add_argument("--demo", action="store_true",
                    help="run the concealed-effect demonstration (simulated recordings) and "
@@ -37,11 +34,11 @@ def add_arguments(p) -> None:
                    help="diagnose a recording of more rows than N on about N means of "
                         "neighbouring readings of a pass (the report says so); 0: every row "
                         "(time and memory grow quickly; default %(default)d)")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal anyway)")
+    add_common(p, json="the diagnosis")
 
 
-def _progress(quiet: bool):
-    if quiet or not sys.stderr.isatty():  # progress is for a person watching, not for logs
+def _progress(args):
+    if not on_terminal(args):  # progress is for a person watching, not for logs
         return None
 
     def show(msg: str) -> None:
@@ -54,7 +51,7 @@ def run(args) -> int:
     if args.demo:
         if args.recordings or args.sensor or args.plot:
             raise FlannError("--demo takes no recordings, --sensor or --plot (it simulates its own)")
-        results = run_demo(progress=_progress(args.quiet), limits=args.limits)
+        results = run_demo(progress=_progress(args), limits=args.limits)
         if args.json:
             obj = [r.to_json() for r in results.cases] + [r.to_json() for r in results.independent]
             if results.limits or results.alarms or results.independent_alarms:
@@ -62,31 +59,25 @@ def run(args) -> int:
                        "detection_limits": results.limits,
                        "independent_false_alarms": results.independent_alarms,
                        "independent_detection_limits": results.independent_limits}
-            if args.json == "-":
-                print(json.dumps(obj, indent=2))
-            else:
-                atomic_write_json(args.json, obj)
-        if args.json != "-":
+            emit_json(args, obj)
+        if not json_to_stdout(args):
             print(demo_table(results), end="")
         return 0 if results.all_right else 1
 
+    json_word_as_input(args, "recordings")   # `flann diagnose --json rec.csv`
     if not args.recordings:
         raise FlannError("diagnose needs a recordings CSV (or --demo)")
 
-    rec = read_recordings(args.recordings)
+    rec = read_recordings(args.recordings, announce=not args.quiet)
     sensor = None
     if args.sensor:
         sensor = load_sensor(args.sensor)
-    dg = diagnose(rec, sensor=sensor, progress=_progress(args.quiet),
+    dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
     # both reports are built before any file is written: a failure leaves no output behind
     obj, text = to_json(dg), format_text(dg)
     if args.plot:
         plot(dg, args.plot)
-    if args.json == "-":
-        print(json.dumps(obj, indent=2))
-    else:
-        if args.json:
-            atomic_write_json(args.json, obj)
+    if not emit_json(args, obj):
         print(text, end="")
     return 0

@@ -6,7 +6,6 @@ voltages quantised to the design's ADC codes, against the physical limit of that
 
 from __future__ import annotations
 
-import json
 import warnings
 
 import numpy as np
@@ -19,6 +18,7 @@ from ..golden.thermal import is_thermal, load_any_model
 from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
 from ..recordings import read_recordings
+from .common import add_common, emit_json
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
@@ -29,7 +29,6 @@ SECTIONS = (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware"))
 def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
     p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v")
-    p.add_argument("--json", action="store_true", help="print the figures as JSON")
     p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
                    help="linearity tolerance in %% of full scale (default %(default)g)")
     p.add_argument("--band", type=float, default=DEFAULT_BAND_PCT_FS, metavar="PCT_FS",
@@ -43,6 +42,7 @@ def add_arguments(p) -> None:
     p.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                    help="error vs displacement: raw sensor, float model, hardware (needs --design) "
                         "and the physical limit")
+    add_common(p, json="the figures")
 
 
 def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
@@ -93,7 +93,7 @@ def run(args) -> int:
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings)
+    rec = read_recordings(args.recordings, announce=not args.quiet)
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
@@ -125,8 +125,7 @@ def run(args) -> int:
             if report["by_temperature"][name] is not None and section in res:
                 res[section]["by_temperature"] = report["by_temperature"][name]
         res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
-    if args.json:
-        print(json.dumps(res, indent=2))
+    if emit_json(args, res):
         return 0
     fs = res["full_scale_mm"]
     print(f"{rec.source}: {res['points']} points, full scale {fs:g} mm "

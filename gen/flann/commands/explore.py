@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import sys
 from pathlib import Path
 
 from ..argtypes import bounded, checked
@@ -18,6 +16,7 @@ from ..hardware.fixed.spec import check_mult_style, max_lanes
 from ..hardware.registry import FORMATS, datapath_for_model, read_design
 from ..hardware.target import DEFAULT_PART
 from ..verify.design import design_model
+from .common import add_common, emit_json, on_terminal
 
 HELP = "design-space table (lanes x multiplier x widths)"
 
@@ -64,7 +63,7 @@ def add_arguments(p):
     p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None, metavar="V",
                    help="volts per ADC code, as for flann gen (default: flann gen's; not with a design "
                         "directory: its own)")
-    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+    add_common(p, json="the rows")
 
 
 def _design_model(args):
@@ -93,12 +92,13 @@ def _design_model(args):
 
 def run(args) -> int:
     dp = _design_model(args)
-    progress = sys.stderr.isatty()   # progress lines on a terminal only, never into a log
+    progress = on_terminal(args)   # progress lines on a terminal only, never into a log
     if args.seed_only:
         rows = explore.seed_rows(args.model, args.device, abc=args.abc, progress=progress)
         if args.float18:
             rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
-        print(json.dumps([r.to_dict() for r in rows], indent=2) if args.json else explore.markdown(rows, args.device))
+        if not emit_json(args, [r.to_dict() for r in rows]):
+            print(explore.markdown(rows, args.device))
         return 0
     rows = explore.EXPLORERS[dp.explore](
         args.model, args.device, lanes=args.lanes, styles=args.mult,
@@ -107,8 +107,6 @@ def run(args) -> int:
     )
     if args.float18:
         rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
-    if args.json:
-        print(json.dumps([r.to_dict() for r in rows], indent=2))
-    else:
+    if not emit_json(args, [r.to_dict() for r in rows]):
         print(explore.markdown(rows, args.device))
     return 0

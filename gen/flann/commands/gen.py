@@ -6,8 +6,6 @@ The datapath is looked up in :mod:`flann.hardware.registry`; the directory is wr
 
 from __future__ import annotations
 
-import json
-import sys
 import warnings
 
 from ..errors import FlannError
@@ -16,6 +14,7 @@ from ..golden.train import converter_mismatch, converter_text, judged_converter,
 from ..hardware import options as gen_options
 from ..hardware.manifest import is_design
 from ..hardware.registry import FORMATS, datapath_for_model, family_datapath
+from .common import add_common, emit_json, info, json_word_as_input
 from .family import add_family_arguments, check_family_args
 
 HELP = "generate VHDL-93 for a model"
@@ -43,17 +42,19 @@ def refuse_generator_options(target, args, given, verb: str) -> None:
 def add_arguments(parser) -> None:
     parser.add_argument("model", nargs="?", help="model.json (flann-model/1, or flann-thermal-model/1: the two-input datapath); "
                         "not with --family")
-    parser.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
-    parser.add_argument("--json", action="store_true", help="print the manifest as JSON")
     parser.add_argument("--format", choices=FORMATS, default=FORMATS[0],
                         help="number format of the products and the sum: fixed point sized by the error "
                              "budget (default) or the seed's 18-bit floating point (docs/float18.md)")
+    add_common(parser, output=dict(help="output directory", metavar="DIR", required=True, legacy_out=True),
+               json="the manifest")
     gen_options.add_arguments(parser)
     add_family_arguments(parser)
 
 
 def run(args) -> int:
     opts, _given = generator_options(args)
+    if args.family is None:
+        json_word_as_input(args, "model")   # `flann gen --json model.json -o DIR`
     model, other = None, ""
     if args.family is not None or args.model is None:
         check_family_args(args)
@@ -66,23 +67,22 @@ def run(args) -> int:
         other = converter_mismatch(model, opts.input_bits, opts.input_lsb_v)
         if other:
             warnings.warn(other)
-    replacing = is_design(args.out)
-    man = dp.generate(source, args.out, opts, **extra)
+    replacing = is_design(args.output)
+    man = dp.generate(source, args.output, opts, **extra)
     if model is not None and opts.input_lsb_v is None and not other:
         # the volts per code were derived from the model's voltage range, not given: say so when
         # the model knows the converter it was recorded with and that one reads other codes
         conv = judged_converter(model)
         if conv is not None and not same_converter(conv, man["input_bits"], man["input_lsb_v"]):
-            warnings.warn(f"{args.out}: input LSB {man['input_lsb_v']:.6g} V, derived from the model's voltage "
+            warnings.warn(f"{args.output}: input LSB {man['input_lsb_v']:.6g} V, derived from the model's voltage "
                           f"range (no --input-lsb-v), but the model was judged for a {converter_text(*conv[:2])} "
                           f"converter ({conv[2]}): give --input-lsb-v for the converter the design will read")
     if replacing:
-        print(f"flann gen: replaced the flann design in {args.out}", file=sys.stderr)
-    if args.json:
-        print(json.dumps(man, indent=2))
+        info(args, f"flann gen: replaced the flann design in {args.output}")
+    if emit_json(args, man):
         return 0
     kept = [f for f in (man.get("model"), *(im["hex"] for im in man.get("images", []))) if f]
-    print(f"wrote {len(man['files'])} VHDL files + manifest.json + {', '.join(dict.fromkeys(kept))} to {args.out} "
+    print(f"wrote {len(man['files'])} VHDL files + manifest.json + {', '.join(dict.fromkeys(kept))} to {args.output} "
           f"({dp.name}, top {man['top']})")
     for line in dp.summary(man):
         print(line)

@@ -6,6 +6,7 @@ import sys
 
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
 from ..implement import ise
+from .common import add_common
 
 HELP = "write an ISE 10.1 project for the generated VHDL"
 
@@ -16,7 +17,6 @@ def add_arguments(p):
                    help="Spartan-II part DEVICE-PACKAGE-SPEED, e.g. xc2s15-tq144-5 (default: the part in "
                         f"DIR/manifest.json, as for flann synth, else {DEFAULT_PART}; the example pin map is for "
                         "PQ208, on other packages ISE chooses the pins)")
-    p.add_argument("-o", "--output", default="ise", metavar="OUT", help="output directory (default ise/)")
     p.add_argument("--force", action="store_true",
                    help="write the project even when the design's resource estimate (or, without one, its synthesized "
                         "netlist) does not fit the part")
@@ -25,6 +25,7 @@ def add_arguments(p):
                         "Spartan-II timing estimate meets, with a warning")
     p.add_argument("--no-timing-check", action="store_true",
                    help="write the PERIOD as given, without synthesising for the timing estimate")
+    add_common(p, output=dict(help="output directory (default ise/)", metavar="OUT", default="ise"))
 
 
 def run(args) -> int:

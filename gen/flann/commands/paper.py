@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 
 from ..argtypes import bounded, checked
@@ -14,6 +12,7 @@ from ..recordings import read_recordings
 from ..golden.train import MAX_EPOCHS, fit_lstsq, normalisation, normalisation_kind
 from ..golden import paper
 from ..hardware.fixed.cost import fixed_point_cost
+from .common import add_common, emit_json
 
 HELP = "reproduce the seed paper's tables and figures"
 
@@ -24,8 +23,6 @@ def _only_pngs(directory) -> bool:
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--json", action="store_true",
-                   help="print {raw_linearity_pct, tolerance_pct_fs, rows: [...]} as JSON")
     p.add_argument("--plot", metavar="DIR", default=None,
                    help="write PNGs equivalent to the paper's Fig. 5 into DIR")
     p.add_argument("--eta", type=bounded(float, 0, lo_open=True), default=paper.DEFAULT_ETA,
@@ -44,6 +41,7 @@ def add_arguments(p) -> None:
     p.add_argument("--dense", action="store_true",
                    help="also run the tool's default (--terms auto) on dense physics-like "
                         "data and print the stroke fraction within +-0.1 %% FS before/after")
+    add_common(p, json="Table 2 {raw_linearity_pct, tolerance_pct_fs, rows}")
 
 
 def _loo_text(loo: np.ndarray, interior: np.ndarray) -> str:
@@ -53,7 +51,7 @@ def _loo_text(loo: np.ndarray, interior: np.ndarray) -> str:
 def run(args) -> int:
     if not (args.tol >= 0):
         raise FlannError(f"--tol must be >= 0 % FS, got {args.tol:g}")
-    rec = paper.table1() if args.data is None else read_recordings(args.data)
+    rec = paper.table1() if args.data is None else read_recordings(args.data, announce=not args.quiet)
     if len(rec) < 3:
         raise FlannError(f"{rec.source}: need at least 3 points, got {len(rec)}")
     offset_scale = normalisation(rec.voltage_v, args.normalise)
@@ -61,8 +59,7 @@ def run(args) -> int:
     if args.plot:
         with atomic_directory(args.plot, _only_pngs, "directory of flann paper plots") as tmp:
             paper.plot_fig5(tmp, rec, details)
-    if args.json:
-        print(json.dumps(out, indent=2))
+    if emit_json(args, out):
         return 0
     _print_report(rec, out, details, args, offset_scale)
     return 0

@@ -21,6 +21,7 @@ from ..fileio import atomic_write_text
 from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..recordings import read_recordings
+from .common import add_common
 
 HELP = "apply a model to recordings"
 
@@ -28,10 +29,10 @@ HELP = "apply a model to recordings"
 def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
     p.add_argument("recordings", help="CSV with voltage_v (displacement_mm copied when given)")
-    p.add_argument("-o", "--output", required=True, help="CSV to write")
     p.add_argument("--extrapolate", action="store_true",
                    help="evaluate the model outside its trained voltage range instead of clamping "
                         "to it as the hardware does")
+    add_common(p, output=dict(help="CSV to write", metavar="OUT.csv", required=True))
 
 
 def outside_range(model, voltage_v, temperature_c=None) -> np.ndarray:
@@ -92,7 +93,7 @@ def _predict_unclamped(model, voltage_v, temperature_c):
 
 def run(args) -> int:
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings, required=("voltage_v",))
+    rec = read_recordings(args.recordings, required=("voltage_v",), announce=not args.quiet)
     temp = rec.temperature_c
     if is_thermal(model) and temp is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "

@@ -8,7 +8,7 @@ cocotb; ``--netlist`` also simulates the Yosys-mapped Spartan-II netlist over ev
 
 from __future__ import annotations
 
-import json
+import argparse
 import sys
 import tempfile
 from pathlib import Path
@@ -27,6 +27,7 @@ from ..verify.plots import plot
 from ..verify.runner import ENGINES
 from ..verify.shards import terminal_progress
 from ..hardware import options as gen_options
+from .common import add_common, cores_limited, emit_json, json_to_stdout, quiet
 from .gen import generator_options, refuse_generator_options
 
 HELP = "verify the generated VHDL by simulation (GHDL + cocotb; --netlist: post-synthesis netlist)"
@@ -70,7 +71,6 @@ def add_arguments(parser) -> None:
                         help="every input code through: ghdl = the VHDL under GHDL; verilator = GHDL's "
                              "synthesised netlist compiled by Verilator (~25x faster), the VHDL on a sample; "
                              "auto (default) = ghdl when that takes about a minute or less, else verilator")
-    parser.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     parser.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                         help="HDL vs golden model (a family design: the bit-true twin of each weight image) "
                              "across the input range, at several temperature codes for a design with "
@@ -84,7 +84,9 @@ def add_arguments(parser) -> None:
                              "cfg port, each simulated (one alone, on a family without temperature: loaded over an "
                              "image the design keeps, so that the load is seen to change the outputs; "
                              "default: the images flann gen kept in DIR, for a design with temperature its last)")
-    parser.add_argument("--summary-json", metavar="FILE", default=None, help="also write the summary here")
+    # before --json FILE: kept for the scripts that write the file and print the JSON too
+    parser.add_argument("--summary-json", metavar="FILE", default=None, help=argparse.SUPPRESS)
+    add_common(parser, json="the summary", jobs="simulation shards")
     gen_options.add_arguments(parser)
 
 
@@ -115,20 +117,21 @@ def run(args) -> int:
         check_output_directory(args.build, lambda _earlier: True, "build directory")
     if args.post_route:
         parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
-    with tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
+    with cores_limited(args.jobs), tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
         if args.post_route:
             require_sweep_driver(design.datapath, args.model)
         images = image_names(args.image or [])
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
-                       progress=terminal_progress, images=images or None)
+                       progress=None if quiet(args) else terminal_progress, images=images or None)
         s = {**res["summary"], **clock_fields()}
         if args.post_route:
             # a family design's routed netlist computes with the last image given, as its bench ends
             check = checker(design, image=images[-1] if images else None)
             rep = ice40.implement(design.directory, args.post_route_device, build / "ice40", work=build / "ice40_work",
-                                  seed=args.seed, progress=not args.json, post_route=check)
+                                  seed=args.seed, progress=not (json_to_stdout(args) or quiet(args)),
+                                  post_route=check)
             s["post_route"] = {**rep.post_route, "device": rep.part.name, "fmax_mhz": rep.fmax_mhz,
                                "timing_met": rep.timing_met}
         plotted = bool(args.plot and res["curve"] is not None)
@@ -140,9 +143,7 @@ def run(args) -> int:
             s["design"] = None
     if args.summary_json:
         atomic_write_json(args.summary_json, s)
-    if args.json:
-        print(json.dumps(s, indent=2))
-    else:
+    if not emit_json(args, s):
         where = s["design"] or "generated in a temporary directory (deleted); keep it with --build DIR"
         print(f"design                  {where}")
         sw = s.get("sweep") or {}

@@ -4,7 +4,7 @@
                    [--seed K] [--temperature-profile SPEC | --temperatures T1,T2,...]
                    [--from-mm A --to-mm B] [--plot P.png]
     flann simulate --fit RECORDINGS.csv [SENSOR.toml] [--params a,b,...] [--write-sensor OUT.toml]
-                   [--json OUT.json] [--plot P.png]
+                   [--json [OUT.json]] [--plot P.png]
 
 Without SENSOR.toml the seed paper's LVDT (data/sensors/paper_lvdt.toml) is used.
 """
@@ -12,12 +12,11 @@ Without SENSOR.toml the seed paper's LVDT (data/sensors/paper_lvdt.toml) is used
 from __future__ import annotations
 
 import re
-import sys
 import warnings
 
 from ..argtypes import bounded, png_path
 from ..errors import FlannError
-from ..fileio import atomic_write_json, atomic_write_text
+from ..fileio import atomic_write_text
 from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
 from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
 from ..physics.lvdt import describe
@@ -25,6 +24,7 @@ from ..physics.sensor import default_sensor, format_sensor, load_sensor
 from ..physics.simulate import (fold_back_mm, parse_temperatures, simulate_calibration,
                                 simulate_recordings)
 from ..recordings import read_recordings, write_recordings
+from .common import add_common, emit_json, info, json_to_stdout, quiet
 
 HELP = "LVDT physics simulator: write recordings from a sensor file"
 
@@ -38,7 +38,6 @@ def add_arguments(p) -> None:
     p._negative_number_matcher = _NEGATIVE_VALUE
     p.add_argument("sensor", nargs="?", default=None,
                    help="sensor TOML (default: the seed paper's LVDT)")
-    p.add_argument("-o", "--output", help="recordings CSV to write (simulation mode)")
     p.add_argument("--sweeps", type=int, default=1,
                    help="forward+reverse passes (default 1)")
     p.add_argument("--step-mm", type=float, default=1.0, help="actuator step (default 1 mm)")
@@ -75,7 +74,8 @@ def add_arguments(p) -> None:
                         "primary_length_mm,secondary_length_mm,secondary_gap_mm,"
                         "demodulator_gain_ratio)")
     p.add_argument("--write-sensor", help="with --fit: write the calibrated sensor TOML")
-    p.add_argument("--json", help="with --fit: write the fit report as JSON")
+    add_common(p, output=dict(help="recordings CSV to write (simulation mode)", metavar="OUT.csv"),
+               json="the fit report (--fit), the quantities (--describe) or the catalogue (--list-effects)")
 
 
 def _sensor(args):
@@ -83,8 +83,12 @@ def _sensor(args):
     return load_sensor(args.sensor) if args.sensor else default_sensor()
 
 
-def _list_effects() -> int:
-
+def _list_effects(args) -> int:
+    if emit_json(args, [{"name": e.name, "stage": e.stage, "description": e.description, "formula": e.formula,
+                         "params": [{"name": p.name, "default": p.default, "description": p.description,
+                                     "unit": p.unit, "lower": p.lower, "upper": p.upper, "neutral": p.neutral}
+                                    for p in e.params]} for e in EFFECTS.values()]):
+        return 0
     for e in EFFECTS.values():
         print(f"[effects.{e.name}]  ({e.stage} stage) {e.description}")
         print(f"    {e.formula}")
@@ -97,13 +101,19 @@ def _list_effects() -> int:
 def _describe(args) -> int:
 
     s = _sensor(args)
-    print(f"{s.name}: {s.description}" if s.description else s.name)
-    for k, v in describe(s).items():
-        print(f"  {k} = {v:.4g}")
+    quantities = describe(s)
     fold = fold_back_mm(s, (-3 * s.stroke_mm, 3 * s.stroke_mm), n=4001)
-    print(f"  output_fold_back_mm = {fold:.4g}" if fold is not None else
-          "  output_fold_back_mm = none within 3 x stroke")
-    print(f"  copper_thermal_coefficient_per_c = {thermal_coefficient_from_copper(s):.3g}")
+    copper = thermal_coefficient_from_copper(s)
+    obj = {"sensor": s.name, "description": s.description, **{k: float(v) for k, v in quantities.items()},
+           "output_fold_back_mm": None if fold is None else float(fold),   # null: none within 3 x stroke
+           "copper_thermal_coefficient_per_c": float(copper)}
+    if not emit_json(args, obj):
+        print(f"{s.name}: {s.description}" if s.description else s.name)
+        for k, v in quantities.items():
+            print(f"  {k} = {v:.4g}")
+        print(f"  output_fold_back_mm = {fold:.4g}" if fold is not None else
+              "  output_fold_back_mm = none within 3 x stroke")
+        print(f"  copper_thermal_coefficient_per_c = {copper:.3g}")
     if args.plot:
         from ..physics.plots import plot_anatomy  # matplotlib: loaded only to plot
 
@@ -113,16 +123,19 @@ def _describe(args) -> int:
 
 def run(args) -> int:
     if args.list_effects:
-        return _list_effects()
+        return _list_effects(args)
     if args.describe:
         return _describe(args)
     if args.fit:
         return _run_fit(args)
     if not args.output:
         raise FlannError("simulate: give -o RECORDINGS.csv (or --fit RECORDINGS.csv)")
-    for opt in ("params", "write_sensor", "json"):
+    for opt in ("params", "write_sensor"):
         if getattr(args, opt):
             raise FlannError(f"simulate: --{opt.replace('_', '-')} needs --fit")
+    if args.json:
+        raise FlannError("simulate: --json is the report of --fit, --describe or --list-effects (a simulation "
+                         "writes its recordings to -o)")
 
 
     s = _sensor(args)
@@ -136,12 +149,12 @@ def run(args) -> int:
         temps = parse_temperatures(args.temperatures)
         rec = simulate_calibration(s, temps, sweeps=args.sweeps, step_mm=args.step_mm,
                                    noise_v=args.noise_v, seed=args.seed, travel_mm=(lo, hi),
-                                   step_time_s=args.step_time_s, progress=True)
+                                   step_time_s=args.step_time_s, progress=not quiet(args))
         temperature = "calibration at " + ", ".join(f"{t:g}" for t in temps) + " degC"
     else:
         rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
                                   seed=args.seed, temperature_profile=args.temperature_profile,
-                                  travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=True)
+                                  travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=not quiet(args))
         temperature = args.temperature_profile
     fold = fold_back_mm(s, (lo, hi))
     if fold is not None:
@@ -161,7 +174,7 @@ def run(args) -> int:
 
         plot_simulation(s, rec, args.plot)
     write_recordings(args.output, rec, comments=comments)
-    print(f"wrote {args.output}: {len(rec)} rows, effects: {effects}", file=sys.stderr)
+    info(args, f"wrote {args.output}: {len(rec)} rows, effects: {effects}")
     return 0
 
 
@@ -170,25 +183,26 @@ def _run_fit(args) -> int:
         raise FlannError("simulate --fit: -o is for simulation; use --write-sensor OUT.toml")
 
     s = _sensor(args)
-    rec = read_recordings(args.fit)
+    rec = read_recordings(args.fit, announce=not args.quiet)
     params = DEFAULT_FIT_PARAMS
     if args.params:
         params = tuple(p.strip() for p in args.params.split(",") if p.strip())
     fit = fit_sensor(rec, sensor=s, params=params)
-    print(f"calibrated {s.name} to {args.fit} ({len(rec)} points, ideal model, no effects):")
-    for line in fit.summary_lines():
-        print(f"  {line}")
-    for row in fit.excluded_rows:
-        print(f"  excluded row {row}: {rec.displacement_mm[row]:g} mm, {rec.voltage_v[row]:g} V "
-              f"is {fit.residual_v[row]:+.3f} V off the curve "
-              f"({abs(fit.residual_v[row]) / fit.noise_v:.0f} x the robust noise "
-              f"{fit.noise_v * 1e3:.0f} mV): outlier, not fitted")
+    if not json_to_stdout(args):
+        print(f"calibrated {s.name} to {args.fit} ({len(rec)} points, ideal model, no effects):")
+        for line in fit.summary_lines():
+            print(f"  {line}")
+        for row in fit.excluded_rows:
+            print(f"  excluded row {row}: {rec.displacement_mm[row]:g} mm, {rec.voltage_v[row]:g} V "
+                  f"is {fit.residual_v[row]:+.3f} V off the curve "
+                  f"({abs(fit.residual_v[row]) / fit.noise_v:.0f} x the robust noise "
+                  f"{fit.noise_v * 1e3:.0f} mV): outlier, not fitted")
     if args.write_sensor:
         atomic_write_text(args.write_sensor, format_sensor(
             fit.sensor, comments=(f"calibrated by: flann simulate --fit {args.fit}",
                                   f"rms residual {fit.rms_v * 1e3:.1f} mV")))
     if args.json:
-        atomic_write_json(args.json, {
+        emit_json(args, {
             "recordings": str(args.fit),
             "params": fit.values,
             "stderr": fit.stderr,

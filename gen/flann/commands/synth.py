@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 import tempfile
 from pathlib import Path
@@ -19,6 +18,7 @@ from ..hardware.target import (DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_
 from ..verify.design import from_directory
 from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver, sweep_datapaths
 from ..verify.post_route import checker
+from .common import add_common, cores_limited, emit_json, json_to_stdout, quiet
 
 HELP = "resource estimate via GHDL synthesis and Yosys"
 
@@ -34,15 +34,11 @@ def add_arguments(p):
         f"else {DEFAULT_PART}; devices " + ", ".join(d.name for d in DEVICES) + "); or an iCE40 part for real "
         "place and route, timing and a bitstream (" + ", ".join(p.name for p in ICE40_PARTS) + ")",
     )
-    p.add_argument("-o", "--output", metavar="OUT", default=None,
-                   help=f"iCE40 only: directory for the bitstream (.bin), example pins (.pcf), .asc and reports "
-                        f"(default {ICE40_OUT}/)")
     p.add_argument("--post-route", action="store_true",
                    help="iCE40 only: simulate the placed-and-routed design (icebox_vlog + Verilator, Yosys's iCE40 "
                         "cell models) over every input code against the twin (needs the model: --model or the "
                         "manifest's)")
     p.add_argument("--seed", type=TOOL_SEED, default=1, help="iCE40 only: nextpnr placement seed (default %(default)s)")
-    p.add_argument("--json", action="store_true", help="print the report as JSON on stdout")
     p.add_argument("--no-lint", action="store_true", help="skip the VSG style check of the VHDL")
     p.add_argument("--vsg-config", metavar="YAML", help="VSG configuration (default: vsg.yaml of the repository)")
     p.add_argument("--abc", choices=ABC_MODES, default="full",
@@ -57,6 +53,9 @@ def add_arguments(p):
                         "temperature codes) against the twin (Verilator), with --model or without "
                         "(the manifest's model), reported as 'netlist check' (JSON: netlist_check, null when not "
                         "run), and a disagreeing design is refused")
+    add_common(p, output=dict(help=f"iCE40 only: directory for the bitstream (.bin), example pins (.pcf), .asc "
+                                   f"and reports (default {ICE40_OUT}/)", metavar="OUT"),
+               json="the report", jobs="netlist simulation shards")
 
 
 def _check_netlist(args, netlist: Path) -> dict:
@@ -73,7 +72,7 @@ def _check_netlist(args, netlist: Path) -> dict:
         return {"netlist_not_run": "no model (pass --model MODEL.json)",
                 "netlist_warning": "netlist not simulated: pass --model MODEL.json (the twin is built from the model)"}
     design = from_directory(args.directory, args.model)
-    if not args.json:
+    if _progress(args):
         print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
     res = check_synthesized(design, netlist)
     if res["mismatches"]:
@@ -101,17 +100,25 @@ def run_ice40(args) -> int:
     check = post_route_check(args.directory, args.model) if args.post_route else None
     with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
         report = ice40.implement(args.directory, args.device, args.output or ICE40_OUT, work=Path(args.work or tmp),
-                                 seed=args.seed, progress=not args.json, post_route=check)
-    if args.json:
-        print(json.dumps(report.to_dict(), indent=2))
-    else:
+                                 seed=args.seed, progress=_progress(args), post_route=check)
+    if not emit_json(args, report.to_dict()):
         print(report.table())
     for w in report.all_warnings():   # the JSON's "warnings" too
         print(f"warning: {w}", file=sys.stderr)
     return 0
 
 
+def _progress(args) -> bool:
+    """synth's steps on stderr, except under JSON on stdout or --quiet."""
+    return not (json_to_stdout(args) or quiet(args))
+
+
 def run(args) -> int:
+    with cores_limited(args.jobs):
+        return _run(args)
+
+
+def _run(args) -> int:
     if args.device is not None and is_ice40(args.device):
         return run_ice40(args)
     if args.post_route:
@@ -130,11 +137,9 @@ def run(args) -> int:
         synth.check_lint(man.files, args.vsg_config, start=args.directory)
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
         work = Path(args.work) if args.work else Path(tmp)
-        report = synth.synthesize(args.directory, args.device, work=work, progress=not args.json, abc=args.abc)
+        report = synth.synthesize(args.directory, args.device, work=work, progress=_progress(args), abc=args.abc)
         report = dataclasses.replace(report, **_check_netlist(args, work / NETLIST))
-    if args.json:
-        print(json.dumps(report.to_dict(), indent=2))
-    else:
+    if not emit_json(args, report.to_dict()):
         print(report.table())
     for w in report.all_warnings():   # the JSON's "warnings" too
         print(f"warning: {w}", file=sys.stderr)

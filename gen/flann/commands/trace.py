@@ -10,8 +10,6 @@ Fig. 6(b)); ``--at CSV`` also lists the error at the recordings' input voltages.
 from __future__ import annotations
 
 import dataclasses
-import json
-import sys
 import tempfile
 from pathlib import Path
 
@@ -24,6 +22,7 @@ from ..analysis.trace import (TWO_INPUT_STAGE_MODELS, check_design_hdl, check_hd
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
 from ..verify.design import from_directory
 from ..hardware import options as gen_options
+from .common import add_common, check_jobs, cores_limited, emit_json, info
 from .gen import generator_options, refuse_generator_options
 
 HELP = "stage-by-stage error of hardware against the golden model"
@@ -44,8 +43,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--hdl", action="store_true",
                         help="also simulate the generated VHDL over every input code (GHDL + cocotb, "
                              "about a minute) and compare its outputs with the twin and the golden model")
-    parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--plot", metavar="OUT.png", type=png_path, help="plot error per stage vs input voltage")
+    add_common(parser, json="the report", jobs="--hdl simulation shards")
     gen_options.add_arguments(parser)
 
 
@@ -80,6 +79,7 @@ def traced(design) -> str:
 
 
 def run(args) -> int:
+    check_jobs(args.jobs)
     design = _design_dir(args)
     model = None if design else load_model(args.model)  # a design's datapath says whether it has stages
     label = None   # a design's: what was traced (traced())
@@ -97,15 +97,15 @@ def run(args) -> int:
         results = {f: run_trace(model, f, **_options(args, f)) for f in fmts}
     if args.hdl:
         for f, r in results.items():
-            print(f"simulating the {f} design over every input code ...", file=sys.stderr)
-            with tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:
+            info(args, f"simulating the {f} design over every input code ...")
+            with cores_limited(args.jobs), tempfile.TemporaryDirectory(prefix="flann-trace-") as tmp:
                 if design:
                     check_design_hdl(r, design, tmp)
                 else:
                     check_hdl(r, args.model, _options(args, f), tmp)
     points = None
     if args.at:
-        rec = read_recordings(args.at)
+        rec = read_recordings(args.at, announce=not args.quiet)
         points = {f: r.at_voltages(rec.voltage_v) for f, r in results.items()}
     if args.plot:
         if args.compare:
@@ -119,8 +119,8 @@ def run(args) -> int:
             out.update(datapath=design.datapath.name if design else args.format, traced=label or args.format)
         if points:
             out = {"trace": out, "at": points}
-        print(json.dumps(out, indent=2))
-        return 0
+        if emit_json(args, out):
+            return 0
     for f, r in results.items():
         print((dataclasses.replace(r, fmt=label) if design else r).text())
         print()

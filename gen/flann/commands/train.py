@@ -22,6 +22,7 @@ from ..golden.inverse import MIN_POSITIONS, fit_default
 from ..hardware.adc import ADC_BITS, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
+from .common import add_common, info, on_terminal, quiet
 from .train_thermal import compensation_hint, run_thermal
 
 HELP = "train a FLANN inverse model on recordings"
@@ -29,7 +30,6 @@ HELP = "train a FLANN inverse model on recordings"
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...)")
-    p.add_argument("-o", "--output", required=True, help="model.json to write")
     p.add_argument("--terms", type=terms_or_auto(1, MAX_TERMS), default="auto",
                    help="expansion terms N (paper: %s) or 'auto' (default): the forward curve "
                         "v(x) fitted where the noise is, inverted, and the FLANN (terms, "
@@ -63,6 +63,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None,
                    help="--terms auto: volts per code of that converter (default: the grid's step, "
                         "or flann gen's default for --input-bits)")
+    add_common(p, output=dict(help="model.json to write", metavar="MODEL.json", required=True))
 
 
 def converter(args, rec) -> dict | None:
@@ -100,16 +101,24 @@ def _check_generatable(model) -> None:
                          "use fewer --terms, a --ridge, or --terms auto (the default)") from None
 
 
-def _stage(text: str) -> None:
+def _stager(args):
     """What --terms auto is doing, on a terminal only (a logger's file takes it a minute)."""
-    if sys.stderr.isatty():
-        print(f"train: {text}", file=sys.stderr, flush=True)
+    def stage(text: str) -> None:
+        if on_terminal(args):
+            print(f"train: {text}", file=sys.stderr, flush=True)
+
+    return stage
+
+
+class _Verdict(str):
+    """A line of the fit's summary that judges the model: said under --quiet too."""
 
 
 def _train_auto(args, rec, provenance: dict) -> tuple:
     """(model, lines to print) of --terms auto: the FLANN fitted to the inverse of the forward
     curve (:mod:`flann.golden.inverse`), or the direct fit's cross-validated choice."""
     said = []
+    _stage = _stager(args)
     check_fit_input(rec.voltage_v, rec.displacement_mm, 1, rec.source)
     positions = int(np.unique(rec.displacement_mm).size)
     if positions < MIN_POSITIONS:
@@ -174,17 +183,17 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
     if "traded" in t:
         said.append(f"auto: {t['selected_by']}: {t['traded']}")
     elif "hardware_why" in t:
-        said.append(f"auto: no candidate builds in fixed point ({t['hardware_why']})")
+        said.append(_Verdict(f"auto: no candidate builds in fixed point ({t['hardware_why']})"))
     return model, said
 
 
 def run(args) -> int:
-    rec = read_recordings(args.recordings)
+    rec = read_recordings(args.recordings, announce=not args.quiet)
     if args.temperature:
         return run_thermal(args, rec)
     hint = compensation_hint(rec)
     if hint:   # before the checks: a multi-temperature recording may not pass them as one
-        print(hint, file=sys.stderr)
+        info(args, hint)
     # --terms auto screens gross outliers: a glitch among repeated readings is left to it
     rec = prepare_for_fit(rec, trim=args.trim, lone_glitches=args.terms == "auto" and screens(rec.displacement_mm))
     explicit = None
@@ -227,7 +236,8 @@ def run(args) -> int:
     _check_generatable(model)
     model.save(args.output)   # first: the summary's reader (`| head`) may be gone
     for line in said:
-        print(line, file=sys.stderr)
+        if isinstance(line, _Verdict) or not quiet(args):
+            print(line, file=sys.stderr)
     if args.terms != "auto":
         hw = fixed_point_cost(model)
         if not hw["buildable"]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +10,7 @@ from ..errors import FlannError
 from ..golden.thermal_train import MIN_TEMPERATURES, compensable, fit_thermal_auto
 from ..golden.thermal import temperature_groups
 from ..recordings import prepare_for_fit
+from .common import info
 
 
 def compensation_hint(rec) -> str | None:
@@ -49,10 +49,10 @@ def run_thermal(args, rec) -> int:
     model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
     model.save(args.output)
     tr = model.training
-    print(f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "
-          f"coefficients; the smallest weights of {tr['as_good_candidates']} as good), "
-          f"normalisation {choice.norm}, "
-          f"ridge {choice.ridge:g}; held-out error (cross-validation over "
-          f"{tr['cv_position_folds']} position folds and {tr['cv_temperature_folds']} held-out "
-          f"temperatures): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm", file=sys.stderr)
+    info(args, f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "
+               f"coefficients; the smallest weights of {tr['as_good_candidates']} as good), "
+               f"normalisation {choice.norm}, "
+               f"ridge {choice.ridge:g}; held-out error (cross-validation over "
+               f"{tr['cv_position_folds']} position folds and {tr['cv_temperature_folds']} held-out "
+               f"temperatures): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
     return 0
