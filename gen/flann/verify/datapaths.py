@@ -8,6 +8,7 @@ without a bench is refused in one line saying why.  Every entry returns {"summar
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +23,9 @@ from .design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
 from .images import checked_image, image_model, kept_images
-from .netlist import netlist_summary, require_sweep_driver
+from .netlist import check_rtl_netlist, compare, netlist_summary, require_sweep_driver
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
-from .runner import backend_for, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
+from .runner import backend_for, choose_engine, run_family_bench, simulate as simulate_fixed, sweep_temperatures, throughput
 
 
 def _summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:
@@ -129,16 +130,50 @@ def _fixed(design: Design, build_dir, *, seed=1, engine="auto", progress=None, *
     return simulate_fixed(design, build_dir, seed=seed, engine=engine, progress=progress)
 
 
-def _thermal(design: Design, build_dir, *, seed=1, codes=None, progress=None, **_) -> dict:
-    """``codes``: (lo, hi), a narrower voltage code range than every code (tests of wide inputs)."""
-    spec, man = design.spec, design.manifest
+def _thermal(design: Design, build_dir, *, seed=1, codes=None, engine="auto", progress=None, **_) -> dict:
+    """``codes``: (lo, hi), a narrower voltage code range than every code (tests of wide inputs).
+    Every sample through the VHDL under GHDL, or (engine verilator; auto when GHDL would take more
+    than about a minute) through GHDL's synthesised netlist compiled by Verilator, with the VHDL
+    under GHDL on a sample of it."""
+    spec = design.spec
     temps, every = thermal_temperature_codes(spec)
     code_lo, code_hi = (spec.code_min, spec.code_max) if codes is None else codes
-    build_dir = Path(build_dir).resolve()
     samples = len(temps) * (code_hi - code_lo + 1)
-    backend = backend_for(samples * man["cycles_per_sample"])
-    out_file = build_dir / "thermal_sweep.txt"
+    build_dir = Path(build_dir).resolve()
     build_dir.mkdir(parents=True, exist_ok=True)
+    if codes is None and choose_engine(design, engine, samples) == "verilator":
+        return _thermal_netlist(design, build_dir, temps, every, seed=seed, progress=progress)
+    res, rec, backend, out_file = _thermal_vhdl(design, build_dir, temps, (code_lo, code_hi), seed=seed,
+                                                progress=progress)
+    benches = {"thermal_sweep": _bench_entry(res)}
+    lsb = spec.output_lsb_mm
+    err = rec.get("max_err_lsb")
+    s = _summary(design, rec.get("samples", 0), rec.get("mismatches"), None if err is None else err * lsb,
+                 benches, res.ok and bool(rec), lsb)
+    s["sweep"] = _sweep_about(backend, res, samples=samples)
+    _temperature_fields(s, temps, every, code_hi - code_lo + 1)
+    got = _sweep_rows(out_file, samples)
+    curve = None if got is None else _thermal_curve(design, *got, temps, f"GHDL, {backend}")
+    return {"summary": s, "curve": curve, "spec": spec}
+
+
+def _bench_entry(res) -> dict:
+    return {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests, "seconds": round(res.seconds, 1)}
+
+
+def _temperature_fields(s: dict, temps, every: bool, voltage_codes: int) -> None:
+    s["temperature_codes"] = "every" if every else temps
+    s["temperature_codes_tested"] = len(temps)
+    s["voltage_codes_tested"] = voltage_codes
+
+
+def _thermal_vhdl(design: Design, build_dir: Path, temps, codes: tuple[int, int], *, seed=1, progress=None):
+    """The thermal sweep harness under GHDL over voltage codes ``codes`` (lo, hi) at each of
+    ``temps``: (bench result, its record, GHDL backend, the joined output file)."""
+    spec, man = design.spec, design.manifest
+    code_lo, code_hi = codes
+    backend = backend_for(len(temps) * (code_hi - code_lo + 1) * man["cycles_per_sample"])
+    out_file = build_dir / "thermal_sweep.txt"
     sweep = {"file": str(out_file), "code_lo": code_lo, "code_hi": code_hi}
     params = {"in_bits_g": spec.input_bits, "temp_bits_g": spec.temp_bits, "out_bits_g": spec.out_fmt.width,
               "code_lo_g": code_lo, "code_hi_g": code_hi}
@@ -148,29 +183,56 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, progress=None, **
                                                            "sweep": sweep},
                              params, temps, name="thermal_sweep", seed=seed, backend=backend,
                              progress=progress("sweep") if progress else None)
-    rec = res.records.get("thermal_sweep", {})
-    benches = {"thermal_sweep": {"tests": res.tests, "failures": res.failures, "failed": res.failed_tests,
-                                 "seconds": round(res.seconds, 1)}}
+    return res, res.records.get("thermal_sweep", {}), backend, out_file
+
+
+# the VHDL sample beside the compiled netlist: a window of voltage codes across the upper clamp
+# code at the ends and the middle of the temperature codes
+VHDL_SAMPLE_CODES = 64
+
+
+def _thermal_netlist(design: Design, build_dir: Path, temps, every: bool, *, seed=1, progress=None) -> dict:
+    spec, man = design.spec, design.manifest
+    # the VHDL itself under GHDL on a sample, judged against the twin by its bench, run while
+    # the netlist compiles
+    hi_clamp = int(man["clamp_codes"][1])
+    lo = max(spec.code_min, min(hi_clamp - VHDL_SAMPLE_CODES // 2, spec.code_max - VHDL_SAMPLE_CODES + 1))
+    sample_temps = sorted({temps[0], temps[len(temps) // 2], temps[-1]})
+    with ThreadPoolExecutor(1) as pool:
+        vhdl = pool.submit(_thermal_vhdl, design, build_dir / "vhdl_sample", sample_temps,
+                           (lo, min(spec.code_max, lo + VHDL_SAMPLE_CODES - 1)), seed=seed)
+        nl = check_rtl_netlist(design, build_dir / "rtl_netlist",
+                               progress=progress("sweep") if progress else None, temps=temps)
+        res, rec, backend, _ = vhdl.result()
+    judged = compare(nl["sweep"], nl)
+    c, t, out = nl["codes"], nl["temps"], nl["data"]
     lsb = spec.output_lsb_mm
-    err = rec.get("max_err_lsb")
-    s = _summary(design, rec.get("samples", 0), rec.get("mismatches"), None if err is None else err * lsb,
-                 benches, res.ok and bool(rec), lsb)
-    s["temperature_codes"] = "every" if every else temps
-    s["temperature_codes_tested"] = len(temps)
-    s["voltage_codes_tested"] = code_hi - code_lo + 1
-    s["sweep"] = _sweep_about(backend, res, samples=samples)
-    curve = None
-    got = _sweep_rows(out_file, len(temps) * (code_hi - code_lo + 1))
-    if got is not None:
-        c, t, out, sat = got
-        ref = spec.float_reference(c, t) / lsb
-        bound = man["analysis"]["pre_rounding_lsb"] + 0.5
-        curve = plots.two_input([{"name": "", "codes": c, "temps": t, "hdl": out, "ref": ref,
-                                  "valid": ~(sat & (np.abs(ref) > spec.out_fmt.max_int))}],
-                                temps, spec.temp_lsb_c, ref=plots.GOLDEN, simulator=f"GHDL, {backend}",
-                                bound={"value": bound, "label": f"±{bound:.3g} LSB (the design's error bound)"},
-                                calibrated=(spec.temp_lo, spec.temp_hi))
+    ref = spec.float_reference(c, t) / lsb
+    inside = ~(nl["sat"] & (np.abs(ref) > spec.out_fmt.max_int))  # saturated where the model is beyond the output
+    err = float(np.abs(out - ref)[inside].max()) * lsb if inside.any() else None
+    benches = {"thermal_sweep": _bench_entry(res)}
+    ok = res.ok and bool(rec) and not rec.get("mismatches") and judged["codes_tested"] > 0
+    s = _summary(design, judged["codes_tested"], judged["mismatches"], err, benches, ok, lsb)
+    s["sweep"] = {"engine": "verilator", "netlist": "ghdl --synth --out=verilog (repaired), Verilator",
+                  "shards": nl["shards"], "seconds": round(nl["seconds"], 1),
+                  "build_seconds": round(nl["build_seconds"], 1),
+                  "codes_per_s": round(c.size / nl["seconds"], 1) if nl["seconds"] else None,
+                  "vhdl_sample": {"codes": int(rec.get("samples", 0)), "backend": f"ghdl-{backend}",
+                                  "bench_ok": res.ok, "mismatches": rec.get("mismatches")}}
+    _temperature_fields(s, temps, every, spec.code_max - spec.code_min + 1)
+    curve = _thermal_curve(design, c, t, out, nl["sat"], temps, "Verilator, GHDL's synthesised netlist")
     return {"summary": s, "curve": curve, "spec": spec}
+
+
+def _thermal_curve(design: Design, c, t, out, sat, temps, simulator: str):
+    spec, man = design.spec, design.manifest
+    ref = spec.float_reference(c, t) / spec.output_lsb_mm
+    bound = man["analysis"]["pre_rounding_lsb"] + 0.5
+    valid = ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
+    return plots.two_input([{"name": "", "codes": c, "temps": t, "hdl": out, "ref": ref, "valid": valid}],
+                           temps, spec.temp_lsb_c, ref=plots.GOLDEN, simulator=simulator,
+                           bound={"value": bound, "label": f"±{bound:.3g} LSB (the design's error bound)"},
+                           calibrated=(spec.temp_lo, spec.temp_hi))
 
 
 def _sweep_about(backend: str, *runs, samples: int) -> dict:
@@ -261,9 +323,9 @@ def simulate(design: Design, build_dir, *, netlist: bool = False, **kw) -> dict:
         raise FlannError(f"{design.directory}: {dp.why_no_bench}")
     if netlist:
         require_sweep_driver(dp, design.directory, "--netlist")
-    if kw.get("engine") == "verilator" and BENCHES[dp.bench] is not _fixed:
-        # GHDL's netlist compiled by Verilator stands in for the fixed-point sweep bench only
-        raise FlannError(f"--engine verilator: replaces the fixed-point datapath's VHDL sweep; {design.directory} "
+    if kw.get("engine") == "verilator" and BENCHES[dp.bench] not in (_fixed, _thermal):
+        # GHDL's netlist compiled by Verilator stands in for the one-input and thermal sweep benches only
+        raise FlannError(f"--engine verilator: replaces the fixed-point and thermal datapaths' VHDL sweep; {design.directory} "
                          f"holds a {dp.name} design (its bench runs under GHDL)")
     if kw.get("images") and BENCHES[dp.bench] not in LOADS_IMAGES:
         raise FlannError(f"--image: {design.directory} is a {dp.name} design, its weights are built in "

@@ -17,6 +17,7 @@ design keeps, over the memory's initial sensor, so that the load is what the swe
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 import subprocess
 import tempfile
@@ -270,20 +271,24 @@ def netlist_summary(design: Design, build_dir, progress=None, image: dict | None
     return entry, nl["mismatches"] == 0 and nl["codes_tested"] > 0
 
 
-def check_rtl_netlist(design: Design, build, progress=None) -> dict:
+def check_rtl_netlist(design: Design, build, progress=None, temps=None) -> dict:
     """Every input code through GHDL's own synthesis of the VHDL (``ghdl --synth``, repaired, the
     text Yosys maps), compiled by Verilator: the fast exhaustive engine (``flann sim --engine
-    verilator``).  Returns the arrays in code order as the VHDL sweep does, plus timings."""
+    verilator``).  ``temps``: a two-input design's temperature codes (default: its netlist
+    sweep's).  Returns the arrays in code order as the VHDL sweep does, plus timings and the
+    ``sweep`` (what :func:`compare` judges them by)."""
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     sweep = sweep_of(design)
+    if temps is not None:
+        sweep = dataclasses.replace(sweep, temps=tuple(int(t) for t in temps))
     verilog = ghdl_to_verilog(read_manifest(design.directory), build / "ghdl_synth")
     exe = compile_netlist(verilog, build / "verilator", sweep, cells=False)
     t_build = time.monotonic() - t0
     lo, hi = sweep.codes
     got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
-    return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1)}
+    return {**got, "build_seconds": t_build, "shards": min(cores(), hi - lo + 1), "sweep": sweep}
 
 
 def sweep_datapaths() -> str:

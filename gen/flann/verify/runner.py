@@ -362,15 +362,17 @@ ENGINES = ("auto", "ghdl", "verilator")
 GHDL_CYCLES_PER_MINUTE = 6e6
 
 
-def choose_engine(design: Design, engine: str = "auto") -> str:
-    """``auto``: the VHDL under GHDL when every code fits in about a minute there (or Verilator is
-    missing), else GHDL's synthesised netlist compiled by Verilator with the VHDL on a sample."""
+def choose_engine(design: Design, engine: str = "auto", samples: int | None = None) -> str:
+    """``auto``: the VHDL under GHDL when every sample (default: every input code) fits in about a
+    minute there (or Verilator is missing), else GHDL's synthesised netlist compiled by Verilator
+    with the VHDL on a sample."""
     if engine not in ENGINES:
         raise FlannError(f"engine {engine!r}: must be one of {', '.join(ENGINES)}")
     if engine != "auto":
         return engine
     man = design.manifest
-    cycles = (1 << man["input_bits"]) * man["cycles_per_sample"] / max(1, cores())
+    samples = (1 << man["input_bits"]) if samples is None else samples
+    cycles = samples * man["cycles_per_sample"] / max(1, cores())
     return "verilator" if cycles > GHDL_CYCLES_PER_MINUTE and shutil.which("verilator") else "ghdl"
 
 
@@ -465,5 +467,5 @@ def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES)
     return {"summary": summary, "curve": curve, "spec": spec}
 
 
-__all__ = ["throughput", "simulator_name", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "backend_for", "simulate", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "choose_engine", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "backend_for", "simulate", "BenchResult", "BENCHES", "sim_dir",
            "ghdl_backend"]
