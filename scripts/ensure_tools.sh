@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Make sure the simulators and synthesis tools are present; install the Debian packages when root.
-#   ghdl, ghdl-llvm  VHDL simulation (LLVM backend: the exhaustive sweep runs ~2.6x faster than mcode)
+#   ghdl, ghdl-mcode, ghdl-llvm  VHDL simulation: mcode for the short cocotb benches (it compiles in
+#                    a second; without it Debian's ghdl wrapper falls back to LLVM, which compiles and
+#                    links every bench, several seconds each), LLVM for long sweeps (~2.6x faster)
 #   yosys            synthesis (synth_xilinx -family xcv) and its Xilinx cell models
 #   verilator        post-synthesis netlist simulation; iverilog: the netlist regression test
 #   nextpnr-ice40    iCE40 place and route + static timing (flann synth --device ice40-...)
@@ -8,6 +10,7 @@
 set -euo pipefail
 missing=()
 command -v ghdl      >/dev/null 2>&1 || missing+=(ghdl)
+command -v ghdl-mcode >/dev/null 2>&1 || missing+=(ghdl-mcode)
 command -v ghdl-llvm >/dev/null 2>&1 || missing+=(ghdl-llvm)
 command -v yosys     >/dev/null 2>&1 || missing+=(yosys)
 command -v verilator >/dev/null 2>&1 || missing+=(verilator)

@@ -1,13 +1,23 @@
-"""Shared fixtures: the repository's data files, located once."""
+"""Shared fixtures: the repository's data files, located once; slow artefacts (designs, simulations)
+made once per test run and shared by every xdist worker (:func:`once`)."""
 
+import contextlib
+import fcntl
+import io
+import os
+import pickle
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from flann import cache as flann_cache
 from flann.cli import main
 from flann.golden.thermal_train import fit_thermal
 from flann.golden.train import fit_lstsq
+from flann.hardware.seed import render as seed_render
+from flann.hardware.seed.spec import derive_seed_spec
 from flann.production.demo import write_batch
 from flann.recordings import prepare_for_fit, read_recordings
 
@@ -33,6 +43,60 @@ def table1_csv() -> Path:
 @pytest.fixture(scope="session")
 def default_model_json() -> Path:
     return DATA / "default_model.json"
+
+
+@pytest.fixture(scope="session")
+def run_root(tmp_path_factory, worker_id) -> Path:
+    """A directory of this test run that every xdist worker shares (new each run)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if worker_id != "master" else base
+
+
+@pytest.fixture(scope="session", autouse=True)
+def tool_cache(run_root):
+    """flann's cache of synthesised and compiled netlists (:mod:`flann.cache`), empty at the start
+    of each run and shared by its workers and the flann processes they start: each design is
+    synthesised once per run, as a user's synth then ise would."""
+    path = run_root / "flann-cache"
+    path.mkdir(exist_ok=True)
+    os.environ[flann_cache.ENV] = str(path)
+    return path
+
+
+@pytest.fixture(scope="session")
+def once(run_root):
+    """``once(key, make)``: ``make(directory)`` run once per test run, whichever worker asks
+    first, in a fresh ``directory`` every worker sees; its (picklable) result returned to each.
+    A slow property (a simulation, a synthesis) is checked once per design and the tests that
+    look at its outputs share it.  A ``make`` that raises leaves nothing: the next asker tries
+    again, and fails as the first did."""
+    root = run_root / "once"
+    root.mkdir(exist_ok=True)
+
+    def run(key: str, make):
+        directory, done = root / key, root / f"{key}.pickle"
+        with open(root / f"{key}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # the other workers wait here while one makes it
+            if done.is_file():
+                return pickle.loads(done.read_bytes())
+            if directory.exists():
+                shutil.rmtree(directory)
+            directory.mkdir()
+            value = make(directory)
+            done.write_bytes(pickle.dumps(value))
+            return value
+    return run
+
+
+def run_cli(argv) -> tuple:
+    """flann in process outside a test's capture: (exit code, stdout, stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main([str(a) for a in argv])
+        except SystemExit as exc:
+            rc = exc.code
+    return rc, out.getvalue(), err.getvalue()
 
 
 @pytest.fixture
@@ -65,11 +129,17 @@ SMALL_DESIGN_BITS = 8
 
 
 @pytest.fixture(scope="session")
-def small_designs(tmp_path_factory) -> dict:
+def small_designs(once) -> dict:
     """Small designs (4-5 terms, 8-bit input) of every datapath flann gen writes, by datapath
-    name under ``dir``; ``model`` the one-input model, ``rec`` a recording of its sensor,
-    ``thermal`` the two-input model (of :func:`thermal_sensor_v`)."""
-    d = tmp_path_factory.mktemp("small_designs")
+    name under ``dir``, made once per run (read them; copy one to change it); ``model`` the
+    one-input model, ``rec`` a recording of its sensor, ``thermal`` the two-input model (of
+    :func:`thermal_sensor_v`), ``held_thermal`` a held-out recording of that sensor.  Beside them:
+    ``seed/`` (the paper's parallel architecture, which flann explore writes for comparison) and
+    ``plain/`` (VHDL with a hand-written manifest, a design flann did not write)."""
+    return once("small_designs", _small_designs)
+
+
+def _small_designs(d: Path) -> dict:
     recs = write_batch(d / "rec", 2, seed=11, points=400)
     rec = prepare_for_fit(read_recordings(recs[0]))
     model = d / "m5.json"
@@ -88,6 +158,14 @@ def small_designs(tmp_path_factory) -> dict:
                  # 4 terms, 4-bit temperature code: 10 calibrated codes
                  ("--family", *members, "--terms", 4, "-o", d / "family_thermal", "--temp-bits", 4,
                   "--temp-lsb-c", 12)):
-        if main(["gen", *map(str, args), "--input-bits", str(SMALL_DESIGN_BITS)]) != 0:
-            raise RuntimeError(f"flann gen {args} failed")
-    return {"dir": d, "model": model, "rec": recs[0], "thermal": thermal}
+        rc, _out, err = run_cli(["gen", *map(str, args), "--input-bits", str(SMALL_DESIGN_BITS)])
+        if rc != 0:
+            raise RuntimeError(f"flann gen {args} failed: {err}")
+    # held out between and beside the calibration temperatures, for flann eval
+    xh, th = np.tile(np.linspace(-9.5, 9.5, 39), 2), np.repeat([10.0, 65.0], 39)
+    held = d / "held_thermal.csv"
+    held.write_text("displacement_mm,voltage_v,temperature_c\n"
+                    + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, thermal_sensor_v(xh, th), th)))
+    seed_render.write(derive_seed_spec(model, input_bits=SMALL_DESIGN_BITS), d / "seed")
+    shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
+    return {"dir": d, "model": model, "rec": recs[0], "thermal": thermal, "held_thermal": held}

@@ -9,12 +9,14 @@ resource estimate (:mod:`flann.implement.synth`) and the mapped-netlist check
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import shutil
 import subprocess
 from pathlib import Path
 
+from . import __version__, cache
 from .errors import FlannError
 from .hardware.manifest import Manifest
 
@@ -230,5 +232,33 @@ def yosys_cells(verilog: Path, top: str, work: Path, abc: str = "full") -> tuple
     return {str(k): int(v) for k, v in cells.items()}, warnings
 
 
-__all__ = ["ABC_MODES", "BENIGN_YOSYS_WARNINGS", "FAMILY", "MAPPED_JSON", "NETLIST", "SynthCheckError",
+@functools.lru_cache(maxsize=None)
+def tool_version(name: str, flag: str = "--version") -> str:
+    """The first line ``name flag`` prints (part of every cache key the tool's output enters)."""
+    r = subprocess.run([need_tool(name), flag], capture_output=True, text=True)
+    return (r.stdout or r.stderr).strip().splitlines()[0] if (r.stdout or r.stderr).strip() else ""
+
+
+CELLS_JSON = "cells.json"  # the cell counts and the warnings that matter, as yosys_cells returns them
+
+
+def synthesize_cells(man: Manifest, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
+    """:func:`ghdl_to_verilog` then :func:`yosys_cells` into ``work`` (its files: GHDL's Verilog,
+    ``stat.json``, ``modules.json``, the mapped netlist and its JSON), once per design: a design
+    synthesised before with the same files, tools and flow is taken from :mod:`flann.cache`."""
+    work = Path(work).resolve()
+    work.mkdir(parents=True, exist_ok=True)
+    names = [f"{man.top}.v", "stat.json", "modules.json", MAPPED_JSON, NETLIST, "yosys.log", CELLS_JSON]
+    digest = cache.key(__version__, tool_version("ghdl"), tool_version("yosys", "-V"), Path(__file__), man.top,
+                       yosys_script("design.v", man.top, abc), *[x for f in man.files for x in (f.name, f)])
+    with cache.entry("synth", digest, work, names) as hit:
+        if not hit:
+            verilog = ghdl_to_verilog(man, work)
+            cells, warnings = yosys_cells(verilog, man.top, work, abc)
+            (work / CELLS_JSON).write_text(json.dumps({"cells": cells, "warnings": warnings}))
+    data = json.loads((work / CELLS_JSON).read_text())
+    return data["cells"], data["warnings"]
+
+
+__all__ = ["ABC_MODES", "CELLS_JSON", "synthesize_cells", "tool_version", "BENIGN_YOSYS_WARNINGS", "FAMILY", "MAPPED_JSON", "NETLIST", "SynthCheckError",
            "complete_pmux_cases", "ghdl_to_verilog", "need_tool", "repair_ghdl_verilog", "yosys_cells", "yosys_script"]

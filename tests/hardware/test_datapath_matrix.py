@@ -13,8 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flann.hardware.seed import render as seed_render
-from flann.hardware.seed.spec import derive_seed_spec
 from flann.implement.synth import lint_vhdl
 from flann.verify.runner import simulator_name, throughput
 
@@ -28,22 +26,11 @@ def flann(*args, cwd=None):
 
 
 @pytest.fixture(scope="module")
-def designs(small_designs, thermal_sensor):
+def designs(small_designs):
     """Small designs (4-5 terms, 8-bit input) of every datapath flann gen writes
     (``small_designs``), the seed architecture, a design flann did not write, and held-out
     recordings of the two-input sensor."""
-    d = small_designs["dir"]
-    # its held-out recording (between and beside the calibration temperatures), for flann eval
-    xh, th = np.tile(np.linspace(-9.5, 9.5, 39), 2), np.repeat([10.0, 65.0], 39)
-    held = d / "held_thermal.csv"
-    held.write_text("displacement_mm,voltage_v,temperature_c\n"
-                    + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, thermal_sensor(xh, th), th)))
-    # the seed architecture is written by flann explore only (for comparison)
-    if not (d / "seed").exists():
-        seed_render.write(derive_seed_spec(small_designs["model"], input_bits=int(BITS)), d / "seed")
-    # a design flann did not write: VHDL with a hand-written manifest (synth and ise take it)
-    if not (d / "plain").exists():
-        shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
+    d, held = small_designs["dir"], small_designs["held_thermal"]
     return {"dir": d, "model": small_designs["model"], "rec": small_designs["rec"],
             # the family's initial image is its first member, the sensor the held-out recording is of
             "eval": {"thermal": (small_designs["thermal"], held),
@@ -64,8 +51,9 @@ COMMANDS = {
     "trace": lambda d, fx: ("trace", d),
     "eval": lambda d, fx: ("eval", *fx["eval"].get(d.name, (fx["model"], fx["rec"])), "--design", d),
     "ise": lambda d, fx: ("ise", d, "-o", fx["dir"] / f"ise_{d.name}"),
-    # lint on; the mapped netlist checked where a bench drives it; abc -fast: the seed is parallel
-    "synth": lambda d, fx: ("synth", d, "--abc", "fast"),
+    # lint on; the mapped netlist checked where a bench drives it; the synthesis ise's timing check
+    # then takes from the cache (abc -fast for the seed: its parallel multipliers are wide)
+    "synth": lambda d, fx: ("synth", d, *(("--abc", "fast") if d.name == "seed" else ())),
     # one lane: the fixed design's two multiplier styles; the float18 design's one (it has no --mult)
     "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--widths", "budget", "--no-seed"),
 }

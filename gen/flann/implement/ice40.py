@@ -24,7 +24,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..eda import ghdl_to_verilog, need_tool
+from .. import __version__, cache
+from ..eda import ghdl_to_verilog, need_tool, tool_version
 from ..errors import FlannError
 from ..fileio import atomic_directory, check_output_directory
 from ..hardware.manifest import read_manifest
@@ -241,6 +242,32 @@ def fmax_of(report: dict) -> float | None:
     return min(vals) if vals else None
 
 
+CELLS_JSON = "ice40_cells.json"
+
+
+def _synth_place_route(man, part: Ice40Part, wdir: Path, clock_mhz: float, seed: int, say) -> None:
+    """GHDL synthesis, Yosys synth_ice40, nextpnr and icepack in ``wdir``."""
+    say(f"ghdl --synth --std=93c {man.top}")
+    verilog = ghdl_to_verilog(man, wdir)
+    say("yosys synth_ice40")
+    cells = yosys_ice40(verilog, man.top, wdir)
+    luts = cells.get("SB_LUT4", 0)
+    brams_needed = sum(n for c, n in cells.items() if c.startswith("SB_RAM40"))
+    if luts > part.logic_cells or brams_needed > part.brams:
+        raise FlannError(f"{man.top} does not fit {part.name}: {luts} LUT4 (of {part.logic_cells} logic cells), "
+                         f"{brams_needed} block RAMs (of {part.brams})")
+    say(f"nextpnr-ice40 --{part.nextpnr} --package {part.package} --freq {clock_mhz:g} (place, route, timing)")
+    place_and_route(part, man.top, wdir, clock_mhz, seed)
+    routed = json.loads((wdir / ROUTED_JSON).read_text())
+    (wdir / f"{man.top}.pcf").write_text(example_pcf(routed, part, man.top))
+    say("icepack")
+    r = subprocess.run([_tool("icepack"), f"{man.top}.asc", f"{man.top}.bin"], capture_output=True, text=True,
+                       cwd=wdir)
+    if r.returncode != 0:
+        raise FlannError(f"icepack failed: {r.stderr.strip() or r.returncode}")
+    (wdir / CELLS_JSON).write_text(json.dumps(cells))
+
+
 def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, progress: bool = False,
               post_route=None) -> Ice40Report:
     """The whole iCE40 flow for one design directory; writes ``out_dir`` as a whole.
@@ -258,25 +285,18 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
     with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
         wdir = Path(work).resolve() if work is not None else Path(tmp)
         wdir.mkdir(parents=True, exist_ok=True)
-        say(f"ghdl --synth --std=93c {man.top}")
-        verilog = ghdl_to_verilog(man, wdir)
-        say("yosys synth_ice40")
-        cells = yosys_ice40(verilog, man.top, wdir)
-        luts = cells.get("SB_LUT4", 0)
-        brams_needed = sum(n for c, n in cells.items() if c.startswith("SB_RAM40"))
-        if luts > part.logic_cells or brams_needed > part.brams:
-            raise FlannError(f"{man.top} does not fit {part.name}: {luts} LUT4 (of {part.logic_cells} logic cells), "
-                             f"{brams_needed} block RAMs (of {part.brams})")
-        say(f"nextpnr-ice40 --{part.nextpnr} --package {part.package} --freq {clock_mhz:g} (place, route, timing)")
-        rep = place_and_route(part, man.top, wdir, clock_mhz, seed)
-        routed = json.loads((wdir / ROUTED_JSON).read_text())
-        pcf = example_pcf(routed, part, man.top)
-        (wdir / f"{man.top}.pcf").write_text(pcf)
-        say("icepack")
-        r = subprocess.run([_tool("icepack"), f"{man.top}.asc", f"{man.top}.bin"], capture_output=True, text=True,
-                           cwd=wdir)
-        if r.returncode != 0:
-            raise FlannError(f"icepack failed: {r.stderr.strip() or r.returncode}")
+        # synthesis, place and route and the bitstream once per design, part, clock and seed
+        names = [f"{man.top}.asc", f"{man.top}.bin", f"{man.top}.pcf", NEXTPNR_REPORT, ROUTED_JSON, CELLS_JSON]
+        digest = cache.key(__version__, *(tool_version(t) for t in ("ghdl", "yosys", "nextpnr-ice40")),
+                           Path(__file__), man.top, part.name, clock_mhz, seed,
+                           *[x for f in man.files for x in (f.name, f)])
+        with cache.entry("ice40", digest, wdir, names) as hit:
+            if hit:
+                say("synthesis, place and route: this design, part and seed done before (cached)")
+            else:
+                _synth_place_route(man, part, wdir, clock_mhz, seed, say)
+        cells = json.loads((wdir / CELLS_JSON).read_text())
+        rep = json.loads((wdir / NEXTPNR_REPORT).read_text())
         util = rep.get("utilization", {})
         post = post_route(wdir / f"{man.top}.asc", wdir / f"{man.top}.pcf", part, wdir) if post_route else None
         report = Ice40Report(

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ..hardware.manifest import Manifest, read_manifest
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, DEVICES, Part, parse_part
-from ..eda import ABC_MODES, FAMILY, MAPPED_JSON, SynthCheckError, ghdl_to_verilog, need_tool, yosys_cells
+from ..eda import ABC_MODES, FAMILY, MAPPED_JSON, SynthCheckError, need_tool, synthesize_cells
 from ..errors import FlannError
 from . import timing as spartan2_timing
 
@@ -265,12 +265,10 @@ def synthesize(directory: str | Path, device: str | None = None, work: str | Pat
         wdir = Path(work).resolve() if work is not None else Path(tmp)
         wdir.mkdir(parents=True, exist_ok=True)
         if progress:
-            print(f"synth: ghdl --synth --std=93c {man.top} ({len(man.files)} files)", file=sys.stderr)
-        verilog = ghdl_to_verilog(man, wdir)
-        if progress:
-            print(f"synth: yosys synth_xilinx -family {FAMILY}, abc {abc} (minutes for wide multipliers)",
+            print(f"synth: ghdl --synth --std=93c {man.top} ({len(man.files)} files), then yosys synth_xilinx "
+                  f"-family {FAMILY}, abc {abc} (minutes for wide multipliers; once per design, then cached)",
                   file=sys.stderr)
-        cells, warnings = yosys_cells(verilog, man.top, wdir, abc)
+        cells, warnings = synthesize_cells(man, wdir, abc)
         modules = entity_breakdown(json.loads((wdir / "modules.json").read_text()))
         est = spartan2_timing.analyse(wdir / MAPPED_JSON, part, man.top)
     return SynthReport(part, man.top, Resources.from_cells(cells), tuple(warnings), man.data, abc, modules, est)

@@ -28,13 +28,14 @@ from typing import Callable
 
 import numpy as np
 
+from .. import cache
 from ..errors import FlannError
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import FlannF18Top
 from ..hardware.thermal.twin import FlannThermalTop
-from ..eda import NETLIST, ghdl_to_verilog, yosys_cells
+from ..eda import NETLIST, ghdl_to_verilog, synthesize_cells, tool_version
 from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR
 from .design import Design
@@ -159,9 +160,7 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     """Synthesise ``design`` as ``flann synth`` does; returns the Yosys-mapped Verilog netlist."""
     work = Path(work).resolve()
     work.mkdir(parents=True, exist_ok=True)
-    man = read_manifest(design.directory)
-    verilog = ghdl_to_verilog(man, work)
-    yosys_cells(verilog, man.top, work, abc)
+    synthesize_cells(read_manifest(design.directory), work, abc)
     return work / NETLIST
 
 
@@ -184,18 +183,24 @@ def compile_netlist(netlist: Path, build: Path, sweep: NetlistSweep, cells: bool
         flags += f" -DTEMP_BITS={sweep.temp_bits}"
     if sweep.image is not None:
         flags += f" -DCFG_ADDR_BITS={sweep.cfg_addr_bits} -DCFG_WORDS={len(sweep.image)}"
+    options = ["--top-module", sweep.top, "--prefix", PREFIX, "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint",
+               "-Wno-style", "-CFLAGS", flags]
     cmd = [exe_tool, "--cc", str(Path(netlist).resolve()), *map(str, models), *(f"+define+{d}" for d in defines),
-           "--top-module", sweep.top, "--prefix", PREFIX, "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2",
-           "-Mdir", str(build / "obj"), "-O3", "--no-timing", "-Wno-fatal", "-Wno-lint", "-Wno-style",
-           "-CFLAGS", flags]
-    log = build / "verilator.log"
-    with open(log, "w") as fh:
-        r = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=build)
+           "--exe", str(BENCH_DIR / DRIVER), "--build", "-j", "2", "-Mdir", str(build / "obj"), *options]
     exe = build / "obj" / PREFIX
-    if r.returncode != 0 or not exe.is_file():
-        text = log.read_text(errors="replace")
-        first = next((ln.strip() for ln in text.splitlines() if "%Error" in ln or "error:" in ln), f"see {log}")
-        raise FlannError(f"verilator could not build the netlist simulation: {first}")
+    # the C++ build takes most of a small design's check: once per netlist, driver and options
+    digest = cache.key(tool_version("verilator"), Path(netlist), *map(Path, models), *defines, *options,
+                       BENCH_DIR / DRIVER)
+    with cache.entry("verilator", digest, build / "obj", [PREFIX]) as hit:
+        if not hit:
+            log = build / "verilator.log"
+            with open(log, "w") as fh:
+                r = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=build)
+            if r.returncode != 0 or not exe.is_file():
+                text = log.read_text(errors="replace")
+                first = next((ln.strip() for ln in text.splitlines() if "%Error" in ln or "error:" in ln),
+                             f"see {log}")
+                raise FlannError(f"verilator could not build the netlist simulation: {first}")
     return exe
 
 
