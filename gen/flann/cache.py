@@ -53,6 +53,7 @@ def entry(kind: str, digest: str, work: Path, names: list[str]):
     first (a lock per entry)."""
     base = root()
     work = Path(work)
+    work.mkdir(parents=True, exist_ok=True)
     if base is None:
         yield False
         return
@@ -76,7 +77,6 @@ def _restore(final: Path, work: Path, names: list[str]) -> bool:
     if not all((final / n).is_file() for n in names):
         return False
     try:
-        work.mkdir(parents=True, exist_ok=True)
         for n in names:
             (work / n).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(final / n, work / n)
