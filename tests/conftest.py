@@ -4,9 +4,11 @@ made once per test run and shared by every xdist worker (:func:`once`)."""
 import contextlib
 import fcntl
 import io
+import json
 import os
 import pickle
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -169,3 +171,68 @@ def _small_designs(d: Path) -> dict:
     seed_render.write(derive_seed_spec(model, input_bits=SMALL_DESIGN_BITS), d / "seed")
     shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
     return {"dir": d, "model": model, "rec": recs[0], "thermal": thermal, "held_thermal": held}
+
+
+@dataclass
+class SimRun:
+    """One ``flann sim`` of a small design, run in process: exit code, the text report, stderr, the
+    summary (``--summary-json``), the PNG ``--plot`` wrote and what each of its figures held, axis
+    by axis (title, y label, lines as (label, x, y))."""
+
+    argv: list
+    rc: int
+    out: str
+    err: str
+    summary: dict | None
+    png: Path
+    figures: list
+
+
+# the one simulation of each small design the tests share: the family's with its mapped netlist
+# (its weight image loaded through the cfg port); the family with temperature with both sensors'
+# images given, the design's last member first
+SIM_FLAGS = {"fixed": (), "float18": (), "family": ("--netlist",), "thermal": (), "family_thermal": "images"}
+
+
+def _captured_figures(run):
+    """run() with every figure matplotlib saves recorded; (its result, the figures)."""
+    from matplotlib.figure import Figure
+
+    seen, save = [], Figure.savefig
+
+    def keep(fig, *args, **kw):
+        seen.append([{"title": ax.get_title(), "ylabel": ax.get_ylabel(),
+                      "lines": [(ln.get_label(), np.asarray(ln.get_xdata(), dtype=float),
+                                 np.asarray(ln.get_ydata(), dtype=float)) for ln in ax.get_lines()]}
+                     for ax in fig.axes])
+        return save(fig, *args, **kw)
+
+    Figure.savefig = keep
+    try:
+        return run(), seen
+    finally:
+        Figure.savefig = save
+
+
+def family_thermal_images(design: Path) -> list[Path]:
+    """The weight images a family design keeps, in the manifest's order."""
+    return [design / im["hex"] for im in json.loads((design / "manifest.json").read_text())["images"]]
+
+
+@pytest.fixture(scope="session")
+def small_sims(small_designs, once):
+    """``small_sims(datapath)``: the :class:`SimRun` of that small design (``flann sim DIR --plot
+    --summary-json`` with :data:`SIM_FLAGS`), simulated once per test run."""
+    def make(datapath: str, d: Path) -> SimRun:
+        design = small_designs["dir"] / datapath
+        flags = SIM_FLAGS[datapath]
+        if flags == "images":
+            flags = [a for h in family_thermal_images(design)[::-1] for a in ("--image", h)]
+        png, summary = d / "sim.png", d / "summary.json"
+        argv = ["sim", design, "--plot", png, "--summary-json", summary, "--build", d / "build", *flags]
+        (rc, out, err), figures = _captured_figures(lambda: run_cli(argv))
+        # a plain dict in the shared store: pickle finds no class of a conftest module by name
+        return {"argv": [str(a) for a in argv], "rc": rc, "out": out, "err": err, "png": png, "figures": figures,
+                "summary": json.loads(summary.read_text()) if summary.is_file() else None}
+
+    return lambda datapath: SimRun(**once(f"sim_{datapath}", lambda d: make(datapath, d)))
