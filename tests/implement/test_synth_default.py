@@ -43,8 +43,8 @@ def test_default_design_passes_vsg(tmp_path):
 @pytest.mark.synth
 @pytest.mark.skipif(not (shutil.which("ghdl") and shutil.which("yosys")), reason="ghdl and yosys are required")
 def test_default_design_fits_its_documented_device_and_xc2s30_as_the_readme_says(tmp_path, capsys):
-    # the README's headline: the default design fits the smallest Spartan-II in PQ208
-    assert "| **ours, default fixed point** |" in (ROOT / "README.md").read_text()
+    # the headline of docs/results.md: the default design fits the smallest Spartan-II in PQ208
+    assert "| **ours, default fixed point** |" in (ROOT / "docs" / "results.md").read_text()
     d = _default_design(tmp_path)
     device = json.loads((d / "manifest.json").read_text())["spec"]["device"]
     rc = main(["synth", str(d), "--device", device, "--json", "--no-lint"])
