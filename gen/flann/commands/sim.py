@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from ..argtypes import TOOL_SEED, png_path
@@ -117,6 +118,7 @@ def run(args) -> int:
         check_output_directory(args.build, lambda _earlier: True, "build directory")
     if args.post_route:
         parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
+    t0 = time.monotonic()
     with cores_limited(args.jobs), tempfile.TemporaryDirectory(prefix="flann-sim-") as tmp:
         build = Path(args.build).resolve() if args.build else Path(tmp)
         design = open_design(args.model, build, opts, model=args.design_model)
@@ -141,6 +143,7 @@ def run(args) -> int:
         temporary = Path(tmp).resolve() in design.directory.parents
         if temporary:
             s["design"] = None
+    s["seconds"] = round(time.monotonic() - t0, 1)   # the whole command: generation, builds, benches
     if args.summary_json:
         atomic_write_json(args.summary_json, s)
     if not emit_json(args, s):
@@ -184,6 +187,7 @@ def run(args) -> int:
                   f"(Fmax {n['fmax_mhz']:.1f} MHz, {n['seconds']:.0f} s)")
         if plotted:
             print(f"plot: {args.plot}")
+        print(f"simulated in {s['seconds']:.0f} s")
     if args.plot and not plotted:
         print(f"{args.plot}: not written, the simulation gave no outputs to plot", file=sys.stderr)
     # on stderr with --json too: a script sees why beside the exit code, its JSON stays clean
