@@ -58,4 +58,4 @@ def test_the_check_sees_an_upward_import():
 
 
 def test_the_check_allows_a_downward_import():
-    assert violations(("implement", "probe.py"), "from ..verify.design import Design\nfrom . import timing\n") == []
+    assert violations(("implement", "probe.py"), "from ..hardware.design import Design\nfrom . import timing\n") == []

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from flann.cli import main
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 from flann.verify.runner import sweep
 
 

@@ -19,7 +19,7 @@ from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
 from flann.hardware.family.images import parse_hex
 from flann.production.thermal import temperature_codes
 from flann.recordings import Recordings, read_recordings, write_recordings
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 
 LSB_V = 2 * 3.6 / 2 ** 14
 

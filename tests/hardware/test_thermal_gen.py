@@ -20,7 +20,7 @@ from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.datapaths import simulate
 from flann.verify.shards import cores
 from flann.verify.temperatures import THERMAL_MAX_SAMPLES, thermal_temperature_codes
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 
 from test_thermal_twin import sensor_v
 

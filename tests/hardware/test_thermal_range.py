@@ -27,7 +27,7 @@ from flann.golden.thermal_train import fit_thermal
 from flann.hardware.thermal.spec import derive_thermal_spec
 from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.datapaths import simulate
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 
 FLANN = [sys.executable, "-m", "flann.cli"]
 STROKE_MM = (-25.0, 25.0)

@@ -12,7 +12,7 @@ import pytest
 from flann.cli import main
 from flann.hardware.target import ICE40_PARTS, parse_ice40
 from flann.implement.ice40 import global_clock_pins, package_pins
-from flann.verify.design import from_model
+from flann.hardware.design import from_model
 from flann.verify.post_route import check_post_route, non_ansi_header
 
 REPO = Path(__file__).resolve().parents[2]

@@ -221,7 +221,7 @@ def test_ghdl_verilog_of_the_default_design_agrees_with_the_twin(tmp_path):
 @pytest.mark.skipif(shutil.which("verilator") is None, reason="needs verilator (scripts/ensure_tools.sh)")
 def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, monkeypatch):
     """Without the Verilog repair (GHDL's text as printed) the mapped netlist is wrong: refused."""
-    from flann import eda
+    from flann import cache, eda
 
     repo = Path(__file__).resolve().parents[2]
     model = tmp_path / "m.json"
@@ -230,6 +230,7 @@ def test_synth_refuses_a_netlist_that_disagrees_with_its_twin(tmp_path, capsys, 
     assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "8"]) == 0
     capsys.readouterr()
     monkeypatch.setattr(eda, "repair_ghdl_verilog", lambda text: (text, 0, 0))
+    monkeypatch.setenv(cache.ENV, "off")   # synthesised here, not the repaired netlist of another test
     rc, out, err = _run(capsys, tmp_path / "d", "--model", model, "--no-lint", "--abc", "fast", "--json")
     assert rc == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and "disagrees with its twin" in err

@@ -21,7 +21,7 @@ from flann.hardware.family_thermal.twin import FlannFamilyThermalTop
 from flann.hardware.family.images import header_fields, parse_hex
 from flann.hardware.family.render import design_hash
 from flann.recordings import Recordings, write_recordings
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 
 SPAN_MM, W_MM, SHARP = 10.0, 7.0, 2.5
 ADC_LSB_V = 2 * 3.6 / 2 ** 14

@@ -8,7 +8,7 @@ import pytest
 
 from flann.cli import main
 from flann.hardware.fixed.render import generate, load
-from flann.verify.design import from_directory
+from flann.hardware.design import from_directory
 
 
 @pytest.mark.parametrize("opts", [

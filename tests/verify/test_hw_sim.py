@@ -14,7 +14,7 @@ import pytest
 
 from flann.cli import main
 from flann.golden.model import FlannModel
-from flann.verify.design import from_directory, from_model
+from flann.hardware.design import from_directory, from_model
 from flann.verify.runner import run_bench, sweep
 
 pytestmark = pytest.mark.sim

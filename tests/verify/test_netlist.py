@@ -20,7 +20,7 @@ from flann.errors import FlannError
 from flann.hardware.family.images import read_image
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.manifest import read_manifest
-from flann.verify.design import from_directory, from_model
+from flann.hardware.design import from_directory, from_model
 from flann.verify.netlist import check_netlist, compare, compile_netlist, mapped_netlist, run_netlist, sweep_of
 
 pytestmark = [pytest.mark.sim, pytest.mark.synth,

@@ -40,7 +40,7 @@ from ..numeric.float18 import FLOAT18
 from ..verify.float18 import run_top
 from ..hardware.family.twin import FlannFamilyTop
 from ..verify.datapaths import simulate as simulate_design
-from ..verify.design import Design, open_design
+from ..hardware.design import Design, open_design
 from ..verify.runner import sweep
 from .thermal_trace import ThermalTraceResult, plot_thermal_trace, trace_family_thermal, trace_thermal
 

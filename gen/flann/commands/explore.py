@@ -8,18 +8,16 @@ from ..argtypes import bounded, checked
 from ..golden.model import MAX_TERMS
 from ..eda import ABC_MODES
 from ..analysis import explore
-from ..hardware.manifest import read_manifest
 from ..implement.synth import manifest_device
 from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
 from ..hardware.fixed.spec import check_mult_style, max_lanes
-from ..hardware.registry import FORMATS, datapath_for_model, read_design
+from ..hardware.registry import FORMATS, datapath_for_model
 from ..hardware.target import DEFAULT_PART
-from ..verify.design import design_model
+from ..hardware.design import design_model, open_directory
 from .common import add_common, emit_json, on_terminal
 
 HELP = "design-space table (lanes x multiplier x widths)"
-
 
 def _list_of(parse_item, name: str):
     """An argparse ``type`` for a comma-separated list, each item read by ``parse_item``: its
@@ -31,13 +29,11 @@ def _list_of(parse_item, name: str):
     parse.__name__ = name
     return parse
 
-
 # a count above what this model takes is a skipped row (its note says why); above what any
 # model takes, or below one lane, it is a typing mistake
 LANES = _list_of(bounded(int, 1, max_lanes(MAX_TERMS)), "lanes")
 STYLES = _list_of(checked(check_mult_style), "multiplier styles")
 WIDTHS = _list_of(checked(explore.check_width_preset), "width presets")
-
 
 def add_arguments(p):
     p.add_argument("model", metavar="MODEL|DIR",
@@ -65,13 +61,13 @@ def add_arguments(p):
                         "directory: its own)")
     add_common(p, json="the rows")
 
-
 def _design_model(args):
     """The datapath whose design space is explored: a design directory's own (its model and,
     unless given, its ADC), else the one flann gen MODEL builds."""
     source = args.model
     is_dir = Path(source).is_dir()
-    man, dp = read_design(args.model) if is_dir else ({}, datapath_for_model(args.model, FORMATS[0]))
+    design = open_directory(source) if is_dir else None   # read once
+    man, dp = (design.manifest, design.datapath) if is_dir else ({}, datapath_for_model(args.model, FORMATS[0]))
     if dp.explore is None:
         raise FlannError(f"{args.model}: {dp.why_no_explore}")
     if is_dir:
@@ -86,9 +82,8 @@ def _design_model(args):
         args.model = str(model)
         args.input_bits, args.input_lsb_v = man["input_bits"], man["input_lsb_v"]
     if args.device is None:   # as flann synth and flann ise: the part the design was generated for
-        args.device = manifest_device(read_manifest(source)) if is_dir else DEFAULT_PART
+        args.device = manifest_device(man) if is_dir else DEFAULT_PART
     return dp
-
 
 def run(args) -> int:
     dp = _design_model(args)

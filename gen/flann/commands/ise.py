@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
+from ..hardware.design import open_directory
 from ..implement import ise
 from .common import add_common
 
@@ -31,16 +32,16 @@ def add_arguments(p):
 def run(args) -> int:
     # the part the design was generated for unless another is asked for, as flann synth does;
     # read first either way: the design's files are inputs no output may replace
-    generated_for = ise.design_device(args.directory)
-    args.device = args.device or generated_for
+    design = open_directory(args.directory)   # read once, handed to every step
+    args.device = args.device or ise.design_device(design)
     parse_part(args.device)  # refuse a bad part before synthesis
     ise.check_output(args.output)  # and an output directory it may not replace
-    ise.check_directory_fits(args.directory, args.device, force=args.force)
+    ise.check_directory_fits(design, args.device, force=args.force)
     clock = args.clock_mhz
     if not args.no_timing_check:
-        clock, why = ise.checked_clock(args.directory, args.device, args.clock_mhz, force=args.force)
+        clock, why = ise.checked_clock(design, args.device, args.clock_mhz, force=args.force)
         if why:
             print(f"warning: {why}", file=sys.stderr)
-    files = ise.write_ise(args.directory, args.device, args.output, clock, force=args.force)
+    files = ise.write_ise(design, args.device, args.output, clock, force=args.force)
     print(ise.summary(files, args.output, args.device))
     return 0

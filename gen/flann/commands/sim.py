@@ -20,7 +20,7 @@ from ..fileio import atomic_write_json, check_output_directory
 from ..hardware.family.images import IMAGE_FILE
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
 from ..implement import ice40
-from ..verify.design import is_design_dir, open_design
+from ..hardware.design import is_design_dir, open_design
 from ..verify.datapaths import simulate
 from ..verify.netlist import require_sweep_driver
 from ..verify.post_route import checker

@@ -11,11 +11,9 @@ from ..argtypes import TOOL_SEED
 from ..eda import ABC_MODES, NETLIST
 from ..errors import FlannError
 from ..implement import ice40, synth
-from ..hardware.manifest import read_manifest
-from ..hardware.registry import read_design
 from ..hardware.target import (DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
-from ..verify.design import from_directory
+from ..hardware.design import Design, open_directory
 from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver, sweep_datapaths
 from ..verify.post_route import checker
 from .common import add_common, cores_limited, emit_json, json_to_stdout, quiet
@@ -58,20 +56,20 @@ def add_arguments(p):
                json="the report", jobs="netlist simulation shards")
 
 
-def _check_netlist(args, netlist: Path) -> dict:
+def _check_netlist(args, design: Design, netlist: Path) -> dict:
     """The mapped netlist against its twin over every input code, as the report's netlist_*
     fields: the result, or why it was not run (and a warning when the user can supply what
     is missing); a design whose netlist disagrees is refused."""
     if args.no_netlist_check:
         return {"netlist_not_run": "--no-netlist-check"}
-    man, dp = read_design(args.directory)
+    man, dp = design.manifest, design.datapath
     if dp.netlist not in SWEEPS:
         return {"netlist_not_run": f"no netlist sweep for a {dp.name} design (it has a driver and twin for "
                                    f"{sweep_datapaths()} designs)"}
     if args.model is None and not man.get("model"):
         return {"netlist_not_run": "no model (pass --model MODEL.json)",
                 "netlist_warning": "netlist not simulated: pass --model MODEL.json (the twin is built from the model)"}
-    design = from_directory(args.directory, args.model)
+    design = design.with_twin(args.model)
     if _progress(args):
         print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
     res = check_synthesized(design, netlist)
@@ -83,23 +81,23 @@ def _check_netlist(args, netlist: Path) -> dict:
                               "temperature_codes": res["temperature_codes"]}}
 
 
-def post_route_check(directory, model):
+def post_route_check(design: Design, model):
     """The post-route simulation as :func:`flann.implement.ice40.implement` calls it; refuses a
     routed design that disagrees with its twin (nothing is written then)."""
-    man, dp = read_design(directory)
-    require_sweep_driver(dp, directory)
-    if model is None and not man.get("model"):
+    require_sweep_driver(design.datapath, design.directory)
+    if model is None and not design.manifest.get("model"):
         raise FlannError("--post-route: pass --model MODEL.json (the twin is built from the model)")
-    return checker(from_directory(directory, model), refuse=True)
+    return checker(design.with_twin(model), refuse=True)
 
 
 def run_ice40(args) -> int:
     parse_ice40(args.device)  # refuse a bad part before any slow step
+    design = open_directory(args.directory)   # read once, handed to every step
     if not args.no_lint:
-        synth.check_lint(read_manifest(args.directory).files, args.vsg_config, start=args.directory)
-    check = post_route_check(args.directory, args.model) if args.post_route else None
+        synth.check_lint(design.files, args.vsg_config, start=args.directory)
+    check = post_route_check(design, args.model) if args.post_route else None
     with tempfile.TemporaryDirectory(prefix="flann-ice40-") as tmp:
-        report = ice40.implement(args.directory, args.device, args.output or ICE40_OUT, work=Path(args.work or tmp),
+        report = ice40.implement(design, args.device, args.output or ICE40_OUT, work=Path(args.work or tmp),
                                  seed=args.seed, progress=_progress(args), post_route=check)
     if not emit_json(args, report.to_dict()):
         print(report.table())
@@ -131,14 +129,14 @@ def _run(args) -> int:
         parse_part(args.device)  # refuse a bad part before any slow step
     if args.work and Path(args.work).exists() and not Path(args.work).is_dir():
         raise FlannError(f"--work {args.work}: exists and is not a directory")
-    read_design(args.directory)  # a tampered manifest is refused before any slow step
+    # read once (a tampered manifest refused before any slow step), handed to every step
+    design = open_directory(args.directory)
     if not args.no_lint:
-        man = read_manifest(args.directory)
-        synth.check_lint(man.files, args.vsg_config, start=args.directory)
+        synth.check_lint(design.files, args.vsg_config, start=args.directory)
     with tempfile.TemporaryDirectory(prefix="flann-synth-") as tmp:
         work = Path(args.work) if args.work else Path(tmp)
-        report = synth.synthesize(args.directory, args.device, work=work, progress=_progress(args), abc=args.abc)
-        report = dataclasses.replace(report, **_check_netlist(args, work / NETLIST))
+        report = synth.synthesize(design, args.device, work=work, progress=_progress(args), abc=args.abc)
+        report = dataclasses.replace(report, **_check_netlist(args, design, work / NETLIST))
     if not emit_json(args, report.to_dict()):
         print(report.table())
     for w in report.all_warnings():   # the JSON's "warnings" too

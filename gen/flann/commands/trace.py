@@ -20,7 +20,7 @@ from ..recordings import read_recordings
 from ..analysis.trace import (TWO_INPUT_STAGE_MODELS, check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
                               trace_design)
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
-from ..verify.design import from_directory
+from ..hardware.design import from_directory
 from ..hardware import options as gen_options
 from .common import add_common, check_jobs, cores_limited, emit_json, info
 from .gen import generator_options, refuse_generator_options

@@ -139,7 +139,7 @@ class Datapath:
     estimate: Callable                 # manifest -> {"luts", "ffs", "brams"}
     fields: tuple = ()                 # manifest fields beyond COMMON_FIELDS
     model_field: str = "model"         # manifest field naming the model file in the directory
-    bench: str | None = None           # verification bench (flann.verify.design.BENCHES)
+    bench: str | None = None           # verification bench (flann.hardware.design.BENCHES)
     stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
     explore: str | None = None         # design space of flann explore (flann.analysis.explore.EXPLORERS)
     eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design

@@ -38,6 +38,12 @@ class Manifest(dict):
     def data(self) -> dict:
         return dict(self)
 
+    @classmethod
+    def written(cls, directory, data: dict) -> "Manifest":
+        """The manifest a generator just wrote into ``directory`` (not read again)."""
+        directory = Path(directory).resolve()
+        return cls(directory, data["top"], tuple(directory / f for f in data["files"]), data)
+
 
 def is_design(directory: Path) -> bool:
     """A directory flann wrote a design into (so it may be replaced as a whole)."""

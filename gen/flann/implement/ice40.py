@@ -28,7 +28,7 @@ from .. import __version__, cache
 from ..eda import ghdl_to_verilog, need_tool, tool_version
 from ..errors import FlannError
 from ..fileio import atomic_directory, check_output_directory
-from ..hardware.manifest import read_manifest
+from ..hardware.design import as_design
 from ..hardware.target import CLOCK_HZ, Ice40Part, parse_ice40
 
 SYNTH_JSON = "synth_ice40.json"
@@ -276,7 +276,7 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
     committed (the post-route simulation), or None."""
     t0 = time.monotonic()
     part = parse_ice40(device)
-    man = read_manifest(directory)
+    man = as_design(directory).manifest
     check_output_directory(out_dir, _is_ice40_output, "flann iCE40 build")   # before minutes of work
     for name in ("ghdl", "yosys", "nextpnr-ice40", "icepack"):
         _tool(name)

@@ -37,7 +37,7 @@ from ..hardware.target import CLOCK_HZ, Part, parse_part
 from ..errors import FlannError
 from ..fileio import atomic_directory, check_output_directory
 from ..textgen import template
-from ..hardware.registry import read_design
+from ..hardware.design import as_design
 from .synth import Resources, manifest_device, not_fit_message, shortfall, smallest_fit, synthesize
 from .timing import safe_clock_mhz
 
@@ -208,16 +208,17 @@ def check_fits(man, dp, part, force: bool = False, warn: bool = True) -> None:
     raise FlannError(f"{why} (--force writes the project anyway)")
 
 
-def design_device(directory) -> str:
-    """The part a design directory was generated for (its manifest's), else the default part."""
-    return manifest_device(read_design(directory)[0])
+def design_device(design) -> str:
+    """The part a design (or the directory it names) was generated for (its manifest's), else the
+    default part."""
+    return manifest_device(as_design(design).manifest)
 
 
-def check_directory_fits(directory, device: str, force: bool = False) -> None:
-    """:func:`check_fits` for a design directory, before anything slow runs (the warning
-    under ``force`` is :func:`write_ise`'s)."""
-    man, dp = read_design(directory)
-    check_fits(man, dp, parse_part(device), force, warn=False)
+def check_directory_fits(design, device: str, force: bool = False) -> None:
+    """:func:`check_fits` for a design (or the directory it names), before anything slow runs (the
+    warning under ``force`` is :func:`write_ise`'s)."""
+    design = as_design(design)
+    check_fits(design.manifest, design.datapath, parse_part(device), force, warn=False)
 
 
 def check_output(out_dir) -> None:
@@ -231,11 +232,12 @@ def check_clock_mhz(clock_mhz: float) -> None:
         raise FlannError(f"--clock-mhz {clock_mhz}: must be in (0, 200] MHz")
 
 
-def write_ise(directory, device: str | None = None, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
+def write_ise(design, device: str | None = None, out_dir="ise", clock_mhz: float = CLOCK_HZ / 1e6,
               force: bool = False) -> list[str]:
-    """Write the ISE 10.1 handoff for a generated design (``device``: default the part its
-    manifest records); returns the files written."""
-    man, dp = read_design(directory)
+    """Write the ISE 10.1 handoff for a generated design (or the directory it names; ``device``:
+    default the part its manifest records); returns the files written."""
+    design = as_design(design)
+    man, dp = design.manifest, design.datapath
     check_output(out_dir)
     part = parse_part(device if device is not None else manifest_device(man))
     check_fits(man, dp, part, force)
@@ -284,7 +286,7 @@ def write_ise(directory, device: str | None = None, out_dir="ise", clock_mhz: fl
     return [*texts, *sources, "src/manifest.json"]
 
 
-def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full",
+def checked_clock(design, device: str, clock_mhz: float, abc: str = "full",
                   force: bool = False) -> tuple[float, str | None]:
     """The clock for the PERIOD constraint: ``clock_mhz`` when the Spartan-II timing estimate
     (:mod:`flann.implement.timing`, on the Yosys-mapped netlist) meets it, else the highest
@@ -292,7 +294,7 @@ def checked_clock(directory, device: str, clock_mhz: float, abc: str = "full",
     A mapped netlist that does not fit the part is refused (unless ``force``): the check for a
     datapath with no estimate before synthesis."""
     check_clock_mhz(clock_mhz)
-    report = synthesize(directory, device, abc=abc)
+    report = synthesize(design, device, abc=abc)
     if not force and not report.fits:
         raise FlannError(f"{not_fit_message(report)} (synthesized; --force writes the project anyway)")
     t = report.timing

@@ -20,7 +20,8 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..hardware.manifest import Manifest, read_manifest
+from ..hardware.design import Design, as_design
+from ..hardware.manifest import Manifest
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, DEVICES, Part, parse_part
 from ..eda import ABC_MODES, FAMILY, MAPPED_JSON, SynthCheckError, need_tool, synthesize_cells
 from ..errors import FlannError
@@ -248,13 +249,13 @@ def manifest_device(man: Manifest) -> str:
     return dev if isinstance(dev, str) and dev else DEFAULT_PART
 
 
-def synthesize(directory: str | Path, device: str | None = None, work: str | Path | None = None,
+def synthesize(design: Design | str | Path, device: str | None = None, work: str | Path | None = None,
                progress: bool = False, abc: str = "full") -> SynthReport:
     """Full flow for one generated design directory.  ``work`` keeps the intermediate files.
 
     ``device`` defaults to the part recorded in the manifest (``flann gen --device``).
     """
-    man = read_manifest(directory)
+    man = as_design(design).manifest
     part = parse_part(device if device is not None else manifest_device(man))
     if abc not in ABC_MODES:
         raise FlannError(f"--abc {abc!r}: allowed {', '.join(ABC_MODES)}")

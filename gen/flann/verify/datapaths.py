@@ -19,7 +19,7 @@ from ..hardware.family.spec import member_spec
 from ..hardware.family.twin import FlannFamilyTop
 from ..hardware.family_thermal.twin import FlannFamilyThermalTop
 from . import plots
-from .design import Design
+from ..hardware.design import Design
 from .float18 import run_design
 from .benches import BENCH_DIR
 from .images import checked_image, image_model, kept_images
@@ -89,7 +89,7 @@ def _two_images(design: Design, loaded: list, given: bool) -> list:
 def _family(design: Design, build_dir, *, seed=1, images=None, **_) -> dict:
     loaded = _two_images(design, _images(design, images, design.spec.mem_depth), bool(images))
     images = [im for im, _words in loaded]
-    res = run_family_bench(design.directory, images, build_dir, seed=seed)
+    res = run_family_bench(design, images, build_dir, seed=seed)
     rec = res.records.get("family_every_code", {})
     curve = None
     if rec.get("outputs"):

@@ -34,7 +34,7 @@ def run_top(model, build_dir, codes=None, seed: int = 1, stage_codes=(), **optio
 
 
 def run_design(design, build_dir, codes=None, seed: int = 1, stage_codes=()) -> dict:
-    """The float18 design of a directory (:class:`flann.verify.design.Design`), as written."""
+    """The float18 design of a directory (:class:`flann.hardware.design.Design`), as written."""
     return run_files(design.spec, design.manifest, design.files, Path(build_dir), codes, seed, stage_codes)
 
 

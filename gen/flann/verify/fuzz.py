@@ -28,7 +28,8 @@ from ..hardware.fixed.render import write
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import DATAPATHS, datapath
-from .design import Design
+from ..hardware.design import Design
+from ..hardware.manifest import Manifest
 from .float18 import run_top
 from .runner import sweep
 
@@ -121,7 +122,8 @@ def _check_sweep(model, case: Case, spec, rng, work: Path, hdl_codes: int) -> Ca
         case.bound_lsb = round(max(1.0, float(spec.analysis["bound_total_lsb"])), 4)
         man = write(spec, work / "hdl")
         model.save(work / "model.json")
-        design = Design((work / "hdl").resolve(), man, (work / "model.json").resolve(), case.options, spec)
+        design = Design((work / "hdl").resolve(), Manifest.written(work / "hdl", man), (work / "model.json").resolve(),
+                        case.options, spec)
         windows = [_window(spec.code_min, spec.code_max, rng, hdl_codes),
                    (max(spec.code_min, spec.clamp_lo - 2), min(spec.code_max, spec.clamp_lo + 2)),
                    (max(spec.code_min, spec.clamp_hi - 2), min(spec.code_max, spec.clamp_hi + 2))]

@@ -10,7 +10,7 @@ from ..golden.model import FlannModel, load_model, text_sha256
 from ..hardware.family.images import MODEL_FILE, header_fields, header_model_sha256, parse_hex
 from ..hardware.family.render import design_hash
 from ..inputs import read_text
-from .design import Design
+from ..hardware.design import Design
 
 
 def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:

@@ -36,9 +36,8 @@ from ..hardware.fixed.twin import FlannTop
 from ..hardware.float18.spec import FlannF18Top
 from ..hardware.thermal.twin import FlannThermalTop
 from ..eda import NETLIST, ghdl_to_verilog, synthesize_cells, tool_version
-from ..hardware.manifest import read_manifest
 from .benches import BENCH_DIR
-from .design import Design
+from ..hardware.design import Design
 from .images import checked_image, kept_images
 from .shards import cores, count_lines, merge, read_results, split
 from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
@@ -160,7 +159,7 @@ def mapped_netlist(design: Design, work, abc: str = "full") -> Path:
     """Synthesise ``design`` as ``flann synth`` does; returns the Yosys-mapped Verilog netlist."""
     work = Path(work).resolve()
     work.mkdir(parents=True, exist_ok=True)
-    synthesize_cells(read_manifest(design.directory), work, abc)
+    synthesize_cells(design.manifest, work, abc)
     return work / NETLIST
 
 
@@ -288,7 +287,7 @@ def check_rtl_netlist(design: Design, build, progress=None, temps=None) -> dict:
     sweep = sweep_of(design)
     if temps is not None:
         sweep = dataclasses.replace(sweep, temps=tuple(int(t) for t in temps))
-    verilog = ghdl_to_verilog(read_manifest(design.directory), build / "ghdl_synth")
+    verilog = ghdl_to_verilog(design.manifest, build / "ghdl_synth")
     exe = compile_netlist(verilog, build / "verilator", sweep, cells=False)
     t_build = time.monotonic() - t0
     lo, hi = sweep.codes

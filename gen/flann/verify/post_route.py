@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..hardware.target import Ice40Part
-from .design import Design
+from ..hardware.design import Design
 from .netlist import compare, compile_netlist, run_netlist, sweep_of, yosys_datdir
 from .shards import cores
 
