@@ -48,10 +48,10 @@ def default_model_json() -> Path:
 
 
 @pytest.fixture(scope="session")
-def run_root(tmp_path_factory, worker_id) -> Path:
+def run_root(tmp_path_factory) -> Path:
     """A directory of this test run that every xdist worker shares (new each run)."""
     base = tmp_path_factory.getbasetemp()
-    return base.parent if worker_id != "master" else base
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -111,18 +111,25 @@ def test_repeats_at_few_positions_are_averaged_into_the_curve(tmp_path):
     assert held_out_max_mm(model) < 0.05
 
 
-def test_the_forward_curve_follows_a_shape_outside_its_family():
-    """arctan is no finite sum of tanh units: the average follows it within the noise."""
+@pytest.fixture(scope="module")
+def arctan_fit():
+    """Two noisy readings at each of 81 positions of the arctan sensor, and their forward
+    curve, fitted once for the tests that look at it."""
     rng = np.random.default_rng(7)
     x = np.repeat(np.linspace(-20, 20, 81), 2)
     v = sensor(x) + rng.normal(0, 1e-3, x.size)
-    fw = fit_forward(x, v)
+    return x, v, fit_forward(x, v)
+
+
+def test_the_forward_curve_follows_a_shape_outside_its_family(arctan_fit):
+    """arctan is no finite sum of tanh units: the average follows it within the noise."""
+    x, v, fw = arctan_fit
     assert fw is not None
     assert fw.weights.sum() == pytest.approx(1.0)
     fine = np.linspace(-20, 20, 4001)
     assert np.all(np.diff(fw(fine)) > 0)
     assert np.max(np.abs(fw(fine) - sensor(fine))) < 1.5e-3
-    again = fit_forward(x, v)                       # deterministic: same starts, same fit
+    again = fit_forward(x, v)       # deterministic: same starts, same fit (a fit of its own)
     assert np.array_equal(again(fine), fw(fine))
 
 
@@ -175,12 +182,10 @@ def test_repeats_on_one_converter_code_are_no_misfit(tmp_path):
     assert fit_forward(x, v).describe()["largest_units"] > MAX_UNITS
 
 
-def test_near_equal_local_optima_are_members_of_the_average():
+def test_near_equal_local_optima_are_members_of_the_average(arctan_fit):
     """Which of near-equal optima the solver reaches turns on rounding: every one within 5 %
     of its K's best residual is a member, none further, and no optimum twice."""
-    rng = np.random.default_rng(7)
-    x = np.repeat(np.linspace(-20, 20, 81), 2)
-    fw = fit_forward(x, sensor(x) + rng.normal(0, 1e-3, x.size))
+    fw = arctan_fit[2]
     groups: dict = {}
     for m in fw.members:
         groups.setdefault((m.shape, m.units, m.linear), []).append(m.sse)
@@ -336,9 +341,22 @@ def test_no_monotone_spline_through_the_positions_is_none():
     assert spline_curve(x, sensor(x)) is not None
 
 
-def test_no_candidate_that_builds_falls_back_to_the_direct_fit():
+@pytest.fixture(scope="module")
+def thirteen_noise_free():
+    """13 noise-free positions of the arctan sensor and the spline curve through them, fitted
+    once: its check by leaving each position out refits the trend twelve times (~20 s)."""
     x = np.linspace(-20, 20, 13)
-    v = sensor(x)
+    return x, sensor(x), spline_curve(x, sensor(x))
+
+
+def test_no_candidate_that_builds_falls_back_to_the_direct_fit(thirteen_noise_free, monkeypatch):
+    x, v, curve = thirteen_noise_free
+    real = inverse.forward_curve
+
+    def forward_curve(xs, vs, step_v=0.0):   # these readings' curve is the one fitted above
+        same = np.array_equal(xs, x) and np.array_equal(vs, v) and step_v == 0.0
+        return curve if same else real(xs, vs, step_v)
+    monkeypatch.setattr(inverse, "forward_curve", forward_curve)
     _, choice = fit_auto(v, x)
     never = inverse_fit(x, v, choice, lambda m: {"buildable": False, "why": "test", "cost": np.inf}, {})
     assert never is None
@@ -348,9 +366,17 @@ def test_no_candidate_that_builds_falls_back_to_the_direct_fit():
     assert built is not None and "forward_model" in built.training
 
 
-def test_a_curve_the_flann_cannot_follow_keeps_the_direct_fit():
+def test_a_curve_the_flann_cannot_follow_keeps_the_direct_fit(monkeypatch):
     """With many positions the direct fit stays when the FLANN's best buildable deviation
     from the curve's inverse exceeds the direct fit's own held-out max error."""
+    real, fitted = inverse.forward_curve, {}
+
+    def forward_curve(xs, vs, step_v=0.0):   # both inverse_fit calls below: one fit (deterministic)
+        key = (np.asarray(xs, float).tobytes(), np.asarray(vs, float).tobytes(), step_v)
+        if key not in fitted:
+            fitted[key] = real(xs, vs, step_v)
+        return fitted[key]
+    monkeypatch.setattr(inverse, "forward_curve", forward_curve)
     x = np.repeat(np.linspace(-20, 20, SPARSE_POSITIONS + 10), 2)
     v = sensor(x)
     _, choice = fit_auto(v, x)
@@ -399,11 +425,10 @@ def test_a_straight_sensor_is_mostly_the_straight_line():
     assert np.max(np.abs(fw(fine) - 0.2 * fine)) < 1e-3
 
 
-def test_few_positions_take_the_spline_on_a_trend_when_it_leaves_out_better():
+def test_few_positions_take_the_spline_on_a_trend_when_it_leaves_out_better(thirteen_noise_free):
     """13 noise-free positions of the arctan sensor: a cubic through what a 2-unit trend
     leaves bends less between them than a cubic through the readings themselves."""
-    x = np.linspace(-20, 20, 13)
-    fw = spline_curve(x, sensor(x))
+    _x, _v, fw = thirteen_noise_free
     assert fw.trend is not None
     plain = Forward(fw.positions, fw.mean_v, fw.kind)
     fine = np.linspace(-20, 20, 4001)

@@ -89,14 +89,13 @@ class Smoother:
     def penalty(self) -> np.ndarray | None:
         if self.kind == "poly":
             return None
-        n = self.segments + 3
-        D = np.diff(np.eye(n), 3, axis=0)
-        return D.T @ D
+        return _penalty(self.segments + 3)[0]
 
-    def solve(self, pos: Positions, keep=None) -> np.ndarray:
-        """Coefficients fitted to the positions (``keep``: a mask of positions used)."""
+    def solve(self, pos: Positions, keep=None, basis: np.ndarray | None = None) -> np.ndarray:
+        """Coefficients fitted to the positions (``keep``: a mask of positions used;
+        ``basis``: :meth:`basis` at those positions, when the caller has it)."""
         k = np.ones(pos.x.size, bool) if keep is None else keep
-        B = self.basis(pos.x[k])
+        B = self.basis(pos.x[k]) if basis is None else basis
         w = pos.w[k]
         sw = np.sqrt(w)
         A = B * sw[:, None]
@@ -104,7 +103,7 @@ class Smoother:
         P = self.penalty()
         if P is not None:
             scale = float(np.sum(w)) / max(1, int(k.sum()))
-            L = np.linalg.cholesky(P + 1e-12 * np.eye(P.shape[0])).T
+            L = _penalty(self.segments + 3)[1]
             A = np.vstack([A, math.sqrt(self.param * scale) * L])
             y = np.concatenate([y, np.zeros(P.shape[0])])
         coef, *_ = np.linalg.lstsq(A, y, rcond=None)
@@ -123,6 +122,24 @@ class Smoother:
         scale = float(np.sum(pos.w)) / pos.x.size
         M = G + self.param * scale * (P + 1e-12 * np.eye(P.shape[0]))
         return float(np.trace(np.linalg.solve(M, G)))
+
+
+_PENALTIES: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _penalty(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The third-difference penalty on n spline coefficients and its Cholesky factor
+    (transposed, of the penalty plus 1e-12), made once per n: every fold's fit of every
+    candidate uses them."""
+    hit = _PENALTIES.get(n)
+    if hit is None:
+        D = np.diff(np.eye(n), 3, axis=0)
+        P = D.T @ D
+        L = np.linalg.cholesky(P + 1e-12 * np.eye(P.shape[0])).T
+        P.setflags(write=False)
+        L.setflags(write=False)
+        hit = _PENALTIES[n] = (P, L)
+    return hit
 
 
 def _knots(segments: int) -> np.ndarray:
@@ -153,10 +170,14 @@ def position_folds(n: int, k: int = FORWARD_FOLDS) -> list[np.ndarray]:
 def heldout_predictions(sm: Smoother, pos: Positions, folds) -> np.ndarray:
     """Each held-out position's prediction from the fit without its fold (NaN at the ends)."""
     pred = np.full(pos.x.size, np.nan)
+    # a basis row depends on its own position alone: each fold's fit takes its rows of one
+    # basis (least squares copies them as it needs them; the held-out product keeps predict's
+    # own basis, whose memory order the product's rounding follows)
+    B = sm.basis(pos.x)
     for held in folds:
         keep = np.ones(pos.x.size, bool)
         keep[held] = False
-        pred[held] = sm.predict(sm.solve(pos, keep), pos.x[held])
+        pred[held] = sm.predict(sm.solve(pos, keep, B[keep]), pos.x[held])
     return pred
 
 

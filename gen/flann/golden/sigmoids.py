@@ -163,6 +163,23 @@ class _Odd:
         return np.column_stack([d_null, d_gain] + widths)
 
 
+def _polynomials(ps) -> list:
+    """What calling each of ``ps`` (numpy Polynomials) at an array does, for :func:`_at`."""
+    return [(*np.polynomial.polyutils.mapparms(p.domain, p.window), p.coef) for p in ps]
+
+
+def _at(x: np.ndarray, poly) -> np.ndarray:
+    """``Polynomial.__call__`` at an array, the same operations in the same order (map the
+    domain to the window, then Horner as polyval) without its per-call checks: the fits
+    call the units' polynomials some hundred thousand times."""
+    off, scl, c = poly
+    x = off + scl * x
+    c0 = c[-1] + x * 0
+    for i in range(2, len(c) + 1):
+        c0 = c[-i] + c0 * x
+    return c0
+
+
 class _TanhUnit:
     """tanh(u) and its derivatives, as polynomials in t = tanh(u): an exponential tail."""
 
@@ -172,11 +189,12 @@ class _TanhUnit:
         self._p = [np.polynomial.Polynomial([0.0, 1.0])]
         for _ in range(n):
             self._p.append(np.polynomial.Polynomial([1.0, 0.0, -1.0]) * self._p[-1].deriv())
+        self._fast = _polynomials(self._p)
 
     def __call__(self, u: np.ndarray) -> list[np.ndarray]:
         """The unit and its first n derivatives at u."""
         t = np.tanh(u)
-        return [f(t) for f in self._p]
+        return [_at(t, f) for f in self._fast]
 
 
 class _AlgebraicUnit:
@@ -191,10 +209,11 @@ class _AlgebraicUnit:
         self._p = [u]
         for j in range(n):      # (P r^m)' = (P' (1 + u^2) - m u P) r^(m+2)
             self._p.append(self._p[-1].deriv() * (1 + u * u) - (2 * j + 1) * u * self._p[-1])
+        self._fast = _polynomials(self._p)
 
     def __call__(self, u: np.ndarray) -> list[np.ndarray]:
         r = 1.0 / np.sqrt(1.0 + u * u)
-        return [f(u) * r ** (2 * j + 1) for j, f in enumerate(self._p)]
+        return [_at(u, f) * r ** (2 * j + 1) for j, f in enumerate(self._fast)]
 
 
 class _OddSpread:
@@ -214,19 +233,21 @@ class _OddSpread:
     def units(self, nl: np.ndarray) -> int:
         return self.derivatives + 1
 
-    def _columns(self, nl, x):
-        """(z, gain, u, columns, their derivatives in u)"""
+    def _columns(self, nl, x, derivatives: bool = True):
+        """(z, gain, u, columns, their derivatives in u (None unless ``derivatives``))"""
         z = x - nl[0]
         gain = 1.0 + nl[1] * np.sign(z)
         u = z * np.exp(-nl[2])
         p = self._unit(u)
-        cols = [u ** j * p[j] for j in range(self.derivatives + 1)]
-        d_cols = [(j * u ** (j - 1) * p[j] if j else 0.0) + u ** j * p[j + 1]
-                  for j in range(self.derivatives + 1)]
+        powers = [u ** j for j in range(self.derivatives + 1)]    # each power once
+        cols = [powers[j] * p[j] for j in range(self.derivatives + 1)]
+        d_cols = None if not derivatives else [
+            (j * powers[j - 1] * p[j] if j else 0.0) + powers[j] * p[j + 1]
+            for j in range(self.derivatives + 1)]
         return z, gain, u, cols, d_cols
 
     def basis(self, nl: np.ndarray, x: np.ndarray, linear: bool) -> np.ndarray:
-        z, gain, _u, cols, _d = self._columns(nl, x)
+        z, gain, _u, cols, _d = self._columns(nl, x, derivatives=False)
         return np.column_stack([np.ones_like(x)] + ([z * gain] if linear else [])
                                + [c * gain for c in cols])
 

@@ -48,7 +48,6 @@ y = output, y0(x) = ideal output, v1/v2 = secondary e.m.f.s, G = demodulator gai
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Callable, Mapping
@@ -110,7 +109,12 @@ class Effect:
 
 
 def _rep(sig: Signal, **kw) -> Signal:
-    return dataclasses.replace(sig, **kw)
+    """dataclasses.replace(sig, **kw) without its per-field walk (Signal has no
+    __post_init__; every field is an init field): the same values in a new instance."""
+    new = object.__new__(Signal)
+    new.__dict__.update(sig.__dict__)
+    new.__dict__.update(kw)
+    return new
 
 
 # -- position stage ---------------------------------------------------------------------

@@ -331,14 +331,27 @@ def primary_current_a(s: Sensor, lp_h) -> np.ndarray:
     return s.excitation_peak_v / (s.primary_resistance_ohm + 1j * s.omega_rad_s * np.asarray(lp_h))
 
 
+_REFERENCE_PHASES: dict[tuple, float] = {}
+
+
 def reference_phase_rad(s: Sensor) -> float:
     """Phase-sensitive detector reference, trimmed at null as in practice: the phase of
     the differential e.m.f. for a small core movement, ``arg(j w Ip(0) dM_d/dx(0))``
-    (``arg(j w Ip(0))`` when the inductances are real, i.e. without eddy currents)."""
+    (``arg(j w Ip(0))`` when the inductances are real, i.e. without eddy currents).
+    Cached on what it depends on (every simulated output asks for it)."""
+    key = (s.magnetics_key(), s.primary_resistance_ohm, s.excitation_amplitude_vpp,
+           s.excitation_frequency_hz)
+    hit = _REFERENCE_PHASES.get(key)
+    if hit is not None:
+        return hit
     m1, m2, lp = inductances_h(s, np.array([-1e-3, 0.0, 1e-3]))
     slope = (m1[2] - m2[2]) - (m1[0] - m2[0])
     slope_phase = float(np.angle(slope)) if np.iscomplexobj(slope) and slope != 0 else 0.0
-    return float(np.angle(1j * s.omega_rad_s * primary_current_a(s, lp[1]))) + slope_phase
+    phase = float(np.angle(1j * s.omega_rad_s * primary_current_a(s, lp[1]))) + slope_phase
+    if len(_REFERENCE_PHASES) >= 4 * _CACHE_SIZE:
+        _REFERENCE_PHASES.clear()
+    _REFERENCE_PHASES[key] = phase
+    return phase
 
 
 def secondary_emf_v(s: Sensor, core_position_mm, drive_scale=1.0) -> tuple[np.ndarray, np.ndarray]:

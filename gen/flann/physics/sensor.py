@@ -164,9 +164,7 @@ class Sensor:
 
     def __post_init__(self) -> None:
         _validate(self)
-        frozen = MappingProxyType({str(k): MappingProxyType(dict(v))
-                                   for k, v in dict(self.effects).items()})
-        object.__setattr__(self, "effects", frozen)
+        object.__setattr__(self, "effects", _frozen_effects(self.effects))
 
     def __hash__(self) -> int:  # effects is a mapping: hash its items
         fields = tuple(getattr(self, f.name) for f in dataclasses.fields(self)
@@ -180,7 +178,16 @@ class Sensor:
         unknown = [k for k in changes if k not in _FIELD_NAMES]
         if unknown:
             raise SensorError(f"Sensor.replace: unknown field(s) {', '.join(unknown)}")
-        return dataclasses.replace(self, **changes)
+        # what dataclasses.replace does (a new instance through __post_init__), checking only
+        # what changed: this sensor passed every check, and a check of unchanged fields would
+        # pass again (a fit's every evaluation replaces the gain and the effects)
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(changes)
+        _validate(new, changed=changes.keys())
+        if "effects" in changes:
+            object.__setattr__(new, "effects", _frozen_effects(new.effects))
+        return new
 
     def without_effects(self) -> "Sensor":
         return self.replace(effects={})
@@ -226,10 +233,24 @@ def _bad(src: str, msg: str) -> SensorError:
     return SensorError(f"{src}: {msg}")
 
 
-def _validate(s: Sensor) -> None:
+def _frozen_effects(effects) -> MappingProxyType:
+    return MappingProxyType({str(k): MappingProxyType(dict(v)) for k, v in dict(effects).items()})
+
+
+_RADIAL_FIELDS = frozenset(("core_inner_diameter_mm", "core_outer_diameter_mm", "coil_inner_diameter_mm",
+                            "coil_outer_diameter_mm", "housing_inner_diameter_mm"))
+
+
+def _validate(s: Sensor, changed=None) -> None:
+    """Raise SensorError for the first field out of its range or relation.  ``changed``: the
+    only fields that may fail (the others are a valid sensor's): the checks of the others are
+    skipped, the rest run in the same order, so the first failure is the same."""
     src = s.source
+    every = changed is None
     for section, keys in _SCHEMA.items():
         for key, (fname, lo, lo_incl, hi) in keys.items():
+            if not every and fname not in changed:
+                continue
             value = getattr(s, fname)
             if value is None and section in _OPTIONAL_SECTIONS:
                 continue
@@ -242,14 +263,19 @@ def _validate(s: Sensor) -> None:
             if not ok_lo or value > hi:
                 lo_txt = f"{'>=' if lo_incl else '>'} {lo:g}"
                 raise _bad(src, f"{label} = {value:g} out of range (must be {lo_txt} and <= {hi:g})")
-    if s.demodulator_kind not in DEMODULATORS:
+    if (every or "demodulator_kind" in changed) and s.demodulator_kind not in DEMODULATORS:
         raise _bad(src, f"demodulator.kind = {s.demodulator_kind!r}: allowed {', '.join(DEMODULATORS)}")
-    if s.demodulator_gain_ratio == 0:
+    if (every or "demodulator_gain_ratio" in changed) and s.demodulator_gain_ratio == 0:
         raise _bad(src, "demodulator.gain_ratio must be non-zero (negative means reversed wiring)")
-    if (s.adc_bits is None) != (s.adc_full_scale_v is None):
-        raise _bad(src, "adc: give both bits and full_scale_v, or omit the [adc] table")
-    if s.adc_bits is not None and float(s.adc_bits) != int(s.adc_bits):
-        raise _bad(src, f"adc.bits = {s.adc_bits} must be an integer")
+    if every or "adc_bits" in changed or "adc_full_scale_v" in changed:
+        if (s.adc_bits is None) != (s.adc_full_scale_v is None):
+            raise _bad(src, "adc: give both bits and full_scale_v, or omit the [adc] table")
+        if s.adc_bits is not None and float(s.adc_bits) != int(s.adc_bits):
+            raise _bad(src, f"adc.bits = {s.adc_bits} must be an integer")
+    if not every and _RADIAL_FIELDS.isdisjoint(changed):
+        if "effects" in changed:
+            validate_effects(s.effects, src)
+        return
     # Radial order: core fits in the former, the winding has a build, the housing encloses it.
     if not s.core_inner_diameter_mm < s.core_outer_diameter_mm:
         raise _bad(src, f"core.inner_diameter_mm = {s.core_inner_diameter_mm:g} must be < "

@@ -25,7 +25,6 @@ Public API (stable):
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import sys
 from typing import Callable
@@ -36,7 +35,7 @@ from ..errors import FlannError
 from ..numeric.fixed import nearest_codes, signed_range
 from ..recordings import Recordings
 from .effect_params import TEMPERATURE_RANGE_C
-from .effects import EFFECTS, Context, Signal
+from .effects import EFFECTS, Context, Signal, _rep
 from .lvdt import demodulate_v, inductances_h
 from .sensor import Sensor
 
@@ -105,8 +104,12 @@ _MU_NODES = 16
 def _inductances(s: Sensor, core_mm, permeability_scale, loop: bool) -> tuple[np.ndarray, ...]:
     """inductances_h with the core's permeability scaled per sample (thermal_construction)."""
     core = np.asarray(core_mm, dtype=float)
-    scale = np.broadcast_to(np.asarray(permeability_scale, dtype=float), core.shape)
-    levels = np.unique(scale)
+    if isinstance(permeability_scale, float) and core.size:
+        # one level for every sample (no thermal_construction): what np.unique would return
+        levels = np.array([permeability_scale])
+    else:
+        scale = np.broadcast_to(np.asarray(permeability_scale, dtype=float), core.shape)
+        levels = np.unique(scale)
     if levels.size == 1:
         if levels[0] == 1.0:
             return inductances_h(s, core, loop=loop)
@@ -146,7 +149,7 @@ def _transformer(s: Sensor, sig: Signal) -> Signal:
     if loaded:
         v_diff = v_diff * (sig.load_ohm / z_loop)
     out = demodulate_v(s, v_diff, quadrature_v=sig.quadrature_v)
-    return dataclasses.replace(sig, output_v=out)
+    return _rep(sig, output_v=out)
 
 
 def contributions_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
