@@ -34,7 +34,7 @@ from ..errors import FlannError
 from ..hardware.target import CLOCK_HZ
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from . import plots
-from ..hardware.design import Design
+from ..hardware.design import Design, as_design
 from .netlist import check_rtl_netlist
 from .shards import count_lines, cores, merge, read_results, split
 
@@ -220,10 +220,11 @@ def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase:
                       parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
 
 
-def run_family_bench(design: Design, images: list[dict], build_dir, *, seed: int = 1,
+def run_family_bench(design, images: list[dict], build_dir, *, seed: int = 1,
                      backend: str | None = None) -> BenchResult:
-    """The family design in ``directory`` with sensors' weight images ({name, hex}) loaded
+    """The family ``design`` (or the directory it names) with sensors' weight images ({name, hex}) loaded
     through its cfg_* port, each over every input code against that sensor's twin."""
+    design = as_design(design)
     cfg = {"design": str(design.directory), "images": images}
     return run_cocotb(design.files, design.top, FAMILY_BENCH, Path(build_dir) / "family", cfg, name="family",
                       seed=seed, backend=backend)
