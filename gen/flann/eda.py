@@ -242,15 +242,20 @@ def tool_version(name: str, flag: str = "--version") -> str:
 CELLS_JSON = "cells.json"  # the cell counts and the warnings that matter, as yosys_cells returns them
 
 
+def design_key(man: Manifest, *parts) -> str:
+    """The cache key of a flow from ``man``'s VHDL through GHDL's synthesis (this module) and
+    ``parts`` (the later tools' versions, their flow's source and options)."""
+    return cache.key(__version__, tool_version("ghdl"), Path(__file__), man.top, *parts,
+                     *[x for f in man.files for x in (f.name, f)])
+
+
 def synthesize_cells(man: Manifest, work: Path, abc: str = "full") -> tuple[dict[str, int], list[str]]:
     """:func:`ghdl_to_verilog` then :func:`yosys_cells` into ``work`` (its files: GHDL's Verilog,
     ``stat.json``, ``modules.json``, the mapped netlist and its JSON), once per design: a design
     synthesised before with the same files, tools and flow is taken from :mod:`flann.cache`."""
     work = Path(work).resolve()
-    work.mkdir(parents=True, exist_ok=True)
     names = [f"{man.top}.v", "stat.json", "modules.json", MAPPED_JSON, NETLIST, "yosys.log", CELLS_JSON]
-    digest = cache.key(__version__, tool_version("ghdl"), tool_version("yosys", "-V"), Path(__file__), man.top,
-                       yosys_script("design.v", man.top, abc), *[x for f in man.files for x in (f.name, f)])
+    digest = design_key(man, tool_version("yosys", "-V"), yosys_script("design.v", man.top, abc))
     with cache.entry("synth", digest, work, names) as hit:
         if not hit:
             verilog = ghdl_to_verilog(man, work)
@@ -260,5 +265,5 @@ def synthesize_cells(man: Manifest, work: Path, abc: str = "full") -> tuple[dict
     return data["cells"], data["warnings"]
 
 
-__all__ = ["ABC_MODES", "CELLS_JSON", "synthesize_cells", "tool_version", "BENIGN_YOSYS_WARNINGS", "FAMILY", "MAPPED_JSON", "NETLIST", "SynthCheckError",
+__all__ = ["ABC_MODES", "CELLS_JSON", "design_key", "synthesize_cells", "tool_version", "BENIGN_YOSYS_WARNINGS", "FAMILY", "MAPPED_JSON", "NETLIST", "SynthCheckError",
            "complete_pmux_cases", "ghdl_to_verilog", "need_tool", "repair_ghdl_verilog", "yosys_cells", "yosys_script"]

@@ -24,8 +24,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .. import __version__, cache
-from ..eda import ghdl_to_verilog, need_tool, tool_version
+from .. import cache
+from ..eda import design_key, ghdl_to_verilog, need_tool, tool_version
 from ..errors import FlannError
 from ..fileio import atomic_directory, check_output_directory
 from ..hardware.design import as_design
@@ -287,9 +287,8 @@ def implement(directory, device: str, out_dir, *, work=None, seed: int = 1, prog
         wdir.mkdir(parents=True, exist_ok=True)
         # synthesis, place and route and the bitstream once per design, part, clock and seed
         names = [f"{man.top}.asc", f"{man.top}.bin", f"{man.top}.pcf", NEXTPNR_REPORT, ROUTED_JSON, CELLS_JSON]
-        digest = cache.key(__version__, *(tool_version(t) for t in ("ghdl", "yosys", "nextpnr-ice40")),
-                           Path(__file__), man.top, part.name, clock_mhz, seed,
-                           *[x for f in man.files for x in (f.name, f)])
+        digest = design_key(man, tool_version("yosys", "-V"), tool_version("nextpnr-ice40"), Path(__file__), part.name,
+                            clock_mhz, seed)
         with cache.entry("ice40", digest, wdir, names) as hit:
             if hit:
                 say("synthesis, place and route: this design, part and seed done before (cached)")

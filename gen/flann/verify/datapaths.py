@@ -153,7 +153,8 @@ def _thermal(design: Design, build_dir, *, seed=1, codes=None, engine="auto", pr
     s["sweep"] = _sweep_about(backend, res, samples=samples)
     _temperature_fields(s, temps, every, code_hi - code_lo + 1)
     got = _sweep_rows(out_file, samples)
-    curve = None if got is None else _thermal_curve(design, *got, temps, f"GHDL, {backend}")
+    curve = None if got is None else _thermal_curve(design, *got[:3], *_against_model(spec, *got), temps,
+                                                    f"GHDL, {backend}")
     return {"summary": s, "curve": curve, "spec": spec}
 
 
@@ -207,8 +208,7 @@ def _thermal_netlist(design: Design, build_dir: Path, temps, every: bool, *, see
     judged = compare(nl["sweep"], nl)
     c, t, out = nl["codes"], nl["temps"], nl["data"]
     lsb = spec.output_lsb_mm
-    ref = spec.float_reference(c, t) / lsb
-    inside = ~(nl["sat"] & (np.abs(ref) > spec.out_fmt.max_int))  # saturated where the model is beyond the output
+    ref, inside = _against_model(spec, c, t, out, nl["sat"])
     err = float(np.abs(out - ref)[inside].max()) * lsb if inside.any() else None
     benches = {"thermal_sweep": _bench_entry(res)}
     ok = res.ok and bool(rec) and not rec.get("mismatches") and judged["codes_tested"] > 0
@@ -220,15 +220,20 @@ def _thermal_netlist(design: Design, build_dir: Path, temps, every: bool, *, see
                   "vhdl_sample": {"codes": int(rec.get("samples", 0)), "backend": f"ghdl-{backend}",
                                   "bench_ok": res.ok, "mismatches": rec.get("mismatches")}}
     _temperature_fields(s, temps, every, spec.code_max - spec.code_min + 1)
-    curve = _thermal_curve(design, c, t, out, nl["sat"], temps, "Verilator, GHDL's synthesised netlist")
+    curve = _thermal_curve(design, c, t, out, ref, inside, temps, "Verilator, GHDL's synthesised netlist")
     return {"summary": s, "curve": curve, "spec": spec}
 
 
-def _thermal_curve(design: Design, c, t, out, sat, temps, simulator: str):
-    spec, man = design.spec, design.manifest
+def _against_model(spec, c, t, out, sat):
+    """(the float model in output LSBs, the samples judged against it): a saturated output is
+    left out where the model itself lies beyond the output's range, as the sweep bench judges."""
     ref = spec.float_reference(c, t) / spec.output_lsb_mm
+    return ref, ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
+
+
+def _thermal_curve(design: Design, c, t, out, ref, valid, temps, simulator: str):
+    spec, man = design.spec, design.manifest
     bound = man["analysis"]["pre_rounding_lsb"] + 0.5
-    valid = ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
     return plots.two_input([{"name": "", "codes": c, "temps": t, "hdl": out, "ref": ref, "valid": valid}],
                            temps, spec.temp_lsb_c, ref=plots.GOLDEN, simulator=simulator,
                            bound={"value": bound, "label": f"±{bound:.3g} LSB (the design's error bound)"},
