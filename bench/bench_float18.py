@@ -5,7 +5,7 @@
 Generates both designs for MODEL (default data/default_model.json) with the generators'
 default options, measures each with the `flann synth` flow (GHDL synthesis + Yosys
 synth_xilinx -family xcv), also each float18 block alone, and takes the accuracy from
-`flann trace` over every input code (the float18 row is `flann.analysis.explore_float18.measure`).
+`flann trace` over every input code (the float18 row is `flann.hardware.float18.analysis.measure`).
 Prints a table (samples/s at the clock each design meets by the timing estimate); about
 20 s to 3 min on 2 cores.
 

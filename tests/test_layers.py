@@ -1,6 +1,7 @@
 """The package's folders follow the data flow (docs/architecture.md): each layer imports only
 the layers to its left, and nothing in the flow imports the commands, the production line or
-the physics beside it."""
+the physics beside it.  A datapath's folder under hardware/ spans layers: its ``verify.py``
+belongs to the verify layer and its ``analysis.py`` to the analysis layer."""
 
 import ast
 from pathlib import Path
@@ -13,7 +14,11 @@ BESIDE = ("physics", "diagnose", "production", "commands", "cli")
 
 
 def _layer(parts: tuple[str, ...]) -> str:
-    return parts[0].removesuffix(".py")
+    """The layer of the module at ``parts`` (its path in the package, or its dotted name split)."""
+    parts = tuple(p.removesuffix(".py") for p in parts)
+    if len(parts) == 3 and parts[0] == "hardware" and parts[2] in FLOW:
+        return parts[2]
+    return parts[0]
 
 
 def imported_layers(rel: tuple[str, ...], text: str) -> set[str]:
@@ -29,9 +34,10 @@ def imported_layers(rel: tuple[str, ...], text: str) -> set[str]:
                 target = node.module.split(".")[1:] or [a.name for a in node.names]
             else:
                 continue
-            found.add(target[0])
+            found |= {_layer(tuple(target) + (a.name,)) if len(target) == 2 else _layer(tuple(target))
+                      for a in node.names}
         elif isinstance(node, ast.Import):
-            found |= {a.name.split(".")[1] for a in node.names if a.name.startswith("flann.")}
+            found |= {_layer(tuple(a.name.split(".")[1:])) for a in node.names if a.name.startswith("flann.")}
     return found
 
 
@@ -59,3 +65,11 @@ def test_the_check_sees_an_upward_import():
 
 def test_the_check_allows_a_downward_import():
     assert violations(("implement", "probe.py"), "from ..hardware.design import Design\nfrom . import timing\n") == []
+
+
+def test_a_datapath_folder_spans_layers():
+    assert violations(("hardware", "fixed", "verify.py"), "from ...verify.runner import sweep\nfrom .twin import FlannTop\n") == []
+    assert violations(("hardware", "fixed", "datapath.py"), "from .verify import VERIFICATION\n") == [
+        "hardware/fixed/datapath.py: hardware imports verify, which comes after it"]
+    assert violations(("hardware", "fixed", "datapath.py"), "from . import analysis\n") == [
+        "hardware/fixed/datapath.py: hardware imports analysis, which comes after it"]

@@ -2,12 +2,15 @@
 multiplier style or width preset stops the command with one line and exit code 2 before any
 design is built (not a table of empty rows with the reason in their notes)."""
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
 from flann.cli import main
 from flann.analysis import explore
+from flann.analysis.plugin import insight
+from flann.commands import explore as explore_command
 
 MODEL = Path(__file__).resolve().parents[2] / "data" / "default_model.json"
 
@@ -20,8 +23,7 @@ def explored(monkeypatch):
     def record(model, device, **kw):
         calls.append(dict(kw, device=device))
         return []
-    monkeypatch.setitem(explore.EXPLORERS, "fixed_space", record)
-    monkeypatch.setitem(explore.EXPLORERS, "float18_widths", record)
+    monkeypatch.setattr(explore_command, "insight", lambda dp: dataclasses.replace(insight(dp), explore=record))
     return calls
 
 

@@ -13,7 +13,9 @@ from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 from flann.golden.model import load_model, term_kind
 from flann.recordings import read_recordings
 from flann.hardware.fixed.spec import derive_spec
-from flann.analysis.trace import attribute, run_trace, stages_fixed, stages_float18
+from flann.analysis.trace import attribute, run_trace
+from flann.hardware.fixed.analysis import stages as stages_fixed
+from flann.hardware.float18.analysis import stages as stages_float18
 from flann.golden.train import fit_lstsq
 from flann.hardware.fixed.twin import FlannTop
 

@@ -19,7 +19,7 @@ from flann.hardware.registry import DATAPATHS, read_design
 from flann.hardware.thermal.twin import FlannThermalTop
 from flann.verify.datapaths import simulate
 from flann.verify.shards import cores
-from flann.verify.temperatures import THERMAL_MAX_SAMPLES, thermal_temperature_codes
+from flann.hardware.thermal.verify import THERMAL_MAX_SAMPLES, temperature_codes as thermal_temperature_codes
 from flann.hardware.design import from_directory
 
 from test_thermal_twin import sensor_v
@@ -144,7 +144,7 @@ def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
     out = simulate(d, tmp_path / "b", codes=(hi - 150, hi + 50))
     temps, _ = thermal_temperature_codes(d.spec)
     assert {d.spec.temp_code_min, d.spec.temp_code_max} <= set(temps)
-    assert out["summary"]["mismatches"] == 0 and out["summary"]["codes_tested"] == 201 * len(temps), out["summary"]
+    assert out.summary["mismatches"] == 0 and out.summary["codes_tested"] == 201 * len(temps), out.summary
 
 
 def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path):
@@ -238,11 +238,11 @@ def test_the_sweep_runs_in_shards_of_temperature_codes_and_a_fault_in_one_fails_
     n = (codes[1] - codes[0] + 1) * 32
     out = simulate(from_directory(design["dir"]), tmp_path / "b", codes=codes,
                    progress=lambda label: (lambda done, total, secs: seen.append((label, done, total))))
-    s = out["summary"]
+    s = out.summary
     assert s["all_passed"] and s["mismatches"] == 0 and s["codes_tested"] == n, s
     assert s["sweep"]["shards"] == min(cores(), 32)
     assert seen[-1] == ("sweep", n, n)
-    assert out["curve"] is not None
+    assert out.curve is not None
     bad = tmp_path / "bad"
     shutil.copytree(design["dir"], bad)
     top = bad / "flann_thermal_top.vhd"
@@ -251,6 +251,6 @@ def test_the_sweep_runs_in_shards_of_temperature_codes_and_a_fault_in_one_fails_
     line = next(ln for ln in text.splitlines() if "constant temp_hi_c" in ln)
     assert line.endswith('"01101";')                          # 13, the fixture's upper clamp code
     top.write_text(text.replace(line, line.replace('"01101"', '"01100"')))
-    s = simulate(from_directory(bad), tmp_path / "b2", codes=codes)["summary"]
+    s = simulate(from_directory(bad), tmp_path / "b2", codes=codes).summary
     assert not s["all_passed"] and s["codes_tested"] == n
     assert 0 < s["mismatches"] <= n // 32 * (hi - 12), s

@@ -123,7 +123,7 @@ def test_the_vhdl_saturates_at_the_limits_as_its_twin(model, tmp_path):
     lo, hi = _limits(q)
     window = (d.spec.clamp_hi - 10, d.spec.code_max)
     res = simulate(d, tmp_path / "b", codes=window)
-    s = res["summary"]
+    s = res.summary
     temps = d.spec.temp_code_max - d.spec.temp_code_min + 1
     assert s["mismatches"] == 0 and s["all_passed"], s
     assert s["codes_tested"] == (window[1] - window[0] + 1) * temps, s

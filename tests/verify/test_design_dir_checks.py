@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 import flann.implement.ise  # noqa: F401  imported before no_simulation patches synthesize, which it imports by name
-from flann.analysis import explore
+from flann.analysis.plugin import Insight
+from flann.commands import explore as explore_command
 from flann.cli import build_parser
 from flann.commands.gen import generator_options
 from flann.errors import FlannError
@@ -20,7 +21,6 @@ from flann.hardware.family.images import hex_text, read_image
 from flann.hardware.family.render import design_hash
 from flann.hardware.manifest import read_manifest
 from flann.hardware.registry import read_design
-from flann.verify import datapaths
 
 
 def one_line(rc, out, err, *needles):
@@ -51,8 +51,11 @@ def no_simulation(monkeypatch):
     """Fail the test if a bench or a synthesis starts (each refusal comes before them)."""
     def started(*_a, **_kw):
         raise AssertionError("a slow step started")
-    for name in ("simulate_fixed", "sweep_temperatures", "run_family_bench", "run_design"):
-        monkeypatch.setattr(datapaths, name, started)
+    # the slow step of each datapath's bench: what comes before it (the checks) still runs
+    for target in ("flann.hardware.fixed.verify.simulate", "flann.hardware.float18.verify.run_design",
+                   "flann.hardware.family.verify.run_family_bench", "flann.hardware.thermal.verify.sweep_temperatures",
+                   "flann.hardware.family_thermal.verify.sweep_temperatures"):
+        monkeypatch.setattr(target, started)
     monkeypatch.setattr("flann.implement.synth.synthesize", started)
 
 
@@ -166,7 +169,7 @@ def test_sim_and_trace_refuse_generator_flags_with_a_directory(small_designs, cl
 
 
 def test_explore_refuses_another_adc_for_a_directory(small_designs, cli, monkeypatch):
-    monkeypatch.setitem(explore.EXPLORERS, "fixed_space", lambda *a, **kw: [])
+    monkeypatch.setattr(explore_command, "insight", lambda dp: Insight(explore=lambda *a, **kw: []))
     d = small_designs["dir"] / "fixed"
     one_line(*cli(["explore", d, "--input-bits", "10", "--no-seed"]), "explored with the ADC",
              str(d / "model.json"), "--input-bits 10")
@@ -228,7 +231,7 @@ def test_one_image_on_a_family_is_loaded_over_one_the_design_keeps(small_designs
     def bench(directory, images, build_dir, **kw):
         seen.append(images)
         raise FlannError("stopped before the bench")
-    monkeypatch.setattr(datapaths, "run_family_bench", bench)
+    monkeypatch.setattr("flann.hardware.family.verify.run_family_bench", bench)
     given = _calibrated(d, read_image(d / kept[0]["hex"]), tmp_path / "weights.hex")
     one_line(*cli(["sim", d, "--image", given]), "stopped before the bench")
     # the given image second, over the kept image that differs from it; calibrate names every

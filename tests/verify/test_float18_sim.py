@@ -71,7 +71,7 @@ def test_block_matches_twin_under_ghdl(kind, tmp_path):
 
 # -- top level: every input code ------------------------------------------------------------
 def _run_top(tmp_path, model, step: int, seed: int, **options):
-    from flann.verify.float18 import run_top
+    from flann.hardware.float18.verify import run_top
     from flann.hardware.float18.spec import FlannF18Top, derive_f18_spec
 
     codes = FlannF18Top(derive_f18_spec(model, **options)).all_codes()[::step]

@@ -4,6 +4,7 @@ design is simulated once per run (``small_sims``); these tests look at that run'
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 from pathlib import Path
@@ -13,10 +14,13 @@ import pytest
 
 from flann.cli import main
 from flann.hardware.registry import DATAPATHS
+from flann.verify.plugin import bench_of, verification
+from flann.verify.results import SimResult, summary
 
 pytestmark = [pytest.mark.sim, pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
 
 BITS = 8
+
 SIMULATED = ["fixed", "float18", "family", "thermal", "family_thermal"]
 
 
@@ -27,7 +31,7 @@ def designs(small_designs):
 
 
 def test_every_datapath_with_a_bench_is_covered():
-    assert sorted(n for n, dp in DATAPATHS.items() if dp.bench) == sorted(SIMULATED)
+    assert sorted(n for n, dp in DATAPATHS.items() if verification(dp) is not None) == sorted(SIMULATED)
 
 
 def _is_png(path: Path) -> bool:
@@ -78,12 +82,10 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
                 "seconds": 0.0}, False
 
     def bench(design, build_dir, **_):
-        return {"summary": datapaths._summary(design, 256, 0, None, {}, True), "curve": None, "spec": design.spec}
+        return SimResult.from_summary(summary(design, 256, 0, None, {}, True), None, design.spec)
 
     monkeypatch.setattr(datapaths, "netlist_summary", sweep)
-    if datapaths.BENCHES[DATAPATHS[datapath].bench] in datapaths.LOADS_IMAGES:
-        monkeypatch.setattr(datapaths, "LOADS_IMAGES", (*datapaths.LOADS_IMAGES, bench))
-    monkeypatch.setitem(datapaths.BENCHES, DATAPATHS[datapath].bench, bench)
+    monkeypatch.setattr(datapaths, "bench_of", lambda design: dataclasses.replace(bench_of(design), bench=bench))
     d = designs["dir"] / datapath
     # a family design's netlist computes with the image given, as its bench ends
     image = json.loads((d / "manifest.json").read_text())["images"][0]["hex"] if "family" in datapath else None
@@ -145,10 +147,9 @@ def test_temporary_design_is_not_reported_as_a_path(designs, tmp_path, capsys, m
     returns: neither the text nor the JSON names it.  What is simulated is beside the point here
     (every bench runs in the tests above): the benches are stood in for."""
     from flann.commands import sim as sim_command
-    from flann.verify import datapaths
 
     def bench(design, build_dir, **_):
-        return {"summary": datapaths._summary(design, 256, 0, None, {}, True), "curve": None, "spec": design.spec}
+        return SimResult.from_summary(summary(design, 256, 0, None, {}, True), None, design.spec)
 
     monkeypatch.setattr(sim_command, "simulate", bench)
     model = str(designs["model"])

@@ -23,14 +23,11 @@ from ..golden.model import load_model
 from ..hardware.fixed import render as hdlgen
 from ..hardware.fixed.spec import check_mult_style, max_lanes
 from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.render import render_block
-from ..hardware.manifest import write_design
 from ..hardware.registry import FLOAT18
 from ..hardware.seed import render as seed_render
 from ..hardware.seed.spec import derive_seed_spec
 from ..hardware.seed.twin import FlannSeedTop
 from ..hardware.target import CLOCK_HZ, DEFAULT_PART, parse_part
-from .explore_float18 import measure
 from ..implement.synth import Resources, shortfall, smallest_fit, synthesize
 
 
@@ -269,100 +266,3 @@ def markdown(rows: list[Row], device: str) -> str:
 F18 = FLOAT18.number_format
 
 
-def _float18_row(model_path, device: str, widths: str, options: dict, abc: str = "full") -> Row:
-    """The serial float18 design with ``options`` (derive options of the float18 datapath), measured."""
-    r = Row(f"{F18} (serial)", 1, F18, widths)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the front end's fixed output-LSB bound: no output LSB here
-            m = measure(model_path, device, abc=abc, **options)
-        r.luts, r.ffs, r.brams, r.fits = m["luts"], m["ffs"], m["brams"], m["fits"]
-        r.cycles_per_sample, r.samples_per_s = m["cycles_per_sample"], m["samples_per_s_at_50mhz"]
-        r.max_err_mm = m["max_err_mm"]
-        r.note = f"dominant error: {m['dominant_error_stage']}"
-        part = parse_part(device)
-        best = smallest_fit(Resources(m["luts"], m["ffs"], m["brams"], 0, 0, 0, 0, 0, 0), part)
-        r.smallest_device = best.name if best else None
-    except FlannError as exc:
-        r.note = str(exc)
-    return r
-
-
-def explore_float18(model_path, device: str = DEFAULT_PART, lanes=None, styles=None, widths=WIDTH_PRESETS,
-                    seed: bool = True, progress: bool = True, abc: str = "fast", adc: dict | None = None) -> list[Row]:
-    """The float18 design's own choices: the width presets of its fixed front end's terms
-    (budget: the error budget's term width, widened to the code's; narrow: NARROW_BITS fraction
-    bits fewer), each generated, synthesised and scored by its twin.  Its float format is the
-    seed's 18 bits (the float blocks are written for it) and it has one lane and the seed's
-    float multiplier, so --lanes other than 1 and --mult are refused."""
-    parse_part(device)
-    if lanes is not None and tuple(lanes) != (1,):
-        raise FlannError(f"--lanes {','.join(map(str, lanes))}: a {F18} design has one lane (its float sum "
-                         "is sequential, in model term order); explore its --widths")
-    if styles is not None:
-        raise FlannError(f"--mult {','.join(styles)}: a {F18} design multiplies with the seed's {F18} "
-                         "multiplier, it has no multiplier style; explore its --widths")
-    for preset in widths:
-        check_width_preset(preset)
-    rows = []
-    for k, preset in enumerate(widths, 1):
-        if progress:
-            print(f"explore [{k}/{len(widths)}] {F18} widths={preset}", file=sys.stderr)
-        options = dict(adc or {})
-        if preset == "narrow":
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    ref = FLOAT18.derive(load_model(model_path), **options)
-            except FlannError as exc:
-                rows.append(Row(f"{F18} (serial)", 1, F18, preset, note=str(exc)))
-                continue
-            options["term_frac_bits"] = max(4, ref.term_frac_bits - NARROW_BITS)
-        rows.append(_float18_row(model_path, device, preset, options, abc))
-    if seed:
-        rows += seed_rows(model_path, device, abc=abc, progress=progress)
-    return rows
-
-
-def explore_fixed(model_path, device: str = DEFAULT_PART, lanes=None, styles=None, **kw) -> list[Row]:
-    return explore(model_path, device, lanes=DEFAULT_LANES if lanes is None else lanes,
-                   styles=DEFAULT_STYLES if styles is None else styles, **kw)
-
-
-# the design space a datapath names (Datapath.explore); None for lanes/styles: the default
-EXPLORERS = {"fixed_space": explore_fixed, "float18_widths": explore_float18}
-def float18_rows(model_path, device: str, abc: str = "fast", seed_terms: int | None = None,
-                 progress: bool = True) -> list[Row]:
-    """The paper's 18-bit floating point: the project's serial float18 design, and the
-    seed architecture's arithmetic in float18 (N multipliers + N-1 adders, each block
-    synthesised once with this flow and multiplied by its count; tables not included).
-    """
-    if progress:
-        print("explore: float18 design (serial)", file=sys.stderr)
-    rows = [_float18_row(model_path, device, F18, {})]
-
-    n = seed_terms or load_model(model_path).terms
-    per = {}
-    with tempfile.TemporaryDirectory(prefix="flann-f18blk-") as tmp:
-        for kind in ("mul", "add"):
-            if progress:
-                print(f"explore: float18 {kind} block", file=sys.stderr)
-            name, text = render_block(kind)
-            d = Path(tmp) / kind
-            write_design({name: text}, {"top": name[:-4], "files": [name]}, d)
-            rep = synthesize(d, device, abc=abc)
-            per[kind] = (rep.resources.luts, rep.resources.ffs, rep.resources.brams)
-    luts = n * per["mul"][0] + (n - 1) * per["add"][0]
-    ffs = n * per["mul"][1] + (n - 1) * per["add"][1]
-    brams = n * per["mul"][2] + (n - 1) * per["add"][2]
-    part = parse_part(device)
-    res = Resources(luts, ffs, brams, 0, 0, 0, 0, 0, 0)
-    best = smallest_fit(res, part)
-    rows.append(Row(
-        f"seed arithmetic in {F18}, {n} terms", None, F18, F18, luts=luts, ffs=ffs, brams=brams,
-        cycles_per_sample=1, samples_per_s=CLOCK_HZ, fits=not shortfall(res, part),
-        smallest_device=best.name if best else None,
-        note=(f"{n} x flann_f18_mul ({per['mul'][0]} LUT4, {per['mul'][1]} FF) + {n - 1} x flann_f18_add "
-              f"({per['add'][0]} LUT4, {per['add'][1]} FF), each synthesised once; expansion tables not counted"),
-    ))
-    return rows

@@ -32,21 +32,13 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.model import FlannModel, term_kind
-from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import FORMATS, datapath
 from ..numeric.fixed import nearest_codes
-from ..numeric.float18 import FLOAT18
-from ..verify.float18 import run_top
-from ..hardware.family.twin import FlannFamilyTop
 from ..verify.datapaths import simulate as simulate_design
-from ..hardware.design import Design, open_design
-from ..verify.runner import sweep
-from .thermal_trace import ThermalTraceResult, plot_thermal_trace, trace_family_thermal, trace_thermal
+from ..hardware.design import Design
+from .plugin import insight, traced
+from .two_input_trace import ThermalTraceResult, plot_thermal_trace
 
-THERMAL_STAGES = "thermal"   # a two-input design's stage model (its own result type)
-# the two-input designs' stage models (Datapath.stages), each from the design's spec
-TWO_INPUT_STAGE_MODELS = {THERMAL_STAGES: trace_thermal, "family_thermal": trace_family_thermal}
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
 STAGE_TEXT = {
@@ -96,76 +88,18 @@ class Stages:
         return self.g_start + self.g_terms @ self.g_weights
 
 
+def twin_trace(top, codes=None) -> tuple:
+    """(codes, the twin's trace at them): every code when ``codes`` is None."""
+    codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
+    return codes, top.trace(codes)
+
+
 @dataclass
 class Source:
     stage: str
     term: int | None             # model term index; None for bias/start; step for adder
     label: str
     contrib: np.ndarray          # (n,) mm
-
-
-# -- building the stage data --------------------------------------------------------------
-def stages_fixed(spec, codes=None) -> Stages:
-    top = FlannTop(spec)
-    codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
-    t = top.trace(codes)
-    m = spec.model
-    q = spec.output_lsb_mm
-    Tf, Wf, Pf = spec.term_fmt.frac_bits, spec.weight_fmt.frac_bits, spec.product_fmt.frac_bits
-    N = m.terms
-    c = t.norm["code"]
-    v = c * spec.input_lsb_v
-    vn = m.normalise(v)
-    idx = list(range(1, N))
-    g_terms = m.features(v)[:, 1:]
-    g_w = np.asarray(m.weights[1:], dtype=float)
-    L = spec.lanes
-    rom = np.asarray(spec.weight_rom, dtype=np.int64)          # [lane][step]
-    w_int = np.array([rom[j % L][j // L] for j in range(N - 1)], dtype=np.int64)
-    h_terms = t.by_term("terms").astype(float) * 2.0 ** -Tf
-    h_w = w_int * 2.0 ** -Wf * q
-    h_p = t.by_term("products", "multiplier").astype(float) * 2.0 ** -Pf * q
-    running = t.adder["running"].astype(float) * 2.0 ** -Pf * q
-    step_cols = [[j for j in range(k * L, min((k + 1) * L, N - 1))] for k in range(spec.steps)]
-    return Stages(
-        fmt=spec.number_format, codes=codes, volts=codes * spec.input_lsb_v,
-        valid=(codes >= spec.clamp_lo) & (codes <= spec.clamp_hi), term_index=idx,
-        g_terms=g_terms, g_weights=g_w, g_start=m.bias + m.weights[0] * vn,
-        h_fixed_terms=h_terms, h_terms=h_terms, h_weights=h_w, h_products=h_p,
-        h_start=t.norm["lin"].astype(float) * 2.0 ** -Pf * q, h_running=running,
-        step_cols=step_cols, h_out=t.adder["out"].astype(float) * q, start_stage="linear",
-        info=dict(table_addr_bits=spec.table_addr_bits, interp=spec.interp, phase_bits=spec.phase_bits,
-                  term_frac_bits=Tf, weight_frac_bits=Wf, product_frac_bits=Pf, output_lsb_mm=q,
-                  lanes=L, input_lsb_v=spec.input_lsb_v),
-    )
-
-
-def stages_float18(fspec, codes=None) -> Stages:
-    top = FlannF18Top(fspec)
-    codes = top.all_codes() if codes is None else np.asarray(codes, dtype=np.int64)
-    t = top.trace(codes)
-    fmt = fspec.fmt
-    base = fspec.front
-    m = fspec.model
-    N = m.terms
-    Tf = fspec.term_frac_bits
-    v = t.code * base.input_lsb_v
-    g_terms = m.features(v)
-    g_terms[:, 0] = t.code * 2.0 ** -Tf              # term 0 enters as the code (see float18_top)
-    dec = fmt.decode_array
-    return Stages(
-        fmt=fspec.number_format, codes=codes, volts=codes * base.input_lsb_v,
-        valid=(codes >= base.clamp_lo) & (codes <= base.clamp_hi), term_index=list(range(N)),
-        g_terms=g_terms, g_weights=fspec.golden_weights(),
-        g_start=np.full(codes.size, fspec.golden_start()),
-        h_fixed_terms=t.fixed_terms.astype(float) * 2.0 ** -Tf, h_terms=dec(t.terms),
-        h_weights=dec(np.asarray(fspec.weight_codes)), h_products=dec(t.products),
-        h_start=np.full(codes.size, float(fmt.decode(fspec.start_code))), h_running=dec(t.running),
-        step_cols=[[i] for i in range(N)], h_out=dec(t.out), start_stage="weights", converts=True,
-        info=dict(table_addr_bits=base.table_addr_bits, interp=base.interp, phase_bits=base.phase_bits,
-                  term_frac_bits=Tf, sig_bits=fmt.sig_bits, format=fmt.describe(),
-                  input_lsb_v=base.input_lsb_v),
-    )
 
 
 # -- attribution ----------------------------------------------------------------------------
@@ -471,27 +405,6 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
     plt.close(fig)
 
 
-def _hdl_sweep(model_path, options: dict, build_dir: Path, stage_codes, design_model) -> tuple:
-    """The fixed-point sweep harness; the design's blocks are checked by their own block benches."""
-    design = open_design(model_path, build_dir, options, model=design_model)
-    sw = sweep(design, build_dir)
-    if sw["codes"].size == 0:
-        raise FlannError(f"fixed-point simulation produced no outputs (see {build_dir})")
-    spec = design.spec
-    codes, data = sw["codes"], sw["data"]
-    mism = int(np.count_nonzero(data != FlannTop(spec).process(codes)[0]))
-    return codes, data * spec.output_lsb_mm, mism, design.manifest["top"], None
-
-
-def _hdl_f18_top(model_path, options: dict, build_dir: Path, stage_codes, design_model) -> tuple:
-    r = run_top(model_path, build_dir, stage_codes=stage_codes, **options)
-    return r["codes"], FLOAT18.decode_array(r["out"]), r["mismatches"], r["manifest"]["top"], r["stages"]
-
-
-# how flann trace --hdl simulates a model's design, by its datapath's bench (Datapath.bench)
-HDL_CHECKS = {"sweep": _hdl_sweep, "f18_top": _hdl_f18_top}
-
-
 def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_samples: int = 64,
               design_model=None) -> dict:
     """Simulate the generated top level over every input code (GHDL + cocotb) and compare the
@@ -500,13 +413,13 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_s
     datapath whose bench captures internal stages (``stage_capture``) also compares those at a
     spread of ``stage_samples`` codes."""
     dp = datapath(result.fmt)
-    if dp.bench not in HDL_CHECKS:
+    found = insight(dp)
+    if found.hdl is None:
         raise FlannError(f"--hdl: the {dp.name} datapath's bench does not simulate a model's design "
                          "(generate it with flann gen -o DIR, then flann trace DIR --hdl)")
     stage_codes = (result.codes[np.linspace(0, result.codes.size - 1, stage_samples).astype(int)]
-                   if dp.stage_capture else ())
-    codes, hdl_mm, mism, top, stages = HDL_CHECKS[dp.bench](model_path, options, Path(build_dir), stage_codes,
-                                                            design_model)
+                   if found.stage_capture else ())
+    codes, hdl_mm, mism, top, stages = found.hdl(model_path, options, Path(build_dir), stage_codes, design_model)
     pos = {int(c): k for k, c in enumerate(result.codes)}
     sel = np.array([int(c) in pos for c in codes])
     idx = np.array([pos[int(c)] for c in codes[sel]], dtype=np.int64)
@@ -517,46 +430,34 @@ def check_hdl(result: TraceResult, model_path, options: dict, build_dir, stage_s
     return result.hdl
 
 
-def stages_family(fam, codes=None) -> Stages:
-    """The family design with its memory as initialised: the fixed datapath's stages of those values."""
-    return stages_fixed(FlannFamilyTop(fam).top().spec, codes)
-
-
-# the stage model a datapath names (Datapath.stages)
-STAGE_MODELS = {"fixed_point": stages_fixed, "float18_terms": stages_float18, "family_member": stages_family}
-
-
 def run_trace(model: FlannModel, fmt: str = FORMATS[0], codes=None, **spec_options) -> TraceResult:
     """The stages of ``model`` in the datapath ``fmt`` (a model without a design directory)."""
     if fmt not in FORMATS:
         raise FlannError(f"--format {fmt!r}: allowed {', '.join(FORMATS)}")
     dp = datapath(fmt)
-    st = STAGE_MODELS[dp.stages](dp.derive(model, **spec_options), codes)
+    st = insight(dp).stages(dp.derive(model, **spec_options), codes)
     st.fmt = dp.name  # check_hdl finds the datapath again by it
     return trace(st)
 
 
 def trace_design(design: Design, codes=None) -> TraceResult | ThermalTraceResult:
     """The stages of a written design (any datapath with a stage model), from its own spec; a
-    two-input design has its own (:mod:`.thermal_trace`)."""
-    dp = design.datapath
-    if dp.stages is None:
-        raise FlannError(f"{design.directory}: {dp.why_no_stages}")
-    if dp.stages in TWO_INPUT_STAGE_MODELS:
-        return TWO_INPUT_STAGE_MODELS[dp.stages](design.spec)
-    return trace(STAGE_MODELS[dp.stages](design.spec, codes))
+    design with temperature has its own trace (its folder's ``analysis.py``)."""
+    found = traced(design)
+    if found.trace is not None:
+        return found.trace(design.spec)
+    return trace(found.stages(design.spec, codes))
 
 
 def check_design_hdl(result: TraceResult, design: Design, build_dir) -> dict:
     """A design directory's VHDL over every input code with its datapath's bench (flann sim's)."""
     res = simulate_design(design, build_dir)
-    s = res["summary"]
+    s = res.summary
     result.hdl = {"top": design.manifest["top"], "codes": s["codes_tested"], "mismatches": s["mismatches"],
-                  "max_err_mm": s["max_err_mm"], "equals_twin": bool(s["mismatches"] == 0 and s["all_passed"]),
+                  "max_err_mm": s["max_err_mm"], "equals_twin": bool(s["mismatches"] == 0 and res.passed),
                   "stages": None}
     return result.hdl
 
 
-__all__ = ["Stages", "Source", "TraceResult", "STAGES", "attribute", "trace", "stages_fixed",
-           "stages_float18", "stages_family", "plot_trace", "plot_compare", "run_trace", "check_hdl", "term_label",
-           "trace_design", "check_design_hdl", "STAGE_MODELS", "TWO_INPUT_STAGE_MODELS"]
+__all__ = ["Stages", "Source", "twin_trace", "TraceResult", "STAGES", "attribute", "trace", "plot_trace", "plot_compare",
+           "run_trace", "check_hdl", "term_label", "trace_design", "check_design_hdl"]

@@ -8,6 +8,8 @@ from ..argtypes import bounded, checked
 from ..golden.model import MAX_TERMS
 from ..eda import ABC_MODES
 from ..analysis import explore
+from ..analysis.plugin import insight
+from ..hardware.float18.analysis import float18_rows
 from ..implement.synth import manifest_device
 from ..hardware.adc import ADC_BITS
 from ..errors import FlannError
@@ -68,8 +70,8 @@ def _design_model(args):
     is_dir = Path(source).is_dir()
     design = open_directory(source) if is_dir else None   # read once
     man, dp = (design.manifest, design.datapath) if is_dir else ({}, datapath_for_model(args.model, FORMATS[0]))
-    if dp.explore is None:
-        raise FlannError(f"{args.model}: {dp.why_no_explore}")
+    if insight(dp).explore is None:
+        raise dp.lacking(args.model, "design space for flann explore")
     if is_dir:
         model = design_model(args.model, man, dp)
         given = " ".join(f"{flag} {value:g}" for flag, value in (("--input-bits", args.input_bits),
@@ -91,17 +93,17 @@ def run(args) -> int:
     if args.seed_only:
         rows = explore.seed_rows(args.model, args.device, abc=args.abc, progress=progress)
         if args.float18:
-            rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
+            rows += float18_rows(args.model, args.device, abc=args.abc, progress=progress)
         if not emit_json(args, [r.to_dict() for r in rows]):
             print(explore.markdown(rows, args.device))
         return 0
-    rows = explore.EXPLORERS[dp.explore](
+    rows = insight(dp).explore(
         args.model, args.device, lanes=args.lanes, styles=args.mult,
         widths=args.widths, seed=not args.no_seed, progress=progress, abc=args.abc,
         adc={k: v for k, v in (("input_bits", args.input_bits), ("input_lsb_v", args.input_lsb_v)) if v is not None},
     )
     if args.float18:
-        rows += explore.float18_rows(args.model, args.device, abc=args.abc, progress=progress)
+        rows += float18_rows(args.model, args.device, abc=args.abc, progress=progress)
     if not emit_json(args, [r.to_dict() for r in rows]):
         print(explore.markdown(rows, args.device))
     return 0

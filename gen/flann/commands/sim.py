@@ -127,7 +127,7 @@ def run(args) -> int:
         images = image_names(args.image or [])
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=None if quiet(args) else terminal_progress, images=images or None)
-        s = {**res["summary"], **clock_fields()}
+        s = {**res.summary, **clock_fields()}
         if args.post_route:
             # a family design's routed netlist computes with the last image given, as its bench ends
             check = checker(design, image=images[-1] if images else None)
@@ -136,9 +136,9 @@ def run(args) -> int:
                                   post_route=check)
             s["post_route"] = {**rep.post_route, "device": rep.part.name, "fmax_mhz": rep.fmax_mhz,
                                "timing_met": rep.timing_met}
-        plotted = bool(args.plot and res["curve"] is not None)
+        plotted = bool(args.plot and res.curve is not None)
         if plotted:
-            plot(res["curve"], design.manifest, args.plot)
+            plot(res.curve, design.manifest, args.plot)
         # a design generated into the temporary directory is gone when the command returns
         temporary = Path(tmp).resolve() in design.directory.parents
         if temporary:
@@ -194,7 +194,7 @@ def run(args) -> int:
     if s.get("post_route", {}).get("mismatches"):
         print("error: the placed-and-routed design disagrees with its twin", file=sys.stderr)
         return 1
-    if not s["all_passed"] or s["mismatches"]:
+    if not res.passed or s["mismatches"]:
         why = [f"bench {name}: {', '.join(b['failed']) or 'failed'}" for name, b in s.get("benches", {}).items()
                if b.get("failures")]
         if s["mismatches"]:

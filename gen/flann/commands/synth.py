@@ -14,7 +14,7 @@ from ..implement import ice40, synth
 from ..hardware.target import (DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..hardware.design import Design, open_directory
-from ..verify.netlist import SWEEPS, check_synthesized, require_sweep_driver, sweep_datapaths
+from ..verify.netlist import check_synthesized, has_sweep_driver, require_sweep_driver, sweep_datapaths
 from ..verify.post_route import checker
 from .common import add_common, cores_limited, emit_json, json_to_stdout, quiet
 
@@ -63,7 +63,7 @@ def _check_netlist(args, design: Design, netlist: Path) -> dict:
     if args.no_netlist_check:
         return {"netlist_not_run": "--no-netlist-check"}
     man, dp = design.manifest, design.datapath
-    if dp.netlist not in SWEEPS:
+    if not has_sweep_driver(dp):
         return {"netlist_not_run": f"no netlist sweep for a {dp.name} design (it has a driver and twin for "
                                    f"{sweep_datapaths()} designs)"}
     if args.model is None and not man.get("model"):

@@ -17,7 +17,8 @@ from ..argtypes import png_path
 from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
-from ..analysis.trace import (TWO_INPUT_STAGE_MODELS, check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
+from ..analysis.plugin import insight
+from ..analysis.trace import (check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
                               trace_design)
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
 from ..hardware.design import from_directory
@@ -87,7 +88,7 @@ def run(args) -> int:
     fmts = [args.format] + ([f for f in FORMATS if f != args.format] if args.compare else [])
     if design:
         args.format = design.datapath.name
-        if args.at and design.datapath.stages in TWO_INPUT_STAGE_MODELS:
+        if args.at and insight(design.datapath).trace is not None:
             raise FlannError(f"{args.model}: --at lists the error at one-input voltages; a two-input "
                              "design's error at recordings is flann eval MODEL REC --design DIR")
         # the label names the datapath and, for a family, its member; the JSON keeps the number format

@@ -38,7 +38,7 @@ def design_spec(model_path, design_dir) -> Spec:
     A datapath without one is refused in one line saying why."""
     man, dp = read_design(design_dir)
     if dp.eval_spec is None:
-        raise FlannError(f"{design_dir}: a {dp.name} design: {dp.why_no_eval}")
+        raise dp.lacking(design_dir, "twin for flann eval --design")
     return dp.eval_spec(model_path, man, design_dir)
 
 

@@ -1,7 +1,10 @@
 """What every datapath offers, whatever its number format or architecture.
 
-A datapath (``fixed``, ``float18``, ``family``, ``seed``: one folder each under ``hardware/``)
-is one :class:`Datapath` object, registered in :mod:`flann.hardware.registry`.  Commands never
+A datapath (``fixed``, ``float18``, ``family``, ``thermal``, ...: one folder each under
+``hardware/``) is one :class:`Datapath` object, registered in :mod:`flann.hardware.registry`.
+Its folder also holds what the later layers do with its designs: ``verify.py`` (its bench, its
+netlist sweep, its fuzz check: :mod:`flann.verify.plugin`) and ``analysis.py`` (its stage model
+and design space: :mod:`flann.analysis.plugin`).  Commands never
 ask a datapath's name: they read a design's ``manifest.json`` (whose ``datapath`` field names
 it), look the datapath up there, and call it:
 
@@ -13,13 +16,11 @@ it), look the datapath up there, and call it:
   ``all_codes``, ``error_vs_float``);
 * ``fields``: the manifest fields this datapath's readers rely on, with their types, so
   one reader refuses a tampered manifest in one line naming the field;
-* ``bench`` / ``stages`` / ``explore``: which verification bench, which stage model of
-  ``flann trace`` and which design space of ``flann explore`` apply (``None``: the command refuses in one line saying why);
 * ``derive(model, **options)``: the spec of a model traced or fuzzed without a design directory;
-* ``number_format``, ``stage_capture``, ``fuzz_share`` / ``fuzz_options``: what the datapath can
-  do, asked instead of its name (``flann gen --family`` takes the family's number format only,
-  ``flann trace --hdl`` compares captured stages where the bench captures them, the fuzzer draws
-  each datapath's share of cases and its own options);
+* ``number_format``: its arithmetic, asked instead of its name (``flann gen --family`` takes the
+  family's number format only);
+* ``lacks``: why its designs lack what they lack; a command they cannot take says so in one line
+  (:meth:`Datapath.lacking`);
 * ``estimate(manifest)``: resources before synthesis (LUT4, flip-flops, block RAMs), so
   ``flann ise`` can refuse a part the design cannot fit.
 """
@@ -139,25 +140,20 @@ class Datapath:
     estimate: Callable                 # manifest -> {"luts", "ffs", "brams"}
     fields: tuple = ()                 # manifest fields beyond COMMON_FIELDS
     model_field: str = "model"         # manifest field naming the model file in the directory
-    bench: str | None = None           # verification bench (flann.hardware.design.BENCHES)
-    stages: str | None = None          # stage model of flann trace (flann.analysis.trace.STAGE_MODELS)
-    explore: str | None = None         # design space of flann explore (flann.analysis.explore.EXPLORERS)
     eval_spec: Callable | None = None  # (model path, manifest, directory) -> fixed Spec of flann eval --design
-    why_no_eval: str = ""
-    why_no_explore: str = ""           # why flann explore refuses it (no ``explore``)
-    why_no_bench: str = ""
-    why_no_stages: str = ""
-    why_no_ise: str = ""               # empty: flann ise writes a project for it
+    lacks: str = ""                    # why its designs lack what they lack (a bench, a stage model, ...)
+    ise: bool = True                   # flann ise writes a project for it
     lint: bool = True                  # its VHDL passes VSG with the repository's vsg.yaml
     derive_options: Callable | None = None  # (GenOptions, compared) -> keyword arguments of its derive
-    netlist: str | None = None         # the sweep of its mapped netlist over every code (flann.verify.netlist.SWEEPS)
     summary: Callable | None = None    # manifest -> lines flann gen prints
     derive: Callable | None = None     # (FlannModel, **derive options) -> spec of a model with no design directory
     number_format: str = ""            # the arithmetic of its products and sum (what flann gen --format names)
-    stage_capture: bool = False        # its bench also captures internal stages at chosen codes (trace --hdl)
-    fuzz_share: float = 0.0            # share of the generator fuzz cases (verify/fuzz.py) drawn on it
-    fuzz_options: Callable | None = None  # rng -> its own generator options drawn at random (fuzzing)
     common: tuple = COMMON_FIELDS      # the shared key set (a design flann did not write: fewer)
+
+    def lacking(self, directory, what: str) -> FlannError:
+        """The one-line refusal of a command its designs cannot take: ``what`` they have none of."""
+        why = f": {self.lacks}" if self.lacks else ""
+        return FlannError(f"{directory}: a {self.name} design has no {what}{why}")
 
     def check(self, man: dict, where) -> None:
         check_fields(man, tuple(self.common) + tuple(self.fields), where)

@@ -25,20 +25,19 @@ from .thermal.spec import MAX_INPUT_BITS as THERMAL_INPUT_BITS
 
 def _no(what: str):
     def refuse(*_args, **_kw):
-        raise FlannError(f"{WHY_PLAIN} {what}")
+        raise FlannError(f"{WHY_PLAIN}; it has no {what}")
     return refuse
 
 
 WHY_PLAIN = ("a design flann did not write (its manifest names no datapath and no flann spec): "
-             "synthesis and the ISE handoff take it; it has no")
+             "synthesis and the ISE handoff take it")
 # VHDL with a hand-written manifest: `top`, `files` and the port widths the ISE pin map needs
 PLAIN = Datapath(
     name="plain", top="", about="VHDL with a hand-written manifest (synth and ise only)",
     generate=_no("generator"), rebuild=_no("twin"), twin=_no("twin"), estimate=lambda man: None,
     common=(Field("top", (str,)), Field("files", (list,)), _int("input_bits", 2), _int("output_bits", 2),
             Field("spec", (dict,), optional=True)),
-    model_field="", why_no_bench=f"{WHY_PLAIN} bench", why_no_stages=f"{WHY_PLAIN} stage model",
-    why_no_eval=f"{WHY_PLAIN} twin", why_no_explore=f"{WHY_PLAIN} model",
+    model_field="", lacks=WHY_PLAIN,
 )
 DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, FAMILY_THERMAL, SEED, THERMAL, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)

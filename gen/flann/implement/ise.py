@@ -188,8 +188,8 @@ def check_fits(man, dp, part, force: bool = False, warn: bool = True) -> None:
     """Refuse (one line naming the smallest part that fits) a part the design's resource
     estimate exceeds, unless ``force`` (then a warning, when ``warn``); a datapath without an
     estimate is not checked, one without an ISE handoff is refused."""
-    if dp.why_no_ise:
-        raise FlannError(f"{man.directory}: {dp.why_no_ise}")
+    if not dp.ise:
+        raise dp.lacking(man.directory, "ISE handoff")
     est = dp.estimate(man)
     if est is None:
         return

@@ -16,7 +16,6 @@ and output widths, lanes, multiplier style and digit, interpolation, number form
 
 from __future__ import annotations
 
-import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,14 +23,8 @@ import numpy as np
 
 from ..errors import FlannError
 from ..golden.train import fit_lstsq
-from ..hardware.fixed.render import write
-from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import FlannF18Top
 from ..hardware.registry import DATAPATHS, datapath
-from ..hardware.design import Design
-from ..hardware.manifest import Manifest
-from .float18 import run_top
-from .runner import sweep
+from .plugin import verification
 
 
 @dataclass
@@ -68,17 +61,21 @@ def _sensor(rng) -> tuple[np.ndarray, np.ndarray, float, int]:
     return v, x, lsb, bits
 
 
-# the datapaths fuzzed, the smallest share first (one uniform draw picks one)
-FUZZED = tuple(sorted((dp for dp in DATAPATHS.values() if dp.fuzz_share > 0), key=lambda dp: dp.fuzz_share))
+def fuzzed() -> list:
+    """(datapath, its verification) of the datapaths fuzzed, the smallest share first."""
+    found = [(dp, v) for dp in DATAPATHS.values() if (v := verification(dp)) is not None and v.fuzz_share > 0]
+    return sorted(found, key=lambda f: f[1].fuzz_share)
 
 
 def _draw_datapath(rng):
-    r, upto = rng.random() * sum(dp.fuzz_share for dp in FUZZED), 0.0
-    for dp in FUZZED:
-        upto += dp.fuzz_share
+    """One datapath, drawn with its verification's share (one uniform draw picks one)."""
+    drawn = fuzzed()
+    r, upto = rng.random() * sum(v.fuzz_share for _, v in drawn), 0.0
+    for dp, v in drawn:
+        upto += v.fuzz_share
         if r < upto:
-            return dp
-    return FUZZED[-1]
+            return dp, v
+    return drawn[-1]
 
 
 def draw_case(rng, index: int):
@@ -87,14 +84,14 @@ def draw_case(rng, index: int):
     v, x, lsb, bits = _sensor(rng)
     terms = int(rng.integers(3, 52))
     model = fit_lstsq(v, x, terms)
-    dp = _draw_datapath(rng)
+    dp, checks = _draw_datapath(rng)
     opts = {"input_bits": bits, "input_lsb_v": float(f"{lsb:.6g}"), "interp": bool(rng.random() < 0.8)}
-    if dp.fuzz_options is not None:
-        opts.update(dp.fuzz_options(rng))
+    if checks.fuzz_options is not None:
+        opts.update(checks.fuzz_options(rng))
     return model, Case(index, opts, terms, dp.name)
 
 
-def _window(lo: int, hi: int, rng, n: int) -> tuple[int, int]:
+def window(lo: int, hi: int, rng, n: int) -> tuple[int, int]:
     n = min(n, hi - lo + 1)
     a = int(rng.integers(lo, hi - n + 2))
     return a, a + n - 1
@@ -108,63 +105,7 @@ def check_case(model, case: Case, rng, work: Path, hdl_codes: int = 24) -> Case:
     except FlannError as exc:
         case.outcome, case.detail = "refused", str(exc)
         return case
-    return CHECKS[dp.bench](model, case, spec, rng, work, hdl_codes)
-
-
-def _check_sweep(model, case: Case, spec, rng, work: Path, hdl_codes: int) -> Case:
-    try:
-        top = FlannTop(spec)
-        codes = top.all_codes()
-        out, _ = top.process(codes)
-        err = np.abs(out - spec.float_reference(codes) / spec.output_lsb_mm)
-        case.codes_twin = int(codes.size)
-        case.max_err_lsb = round(float(err.max()), 4)
-        case.bound_lsb = round(max(1.0, float(spec.analysis["bound_total_lsb"])), 4)
-        man = write(spec, work / "hdl")
-        model.save(work / "model.json")
-        design = Design((work / "hdl").resolve(), Manifest.written(work / "hdl", man), (work / "model.json").resolve(),
-                        case.options, spec)
-        windows = [_window(spec.code_min, spec.code_max, rng, hdl_codes),
-                   (max(spec.code_min, spec.clamp_lo - 2), min(spec.code_max, spec.clamp_lo + 2)),
-                   (max(spec.code_min, spec.clamp_hi - 2), min(spec.code_max, spec.clamp_hi + 2))]
-        sample = sorted({c for a, b in windows for c in range(a, b + 1)})
-        r = sweep(design, work / "build", codes=sample, shards=1)
-        total = len(sample)
-        want_out, want_sat = top.process(r["codes"])
-        case.mismatches = int(np.count_nonzero((r["data"] != want_out) | (r["sat"] != want_sat)))
-        case.mismatches += total - int(r["codes"].size)
-        if not r["bench"].ok:
-            case.mismatches = max(case.mismatches, 1)
-            case.detail = f"sweep bench failed: {r['bench'].failed_tests}"
-        case.codes_hdl = total
-        bad = case.max_err_lsb > case.bound_lsb + 1e-9 or case.mismatches
-        case.outcome = "FAIL" if bad else "ok"
-        if case.max_err_lsb > case.bound_lsb + 1e-9:
-            case.detail = f"twin {case.max_err_lsb} LSB from the float model > bound {case.bound_lsb}"
-    except FlannError as exc:
-        case.outcome, case.detail = "FAIL", f"after a valid spec: {exc}"
-    except Exception:  # a crash is a finding: record it, go on with the next case
-        case.outcome, case.detail = "FAIL", traceback.format_exc(limit=3).strip().splitlines()[-1]
-    return case
-
-
-def _check_f18_top(model, case: Case, fspec, rng, work: Path, hdl_codes: int) -> Case:
-    try:
-        top = FlannF18Top(fspec)
-        codes = top.all_codes()
-        lo, hi = _window(int(codes[0]), int(codes[-1]), rng, hdl_codes)
-        r = run_top(model, work, codes=np.arange(lo, hi + 1), seed=case.index, **case.options)
-        case.codes_twin = int(codes.size)
-        case.codes_hdl = int(r["codes"].size)
-        case.mismatches = r["mismatches"] if r["mismatches"] is not None else hi - lo + 1
-        case.outcome = "FAIL" if (case.mismatches or r["bench_failed"]) else "ok"
-    except Exception:
-        case.outcome, case.detail = "FAIL", traceback.format_exc(limit=3).strip().splitlines()[-1]
-    return case
-
-
-# how a fuzz case is checked, by the datapath's bench (Datapath.bench)
-CHECKS = {"sweep": _check_sweep, "f18_top": _check_f18_top}
+    return verification(dp).fuzz(model, case, spec, rng, work, hdl_codes)
 
 
 def run_cases(seed: int, n: int, work, hdl_codes: int = 24, progress=None) -> list[Case]:
@@ -179,4 +120,4 @@ def run_cases(seed: int, n: int, work, hdl_codes: int = 24, progress=None) -> li
     return cases
 
 
-__all__ = ["Case", "draw_case", "check_case", "run_cases"]
+__all__ = ["Case", "draw_case", "check_case", "run_cases", "window", "fuzzed"]

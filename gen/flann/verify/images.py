@@ -33,6 +33,24 @@ def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[i
     return image, got
 
 
+def checked_images(design: Design, images, words: int) -> list[tuple[dict, list[int]]]:
+    """Each of ``images`` read and checked (:func:`checked_image`): a bad file is one line before
+    the simulation, not a failed bench after it."""
+    return [checked_image(design, im, words) for im in images]
+
+
+def loaded_image(design: Design, words: int, image: dict | None) -> list[int]:
+    """The words a netlist sweep loads through the cfg port first: ``image`` ({name, hex}: one
+    the user gave), else the last image the design keeps."""
+    if image is not None:
+        return checked_image(design, image, words)[1]
+    kept = kept_images(design)
+    if not kept:
+        raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
+                         "design keeps none (regenerate it with flann gen --family from the recordings)")
+    return checked_image(design, kept[-1], words)[1]
+
+
 def kept_images(design: Design) -> list[dict]:
     """The weight images flann gen kept in the design, as {name, hex path[, model path]}."""
     return [{"name": im["name"], "hex": str(design.directory / im["hex"]),
@@ -54,4 +72,4 @@ def image_model(image: dict) -> FlannModel | None:
     return load_model(beside) if named is not None and named == text_sha256(text) else None
 
 
-__all__ = ["checked_image", "kept_images", "image_model"]
+__all__ = ["checked_image", "checked_images", "loaded_image", "kept_images", "image_model"]

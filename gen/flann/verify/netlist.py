@@ -8,11 +8,11 @@ not model) and a C++ driver that steps through every input code -> every output 
 the twin in one pass.  Verilator, not Icarus: on the default design's mapped netlist Icarus runs
 about 1 code/s, Verilator a few hundred.
 
-A datapath names its sweep (``Datapath.netlist``, a key of :data:`SWEEPS`): the top the driver
-drives, the twin it is compared with, for a design with temperature the temperature codes each
-voltage code runs at (those of its RTL sweep, :mod:`flann.verify.temperatures`), and for a
-family design the weight image the driver first loads through the cfg port (the last one the
-design keeps, over the memory's initial sensor, so that the load is what the sweep sees).
+A datapath's folder states its sweep (``netlist`` of its :class:`~flann.verify.plugin.Verification`):
+the top the driver drives, the twin it is compared with, for a design with temperature the
+temperature codes each voltage code runs at (those of its RTL sweep), and for a family design
+the weight image the driver first loads through the cfg port (the last one the design keeps,
+over the memory's initial sensor, so that the load is what the sweep sees).
 """
 
 from __future__ import annotations
@@ -30,17 +30,11 @@ import numpy as np
 
 from .. import cache
 from ..errors import FlannError
-from ..hardware.family.twin import FlannFamilyTop
-from ..hardware.family_thermal.twin import FlannFamilyThermalTop
-from ..hardware.fixed.twin import FlannTop
-from ..hardware.float18.spec import FlannF18Top
-from ..hardware.thermal.twin import FlannThermalTop
 from ..eda import NETLIST, ghdl_to_verilog, synthesize_cells, tool_version
 from .benches import BENCH_DIR
 from ..hardware.design import Design
-from .images import checked_image, kept_images
+from .plugin import verification, with_netlist
 from .shards import cores, count_lines, merge, read_results, split
-from .temperatures import family_thermal_temperature_codes, thermal_temperature_codes
 
 DRIVER = "netlist_main.cpp"
 RAM_MODELS = "ramb4_sim.v"
@@ -78,64 +72,17 @@ class NetlistSweep:
         return self.process(got["codes"]) if self.temps is None else self.process(got["codes"], got["temps"])
 
 
-def _sweep(design: Design, process: Callable, **more) -> NetlistSweep:
+def top_sweep(design: Design, process: Callable, **more) -> NetlistSweep:
     """The sweep of ``design``'s top as its manifest states it, compared with ``process``."""
     man = design.manifest
     return NetlistSweep(man["top"], man["input_bits"], man["output_bits"], man["latency_cycles"], process, **more)
 
 
-def _fixed_sweep(design: Design, image=None) -> NetlistSweep:
-    return _sweep(design, FlannTop(design.spec).process)
-
-
-def _float18_sweep(design: Design, image=None) -> NetlistSweep:
-    return _sweep(design, FlannF18Top(design.spec).process)
-
-
-def _loaded_image(design: Design, words: int, image: dict | None) -> list[int]:
-    """The words the driver loads: ``image`` ({name, hex}: one the user gave), else the last image
-    the design keeps."""
-    if image is not None:
-        return checked_image(design, image, words)[1]
-    kept = kept_images(design)
-    if not kept:
-        raise FlannError(f"{design.directory}: the netlist sweep loads a weight image through the cfg port and the "
-                         "design keeps none (regenerate it with flann gen --family from the recordings)")
-    return checked_image(design, kept[-1], words)[1]
-
-
-def _family_sweep(design: Design, image=None) -> NetlistSweep:
-    words = _loaded_image(design, design.spec.mem_depth, image)
-    return _sweep(design, FlannFamilyTop(design.spec, words).process, image=tuple(words),
-                  cfg_addr_bits=design.spec.addr_bits)
-
-
-# every temperature code while a sweep stays below this many samples (the mapped netlist runs
-# some thousands of samples a second on a core); above it, the RTL sweep's spread of codes
-NETLIST_MAX_SAMPLES = 150_000
-
-
-def _thermal_sweep(design: Design, image=None) -> NetlistSweep:
-    spec = design.spec
-    temps, _ = thermal_temperature_codes(spec, NETLIST_MAX_SAMPLES)
-    return _sweep(design, FlannThermalTop(spec).process, temps=tuple(temps), temp_bits=spec.temp_bits)
-
-
-def _family_thermal_sweep(design: Design, image=None) -> NetlistSweep:
-    spec = design.spec
-    words = _loaded_image(design, spec.image_words, image)
-    return _sweep(design, FlannFamilyThermalTop(spec, words).process, image=tuple(words),
-                  cfg_addr_bits=spec.cfg_addr_bits, temps=tuple(family_thermal_temperature_codes(spec)),
-                  temp_bits=spec.temp_bits)
-
-
-SWEEPS = {"fixed": _fixed_sweep, "float18": _float18_sweep, "family": _family_sweep, "thermal": _thermal_sweep,
-          "family_thermal": _family_thermal_sweep}
-
-
 def sweep_of(design: Design, image: dict | None = None) -> NetlistSweep:
+    """The sweep the design's datapath folder states for its netlist (``image``: the weight
+    image a family design loads first)."""
     require_sweep_driver(design.datapath, design.directory, "the netlist sweep")
-    return SWEEPS[design.datapath.netlist](design, image)
+    return verification(design.datapath).netlist(design, image)
 
 
 def yosys_datdir() -> Path:
@@ -297,14 +244,19 @@ def check_rtl_netlist(design: Design, build, progress=None, temps=None) -> dict:
 
 def sweep_datapaths() -> str:
     """The datapaths the netlist sweep drives, as a sentence lists them."""
-    names = list(SWEEPS)
+    names = [dp.name for dp in with_netlist()]
     return f"{', '.join(names[:-1])} and {names[-1]}"
 
 
+def has_sweep_driver(datapath) -> bool:
+    found = verification(datapath)
+    return found is not None and found.netlist is not None
+
+
 def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> None:
-    """The netlist and post-route sweeps drive the tops of :data:`SWEEPS`: refuse another
-    datapath's design before any slow step."""
-    if datapath.netlist not in SWEEPS:
+    """The netlist and post-route sweeps drive the tops whose datapath states a netlist sweep:
+    refuse another datapath's design before any slow step."""
+    if not has_sweep_driver(datapath):
         raise FlannError(f"{flag}: {directory} holds a {datapath.name} design, and the netlist sweep has a driver "
                          f"and twin for {sweep_datapaths()} designs only")
 
@@ -315,5 +267,5 @@ def check_synthesized(design: Design, netlist: Path) -> dict:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["NetlistSweep", "netlist_summary", "SWEEPS", "sweep_of", "sweep_datapaths", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["NetlistSweep", "netlist_summary", "top_sweep", "sweep_of", "sweep_datapaths", "has_sweep_driver", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

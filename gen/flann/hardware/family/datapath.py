@@ -91,9 +91,9 @@ FIELDS = (
 DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="one design for a family of sensors, weights in a memory",
     generate=generate, rebuild=rebuild, twin=FlannFamilyTop, estimate=estimate, fields=FIELDS,
-    why_no_explore="flann explore sizes one sensor's design from its model; a family design is sized by "
-                   "its members (flann gen --family): explore one of them, e.g. DIR/init_model.json",
-    bench="family", stages="family_member", netlist="family", summary=summary, eval_spec=eval_spec,
+    lacks="flann explore sizes one sensor's design from its model; a family design is sized by "
+          "its members (flann gen --family): explore one of them, e.g. DIR/init_model.json",
+    summary=summary, eval_spec=eval_spec,
     number_format=FIXED.number_format,  # the fixed blocks, weights from a memory
 )
 

@@ -109,9 +109,8 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP,
     about="a sensor family with temperature: one family datapath per temperature order, weights in memories",
     generate=generate, rebuild=rebuild, twin=FlannFamilyThermalTop, estimate=estimate, fields=FIELDS,
-    bench="family_thermal", netlist="family_thermal", summary=summary, eval_spec=eval_spec,
-    stages="family_thermal",
-    why_no_explore="a family design is sized by its members (flann gen --family)",
+    summary=summary, eval_spec=eval_spec,
+    lacks="a family design is sized by its members (flann gen --family)",
 )
 
 __all__ = ["DATAPATH", "rebuild"]

@@ -41,17 +41,6 @@ def summary(man: dict) -> list[str]:
             f"  error bound {a['bound_total_lsb']:.3f} LSB; estimate {a['estimate']}"]
 
 
-def fuzz_options(rng) -> dict:
-    """The fixed datapath's own generator options, drawn at random (the generator fuzzer)."""
-    opts = {"lanes": int(rng.choice([1, 1, 2, 3])), "mult_style": str(rng.choice(["shiftadd", "lut"]))}
-    if opts["mult_style"] == "shiftadd":
-        opts["mult_digit_bits"] = int(rng.choice([1, 2, 4]))
-    if rng.random() < 0.5:
-        opts["output_bits"] = int(rng.choice([14, 16, 18, 20]))
-    opts["check_device"] = False  # verify every datapath, not only those that fit a part
-    return opts
-
-
 FIELDS = (
     _num("output_lsb_mm", 0), Field("model_sha256", (str,)),
     _int("adc_bits", 2), _num("adc_lsb_v", 0), Field("clamp_codes", (list,)),
@@ -65,8 +54,7 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP, about="fixed point, widths from the error budget",
     generate=generate, rebuild=rebuild, twin=FlannTop, estimate=estimate, fields=FIELDS,
     derive_options=lambda options, compared=False: options.to_kwargs(),
-    bench="sweep", stages="fixed_point", explore="fixed_space", netlist="fixed", summary=summary, eval_spec=eval_spec,
-    derive=derive_spec, number_format=render.DATAPATH, fuzz_share=0.8, fuzz_options=fuzz_options,
+    summary=summary, eval_spec=eval_spec, derive=derive_spec, number_format=render.DATAPATH,
 )
 
 __all__ = ["DATAPATH"]

@@ -105,10 +105,9 @@ DATAPATH = Datapath(
     generate=generate, rebuild=rebuild, twin=FlannF18Top, estimate=estimate, fields=FIELDS,
     # compared with the fixed design, fixed-only options are meant for that one
     derive_options=lambda options, compared=False: float18_options(options, fixed_too=compared),
-    bench="f18_top", stages="float18_terms", netlist="float18", explore="float18_widths", summary=summary, derive=derive_f18_spec,
-    number_format=render.DATAPATH, stage_capture=True, fuzz_share=0.2,
-    why_no_eval="flann eval --design compares a fixed-point output LSB with the ADC's physical limit; "
-                "a float18 design has no output LSB: see its accuracy with flann sim DIR or flann trace DIR",
+    summary=summary, derive=derive_f18_spec, number_format=render.DATAPATH,
+    lacks="flann eval --design compares a fixed-point output LSB with the ADC's physical limit; "
+          "a float18 design has no output LSB: see its accuracy with flann sim DIR or flann trace DIR",
 )
 
 __all__ = ["DATAPATH"]

@@ -8,7 +8,7 @@ from . import render
 from .spec import ENTITY
 from .twin import FlannSeedTop
 
-WHY = "the seed architecture is a comparison design that flann explore measures; it has no {}"
+WHY = "the seed architecture is a comparison design that flann explore measures"
 
 
 def generate(model, out_dir, options=None) -> dict:
@@ -16,7 +16,7 @@ def generate(model, out_dir, options=None) -> dict:
 
 
 def rebuild(model, man: dict, where="design"):
-    raise FlannError(f"{where}: " + WHY.format("twin rebuilt from a directory"))
+    raise FlannError(f"{where}: {WHY}; it has no twin rebuilt from a directory")
 
 
 def estimate(man: dict) -> dict | None:
@@ -27,9 +27,7 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=ENTITY, about="the seed paper's parallel architecture (comparison only)",
     generate=generate, rebuild=rebuild, twin=FlannSeedTop, estimate=estimate,
     fields=(_num("output_lsb_mm", 0), _int("spec.terms")), model_field="",
-    why_no_bench=WHY.format("simulation bench"), why_no_eval=WHY.format("twin rebuilt from a directory"),
-    why_no_explore=WHY.format("model kept in its directory"), why_no_stages=WHY.format("stage model for flann trace"),
-    why_no_ise=WHY.format("ISE handoff (its parallel multipliers exceed every Spartan-II)"),
+    lacks=f"{WHY} (its parallel multipliers exceed every Spartan-II)", ise=False,
 )
 
 __all__ = ["DATAPATH"]

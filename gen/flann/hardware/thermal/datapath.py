@@ -41,10 +41,8 @@ DATAPATH = Datapath(
     name=render.DATAPATH, top=render.TOP,
     about="two inputs (voltage, temperature): one fixed datapath per temperature order",
     generate=render.generate, rebuild=render.rebuild, twin=FlannThermalTop, estimate=estimate, fields=FIELDS,
-    bench="thermal_sweep", netlist="thermal", summary=summary, number_format=FIXED.number_format,
-    stages="thermal",
-    eval_spec=eval_spec,
-    why_no_explore="flann explore explores one-input models; a thermal design keeps a two-input model",
+    summary=summary, number_format=FIXED.number_format, eval_spec=eval_spec,
+    lacks="flann explore explores one-input models; a thermal design keeps a two-input model",
 )
 
 __all__ = ["DATAPATH"]
