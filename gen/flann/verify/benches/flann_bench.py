@@ -132,11 +132,13 @@ class TopDriver:
 
 
 class TopMonitor:
-    """One record per out_valid pulse: (data, sat, cycle)."""
+    """One record per out_valid pulse: (data, sat, cycle); ``signed``: out_data as a two's
+    complement number (a fixed-point output), else as its bits (a float18 code)."""
 
-    def __init__(self, dut, on_output):
+    def __init__(self, dut, on_output, signed: bool = True):
         self.dut = dut
         self.on_output = on_output
+        self.signed = signed
         self.count = 0
         self.event = Event()
         self._task = cocotb.start_soon(self._run())
@@ -146,7 +148,9 @@ class TopMonitor:
         while True:
             await RisingEdge(dut.out_valid)  # out_data/out_sat change in the same delta
             self.count += 1
-            self.on_output(dut.out_data.value.to_signed(), int(dut.out_sat.value), cycle_now())
+            data = dut.out_data.value
+            self.on_output(data.to_signed() if self.signed else data.to_unsigned(), int(dut.out_sat.value),
+                           cycle_now())
             self.event.set()
 
     def stop(self) -> None:
@@ -189,24 +193,32 @@ class Scoreboard:
 
 
 class TopBench:
-    """flann_top + twin + driver/monitor/scoreboard."""
+    """A top (flann_top, flann_f18_top, flann_family_top) + its twin (the model) + driver /
+    monitor / scoreboard: the one bench shape of every top.  ``twin``: anything with
+    ``process(codes) -> (out, sat)`` and ``latency``; default: flann_top's, rebuilt from the
+    configuration's model and options."""
 
-    def __init__(self, dut, cfg: dict | None = None):
+    def __init__(self, dut, twin=None, cfg: dict | None = None, signed: bool = True):
         self.dut = dut
         self.cfg = cfg or config()
-        self.spec = load_spec(self.cfg)
-        self.twin = FlannTop(self.spec)
+        self.spec = load_spec(self.cfg) if twin is None else None
+        self.twin = FlannTop(self.spec) if twin is None else twin
         self.log = dut._log
         self.rng = rng(self.cfg, self.log)
         self.sb = Scoreboard(self.log)
         self.driver = TopDriver(dut, self._accepted)
         self.monitor: TopMonitor | None = None
+        self.signed = signed
         self._exp_cache: dict[int, tuple[int, int]] = {}
 
     def expectation(self, codes) -> None:
         codes = np.asarray(list(codes), dtype=np.int64)
         out, sat = self.twin.process(codes)
         self._exp_cache.update({int(c): (int(o), int(s)) for c, o, s in zip(codes, out, sat)})
+
+    def forget(self) -> None:
+        """The twin changed (a weight written): expectations are computed again."""
+        self._exp_cache.clear()
 
     def _accepted(self, code: int, cycle: int) -> None:
         if code not in self._exp_cache:
@@ -218,10 +230,11 @@ class TopBench:
         if not self.cfg.get("harness"):  # the harness makes its clock in VHDL
             await start_clock(self.dut)
         await reset(self.dut)
-        self.monitor = TopMonitor(self.dut, self.sb.got)
+        self.monitor = TopMonitor(self.dut, self.sb.got, self.signed)
 
     async def run_codes(self, codes, gap=None) -> None:
         """Send codes; with ``gap`` None wait for each result (fast exhaustive path)."""
+        codes = [int(c) for c in codes]
         self.expectation(codes)
         for code in codes:
             if gap is not None:
@@ -236,9 +249,22 @@ class TopBench:
                 await FallingEdge(self.dut.clk)
 
     async def drain(self) -> None:
-        budget = self.spec.latency_cycles + 4
+        budget = self.twin.latency + 4
         for _ in range(len(self.sb.expected) + 1):
             if not self.sb.expected:
                 break
             await ClockCycles(self.dut.clk, budget)
         await ClockCycles(self.dut.clk, 2)
+
+
+class TableTwin:
+    """A twin given as its outputs at listed codes (computed by the runner, passed in the bench
+    configuration): ``process`` looks them up."""
+
+    def __init__(self, codes, out, sat, latency: int):
+        self.table = {int(c): (int(o), int(s)) for c, o, s in zip(codes, out, sat)}
+        self.latency = latency
+
+    def process(self, codes):
+        got = [self.table[int(c)] for c in codes]
+        return [o for o, _ in got], [s for _, s in got]

@@ -1,4 +1,5 @@
-"""cocotb: flann_f18_top against its twin FlannF18Top over a list of input codes (bit-exact).
+"""cocotb: flann_f18_top against its twin FlannF18Top over a list of input codes (bit-exact),
+through the one top bench (:class:`~flann.verify.benches.flann_bench.TopBench`).
 
 The expected outputs come from the twin, computed by the runner and passed in the bench
 configuration (flann.verify.benches.config; GHDL's VPI cannot read generics):
@@ -12,92 +13,49 @@ converted term (term_f at term_valid), product (prod_f at prod_valid) and runnin
 """
 
 import json
-import random
 
 import cocotb
-from cocotb.clock import Clock
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ReadOnly, RisingEdge
 
-from flann.verify.benches import CLK_NS, config
+from flann.verify.benches import config
+from flann.verify.benches.flann_bench import TableTwin, TopBench
 
 
-class TopBench:
-    def __init__(self, dut):
-        self.dut = dut
-        self.spec = config()
-        self.rng = random.Random(self.spec["seed"])
-        dut._log.info(f"seed {self.spec['seed']}, {len(self.spec['codes'])} codes")
-        self.mask = (1 << self.spec["in_bits"]) - 1
-        self.errors = []
-        self.latencies = set()
-        self.record = []                     # (code, out_data, out_sat) as the HDL gave them
-        self.stage_codes = set(self.spec.get("stage_codes", []))
-        self.stages = {}                     # code -> {"terms": [...], "products": [...], "sums": [...]}
-
-    async def reset(self):
-        cocotb.start_soon(Clock(self.dut.clk, CLK_NS, unit="ns", impl="gpi").start())
-        self.dut.in_valid.value = 0
-        self.dut.in_data.value = 0
-        self.dut.rst.value = 1
-        for _ in range(3):
-            await RisingEdge(self.dut.clk)
-        await FallingEdge(self.dut.clk)
-        self.dut.rst.value = 0
-
-    async def capture(self, valid, data, out: list):
-        """Monitor one internal stage: the data of every valid pulse, in order."""
-        while True:
-            await RisingEdge(valid)
-            await ReadOnly()
-            out.append(data.value.to_unsigned())
-
-    async def one(self, code, want_out, want_sat):
-        """Driver + monitor for one sample: wait for in_ready, present, wait for out_valid."""
-        while str(self.dut.in_ready.value) != "1":
-            await FallingEdge(self.dut.clk)
-        monitors = []
-        if code in self.stage_codes:
-            st = self.stages[code] = {"terms": [], "products": [], "sums": []}
-            d = self.dut
-            monitors = [cocotb.start_soon(self.capture(d.term_valid, d.term_f, st["terms"])),
-                        cocotb.start_soon(self.capture(d.prod_valid, d.prod_f, st["products"])),
-                        cocotb.start_soon(self.capture(d.sum_valid, d.sum_f, st["sums"]))]
-        self.dut.in_data.value = code & self.mask
-        self.dut.in_valid.value = 1
-        await RisingEdge(self.dut.clk)            # the accepting edge
-        t0 = cocotb.utils.get_sim_time(unit="ns")
-        await FallingEdge(self.dut.clk)
-        self.dut.in_valid.value = 0
-        await RisingEdge(self.dut.out_valid)
+async def capture(valid, data, out: list):
+    """Monitor one internal stage: the data of every valid pulse, in order."""
+    while True:
+        await RisingEdge(valid)
         await ReadOnly()
-        self.latencies.add(round((cocotb.utils.get_sim_time(unit="ns") - t0) / 10))
-        got = self.dut.out_data.value.to_unsigned()
-        sat = str(self.dut.out_sat.value) == "1"
-        self.record.append((code, got, sat))
-        for m in monitors:
-            m.cancel()
-        if got != want_out or sat != want_sat:
-            self.errors.append(f"code {code}: out {got:#07x} sat {sat}, twin {want_out:#07x} sat {want_sat}")
-        await FallingEdge(self.dut.clk)
+        out.append(data.value.to_unsigned())
 
 
 @cocotb.test()
 async def every_code(dut):
-    tb = TopBench(dut)
-    await tb.reset()
-    s = tb.spec
-    order = list(range(len(s["codes"])))
-    tb.rng.shuffle(order)                # independent of the previous sample's state
-    for k in order:
-        await tb.one(s["codes"][k], s["out"][k], s["sat"][k])
-    if s.get("records"):
+    cfg = config()
+    bench = TopBench(dut, TableTwin(cfg["codes"], cfg["out"], cfg["sat"], cfg["latency"]), cfg, signed=False)
+    dut._log.info(f"seed {cfg['seed']}, {len(cfg['codes'])} codes")
+    await bench.start()
+    order = list(cfg["codes"])
+    bench.rng.shuffle(order)                # independent of the previous sample's state
+    stage_codes, stages = set(cfg.get("stage_codes", [])), {}
+    for code in order:
+        monitors = []
+        if code in stage_codes:
+            st = stages[code] = {"terms": [], "products": [], "sums": []}
+            monitors = [cocotb.start_soon(capture(dut.term_valid, dut.term_f, st["terms"])),
+                        cocotb.start_soon(capture(dut.prod_valid, dut.prod_f, st["products"])),
+                        cocotb.start_soon(capture(dut.sum_valid, dut.sum_f, st["sums"]))]
+        await bench.run_codes([code])
+        for m in monitors:
+            m.cancel()
+    sb = bench.sb
+    latencies = sorted(set(sb.latencies))
+    if cfg.get("records"):
         # the HDL's own outputs, for `flann trace --hdl` and the runner's summary
-        with open(s["records"], "w") as fh:
-            json.dump({"codes": [r[0] for r in tb.record], "out": [r[1] for r in tb.record],
-                       "sat": [r[2] for r in tb.record], "latency": sorted(tb.latencies),
-                       "stages": {str(c): v for c, v in tb.stages.items()}}, fh)
-    for e in tb.errors[:20]:
-        dut._log.error(e)
-    dut._log.info(f"{len(order) - len(tb.errors)} of {len(order)} codes bit-exact; latency {sorted(tb.latencies)}")
-    assert not tb.errors, f"{len(tb.errors)} mismatches vs the twin"
-    assert tb.latencies == {s["latency"]}, f"latency {sorted(tb.latencies)}, spec says {s['latency']}"
+        with open(cfg["records"], "w") as fh:
+            json.dump({"codes": [r[0] for r in sb.records], "out": [r[1] for r in sb.records],
+                       "sat": [r[2] for r in sb.records], "latency": latencies,
+                       "stages": {str(c): v for c, v in stages.items()}}, fh)
+    dut._log.info(f"{sb.checked - sb.mismatches} of {len(order)} codes bit-exact; latency {latencies}")
+    assert sb.ok and sb.checked == len(order), f"{sb.mismatches} mismatches vs the twin"
+    assert latencies == [cfg["latency"]], f"latency {latencies}, spec says {cfg['latency']}"

@@ -13,37 +13,21 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
 from flann.hardware.family.render import load_design
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.family.images import parse_hex
-from flann.verify.benches.flann_bench import Scoreboard, TopDriver, TopMonitor, config, reset, rng, start_clock, write_record
+from flann.verify.benches.flann_bench import TopBench, config, reset, write_record
 
 
-class FamilyBench:
-    """flann_family_top + the family twin (fed with what was written) + driver/monitor/scoreboard."""
+class FamilyBench(TopBench):
+    """flann_family_top through the one top bench, its twin fed with what is written through
+    the cfg port."""
 
     def __init__(self, dut):
-        self.dut = dut
-        self.cfg = config()
-        self.fam = load_design(self.cfg["design"])
-        self.twin = FlannFamilyTop(self.fam)  # memory as initialised by the design
-        self.images = [(im["name"], parse_hex(open(im["hex"]).read(), im["hex"])) for im in self.cfg["images"]]
-        self.rng = rng(self.cfg, dut._log)
-        self.sb = Scoreboard(dut._log)
-        self.driver = TopDriver(dut, self._accepted)
-        self.monitor = None
-        self._cache = {}
+        cfg = config()
+        self.fam = load_design(cfg["design"])
+        super().__init__(dut, FlannFamilyTop(self.fam), cfg)   # memory as initialised by the design
+        self.images = [(im["name"], parse_hex(open(im["hex"]).read(), im["hex"])) for im in cfg["images"]]
         dut.cfg_we.value = 0
         dut.cfg_addr.value = 0
         dut.cfg_data.value = 0
-
-    def _accepted(self, code: int, cycle: int) -> None:
-        if code not in self._cache:
-            out, sat = self.twin.process([code])
-            self._cache[code] = (int(out[0]), int(sat[0]))
-        self.sb.expect(code, *self._cache[code], cycle)
-
-    async def start(self) -> None:
-        await start_clock(self.dut)
-        await reset(self.dut)
-        self.monitor = TopMonitor(self.dut, self.sb.got)
 
     async def write(self, addr: int, data: int) -> None:
         """One cfg_we cycle (inputs change away from the rising edge)."""
@@ -53,22 +37,12 @@ class FamilyBench:
         await FallingEdge(self.dut.clk)
         self.dut.cfg_we.value = 0
         self.twin.write(addr, data)
-        self._cache.clear()
+        self.forget()
 
     async def load(self, words) -> None:
         await FallingEdge(self.dut.clk)
         for a, w in enumerate(words):
             await self.write(a, w)
-
-    async def run_codes(self, codes) -> None:
-        codes = [int(c) for c in codes]
-        out, sat = self.twin.process(codes)
-        self._cache.update({c: (int(o), int(s)) for c, o, s in zip(codes, out, sat)})
-        for c in codes:
-            self.monitor.event.clear()
-            await self.driver.send(c)
-            await self.monitor.event.wait()
-            await FallingEdge(self.dut.clk)
 
     def codes(self) -> list[int]:
         s = self.fam.spec
