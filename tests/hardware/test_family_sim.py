@@ -14,7 +14,7 @@ from flann.production.calibrate import check_sensor
 from flann.production.demo import write_batch
 from flann.hardware.family.images import hex_text
 from flann.recordings import read_recordings
-from flann.verify import runner
+from flann.hardware.family.verify import run_family_bench
 
 pytestmark = [pytest.mark.sim,
               pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
@@ -31,7 +31,7 @@ def test_two_sensors_through_cfg_port(tmp_path):
         h = tmp_path / f"{p.stem}.hex"
         h.write_text(hex_text(chk["words"]))
         images.append({"name": p.stem, "hex": str(h)})
-    res = runner.run_family_bench(hdl, images, tmp_path / "build")
+    res = run_family_bench(hdl, images, tmp_path / "build")
     assert res.tests == 4 and res.ok, f"failed: {res.failed_tests} (log {tmp_path / 'build' / 'family' / 'sim.log'})"
     rec = res.records["family_every_code"]
     assert len(rec["codes"]) == 2 ** 8 and rec["mismatches"] == 0
@@ -51,7 +51,7 @@ def test_two_identical_sensors_verify(tmp_path):
     for name in ("a", "b"):
         (tmp_path / f"{name}.hex").write_text(words)
         images.append({"name": name, "hex": str(tmp_path / f"{name}.hex")})
-    res = runner.run_family_bench(hdl, images, tmp_path / "build")
+    res = run_family_bench(hdl, images, tmp_path / "build")
     assert res.tests == 4 and res.ok, f"failed: {res.failed_tests}"
     assert res.records["family_every_code"]["mismatches"] == 0
 

@@ -15,7 +15,8 @@ import pytest
 from flann.cli import main
 from flann.golden.model import FlannModel
 from flann.hardware.design import from_directory, from_model
-from flann.verify.runner import run_bench, sweep
+from flann.hardware.fixed.verify import run_bench
+from flann.verify.runner import sweep
 
 pytestmark = pytest.mark.sim
 

@@ -6,8 +6,7 @@ configuration travels as one JSON file named in ``FLANN_BENCH_CONFIG``; pass/fai
 cocotb's results file.  ``sweep`` is the exhaustive check: the VHDL harness ``flann_sweep.vhd``
 steps through every input code with stimulus and response in VHDL (no Python per sample),
 split into one shard per core, each judged against the twin by ``test_sweep.py``.
-``simulate`` is ``flann sim``: the sweep, the reactive benches (handshake gaps, reset mid
-sample, saturation) and the block benches, summarised.
+Each datapath's folder (``hardware/<name>/verify.py``) composes these into its bench.
 
 GHDL backend: LLVM (Debian ``ghdl-llvm``, about 2.6x faster than mcode on these designs) when
 installed, else mcode; the Debian ``ghdl`` wrapper picks it from ``GHDL_BACKEND``.
@@ -21,7 +20,6 @@ import logging
 import os
 import shutil
 import subprocess
-import sys
 import threading
 import time
 import xml.etree.ElementTree as ET
@@ -33,21 +31,9 @@ import numpy as np
 from ..errors import FlannError
 from ..hardware.target import CLOCK_HZ
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
-from . import plots
-from ..hardware.design import Design, as_design
-from .netlist import check_rtl_netlist
+from ..hardware.design import Design
 from .shards import count_lines, cores, merge, read_results, split
 
-# bench name -> (toplevel entity, cocotb module in flann.verify.benches, testcase filter)
-BENCHES = {
-    "sweep": ("flann_sweep", "test_sweep", None),  # every code, stimulus and response in VHDL
-    "top": ("flann_harness", "test_top", None),   # reactive: gaps, reset mid sample, saturation
-    "norm": ("flann_norm", "test_blocks", "norm_vs_twin"),
-    "expansion": ("flann_expansion", "test_blocks", "expansion_vs_twin"),
-    "multiplier": ("flann_multiplier", "test_blocks", "multiplier_vs_twin"),
-    "adder": ("flann_adder", "test_blocks", "adder_vs_twin"),
-}
-FAMILY_BENCH = "test_flann_family_top"  # flann gen --family designs (weights in memory)
 HARNESSES = {"flann_sweep": "flann_sweep.vhd", "flann_harness": "flann_harness.vhd"}
 BENCH_PACKAGE = "flann.verify.benches"
 
@@ -191,43 +177,15 @@ def _result(name: str, results, records: Path, seconds: float) -> BenchResult:
     return BenchResult(name, tests, failures, seconds, recs, failed, times)
 
 
-def _bench_config(design: Design) -> dict:
+def bench_config(design: Design) -> dict:
     return {"model": str(design.model), "options": design.options, "manifest": design.manifest}
 
 
-def _sources(design: Design, toplevel: str) -> list[Path]:
+def sources(design: Design, toplevel: str) -> list[Path]:
     files = list(design.files)
     if toplevel in HARNESSES:
         files.append(BENCH_DIR / HARNESSES[toplevel])
     return files
-
-
-def run_bench(design: Design, bench: str, build_dir, *, seed: int = 1, testcase: str | None = None,
-              extra: dict | None = None, backend: str | None = None) -> BenchResult:
-    """Run one bench (key of BENCHES, not the sweep) on ``design``; never raises on test failure."""
-    if bench not in BENCHES or bench == "sweep":
-        raise FlannError(f"bench {bench!r}: must be one of {', '.join(b for b in BENCHES if b != 'sweep')}")
-    toplevel, module, tc = BENCHES[bench]
-    man = design.manifest
-    params, plus = {}, []
-    if toplevel == "flann_harness":
-        params = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2}
-        # the harness's clock never stops: bound the run (a test still running is reported failed)
-        n = 3 * int((extra or {}).get("handshake_samples", 60)) + 80
-        plus.append(f"--stop-time={(n * man['cycles_per_sample'] * 3 + 10000) * CLK_NS}ns")
-    cfg = {**_bench_config(design), **(extra or {}), "harness": toplevel == "flann_harness"}
-    return run_cocotb(_sources(design, toplevel), toplevel, module, Path(build_dir) / bench, cfg, name=bench,
-                      parameters=params, plusargs=plus, testcase=testcase or tc, seed=seed, backend=backend)
-
-
-def run_family_bench(design, images: list[dict], build_dir, *, seed: int = 1,
-                     backend: str | None = None) -> BenchResult:
-    """The family ``design`` (or the directory it names) with sensors' weight images ({name, hex}) loaded
-    through its cfg_* port, each over every input code against that sensor's twin."""
-    design = as_design(design)
-    cfg = {"design": str(design.directory), "images": images}
-    return run_cocotb(design.files, design.top, FAMILY_BENCH, Path(build_dir) / "family", cfg, name="family",
-                      seed=seed, backend=backend)
 
 
 def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
@@ -256,7 +214,7 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
     records = build_dir / "records"
     t0 = time.monotonic()
     backend = backend or backend_for(total * man["cycles_per_sample"])
-    backend = build(_sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
+    backend = build(sources(design, "flann_sweep"), "flann_sweep", build_dir, backend)
     t_build = time.monotonic() - t0
     shard_cfg = []
     if listed:
@@ -269,7 +227,7 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
     for k, s in enumerate(shard_cfg):  # one configuration file per shard (the bench's only channel)
         s.update(name=f"sweep_{k}", file=str(build_dir / f"sweep_{k}.txt"))
         (build_dir / f"bench_config_{k}.json").write_text(
-            json.dumps({**_bench_config(design), "records_dir": str(records), "shard": s}))
+            json.dumps({**bench_config(design), "records_dir": str(records), "shard": s}))
     def params(s: dict) -> dict:
         p = {"in_bits_g": man["input_bits"], "out_bits_g": man["output_bits"], "half_ns_g": CLK_NS // 2,
              "code_lo_g": s.get("lo", 0), "code_hi_g": s.get("hi", -1), "out_file_g": s["file"]}
@@ -375,38 +333,6 @@ def choose_engine(design: Design, engine: str = "auto", samples: int | None = No
     return "verilator" if cycles > GHDL_CYCLES_PER_MINUTE and shutil.which("verilator") else "ghdl"
 
 
-def _every_code(design: Design, build_dir: Path, engine: str, progress) -> tuple[dict, dict]:
-    """Every input code: (the VHDL sweep's result, the outputs of every code with a description).
-
-    engine "ghdl": the VHDL itself under GHDL, every code.  engine "verilator": every code through
-    GHDL's synthesis of the VHDL compiled by Verilator (the netlist Yosys maps), and the VHDL
-    under GHDL on a sample (random windows, the clamp edges, both ends of the range), so the
-    compiled netlist is tied to the VHDL's own simulation on every run.
-    """
-    man = design.manifest
-    engine = choose_engine(design, engine)
-    if engine == "ghdl":
-        sw = sweep(design, build_dir, progress=progress("sweep") if progress else None)
-        about = {"engine": "ghdl", "backend": f"ghdl-{sw['backend']}", "shards": sw["shards"],
-                 "seconds": round(sw["seconds"], 1), "build_seconds": round(sw["build_seconds"], 1),
-                 "codes_per_s": round(sw["codes"].size / sw["seconds"], 1) if sw["seconds"] else None}
-        return sw, {**{k: sw[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
-    nl = check_rtl_netlist(design, build_dir / "rtl_netlist", progress=progress("sweep") if progress else None)
-    lo, hi = int(nl["codes"].min()), int(nl["codes"].max())
-    rng = np.random.default_rng(int(man["model_sha256"][:8], 16) if man.get("model_sha256") else 1)
-    c_lo, c_hi = man["clamp_codes"]
-    sample = {lo, lo + 1, hi - 1, hi, -1, 0, 1}
-    sample |= {c + d for c in (c_lo, c_hi) for d in range(-3, 4)}
-    sample |= {int(c) for c in rng.integers(lo, hi + 1, 200)}
-    sw = sweep(design, build_dir, codes=sorted(c for c in sample if lo <= c <= hi))
-    about = {"engine": "verilator", "netlist": "ghdl --synth --out=verilog (repaired), Verilator",
-             "shards": nl["shards"], "seconds": round(nl["seconds"], 1), "build_seconds": round(nl["build_seconds"], 1),
-             "codes_per_s": round(nl["codes"].size / nl["seconds"], 1) if nl["seconds"] else None,
-             "vhdl_sample": {"codes": int(sw["codes"].size), "backend": f"ghdl-{sw['backend']}",
-                             "bench_ok": sw["bench"].ok}}
-    return sw, {**{k: nl[k] for k in ("codes", "data", "sat", "latency")}, "about": about}
-
-
 def throughput(cycles_per_sample: int, clock_hz: float = CLOCK_HZ) -> dict:
     """Samples per second at the design's clock; ``samples_per_s_at_50mhz`` is the older
     name of the same figure (scripts read it), kept as an alias."""
@@ -422,49 +348,5 @@ def simulator_name(about: dict) -> str:
     return f"GHDL, {backend}" if backend else "GHDL"
 
 
-def simulate(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), engine: str = "auto",
-             progress=None) -> dict:
-    """Verify ``design`` (flann sim): every input code (engine ghdl: the VHDL under GHDL; verilator:
-    GHDL's synthesised netlist compiled, plus the VHDL on a sample), the other benches;
-    returns {"summary", "curve", "spec"} (summary =
-    `flann sim --json`)."""
-    build_dir = Path(build_dir)
-    spec, man = design.spec, design.manifest
-    results, summary = [], {
-        "codes_tested": 0, "mismatches": None, "max_err_lsb": None, "max_err_mm": None,
-        "cycles_per_sample": man["cycles_per_sample"], **throughput(man["cycles_per_sample"]),
-    }
-    curve = None
-    for b in benches:
-        if b == "sweep":
-            sw, every = _every_code(design, build_dir, engine, progress)
-            results.append(sw["bench"])
-            codes, data, sat = every["codes"], every["data"], every["sat"]
-            if codes.size:
-                twin_out, twin_sat = design.twin().process(codes)
-                ref = spec.float_reference(codes) / spec.output_lsb_mm
-                err = np.abs(data - ref)
-                bad = (data != twin_out) | (sat != twin_sat) | (every["latency"] != man["latency_cycles"])
-                summary.update(codes_tested=int(codes.size), mismatches=int(np.count_nonzero(bad)),
-                               max_err_lsb=round(float(err.max()), 4),
-                               max_err_mm=round(float(err.max()) * spec.output_lsb_mm, 6))
-                curve = plots.curve([{"title": None, "series": [plots.series("", codes, data, ref)]}],
-                                    ref=plots.GOLDEN, simulator=simulator_name(every["about"]),
-                                    bound={"value": 1.0, "label": "±1 output LSB"})
-            summary["sweep"] = every["about"]
-        else:
-            if progress and sys.stderr.isatty():
-                print(f"simulating {b} ...", file=sys.stderr, flush=True)
-            results.append(run_bench(design, b, build_dir, seed=seed))
-    summary["benches"] = {r.bench: {"tests": r.tests, "failures": r.failures, "failed": r.failed_tests,
-                                    "seconds": round(r.seconds, 1)} for r in results}
-    summary["all_passed"] = all(r.ok for r in results)
-    summary["latency_cycles"] = man["latency_cycles"]
-    summary["output_lsb_mm"] = man["output_lsb_mm"]
-    summary["model_sha256"] = man["model_sha256"]
-    summary["design"] = str(design.directory)
-    return {"summary": summary, "curve": curve, "spec": spec}
-
-
-__all__ = ["throughput", "simulator_name", "choose_engine", "run_bench", "run_family_bench", "run_cocotb", "sweep", "sweep_temperatures", "backend_for", "simulate", "BenchResult", "BENCHES", "sim_dir",
+__all__ = ["throughput", "simulator_name", "choose_engine", "run_cocotb", "bench_config", "sources", "HARNESSES", "sweep", "sweep_temperatures", "backend_for", "BenchResult", "sim_dir",
            "ghdl_backend"]

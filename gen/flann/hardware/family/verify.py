@@ -4,6 +4,8 @@ compares every code with the twin; the sweep of its mapped netlist with an image
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from ...errors import FlannError
@@ -12,10 +14,23 @@ from ...verify.images import checked_images, image_model, kept_images, loaded_im
 from ...verify.netlist import top_sweep
 from ...verify.plugin import Verification
 from ...verify.results import SimResult, summary
-from ...verify.runner import run_family_bench
-from ..design import Design
+from ...verify.runner import BenchResult, run_cocotb
+from ..design import Design, as_design
 from .spec import member_spec
 from .twin import FlannFamilyTop
+
+
+FAMILY_BENCH = "test_flann_family_top"  # flann gen --family designs (weights in memory)
+
+
+def run_family_bench(design, images: list[dict], build_dir, *, seed: int = 1,
+                     backend: str | None = None) -> BenchResult:
+    """The family ``design`` (or the directory it names) with sensors' weight images ({name, hex}) loaded
+    through its cfg_* port, each over every input code against that sensor's twin."""
+    design = as_design(design)
+    cfg = {"design": str(design.directory), "images": images}
+    return run_cocotb(design.files, design.top, FAMILY_BENCH, Path(build_dir) / "family", cfg, name="family",
+                      seed=seed, backend=backend)
 
 
 def _two_images(design: Design, loaded: list, given: bool) -> list:
@@ -86,4 +101,4 @@ def netlist(design: Design, image=None):
 
 VERIFICATION = Verification(bench=bench, netlist=netlist, loads_images=True)
 
-__all__ = ["VERIFICATION", "bench", "netlist"]
+__all__ = ["VERIFICATION", "bench", "netlist", "run_family_bench"]
