@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from ..errors import RecordingsError
 from ..recordings.checks import MIN_REPEAT_PAIRS, repeat_noise_v
@@ -84,6 +83,7 @@ class Smoother:
         if self.kind == "poly":
             return np.polynomial.chebyshev.chebvander(t, int(self.param))
         knots = _knots(self.segments)
+        from scipy.interpolate import BSpline  # slow to import: only where fitted
         return BSpline.design_matrix(t, knots, 3).toarray()
 
     def penalty(self) -> np.ndarray | None:

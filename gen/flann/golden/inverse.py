@@ -26,7 +26,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .forward import aggregate, strictly_monotone
 from .model import FlannModel
@@ -70,6 +69,7 @@ class Forward:
         p = self.positions if positions is None else positions
         m = self.mean_v if mean_v is None else mean_v
         t = self.trend if positions is None else trend
+        from scipy.interpolate import CubicSpline, PchipInterpolator  # slow to import: only where fitted
         base = CubicSpline if self.kind == "cubic" else PchipInterpolator
         if t is None:
             return base(p, m)

@@ -43,8 +43,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.stats import f as f_distribution
 
 from .forward import aggregate, noise_floor_v, strictly_monotone
 
@@ -319,6 +317,7 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
             last[key] = _linear(nl, x, y, sw, linear, shape)
         return last[key]
 
+    from scipy.optimize import least_squares  # slow to import: only where fitted
     r = least_squares(lambda nl: solved(nl)[2], nl0, bounds=(lo, hi),
                       jac=lambda nl: _jacobian(shape, nl, x, sw, linear, *solved(nl)[:2]),
                       method="trf", max_nfev=300)
@@ -511,6 +510,7 @@ def _misfit_p(member: Units, d: _Scaled, floor: float) -> float | None:
     if d.n <= groups or dof <= 0:
         return None
     scatter = max(d.within / (d.n - groups), floor * floor * d.n / groups)
+    from scipy.stats import f as f_distribution  # slow to import: only where tested
     return float(f_distribution.sf(member.sse / dof / scatter, dof, d.n - groups))
 
 
