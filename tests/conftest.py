@@ -8,6 +8,7 @@ import json
 import os
 import pickle
 import shutil
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -99,6 +100,16 @@ def run_cli(argv) -> tuple:
         except SystemExit as exc:
             rc = exc.code
     return rc, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="session")
+def flann():
+    """flann in process, as the command line runs it: ``flann(*args)`` -> a
+    ``subprocess.CompletedProcess`` (returncode, stdout, stderr), without a new interpreter."""
+    def run(*args):
+        rc, out, err = run_cli(args)
+        return subprocess.CompletedProcess(["flann", *map(str, args)], rc, out, err)
+    return run
 
 
 @pytest.fixture

@@ -5,24 +5,17 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
 import sys
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from flann.implement.synth import lint_vhdl
 from flann.verify.runner import simulator_name, throughput
 
-FLANN = [sys.executable, "-m", "flann.cli"]
 REPO = Path(__file__).resolve().parents[2]
 BITS = "8"
-
-
-def flann(*args, cwd=None):
-    return subprocess.run([*FLANN, *map(str, args)], capture_output=True, text=True, cwd=cwd)
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +63,7 @@ REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
 @pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed", "thermal", "family_thermal"])
 @pytest.mark.parametrize("command", sorted(COMMANDS))
-def test_command_on_datapath(designs, datapath, command, small_sims):
+def test_command_on_datapath(designs, datapath, command, small_sims, flann):
     why = REFUSED.get((datapath, command))
     if command == "sim" and not why:
         # each design's one simulation of the run (tests/verify/test_sim_cli.py looks at its outputs)
@@ -95,7 +88,7 @@ def test_command_on_datapath(designs, datapath, command, small_sims):
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-def test_explore_float18_dir_explores_its_own_widths(designs):
+def test_explore_float18_dir_explores_its_own_widths(designs, flann):
     """A float18 design explores the float18 design (its term widths), not the fixed rows; the
     budget row is the design in the directory (its cycles and its trace's error)."""
     d = designs["dir"] / "float18"
@@ -114,7 +107,7 @@ def test_explore_float18_dir_explores_its_own_widths(designs):
         assert word in r.stderr
 
 
-def test_eval_family_thermal_design_by_temperature(designs):
+def test_eval_family_thermal_design_by_temperature(designs, flann):
     """eval --design of a family design with temperature: the hardware judged at held-out
     temperatures (10 and 65 degC, between and beside the calibration ones) like a thermal design,
     on the design's initial image, and within one output LSB of the float model at the same codes."""
@@ -138,7 +131,7 @@ def test_eval_family_thermal_design_by_temperature(designs):
     assert "one-input model" in r.stderr
 
 
-def test_ise_refuses_a_part_too_small(designs):
+def test_ise_refuses_a_part_too_small(designs, flann):
     r = flann("ise", designs["dir"] / "fixed", "--device", "xc2s15-vq100-5", "-o", designs["dir"] / "ise_small")
     one_line_refusal(r)
     assert "smallest Spartan-II that fits: xc2s" in r.stderr
@@ -152,7 +145,7 @@ def test_ise_refuses_a_part_too_small(designs):
     assert "written anyway (--force)" in said[0]
 
 
-def test_ise_refuses_a_part_the_synthesized_design_does_not_fit(designs):
+def test_ise_refuses_a_part_the_synthesized_design_does_not_fit(designs, flann):
     """A datapath with no estimate before synthesis (family_thermal): the timing check's netlist decides."""
     out = designs["dir"] / "ise_ft_small"
     r = flann("ise", designs["dir"] / "family_thermal", "--device", "xc2s15-vq100-5", "-o", out)
@@ -161,7 +154,7 @@ def test_ise_refuses_a_part_the_synthesized_design_does_not_fit(designs):
     assert not out.exists()
 
 
-def test_gen_says_it_replaces_a_design(designs, tmp_path):
+def test_gen_says_it_replaces_a_design(designs, tmp_path, flann):
     out = tmp_path / "d"
     assert flann("gen", designs["model"], "-o", out, "--input-bits", BITS).returncode == 0
     r = flann("gen", designs["model"], "-o", out, "--input-bits", BITS, "--format", "float18")
@@ -214,7 +207,7 @@ TAMPER_COMMANDS = {
 
 @pytest.mark.parametrize("command", sorted(TAMPER_COMMANDS))
 @pytest.mark.parametrize("datapath,edit,field", TAMPERED, ids=[f"{t[0]}-{t[2]}-{k}" for k, t in enumerate(TAMPERED)])
-def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field):
+def test_tampered_manifest(designs, tmp_path, command, datapath, edit, field, flann):
     d = tmp_path / datapath
     shutil.copytree(designs["dir"] / datapath, d)
     man = json.loads((d / "manifest.json").read_text())

@@ -8,7 +8,6 @@ import json
 import re
 import shutil
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -24,15 +23,10 @@ from flann.hardware.design import from_directory
 
 from test_thermal_twin import sensor_v
 
-FLANN = [sys.executable, "-m", "flann.cli"]
-
-
-def flann(*args):
-    return subprocess.run([*FLANN, *map(str, args)], capture_output=True, text=True)
 
 
 @pytest.fixture(scope="module")
-def design(tmp_path_factory):
+def design(tmp_path_factory, flann):
     d = tmp_path_factory.mktemp("thermal")
     x, t = np.tile(np.linspace(-10, 10, 41), 3), np.repeat([-20.0, 25.0, 80.0], 41)
     model = d / "m.json"
@@ -75,7 +69,7 @@ def test_vhdl_compiles_under_ghdl_93c(design, tmp_path):
     assert r.returncode == 0, r.stderr
 
 
-def test_regenerating_gives_identical_bytes(design, tmp_path):
+def test_regenerating_gives_identical_bytes(design, tmp_path, flann):
     r = flann("gen", design["model"], "-o", tmp_path / "again", "--input-bits", 8, "--temp-bits", 5,
               "--temp-lsb-c", 6)
     assert r.returncode == 0, r.stderr
@@ -112,7 +106,7 @@ def test_sweep_covers_every_temperature_code_or_a_stated_set_with_both_ends(desi
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path):
+def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path, flann):
     """An order whose weights are all far below an output LSB (order 2 here is about 3.5e-6 v_n):
     its fixed datapath once wrapped in the linear accumulator and lost the adder's rounding half,
     so the VHDL disagreed with the twin. Every voltage code at every temperature code."""
@@ -131,7 +125,7 @@ def test_an_order_of_near_zero_weights_agrees_with_its_twin(tmp_path):
 
 @pytest.mark.sim
 @pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")
-def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
+def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path, flann):
     """An ADC wider than the order datapaths (18 bits: their grid is 4 codes, the low bits go
     through the interpolation fraction): HDL and twin bit for bit over the codes around the top
     of the calibrated range (the steepest slope, and clamped codes beyond it), the stated temperature codes."""
@@ -147,7 +141,7 @@ def test_an_eighteen_bit_input_agrees_with_its_twin(design, tmp_path):
     assert out.summary["mismatches"] == 0 and out.summary["codes_tested"] == 201 * len(temps), out.summary
 
 
-def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path):
+def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path, flann):
     """flann eval --design of a two-input design: the twin at the recordings' codes, by temperature
     and the drift figure; the codes computed here (nearest code of each reading) give the same
     max error per temperature."""
@@ -183,7 +177,7 @@ def test_eval_design_gives_the_hardware_figures_per_temperature(design, tmp_path
     assert r.returncode == 2 and "generated from another model" in r.stderr and len(r.stderr.splitlines()) == 1
 
 
-def test_trace_design_splits_the_error_into_its_stages(design, tmp_path):
+def test_trace_design_splits_the_error_into_its_stages(design, tmp_path, flann):
     """flann trace DIR of a two-input design: the stages add up to the whole error, which is the
     twin against the float model at the same codes, and each stage stays within its bound from
     the spec's error analysis."""
@@ -212,7 +206,7 @@ def test_trace_design_splits_the_error_into_its_stages(design, tmp_path):
     (("--temp-bits", 5, "--temp-lsb-c", 1), "not the calibrated -20..80 degC"),
     (("--format", "float18"), "fixed point only"),
 ])
-def test_bad_options_are_one_line(design, tmp_path, args, word):
+def test_bad_options_are_one_line(design, tmp_path, args, word, flann):
     out = tmp_path / "bad"
     r = flann("gen", design["model"], "-o", out, "--input-bits", 8, *args)
     assert r.returncode == 2 and r.stderr.startswith("error: ") and len(r.stderr.splitlines()) == 1, r.stderr
