@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from flann.verify.design import from_model
-from flann.verify.netlist import check_netlist, check_rtl_netlist, compare
+from flann.verify.netlist import check_netlist, check_rtl_netlist, compare, sweep_of
 from flann.verify.runner import ghdl_backend, sweep
 from flann.verify.shards import cores, terminal_progress
 
@@ -60,11 +60,11 @@ def main() -> None:
         wall = time.monotonic() - t0
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         n = int(r["codes"].size)
-        res = compare(design, r) if args.codes is None else None
+        res = compare(sweep_of(design), r) if args.codes is None else None
         cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
         out = {
             "design": {"input_bits": args.input_bits, "cycles_per_sample": design.manifest["cycles_per_sample"]},
-            "codes": n, "mismatches_vs_twin": res["mismatches"] if res else None,
+            "codes": n, "mismatches_vs_twin": res.mismatches if res else None,
             "engine": how, "shards": r["shards"], "cores": cores(),
             "sim_wall_s": round(r["seconds"], 2), "codes_per_s": round(n / r["seconds"], 1),
             "build_s": round(r["build_seconds"], 2), "total_wall_s": round(wall, 2),
@@ -73,9 +73,9 @@ def main() -> None:
         }
         if args.netlist:
             nl = check_netlist(design, Path(tmp) / "netlist", progress=terminal_progress("netlist"))
-            out["netlist"] = {k: (round(v, 2) if isinstance(v, float) else v) for k, v in nl.items()
-                              if k in ("codes_tested", "mismatches", "seconds", "run_seconds", "simulator")}
-            out["netlist"]["codes_per_s"] = round(nl["codes_tested"] / nl["run_seconds"], 1)
+            out["netlist"] = {"codes_tested": nl.codes_tested, "mismatches": nl.mismatches,
+                              "seconds": round(nl.seconds, 2), "run_seconds": round(nl.run_seconds, 2),
+                              "simulator": nl.simulator, "codes_per_s": round(nl.codes_tested / nl.run_seconds, 1)}
     print(json.dumps(out, indent=2))
 
 

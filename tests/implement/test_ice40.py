@@ -81,7 +81,7 @@ def test_post_route_sees_a_wrong_design(small, tmp_path, capsys):
     design = from_model(other, tmp_path / "d7", {"input_bits": 8})
     res = check_post_route(design, out / "flann_top.asc", out / "flann_top.pcf", parse_ice40("ice40-hx1k-tq144"),
                            tmp_path / "pr")
-    assert res["codes_tested"] == 256 and res["mismatches"] > 0
+    assert res.codes_tested == 256 and res.mismatches > 0 and not res.passed
 
 
 @pytest.mark.synth

@@ -31,8 +31,8 @@ pytestmark = [pytest.mark.sim, pytest.mark.synth,
 def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
     design = from_model(small_model(11), tmp_path / "d", {"input_bits": 8})
     r = check_netlist(design, tmp_path / "nl")
-    assert r["codes_tested"] == 256 and r["mismatches"] == 0, r
-    assert Path(r["netlist"]).read_text().count("LUT") > 10  # the mapped cells, not RTL
+    assert r.codes_tested == 256 and r.mismatches == 0, r
+    assert Path(r.netlist).read_text().count("LUT") > 10  # the mapped cells, not RTL
     # GHDL's Verilog as GHDL prints it (no repair) disagrees with the twin: the check sees it
     work = tmp_path / "raw"
     ghdl_to_verilog(read_manifest(design.directory), work)
@@ -40,7 +40,7 @@ def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
                           "flann_top"], capture_output=True, text=True, check=True).stdout
     (work / "raw.v").write_text(complete_pmux_cases(raw)[0])
     bad = check_netlist(design, tmp_path / "nl_raw", netlist=work / "raw.v")
-    assert bad["codes_tested"] == 256 and bad["mismatches"] > 0
+    assert bad.codes_tested == 256 and bad.mismatches > 0
 
 
 def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, small_designs):
@@ -62,9 +62,9 @@ def test_family_netlist_computes_with_the_image_its_cfg_port_loaded(tmp_path, sm
         (tmp_path / name).mkdir()
         got = run_netlist(exe, loaded, tmp_path / name, shards=1)
         res = compare(loaded, got)
-        assert res["codes_tested"] == 256 and res["mismatches"] == 0, (name, res)
+        assert res.codes_tested == 256 and res.mismatches == 0, (name, res)
         if loaded is other:
-            assert compare(sweep, got)["mismatches"] > 0
+            assert compare(sweep, got).mismatches > 0
     # an image cut short would leave the memory's initial sensor in place: the driver refuses it
     (tmp_path / "short").mkdir()
     with pytest.raises(FlannError, match=f"{len(kept[0]) - 1} hex words read, the memory takes {len(kept[0])}"):
@@ -84,10 +84,10 @@ def test_two_input_netlist_follows_its_temperature_input(tmp_path, small_designs
     exe = compile_netlist(verilog, tmp_path / "verilator", sweep, cells=False)
     got = run_netlist(exe, sweep, tmp_path, shards=2)
     res = compare(sweep, got)
-    assert res["codes_tested"] == 256 * len(sweep.temps) == sweep.samples and res["mismatches"] == 0, res
+    assert res.codes_tested == 256 * len(sweep.temps) == sweep.samples and res.mismatches == 0, res
     assert sorted(set(got["temps"].tolist())) == list(sweep.temps)
     up = replace(sweep, process=lambda c, t: sweep.process(c, np.minimum(t + 1, spec.temp_code_max)))
-    assert compare(up, got)["mismatches"] > 0
+    assert compare(up, got).mismatches > 0
 
 
 def test_ctrl_c_ends_flann_sim_with_one_line(tmp_path, small_model):

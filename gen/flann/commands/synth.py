@@ -73,12 +73,11 @@ def _check_netlist(args, design: Design, netlist: Path) -> dict:
     if _progress(args):
         print("synth: simulating the mapped netlist over every input code (Verilator)", file=sys.stderr)
     res = check_synthesized(design, netlist)
-    if res["mismatches"]:
-        raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res['mismatches']} of "
-                         f"{res['codes_tested']} samples (first: {res['first_mismatches']}); not handing it on")
-    return {"netlist_check": {"codes": res["codes_tested"], "mismatches": res["mismatches"],
-                              "passed": not res["mismatches"], "simulator": res["simulator"],
-                              "temperature_codes": res["temperature_codes"]}}
+    if not res.passed:
+        raise FlannError(f"the mapped netlist of {args.directory} disagrees with its twin on {res.mismatches} of "
+                         f"{res.codes_tested} samples (first: {res.first_mismatches}); not handing it on")
+    return {"netlist_check": {"codes": res.codes_tested, "mismatches": res.mismatches, "passed": res.passed,
+                              "simulator": res.simulator, "temperature_codes": res.temperature_codes}}
 
 
 def post_route_check(design: Design, model):

@@ -182,7 +182,32 @@ def run_netlist(exe: Path, sweep: NetlistSweep, build: Path, shards: int = 2, pr
     return {**merge([read_results(f, sweep.temps is not None) for f in files]), "seconds": time.monotonic() - t0}
 
 
-def compare(sweep: NetlistSweep, got: dict) -> dict:
+@dataclass
+class NetlistCheck:
+    """A compiled netlist judged against the twin over its sweep: ``passed`` when every sample
+    ran and none differs (a missing sample counts as a mismatch)."""
+
+    codes_tested: int
+    mismatches: int
+    first_mismatches: list
+    temperature_codes: int | None = None
+    simulator: str = "verilator"
+    seconds: float = 0.0
+    run_seconds: float = 0.0
+    netlist: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.mismatches == 0 and self.codes_tested > 0
+
+    def summary(self) -> dict:
+        """What the command summaries report of it."""
+        return {"codes_tested": self.codes_tested, "mismatches": self.mismatches,
+                "first_mismatches": self.first_mismatches, "simulator": self.simulator,
+                "temperature_codes": self.temperature_codes, "seconds": round(self.seconds, 1)}
+
+
+def compare(sweep: NetlistSweep, got: dict) -> NetlistCheck:
     """Mismatches of the netlist's outputs against the twin (and missing samples)."""
     out, sat = sweep.expected(got)
     # the driver prints out_data as signed; a float18 code is a bit pattern
@@ -191,12 +216,12 @@ def compare(sweep: NetlistSweep, got: dict) -> dict:
     ran = np.column_stack([got["codes"]] + ([got["temps"]] if sweep.temps is not None else []))
     missing = sweep.samples - int(np.unique(ran, axis=0).shape[0])
     first = ran[bad][:5].tolist() if sweep.temps is not None else [int(c) for c in got["codes"][bad][:5]]
-    return {"codes_tested": int(got["codes"].size), "mismatches": int(np.count_nonzero(bad)) + missing,
-            "first_mismatches": first, "temperature_codes": None if sweep.temps is None else len(sweep.temps)}
+    return NetlistCheck(int(got["codes"].size), int(np.count_nonzero(bad)) + missing, first,
+                        None if sweep.temps is None else len(sweep.temps), run_seconds=got.get("seconds", 0.0))
 
 
 def check_netlist(design: Design, build, netlist: Path | None = None, progress=None, abc: str = "full",
-                  image: dict | None = None) -> dict:
+                  image: dict | None = None) -> NetlistCheck:
     """Every input code through the mapped netlist (synthesised here unless ``netlist`` is given)."""
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
@@ -206,10 +231,7 @@ def check_netlist(design: Design, build, netlist: Path | None = None, progress=N
         netlist = mapped_netlist(design, build / "synth", abc)
     exe = compile_netlist(netlist, build / "verilator", sweep)
     got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
-    res = compare(sweep, got)
-    res.update(simulator="verilator", seconds=time.monotonic() - t0, run_seconds=got["seconds"],
-               netlist=str(netlist))
-    return res
+    return dataclasses.replace(compare(sweep, got), seconds=time.monotonic() - t0, netlist=str(netlist))
 
 
 def netlist_summary(design: Design, build_dir, progress=None, image: dict | None = None) -> tuple[dict, bool]:
@@ -217,9 +239,9 @@ def netlist_summary(design: Design, build_dir, progress=None, image: dict | None
     passed (every code, no mismatch)."""
     nl = check_netlist(design, Path(build_dir) / "netlist", progress=progress("netlist") if progress else None,
                        image=image)
-    entry = {"codes_tested": nl["codes_tested"], "mismatches": nl["mismatches"], "simulator": nl["simulator"],
-             "temperature_codes": nl["temperature_codes"], "seconds": round(nl["seconds"], 1)}
-    return entry, nl["mismatches"] == 0 and nl["codes_tested"] > 0
+    entry = nl.summary()
+    del entry["first_mismatches"]
+    return entry, nl.passed
 
 
 def check_rtl_netlist(design: Design, build, progress=None, temps=None) -> dict:
@@ -261,11 +283,11 @@ def require_sweep_driver(datapath, directory, flag: str = "--post-route") -> Non
                          f"and twin for {sweep_datapaths()} designs only")
 
 
-def check_synthesized(design: Design, netlist: Path) -> dict:
+def check_synthesized(design: Design, netlist: Path) -> NetlistCheck:
     """``flann synth``'s check of the netlist it just counted (temporary build directory)."""
     with tempfile.TemporaryDirectory(prefix="flann-netlist-") as tmp:
         return check_netlist(design, tmp, netlist=netlist)
 
 
-__all__ = ["NetlistSweep", "netlist_summary", "top_sweep", "sweep_of", "sweep_datapaths", "has_sweep_driver", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
+__all__ = ["NetlistSweep", "NetlistCheck", "netlist_summary", "top_sweep", "sweep_of", "sweep_datapaths", "has_sweep_driver", "require_sweep_driver", "check_netlist", "check_rtl_netlist", "check_synthesized", "mapped_netlist", "compile_netlist", "run_netlist", "compare",
            "yosys_datdir"]

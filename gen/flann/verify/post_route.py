@@ -11,6 +11,7 @@ cells_sim.v``) and the same sweep driver as the Spartan-II netlist
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -20,7 +21,7 @@ from pathlib import Path
 from ..errors import FlannError
 from ..hardware.target import Ice40Part
 from ..hardware.design import Design
-from .netlist import compare, compile_netlist, run_netlist, sweep_of, yosys_datdir
+from .netlist import NetlistCheck, compare, compile_netlist, run_netlist, sweep_of, yosys_datdir
 from .shards import cores
 
 # cells_sim.v gives some cell inputs default values, which Verilator does not parse
@@ -65,9 +66,9 @@ def routed_verilog(asc: Path, pcf: Path, part: Ice40Part, top: str, out: Path) -
 
 
 def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, build, progress=None,
-                     image: dict | None = None) -> dict:
+                     image: dict | None = None) -> NetlistCheck:
     """Every input code through the routed design (a family design loaded with ``image``, else
-    its last kept one); returns {"codes_tested", "mismatches", ...}."""
+    its last kept one)."""
     build = Path(build).resolve()
     build.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
@@ -76,13 +77,8 @@ def check_post_route(design: Design, asc: Path, pcf: Path, part: Ice40Part, buil
     models = [yosys_datdir() / "ice40" / "cells_sim.v"]
     exe = compile_netlist(netlist, build / "verilator_post_route", sweep, models=models, defines=DEFINES)
     got = run_netlist(exe, sweep, build, shards=cores(), progress=progress)
-    res = compare(sweep, got)
-    res.update(simulator="icebox_vlog + Verilator (Yosys iCE40 cell models)", device=part.name,
-               seconds=round(time.monotonic() - t0, 1))
-    return res
-
-
-SUMMARY_KEYS = ("codes_tested", "mismatches", "first_mismatches", "simulator", "seconds")
+    return dataclasses.replace(compare(sweep, got), simulator="icebox_vlog + Verilator (Yosys iCE40 cell models)",
+                               seconds=time.monotonic() - t0, netlist=str(netlist))
 
 
 def checker(design: Design, refuse: bool = False, image: dict | None = None):
@@ -92,11 +88,13 @@ def checker(design: Design, refuse: bool = False, image: dict | None = None):
 
     def check(asc, pcf, part, work) -> dict:
         res = check_post_route(design, asc, pcf, part, Path(work) / "post_route", image=image)
-        if refuse and res["mismatches"]:
+        if refuse and not res.passed:
             raise FlannError(f"the routed design of {design.directory} on {part.name} disagrees with its twin on "
-                             f"{res['mismatches']} of {res['codes_tested']} samples (first: "
-                             f"{res['first_mismatches']}); no bitstream written")
-        return {k: res[k] for k in SUMMARY_KEYS}
+                             f"{res.mismatches} of {res.codes_tested} samples (first: "
+                             f"{res.first_mismatches}); no bitstream written")
+        summary = res.summary()
+        del summary["temperature_codes"]
+        return summary
 
     return check
 

@@ -108,8 +108,8 @@ def _thermal_netlist(design: Design, build_dir: Path, temps, every: bool, *, see
     ref, inside = _against_model(spec, c, t, out, nl["sat"])
     err = float(np.abs(out - ref)[inside].max()) * lsb if inside.any() else None
     benches = {"thermal_sweep": bench_entry(res)}
-    ok = res.ok and bool(rec) and not rec.get("mismatches") and judged["codes_tested"] > 0
-    s = summary(design, judged["codes_tested"], judged["mismatches"], err, benches, ok, lsb)
+    ok = res.ok and bool(rec) and not rec.get("mismatches") and judged.codes_tested > 0
+    s = summary(design, judged.codes_tested, judged.mismatches, err, benches, ok, lsb)
     s["sweep"] = {"engine": "verilator", "netlist": "ghdl --synth --out=verilog (repaired), Verilator",
                   "shards": nl["shards"], "seconds": round(nl["seconds"], 1),
                   "build_seconds": round(nl["build_seconds"], 1),
