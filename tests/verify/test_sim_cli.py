@@ -15,7 +15,7 @@ import pytest
 from flann.cli import main
 from flann.hardware.registry import DATAPATHS
 from flann.verify.plugin import bench_of, verification
-from flann.verify.results import SimResult, summary
+from flann.verify.results import SimResult, summary as bench_summary
 
 pytestmark = [pytest.mark.sim, pytest.mark.skipif(shutil.which("ghdl") is None, reason="ghdl not installed")]
 
@@ -82,7 +82,7 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
                 "seconds": 0.0}, False
 
     def bench(design, build_dir, **_):
-        return SimResult.from_summary(summary(design, 256, 0, None, {}, True), None, design.spec)
+        return SimResult.from_summary(bench_summary(design, 256, 0, None, {}, True), None, design.spec)
 
     monkeypatch.setattr(datapaths, "netlist_summary", sweep)
     monkeypatch.setattr(datapaths, "bench_of", lambda design: dataclasses.replace(bench_of(design), bench=bench))
@@ -149,7 +149,7 @@ def test_temporary_design_is_not_reported_as_a_path(designs, tmp_path, capsys, m
     from flann.commands import sim as sim_command
 
     def bench(design, build_dir, **_):
-        return SimResult.from_summary(summary(design, 256, 0, None, {}, True), None, design.spec)
+        return SimResult.from_summary(bench_summary(design, 256, 0, None, {}, True), None, design.spec)
 
     monkeypatch.setattr(sim_command, "simulate", bench)
     model = str(designs["model"])
