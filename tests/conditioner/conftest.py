@@ -18,9 +18,11 @@ def run_block(spec, entity: str, bench: str, build_dir: Path, seed: int = 1, **c
     build_dir = Path(build_dir).resolve()
     src = build_dir / "hdl"
     src.mkdir(parents=True, exist_ok=True)
-    path = src / f"{entity}.vhd"
-    path.write_text(render(spec)[f"{entity}.vhd"])
-    backend = runner.build([path], entity, build_dir)
+    paths = []
+    for name, text in render(spec).items():   # every entity, in compile order: a top needs its blocks
+        paths.append(src / name)
+        paths[-1].write_text(text)
+    backend = runner.build(paths, entity, build_dir)
     cfg_path = build_dir / "bench_config.json"
     cfg_path.write_text(json.dumps({"spec": spec.to_dict(), "seed": seed, **config}))
     results = build_dir / "results.xml"

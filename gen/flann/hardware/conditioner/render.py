@@ -29,7 +29,14 @@ ENTITIES = (
     Entity("flann_cond_adc", "ADC input port"),
     Entity("flann_cond_demod", "synchronous I/Q demodulation and integration over whole carrier periods"),
     Entity("flann_cond_ratio", "ratiometric (A - B) / (A + B), serial divider"),
+    Entity("flann_cond_top", "LVDT conditioner, top level"),
 )
+TOP = "flann_cond_top"
+
+
+def cycles_per_sample(s: ConditionerSpec) -> int:
+    """Fewest clocks between converter strobes: the demodulator's serial product."""
+    return FlannCondDemod(s).latency + 2
 
 
 def _ubits(value: int) -> int:
@@ -49,7 +56,7 @@ def contexts(s: ConditionerSpec) -> dict[str, dict]:
                                step_literal=bits_literal(s.step, s.table_bits, signed=False)),
         "flann_cond_adc": dict(adc_bits=s.adc_bits),
         "flann_cond_demod": dict(**_table(s), adc_bits=s.adc_bits, acc_bits=s.acc_bits, window=s.window,
-                                 periods=s.periods_per_output, busy=FlannCondDemod(s).latency + 1,
+                                 periods=s.periods_per_output, busy=cycles_per_sample(s),
                                  quarter_literal=bits_literal(s.quarter, s.table_bits, signed=False),
                                  count_bits=_ubits(s.window - 1), bit_bits=_ubits(s.adc_bits - 1),
                                  last_literal=bits_literal(s.window - 1, _ubits(s.window - 1), signed=False)),
@@ -58,6 +65,9 @@ def contexts(s: ConditionerSpec) -> dict[str, dict]:
                                  busy=ratio_busy + 1,
                                  max_literal=bits_literal((1 << s.ratio_frac_bits) - 1, s.ratio_bits),
                                  min_literal=bits_literal(-((1 << s.ratio_frac_bits) - 1), s.ratio_bits)),
+        "flann_cond_top": dict(adc_bits=s.adc_bits, table_bits=s.table_bits, sine_bits=s.sine_bits,
+                               acc_bits=s.acc_bits, ratio_bits=s.ratio_bits, frac_bits=s.ratio_frac_bits,
+                               window=s.window, cycles_per_sample=cycles_per_sample(s)),
     }
 
 
