@@ -15,7 +15,7 @@ from flann.physics.waveforms import WaveformSettings, parse_trajectory, simulate
 CARRIER = 2500.0
 
 
-def test_every_file_analyses_and_synthesises_without_latches(tmp_path):
+def test_every_file_analyses_synthesises_without_latches_and_lints(tmp_path):
     files = render(derive_conditioner())
     assert list(files) == [f"{e.name}.vhd" for e in ENTITIES]
     for name, text in files.items():
@@ -26,6 +26,9 @@ def test_every_file_analyses_and_synthesises_without_latches(tmp_path):
     r = subprocess.run(["ghdl", "--synth", "--std=93c", f"--workdir={tmp_path}", *paths, "-e", "flann_cond_top"],
                        capture_output=True, text=True)
     assert r.returncode == 0 and "latch" not in r.stderr.lower(), r.stderr
+    from flann.implement.synth import lint_vhdl   # VSG with the repository's configuration
+
+    assert lint_vhdl(paths) == []
 
 
 @pytest.mark.sim
