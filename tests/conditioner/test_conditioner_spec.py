@@ -28,7 +28,6 @@ def test_output_rate_is_whole_periods_and_bandwidth_follows():
     (dict(carrier_hz=5000.0, output_rate_hz=6000.0), "at most the carrier"),
     (dict(carrier_hz=5000.0, sample_rate_hz=20000.0), "at least 8"),
     (dict(table_bits=4), "at least 32 entries"),
-    (dict(dac="pwm"), "dac 'pwm'"),
     (dict(carrier_hz=20000.0, output_rate_hz=0.5, adc_bits=24, sine_bits=18), "accumulator"),
 ])
 def test_bad_choices_are_refused_naming_the_option(kw, words):

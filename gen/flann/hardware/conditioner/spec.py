@@ -2,7 +2,8 @@
 
 Signal flow (one clock, one sample strobe at the ADC rate ``fs``)::
 
-    NCO: phase += step (T bits, mod 2^T)  ->  table[phase] -> DAC (parallel or sigma-delta bit)
+    NCO: phase += step (T bits, mod 2^T)  ->  table[phase] -> DAC: the word in parallel and a
+                                                             first-order sigma-delta bit
     ADC port A, B: offset-binary code -> signed sample (B bits)
     demod A, B:   I += x c[phase + offset], Q += x c[phase + offset + 2^T/4] over M samples
     ratio:        (I_A - I_B) / (I_A + I_B) by a serial restoring divider, F fraction bits
@@ -34,7 +35,6 @@ import numpy as np
 from ...errors import SpecError
 
 GUARD_BITS = 2
-DAC_KINDS = ("parallel", "sigma_delta")
 MAX_ACC_BITS = 62   # the twin's int64, with a bit to spare for I_A + I_B
 
 
@@ -46,7 +46,6 @@ class ConditionerSpec:
     samples_per_period: int   # N: fs / carrier, a power of two
     periods_per_output: int   # K: carrier periods integrated per output
     ratio_frac_bits: int      # F: the ratio's fraction bits
-    dac: str = "parallel"     # or "sigma_delta": one bit, first order
 
     @property
     def step(self) -> int:
@@ -92,16 +91,13 @@ def _power_of_two(n: int) -> bool:
 
 
 def derive_conditioner(adc_bits: int = 12, carrier_hz: float = 5000.0, sample_rate_hz: float | None = None,
-                       output_rate_hz: float = 500.0, table_bits: int = 10, sine_bits: int = 12,
-                       dac: str = "parallel") -> ConditionerSpec:
+                       output_rate_hz: float = 500.0, table_bits: int = 10, sine_bits: int = 12) -> ConditionerSpec:
     """The spec for a carrier, a sample rate (default 32 x the carrier) and an output rate
     (one ratio per whole number of carrier periods), checked; each refusal names the option."""
     if not 4 <= adc_bits <= 24:
         raise SpecError(f"adc bits {adc_bits}: must be 4..24")
     if not 4 <= sine_bits <= 18:
         raise SpecError(f"sine bits {sine_bits}: must be 4..18")
-    if dac not in DAC_KINDS:
-        raise SpecError(f"dac {dac!r}: one of {', '.join(DAC_KINDS)}")
     if not (math.isfinite(carrier_hz) and carrier_hz > 0):
         raise SpecError(f"carrier {carrier_hz:g} Hz: must be > 0")
     fs = sample_rate_hz if sample_rate_hz is not None else 32 * carrier_hz
@@ -118,7 +114,7 @@ def derive_conditioner(adc_bits: int = 12, carrier_hz: float = 5000.0, sample_ra
         raise SpecError(f"table bits {table_bits}: the table needs at least {n} entries (N) and at most 2^16")
     frac = adc_bits + math.ceil(math.log2(n * k) / 2) + GUARD_BITS
     spec = ConditionerSpec(adc_bits=adc_bits, table_bits=table_bits, sine_bits=sine_bits,
-                           samples_per_period=n, periods_per_output=k, ratio_frac_bits=frac, dac=dac)
+                           samples_per_period=n, periods_per_output=k, ratio_frac_bits=frac)
     if spec.sum_bits > MAX_ACC_BITS:
         raise SpecError(f"{k} periods of {n} samples need a {spec.sum_bits}-bit accumulator, more than "
                         f"{MAX_ACC_BITS}: raise the output rate")
