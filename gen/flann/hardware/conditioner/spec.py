@@ -91,7 +91,7 @@ def _power_of_two(n: int) -> bool:
 
 
 def derive_conditioner(adc_bits: int = 12, carrier_hz: float = 5000.0, sample_rate_hz: float | None = None,
-                       output_rate_hz: float = 500.0, table_bits: int = 10, sine_bits: int = 12) -> ConditionerSpec:
+                       output_rate_hz: float = 500.0, table_bits: int = 8, sine_bits: int = 12) -> ConditionerSpec:
     """The spec for a carrier, a sample rate (default 32 x the carrier) and an output rate
     (one ratio per whole number of carrier periods), checked; each refusal names the option."""
     if not 4 <= adc_bits <= 24:

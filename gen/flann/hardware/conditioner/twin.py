@@ -86,8 +86,8 @@ class FlannCondDemod:
 
     @property
     def latency(self) -> int:
-        """Clocks from a window's last sample strobe to its output (the serial product)."""
-        return self.spec.adc_bits + 2
+        """Clocks from a window's last sample strobe to its output (table read, serial product)."""
+        return self.spec.adc_bits + 3
 
     def process(self, samples, phases, offset: int) -> DemodOut:
         """Every whole window of ``samples`` (the NCO's ``phases`` of each sample)."""
@@ -117,7 +117,8 @@ class FlannCondRatio:
 
     @property
     def latency(self) -> int:
-        return self.spec.ratio_frac_bits + 2
+        """Clocks from the strobe to the ratio: the operands, then one quotient bit a clock."""
+        return self.spec.ratio_frac_bits + 3
 
     def process(self, a, b) -> RatioOut:
         f = self.spec.ratio_frac_bits
