@@ -43,7 +43,7 @@ from .simulate import adc_convert, parse_temperature_profile, sweep_positions, t
 
 # default sample rate: a whole number of samples per carrier period, enough for the third
 # harmonic and for a demodulator that integrates over whole periods
-SAMPLES_PER_CARRIER = 40
+SAMPLES_PER_CARRIER = 32
 ADC_RANGES_V = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0)   # a DAQ's input ranges
 
 
