@@ -12,7 +12,7 @@ from flann.physics.simulate import simulate_output_v
 from flann.physics.waveforms import (WaveformSettings, parse_trajectory, simulate_waveforms)
 from flann.recordings.waveform import read_waveforms
 
-EXACT = dict(adc_bits=32, adc_range_v=20.0)   # a converter far below every tolerance here
+EXACT = dict(adc_bits=32, adc_range_v=20.0, sample_rate_hz=200_000.0)   # a converter far below every tolerance here
 
 
 def _lockin(wave, carrier_hz, phase_rad, dwell_samples):
@@ -42,7 +42,7 @@ def _sensor(**effects):
 def test_lockin_of_the_waveforms_gives_the_dc_output(effects):
     s = _sensor(**effects)
     fs, carrier = 200_000.0, 5000.0
-    wave = simulate_waveforms(s, WaveformSettings(sample_rate_hz=fs, **EXACT), parse_trajectory("steps:0.002"),
+    wave = simulate_waveforms(s, WaveformSettings(**EXACT), parse_trajectory("steps:0.002"),
                               travel_mm=(-20.0, 20.0), step_mm=5.0)
     ia, _qa, ib, _qb, x = _lockin(wave, carrier, reference_phase_rad(s), int(0.002 * fs))
     dc = simulate_output_v(s, x)
