@@ -2,7 +2,7 @@
 
 The secondaries' volts become the converter's straight-binary codes (the one converter rule,
 :func:`flann.numeric.fixed.nearest_codes`), the reference phase is calibrated from the
-record (the phase of A + B, which the core's position does not turn), and the chain
+record (the phase of the difference's slope against the displacement), and the chain
 (:class:`~.twin.ConditionerChain`) gives one ratio per window of whole carrier periods.
 
 Public API: :func:`adc_codes`, :func:`calibrate_offset`, :func:`condition` -> :class:`Conditioned`.
@@ -44,11 +44,23 @@ def adc_codes(volts, bits: int, range_v: float) -> np.ndarray:
     return nearest_codes(np.asarray(volts, dtype=float), lsb, lo, hi).astype(np.int64) - lo
 
 
-def calibrate_offset(spec: ConditionerSpec, chain_at_zero) -> tuple[int, float]:
-    """(offset register, phase) from the chain's windows at offset 0: the phase of A + B over
-    the record."""
-    total = (np.sum(chain_at_zero.i_a) + np.sum(chain_at_zero.i_b)
-             + 1j * (np.sum(chain_at_zero.q_a) + np.sum(chain_at_zero.q_b)))
+def calibrate_offset(spec: ConditionerSpec, chain_at_zero, displacement_mm=None) -> tuple[int, float]:
+    """(offset register, phase) from the chain's windows at offset 0.  With the windows'
+    displacements: the phase of the difference A - B's slope at the null (a line through the
+    complex differences at the three positions nearest it: a constant quadrature residual
+    does not turn it, and the primary current's phase, which moves with the core, is taken
+    where the detector's reference is trimmed); without them: the phase of A + B."""
+    diff = (chain_at_zero.i_a - chain_at_zero.i_b) + 1j * (chain_at_zero.q_a - chain_at_zero.q_b)
+    x = None if displacement_mm is None else np.asarray(displacement_mm, dtype=float)[: diff.size]
+    if x is not None and np.unique(x).size >= 3:
+        # a line through the three positions nearest the null (the smallest |A - B|)
+        at = np.unique(x)
+        null = at[np.argmin([np.mean(np.abs(diff[x == v])) for v in at])]
+        near = np.isin(x, at[np.argsort(np.abs(at - null))[:3]])
+        total = np.polyfit(x[near], diff[near], 1)[0]
+    else:
+        total = (np.sum(chain_at_zero.i_a) + np.sum(chain_at_zero.i_b)
+                 + 1j * (np.sum(chain_at_zero.q_a) + np.sum(chain_at_zero.q_b)))
     if total == 0:
         raise FlannError("the secondaries carry no carrier: nothing to calibrate the reference phase on")
     phase = float(np.angle(total))
@@ -65,12 +77,12 @@ def condition(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float, offset
     ca = adc_codes(wave.sec_a_v, spec.adc_bits, adc_range_v)
     cb = adc_codes(wave.sec_b_v, spec.adc_bits, adc_range_v)
     chain = ConditionerChain(spec)
+    n = len(wave) // spec.window * spec.window
+    x = wave.displacement_mm[:n].reshape(-1, spec.window)
     phase = float("nan")
     if offset is None:
-        offset, phase = calibrate_offset(spec, chain.process(ca, cb, 0))
+        offset, phase = calibrate_offset(spec, chain.process(ca, cb, 0), x.mean(axis=1))
     out = chain.process(ca, cb, offset)
-    n = out.out_ratio.size * spec.window
-    x = wave.displacement_mm[:n].reshape(-1, spec.window)
     lsb = 2.0 * adc_range_v / (1 << spec.adc_bits)
     # a window's sum is M/2 A |V| cos(...) in codes: back to volts at the secondaries
     scale = lsb / (spec.window / 2 * spec.amplitude)
