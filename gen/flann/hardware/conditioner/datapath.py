@@ -15,7 +15,7 @@ from ..header import NO_MODEL
 from ..manifest import write_design
 from .render import ENTITIES, TOP, cycles_per_sample, render
 from .spec import ConditionerSpec
-from .twin import ConditionerChain, FlannCondDemod, FlannCondRatio
+from .twin import ConditionerChain
 from ... import __version__
 
 NAME = "conditioner"
@@ -23,9 +23,7 @@ WHY = "the conditioner is written from a spec (write_conditioner), not yet from 
 
 
 def latency_cycles(spec: ConditionerSpec) -> int:
-    """Clocks from a window's last converter strobe to its ratio: the port, the serial
-    product, the divider."""
-    return 1 + FlannCondDemod(spec).latency + FlannCondRatio(spec).latency
+    return ConditionerChain(spec).latency
 
 
 def manifest(spec: ConditionerSpec, input_lsb_v: float) -> dict:

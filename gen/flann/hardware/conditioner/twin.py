@@ -152,9 +152,16 @@ class ConditionerChain:
     """The blocks composed as the hardware composes them: the two ADC ports, one NCO phase per
     sample from the start of the record, two demodulators with one reference offset, the ratio."""
 
+    entity = "flann_cond_top"
+
     def __init__(self, spec: ConditionerSpec):
         self.spec = spec
         self.adc, self.demod, self.ratio = FlannCondAdc(spec), FlannCondDemod(spec), FlannCondRatio(spec)
+
+    @property
+    def latency(self) -> int:
+        """Clocks from a window's last converter strobe to its ratio: port, table, product, divider."""
+        return self.adc.latency + self.demod.latency + self.ratio.latency
 
     def process(self, codes_a, codes_b, offset: int) -> ChainOut:
         s = self.spec
