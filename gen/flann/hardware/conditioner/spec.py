@@ -20,7 +20,9 @@ at +-(1 - 2^-F) (a ratio beyond one means the secondaries are out of phase with 
 reference, a fault) and flags it.
 
 Error analysis: the table's rounding and the reference phase's step are common to both
-secondaries and cancel in the ratio to first order; the ratio's quantisation is the ADC's:
+secondaries and cancel in the ratio to first order, except that a quadrature residual leaks
+through the phase step (``sin`` of half a step: 1.2 % of it with T = 8); the ratio's
+quantisation is the ADC's:
 integrating M samples of a B-bit converter resolves ``~2^-(B-1) / sqrt(M/2)`` of full scale,
 so ``F = B + ceil(log2(M) / 2) + GUARD_BITS`` keeps the divider's LSB below a quarter of it.
 """
