@@ -26,7 +26,7 @@ import numpy as np
 
 from flann.golden.metrics import full_scale_mm, raw_line, raw_output_mm
 from flann.hardware.conditioner.condition import condition
-from flann.hardware.conditioner.spec import derive_conditioner
+from flann.hardware.conditioner.spec import derive_conditioner, reference_phase
 from flann.physics.sensor import default_sensor
 from flann.physics.simulate import simulate_output_v
 from flann.physics.waveforms import WaveformSettings, parse_trajectory, simulate_waveforms
@@ -40,10 +40,10 @@ RANGE_V = 5.0
 TRAVEL = (-25.0, 25.0)
 
 
-def float_ratio(wave, spec, offset: int) -> np.ndarray:
+def float_ratio(wave, spec, phase: float) -> np.ndarray:
     """Per window, the ratio of a float lock-in at the chain's reference phase."""
     k = np.arange(len(wave))
-    theta = 2 * math.pi * (k / spec.samples_per_period + offset / (1 << spec.table_bits))
+    theta = 2 * math.pi * k / spec.samples_per_period + phase
     ref = np.cos(theta)
     n = len(wave) // spec.window * spec.window
     ia = (wave.sec_a_v * ref)[:n].reshape(-1, spec.window).sum(axis=1)
@@ -68,7 +68,7 @@ def figures(carrier_hz: float, out_dir: Path) -> dict:
     x, r = c.displacement_mm[keep], c.ratio[keep]
     fs = full_scale_mm(x)
     slope, _ = raw_line(r, x)
-    ref = float_ratio(exact, spec, c.offset)[keep]
+    ref = float_ratio(exact, spec, reference_phase(spec, c.ref))[keep]
     dc = simulate_output_v(s, x)
     per_position = [np.std(r[x == v]) for v in np.unique(x)]
     bias = [abs(np.mean((r - ref)[x == v])) for v in np.unique(x)]

@@ -6,16 +6,18 @@ import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from cond_bench import setup, signed
+from flann.hardware.conditioner.spec import Reference
 from flann.hardware.conditioner.twin import ConditionerChain
 
 
 @cocotb.test()
 async def waveform_through_the_chain(dut):
-    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset"])
-    a, b, offset = cfg["codes_a"], cfg["codes_b"], int(cfg["offset"])
-    want = ConditionerChain(spec).process(a, b, offset)
+    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset", "in_cos", "in_sin"])
+    a, b, ref = cfg["codes_a"], cfg["codes_b"], Reference(**cfg["ref"])
+    chain = ConditionerChain(spec)
+    want = chain.process(a, b, ref)
     table = spec.table()
-    dut.in_offset.value = offset
+    dut.in_offset.value, dut.in_cos.value, dut.in_sin.value = ref.offset, ref.cos, ref.sin
     got, dac_bad = [], 0
     for k in range(len(a)):
         dut.in_valid.value = 1
@@ -30,7 +32,7 @@ async def waveform_through_the_chain(dut):
                 got.append((signed(dut.out_ratio), int(dut.out_sat.value)))
             await FallingEdge(dut.clk)
             dut.in_valid.value = 0
-    for _ in range(spec.ratio_frac_bits + 4):
+    for _ in range(chain.latency + 2):
         await RisingEdge(dut.clk)
         await ReadOnly()
         if int(dut.out_valid.value):

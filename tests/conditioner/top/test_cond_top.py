@@ -2,12 +2,13 @@
 mismatches against the twin; the top's files analyse as VHDL-93."""
 
 import subprocess
+from dataclasses import asdict
 
 import pytest
 
-from flann.hardware.conditioner.condition import adc_codes, calibrate_offset
+from flann.hardware.conditioner.condition import adc_codes, calibrate_reference
 from flann.hardware.conditioner.render import ENTITIES, cycles_per_sample, render
-from flann.hardware.conditioner.spec import derive_conditioner
+from flann.hardware.conditioner.spec import derive_conditioner, identity
 from flann.hardware.conditioner.twin import ConditionerChain
 from flann.physics.sensor import default_sensor
 from flann.physics.waveforms import WaveformSettings, parse_trajectory, simulate_waveforms
@@ -39,7 +40,8 @@ def test_waveform_through_the_whole_chain_matches_twin(block, tmp_path):
                                                   adc_range_v=5.0, noise_v=0.002, seed=2),
                               parse_trajectory("steps:0.0008"), travel_mm=(-30.0, 30.0), step_mm=4.0)
     a, b = adc_codes(wave.sec_a_v, 12, 5.0), adc_codes(wave.sec_b_v, 12, 5.0)
-    offset, _phase = calibrate_offset(spec, ConditionerChain(spec).process(a, b, 0))
+    ref, _phase = calibrate_reference(spec, ConditionerChain(spec).process(a, b, identity(spec)))
+    assert ref.sin != 0   # the rotation is exercised
     r = block(spec, "flann_cond_top", "cond_top_bench", tmp_path / "sim", seed=9,
-              codes_a=a.tolist(), codes_b=b.tolist(), offset=offset, cycles_per_sample=cycles_per_sample(spec))
+              codes_a=a.tolist(), codes_b=b.tolist(), ref=asdict(ref), cycles_per_sample=cycles_per_sample(spec))
     assert r.ok, f"{r.failed_tests} (see {tmp_path / 'sim'})"

@@ -2,10 +2,11 @@
 
 The secondaries' volts become the converter's straight-binary codes (the one converter rule,
 :func:`flann.numeric.fixed.nearest_codes`), the reference phase is calibrated from the
-record (the phase of the difference's slope against the displacement), and the chain
+record (the phase of the difference's slope against the displacement: a table step and a
+fine rotation), and the chain
 (:class:`~.twin.ConditionerChain`) gives one ratio per window of whole carrier periods.
 
-Public API: :func:`adc_codes`, :func:`calibrate_offset`, :func:`condition` -> :class:`Conditioned`.
+Public API: :func:`adc_codes`, :func:`calibrate_reference`, :func:`condition` -> :class:`Conditioned`.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from ...errors import FlannError
 from ...numeric.fixed import nearest_codes, signed_range
 from ...recordings.waveform import Waveforms
-from .spec import ConditionerSpec, calibration_offset
+from .spec import ConditionerSpec, Reference, identity, reference
 from .twin import ConditionerChain
 
 
@@ -33,7 +34,7 @@ class Conditioned:
     difference_v: np.ndarray
     displacement_mm: np.ndarray
     steady: np.ndarray
-    offset: int
+    ref: Reference
     phase_rad: float
 
 
@@ -44,8 +45,8 @@ def adc_codes(volts, bits: int, range_v: float) -> np.ndarray:
     return nearest_codes(np.asarray(volts, dtype=float), lsb, lo, hi).astype(np.int64) - lo
 
 
-def calibrate_offset(spec: ConditionerSpec, chain_at_zero, displacement_mm=None) -> tuple[int, float]:
-    """(offset register, phase) from the chain's windows at offset 0.  With the windows'
+def calibrate_reference(spec: ConditionerSpec, chain_at_zero, displacement_mm=None) -> tuple[Reference, float]:
+    """(reference registers, phase) from the chain's windows at offset 0.  With the windows'
     displacements: the phase of the difference A - B's slope at the null (a line through the
     complex differences at the three positions nearest it: a constant quadrature residual
     does not turn it, and the primary current's phase, which moves with the core, is taken
@@ -64,11 +65,11 @@ def calibrate_offset(spec: ConditionerSpec, chain_at_zero, displacement_mm=None)
     if total == 0:
         raise FlannError("the secondaries carry no carrier: nothing to calibrate the reference phase on")
     phase = float(np.angle(total))
-    return calibration_offset(spec, phase), phase
+    return reference(spec, phase), phase
 
 
-def condition(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float, offset: int | None = None) -> Conditioned:
-    """``wave`` through the conditioner (``offset`` None: calibrated from ``wave`` itself)."""
+def condition(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float, ref: Reference | None = None) -> Conditioned:
+    """``wave`` through the conditioner (``ref`` None: calibrated from ``wave`` itself)."""
     carrier = wave.sample_rate_hz / spec.samples_per_period
     if not math.isclose(carrier * spec.samples_per_period, wave.sample_rate_hz, rel_tol=1e-6):
         raise FlannError("the recording's sample rate does not match the conditioner's")
@@ -80,12 +81,12 @@ def condition(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float, offset
     n = len(wave) // spec.window * spec.window
     x = wave.displacement_mm[:n].reshape(-1, spec.window)
     phase = float("nan")
-    if offset is None:
-        offset, phase = calibrate_offset(spec, chain.process(ca, cb, 0), x.mean(axis=1))
-    out = chain.process(ca, cb, offset)
+    if ref is None:
+        ref, phase = calibrate_reference(spec, chain.process(ca, cb, identity(spec)), x.mean(axis=1))
+    out = chain.process(ca, cb, ref)
     lsb = 2.0 * adc_range_v / (1 << spec.adc_bits)
     # a window's sum is M/2 A |V| cos(...) in codes: back to volts at the secondaries
     scale = lsb / (spec.window / 2 * spec.amplitude)
     return Conditioned(ratio=out.out_ratio / float(1 << spec.ratio_frac_bits), sat=out.out_sat,
-                       difference_v=(out.i_a - out.i_b) * scale, displacement_mm=x.mean(axis=1),
-                       steady=np.ptp(x, axis=1) == 0, offset=int(offset), phase_rad=phase)
+                       difference_v=(out.rot_a - out.rot_b) * scale, displacement_mm=x.mean(axis=1),
+                       steady=np.ptp(x, axis=1) == 0, ref=ref, phase_rad=phase)

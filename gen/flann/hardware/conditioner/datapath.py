@@ -20,6 +20,7 @@ from ... import __version__
 
 NAME = "conditioner"
 WHY = "the conditioner is written from a spec (write_conditioner), not yet from a model: it has no {}"
+LACKS = "it is written from a spec (write_conditioner), not from a model"
 
 
 def latency_cycles(spec: ConditionerSpec) -> int:
@@ -58,9 +59,7 @@ DATAPATH = Datapath(
     generate=generate, rebuild=rebuild, twin=ConditionerChain, estimate=lambda man: None,
     fields=(_int("spec.adc_bits", 4), _int("spec.table_bits", 2), _int("spec.sine_bits", 4),
             _int("spec.samples_per_period", 8), _int("spec.periods_per_output"), _int("spec.ratio_frac_bits")),
-    model_field="", why_no_bench=WHY.format("bench under flann sim (its benches are in tests/conditioner)"),
-    why_no_eval=WHY.format("model to evaluate"), why_no_explore=WHY.format("model to explore"),
-    why_no_stages=WHY.format("stage model for flann trace"), why_no_ise=WHY.format("ISE pin map"),
+    model_field="", lacks=LACKS, ise=False,
 )
 
 __all__ = ["DATAPATH", "write_conditioner", "manifest", "latency_cycles"]

@@ -12,7 +12,7 @@ from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..header import header
 from .spec import ConditionerSpec
-from .twin import FlannCondDemod, FlannCondRatio
+from .twin import FlannCondDemod, FlannCondRatio, FlannCondRotate
 
 TEMPLATES = "hardware/conditioner/templates"
 
@@ -28,6 +28,7 @@ ENTITIES = (
     Entity("flann_cond_nco", "excitation NCO: phase accumulator, cosine table, DAC port"),
     Entity("flann_cond_adc", "ADC input port"),
     Entity("flann_cond_demod", "synchronous I/Q demodulation and integration over whole carrier periods"),
+    Entity("flann_cond_rotate", "fine reference phase: the window sums rotated by a calibrated angle"),
     Entity("flann_cond_ratio", "ratiometric (A - B) / (A + B), serial divider"),
     Entity("flann_cond_top", "LVDT conditioner, top level"),
 )
@@ -60,12 +61,18 @@ def contexts(s: ConditionerSpec) -> dict[str, dict]:
                                  quarter_literal=bits_literal(s.quarter, s.table_bits, signed=False),
                                  count_bits=_ubits(s.window - 1), bit_bits=_ubits(s.adc_bits - 1),
                                  last_literal=bits_literal(s.window - 1, _ubits(s.window - 1), signed=False)),
+        "flann_cond_rotate": dict(acc_bits=s.acc_bits, coef_bits=s.coef_bits, rot_bits=s.rotation_bits,
+                                  prod_bits=s.acc_bits + s.coef_bits + 1, bit_bits=_ubits(s.coef_bits - 1),
+                                  busy=FlannCondRotate(s).latency,
+                                  hi_literal=bits_literal((1 << (s.acc_bits - 1)) - 1, s.acc_bits),
+                                  lo_literal=bits_literal(-(1 << (s.acc_bits - 1)), s.acc_bits)),
         "flann_cond_ratio": dict(in_bits=s.acc_bits, frac_bits=s.ratio_frac_bits, ratio_bits=s.ratio_bits,
                                  work_bits=s.sum_bits + 1, bit_bits=_ubits(s.ratio_frac_bits),
                                  busy=ratio_busy + 1,
                                  max_literal=bits_literal((1 << s.ratio_frac_bits) - 1, s.ratio_bits),
                                  min_literal=bits_literal(-((1 << s.ratio_frac_bits) - 1), s.ratio_bits)),
         "flann_cond_top": dict(adc_bits=s.adc_bits, table_bits=s.table_bits, sine_bits=s.sine_bits,
+                               coef_bits=s.coef_bits, rot_bits=s.rotation_bits,
                                acc_bits=s.acc_bits, ratio_bits=s.ratio_bits, frac_bits=s.ratio_frac_bits,
                                window=s.window, cycles_per_sample=cycles_per_sample(s)),
     }

@@ -6,7 +6,9 @@ Signal flow (one clock, one sample strobe at the ADC rate ``fs``)::
                                                              first-order sigma-delta bit
     ADC port A, B: offset-binary code -> signed sample (B bits)
     demod A, B:   I += x c[phase + offset], Q += x c[phase + offset + 2^T/4] over M samples
-    ratio:        (I_A - I_B) / (I_A + I_B) by a serial restoring divider, F fraction bits
+    rotate:       I' = (I cos d + Q sin d) / 2^R for A and B: the fine reference phase d
+                  within the table's step, (cos, sin) in R fraction bits, calibrated
+    ratio:        (I'_A - I'_B) / (I'_A + I'_B) by a serial restoring divider, F fraction bits
 
 ``c[k] = round(A cos(2 pi k / 2^T))`` with ``A = 2^(W-1) - 1``.  The carrier is ``fs /
 N`` with ``N`` a power of two (``step = 2^T / N``), so a window of ``M = N K`` samples holds
@@ -20,9 +22,14 @@ at +-(1 - 2^-F) (a ratio beyond one means the secondaries are out of phase with 
 reference, a fault) and flags it.
 
 Error analysis: the table's rounding and the reference phase's step are common to both
-secondaries and cancel in the ratio to first order, except that a quadrature residual leaks
-through the phase step (``sin`` of half a step: 1.2 % of it with T = 8); the ratio's
-quantisation is the ADC's:
+secondaries and cancel in the ratio to first order, except that a quadrature residual q (a
+fraction of the full-scale output) leaks through a reference phase error e as ``q sin e``.
+The table alone sets the phase to half a step (0.7 deg with T = 8: 1.2 % of q); the rotation
+after integration sets it to ``2^-(R+1)`` rad, so ``R = ceil(log2(q / budget)) + ROTATION_GUARD``
+keeps a residual of ``QUADRATURE_FRACTION`` of full scale within ``QUADRATURE_BUDGET`` of it
+with the calibration's own error beside it.  ``(cos, sin)`` hold ``2^R`` at most (R + 2 signed
+bits); ``I cos + Q sin`` can exceed the sums' range by the rounding of ``cos^2 + sin^2``, so the
+rotation saturates at it.  The ratio's quantisation is the ADC's:
 integrating M samples of a B-bit converter resolves ``~2^-(B-1) / sqrt(M/2)`` of full scale,
 so ``F = B + ceil(log2(M) / 2) + GUARD_BITS`` keeps the divider's LSB below a quarter of it.
 """
@@ -37,6 +44,9 @@ import numpy as np
 from ...errors import SpecError
 
 GUARD_BITS = 2
+QUADRATURE_FRACTION = 0.1   # the quadrature residual the rotation is sized for, of full scale
+QUADRATURE_BUDGET = 50e-6   # its largest move of the ratio, of full scale
+ROTATION_GUARD = 2          # the rotation's step a quarter of the phase that budget tolerates
 MAX_ACC_BITS = 62   # the twin's int64, with a bit to spare for I_A + I_B
 
 
@@ -48,6 +58,7 @@ class ConditionerSpec:
     samples_per_period: int   # N: fs / carrier, a power of two
     periods_per_output: int   # K: carrier periods integrated per output
     ratio_frac_bits: int      # F: the ratio's fraction bits
+    rotation_bits: int        # R: fraction bits of the fine rotation's (cos, sin)
 
     @property
     def step(self) -> int:
@@ -75,6 +86,11 @@ class ConditionerSpec:
     def sum_bits(self) -> int:
         """Width of I_A - I_B and I_A + I_B."""
         return self.acc_bits + 1
+
+    @property
+    def coef_bits(self) -> int:
+        """Signed width of the rotation's cos and sin (cos reaches 2^R)."""
+        return self.rotation_bits + 2
 
     @property
     def ratio_bits(self) -> int:
@@ -116,11 +132,19 @@ def derive_conditioner(adc_bits: int = 12, carrier_hz: float = 5000.0, sample_ra
         raise SpecError(f"table bits {table_bits}: the table needs at least {n} entries (N) and at most 2^16")
     frac = adc_bits + math.ceil(math.log2(n * k) / 2) + GUARD_BITS
     spec = ConditionerSpec(adc_bits=adc_bits, table_bits=table_bits, sine_bits=sine_bits,
-                           samples_per_period=n, periods_per_output=k, ratio_frac_bits=frac)
+                           samples_per_period=n, periods_per_output=k, ratio_frac_bits=frac,
+                           rotation_bits=rotation_bits())
     if spec.sum_bits > MAX_ACC_BITS:
         raise SpecError(f"{k} periods of {n} samples need a {spec.sum_bits}-bit accumulator, more than "
                         f"{MAX_ACC_BITS}: raise the output rate")
     return spec
+
+
+def rotation_bits() -> int:
+    """R: the rotation's angle step 2^-R rad within the phase error the quadrature budget
+    tolerates (``asin(budget / residual)``), with ROTATION_GUARD bits to spare."""
+    tolerated = math.asin(QUADRATURE_BUDGET / QUADRATURE_FRACTION)
+    return math.ceil(math.log2(1.0 / tolerated)) + ROTATION_GUARD
 
 
 def output_rate_hz(spec: ConditionerSpec, carrier_hz: float) -> float:
@@ -132,7 +156,36 @@ def bandwidth_hz(spec: ConditionerSpec, carrier_hz: float) -> float:
     return 0.4429 * output_rate_hz(spec, carrier_hz)
 
 
+@dataclass(frozen=True)
+class Reference:
+    """The calibrated reference phase as the hardware holds it: the table's step (``offset``)
+    and the rotation by the rest (``cos``, ``sin`` in R fraction bits)."""
+
+    offset: int
+    cos: int
+    sin: int
+
+
 def calibration_offset(spec: ConditionerSpec, phase_rad: float) -> int:
     """The reference-phase register for a secondary phase of ``phase_rad`` against the
     excitation: the table step nearest to it."""
     return int(np.floor(phase_rad / (2 * math.pi) * (1 << spec.table_bits) + 0.5)) % (1 << spec.table_bits)
+
+
+def reference(spec: ConditionerSpec, phase_rad: float) -> Reference:
+    """The registers for a reference phase: its nearest table step, then the rotation by the
+    remainder (within half a step)."""
+    offset = calibration_offset(spec, phase_rad)
+    rest = math.remainder(phase_rad - 2 * math.pi * offset / (1 << spec.table_bits), 2 * math.pi)
+    one = 1 << spec.rotation_bits
+    return Reference(offset, int(math.floor(one * math.cos(rest) + 0.5)), int(math.floor(one * math.sin(rest) + 0.5)))
+
+
+def reference_phase(spec: ConditionerSpec, ref: Reference) -> float:
+    """The phase (rad) the registers set: the table's step plus the rotation's angle."""
+    return 2 * math.pi * ref.offset / (1 << spec.table_bits) + math.atan2(ref.sin, ref.cos)
+
+
+def identity(spec: ConditionerSpec, offset: int = 0) -> Reference:
+    """The table's step alone, no rotation."""
+    return Reference(int(offset), 1 << spec.rotation_bits, 0)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..twin import Record
-from .spec import ConditionerSpec
+from .spec import ConditionerSpec, Reference
 
 
 @dataclass(frozen=True)
@@ -102,6 +102,38 @@ class FlannCondDemod:
 
 
 @dataclass(frozen=True)
+class RotateOut(Record):
+    out_a: np.ndarray   # per window: A's in-phase sum at the fine reference phase
+    out_b: np.ndarray
+
+
+class FlannCondRotate:
+    """The fine reference phase: ``floor((I cos + Q sin) / 2^R)`` of each secondary's window,
+    saturated to the sums' width (``cos^2 + sin^2`` rounds to a little over one)."""
+
+    entity = "flann_cond_rotate"
+
+    def __init__(self, spec: ConditionerSpec):
+        self.spec = spec
+
+    @property
+    def latency(self) -> int:
+        """Clocks from the strobe to the result: the operands, one coefficient bit a clock, the
+        shift and saturation."""
+        return self.spec.coef_bits + 2
+
+    def one(self, i: int, q: int, cos: int, sin: int) -> int:
+        s = self.spec
+        hi = (1 << (s.acc_bits - 1)) - 1
+        return max(-hi - 1, min(hi, (int(i) * cos + int(q) * sin) >> s.rotation_bits))
+
+    def process(self, i_a, q_a, i_b, q_b, cos: int, sin: int) -> RotateOut:
+        a = [self.one(i, q, cos, sin) for i, q in zip(np.asarray(i_a).tolist(), np.asarray(q_a).tolist())]
+        b = [self.one(i, q, cos, sin) for i, q in zip(np.asarray(i_b).tolist(), np.asarray(q_b).tolist())]
+        return RotateOut(np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64))
+
+
+@dataclass(frozen=True)
 class RatioOut(Record):
     out_ratio: np.ndarray   # (A - B) / (A + B) in F fraction bits, truncated towards zero
     out_sat: np.ndarray     # 1: |A - B| >= A + B or A + B <= 0 (out of phase, or no signal)
@@ -146,27 +178,35 @@ class ChainOut(Record):
     q_a: np.ndarray
     i_b: np.ndarray
     q_b: np.ndarray
+    rot_a: np.ndarray   # the in-phase sums at the fine reference phase (the divider's operands)
+    rot_b: np.ndarray
 
 
 class ConditionerChain:
     """The blocks composed as the hardware composes them: the two ADC ports, one NCO phase per
-    sample from the start of the record, two demodulators with one reference offset, the ratio."""
+    sample from the start of the record, two demodulators with one reference offset, the fine
+    rotation of both, the ratio."""
 
     entity = "flann_cond_top"
 
     def __init__(self, spec: ConditionerSpec):
         self.spec = spec
         self.adc, self.demod, self.ratio = FlannCondAdc(spec), FlannCondDemod(spec), FlannCondRatio(spec)
+        self.rotate = FlannCondRotate(spec)
 
     @property
     def latency(self) -> int:
-        """Clocks from a window's last converter strobe to its ratio: port, table, product, divider."""
-        return self.adc.latency + self.demod.latency + self.ratio.latency
+        """Clocks from a window's last converter strobe to its ratio: port, table, product,
+        rotation, divider."""
+        return self.adc.latency + self.demod.latency + self.rotate.latency + self.ratio.latency
 
-    def process(self, codes_a, codes_b, offset: int) -> ChainOut:
+    def process(self, codes_a, codes_b, ref: Reference) -> ChainOut:
+        """The ratio of every whole window, at the reference phase ``ref`` (offset and rotation);
+        ``i_*``, ``q_*`` are the demodulators' sums (at the offset, before the rotation)."""
         s = self.spec
         xa, xb = self.adc.process(codes_a).out_sample, self.adc.process(codes_b).out_sample
         phases = (np.arange(xa.size, dtype=np.int64) * s.step) & ((1 << s.table_bits) - 1)
-        da, db = self.demod.process(xa, phases, offset), self.demod.process(xb, phases, offset)
-        r = self.ratio.process(da.out_i, db.out_i)
-        return ChainOut(r.out_ratio, r.out_sat, da.out_i, da.out_q, db.out_i, db.out_q)
+        da, db = self.demod.process(xa, phases, ref.offset), self.demod.process(xb, phases, ref.offset)
+        rot = self.rotate.process(da.out_i, da.out_q, db.out_i, db.out_q, ref.cos, ref.sin)
+        r = self.ratio.process(rot.out_a, rot.out_b)
+        return ChainOut(r.out_ratio, r.out_sat, da.out_i, da.out_q, db.out_i, db.out_q, rot.out_a, rot.out_b)
