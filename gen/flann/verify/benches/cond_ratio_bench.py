@@ -4,8 +4,8 @@ cases (A + B = 0 or negative, |A - B| = A + B, equal inputs, the accumulator's r
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, signed
 from flann.hardware.conditioner.twin import FlannCondRatio
+from flann.verify.benches.cond_bench import setup, signed
 
 
 def pairs(spec, r, n: int):

@@ -5,9 +5,10 @@ window's ratio and saturation flag in order, and the DAC word after each strobe.
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, signed
 from flann.hardware.conditioner.spec import Reference
 from flann.hardware.conditioner.twin import ConditionerChain
+from flann.verify.benches.cond_bench import setup, signed
+from flann.verify.benches.flann_bench import write_record
 
 
 @cocotb.test()
@@ -39,9 +40,13 @@ async def waveform_through_the_chain(dut):
             got.append((signed(dut.out_ratio), int(dut.out_sat.value)))
         await FallingEdge(dut.clk)
     exp = [(int(q), int(s)) for q, s in zip(want.out_ratio, want.out_sat)]
+    bad = 0
     for k, (g, w) in enumerate(zip(got, exp)):
         if g != w:
+            bad += 1
             dut._log.error("window %d: got %s, twin %s", k, g, w)
+    write_record(cfg, "cond_top", {"windows": len(exp), "mismatches": bad + abs(len(got) - len(exp)),
+                                   "dac_mismatches": dac_bad, "saturated": sum(s for _q, s in exp)})
     assert dac_bad == 0, f"{dac_bad} DAC words differ from the table"
     assert len(got) == len(exp), f"{len(got)} ratios out, {len(exp)} expected"
     assert got == exp

@@ -3,8 +3,8 @@
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, signed
 from flann.hardware.conditioner.twin import FlannCondAdc
+from flann.verify.benches.cond_bench import setup, signed
 
 
 @cocotb.test()

@@ -4,8 +4,8 @@ signed coefficient range, so the saturation is reached) and the rails of both.""
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, signed
 from flann.hardware.conditioner.twin import FlannCondRotate
+from flann.verify.benches.cond_bench import setup, signed
 
 
 def cases(spec, r, n: int):

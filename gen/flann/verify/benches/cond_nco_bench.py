@@ -5,8 +5,8 @@ import cocotb
 import numpy as np
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, unsigned, signed
 from flann.hardware.conditioner.twin import FlannCondNco
+from flann.verify.benches.cond_bench import setup, unsigned, signed
 
 
 @cocotb.test()

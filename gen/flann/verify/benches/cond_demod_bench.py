@@ -6,8 +6,8 @@ import cocotb
 import numpy as np
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
-from cond_bench import setup, signed
 from flann.hardware.conditioner.twin import FlannCondDemod
+from flann.verify.benches.cond_bench import setup, signed
 
 
 def stimulus(spec, r, windows: int):
