@@ -1,5 +1,8 @@
 """Shared pieces of the conditioner's cocotb benches: the spec from the runner's config, the
-clock and reset of every bench, reading a signed port."""
+clock and reset of every bench, stepping the clock while collecting the outputs, reading a
+signed port."""
+
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.hardware.conditioner.spec import ConditionerSpec
 from flann.verify.benches import config
@@ -24,3 +27,15 @@ def signed(handle) -> int:
 
 def unsigned(handle) -> int:
     return handle.value.to_unsigned()
+
+
+async def clocks(dut, n: int, read, got: list) -> None:
+    """``n`` clocks; after each, ``read()`` appended to ``got`` where ``out_valid`` is high; the
+    strobe ``in_valid`` dropped after the first."""
+    for _ in range(n):
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        if int(dut.out_valid.value):
+            got.append(read())
+        await FallingEdge(dut.clk)
+        dut.in_valid.value = 0

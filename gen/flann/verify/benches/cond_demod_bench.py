@@ -4,10 +4,9 @@ gaps between the strobes."""
 
 import cocotb
 import numpy as np
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.hardware.conditioner.twin import FlannCondDemod
-from flann.verify.benches.cond_bench import setup, signed
+from flann.verify.benches.cond_bench import clocks, setup, signed
 
 
 def stimulus(spec, r, windows: int):
@@ -41,24 +40,17 @@ async def demod_vs_twin(dut):
         want_q += list(d.out_q)
     busy = twin.latency + 1
     got = []
+
+    def read():
+        return signed(dut.out_i), signed(dut.out_q)
+
     for k in range(len(x)):
         dut.in_valid.value = 1
         dut.in_sample.value = x[k]
         dut.in_phase.value = ph[k]
         dut.in_offset.value = off[k // spec.window]
-        for c in range(busy + r.choice((0, 0, 1, 5))):
-            await RisingEdge(dut.clk)
-            await ReadOnly()
-            if int(dut.out_valid.value):
-                got.append((signed(dut.out_i), signed(dut.out_q)))
-            await FallingEdge(dut.clk)
-            dut.in_valid.value = 0
-    for _ in range(busy):
-        await RisingEdge(dut.clk)
-        await ReadOnly()
-        if int(dut.out_valid.value):
-            got.append((signed(dut.out_i), signed(dut.out_q)))
-        await FallingEdge(dut.clk)
+        await clocks(dut, busy + r.choice((0, 0, 1, 5)), read, got)
+    await clocks(dut, busy, read, got)
     want = list(zip(want_i, want_q))
     bad = sum(1 for g, w in zip(got, want) if g != (int(w[0]), int(w[1])))
     for k, (g, w) in enumerate(zip(got, want)):

@@ -2,10 +2,9 @@
 cases (A + B = 0 or negative, |A - B| = A + B, equal inputs, the accumulator's rails)."""
 
 import cocotb
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.hardware.conditioner.twin import FlannCondRatio
-from flann.verify.benches.cond_bench import setup, signed
+from flann.verify.benches.cond_bench import clocks, setup, signed
 
 
 def pairs(spec, r, n: int):
@@ -32,13 +31,8 @@ async def ratio_vs_twin(dut):
         dut.in_valid.value = 1
         dut.in_a.value = a
         dut.in_b.value = b
-        for _ in range(twin.latency + 1 + r.choice((0, 0, 3))):
-            await RisingEdge(dut.clk)
-            await ReadOnly()
-            if int(dut.out_valid.value):
-                got.append((signed(dut.out_ratio), int(dut.out_sat.value)))
-            await FallingEdge(dut.clk)
-            dut.in_valid.value = 0
+        await clocks(dut, twin.latency + 1 + r.choice((0, 0, 3)),
+                     lambda: (signed(dut.out_ratio), int(dut.out_sat.value)), got)
     exp = [(int(q), int(s)) for q, s in zip(want.out_ratio, want.out_sat)]
     for k, (g, w) in enumerate(zip(got, exp)):
         if g != w:

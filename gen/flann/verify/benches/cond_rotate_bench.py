@@ -2,10 +2,9 @@
 signed coefficient range, so the saturation is reached) and the rails of both."""
 
 import cocotb
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 
 from flann.hardware.conditioner.twin import FlannCondRotate
-from flann.verify.benches.cond_bench import setup, signed
+from flann.verify.benches.cond_bench import clocks, setup, signed
 
 
 def cases(spec, r, n: int):
@@ -35,13 +34,7 @@ async def rotate_vs_twin(dut):
         dut.in_valid.value = 1
         dut.in_i_a.value, dut.in_q_a.value, dut.in_i_b.value, dut.in_q_b.value = ia, qa, ib, qb
         dut.in_cos.value, dut.in_sin.value = c, s
-        for _ in range(twin.latency + r.choice((0, 0, 3))):
-            await RisingEdge(dut.clk)
-            await ReadOnly()
-            if int(dut.out_valid.value):
-                got.append((signed(dut.out_a), signed(dut.out_b)))
-            await FallingEdge(dut.clk)
-            dut.in_valid.value = 0
+        await clocks(dut, twin.latency + r.choice((0, 0, 3)), lambda: (signed(dut.out_a), signed(dut.out_b)), got)
     for k, (g, w) in enumerate(zip(got, exp)):
         if g != w:
             dut._log.error("case %s: got %s, twin %s", todo[k], g, w)
