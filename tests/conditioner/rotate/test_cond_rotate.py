@@ -1,5 +1,6 @@
-"""The fine rotation: the twin turns (I, Q) by the calibrated angle within a count of the exact
-product and saturates at the sums' range; under GHDL it matches the twin."""
+"""The fine rotation: the twin turns (I, Q) by the calibrated angle (without its cos, common to
+both secondaries) within a count of the exact value and saturates at the sums' range; under
+GHDL it matches the twin."""
 
 import math
 
@@ -18,17 +19,17 @@ def test_twin_turns_by_the_calibrated_angle():
         assert abs(math.remainder(reference_phase(spec, ref) - phase, 2 * math.pi)) < 2.0 ** -spec.rotation_bits
         rest = phase - 2 * math.pi * ref.offset / (1 << spec.table_bits)
         i, q = 123456789, -98765432
-        got = FlannCondRotate(spec).one(i, q, ref.cos, ref.sin)
-        assert abs(got - (i * math.cos(rest) + q * math.sin(rest))) < abs(i) * 2.0 ** -spec.rotation_bits + 1
+        got = FlannCondRotate(spec).one(i, q, ref.tan)
+        assert abs(got - (i + q * math.tan(rest))) < abs(q) * 2.0 ** -spec.rotation_bits + 1
 
 
 def test_twin_saturates_at_the_sums_range():
     spec = derive_conditioner()
     hi = (1 << (spec.acc_bits - 1)) - 1
     rot = FlannCondRotate(spec)
-    big = (1 << (spec.coef_bits - 1)) - 1
-    assert rot.one(hi, hi, big, big) == hi
-    assert rot.one(-hi - 1, -hi - 1, big, big) == -hi - 1
+    big = (1 << (spec.tan_bits - 1)) - 1
+    assert rot.one(hi, hi, big) == hi
+    assert rot.one(-hi - 1, -hi - 1, big) == -hi - 1
 
 
 # the default sums, and the widest a 16-bit converter over 50 carrier periods gives

@@ -41,7 +41,7 @@ def test_waveform_through_the_whole_chain_matches_twin(block, tmp_path):
                               parse_trajectory("steps:0.0008"), travel_mm=(-30.0, 30.0), step_mm=4.0)
     a, b = adc_codes(wave.sec_a_v, 12, 5.0), adc_codes(wave.sec_b_v, 12, 5.0)
     ref, _phase = calibrate_reference(spec, ConditionerChain(spec).process(a, b, identity(spec)))
-    assert ref.sin != 0   # the rotation is exercised
+    assert ref.tan != 0   # the rotation is exercised
     r = block(spec, "flann_cond_top", "cond_top_bench", tmp_path / "sim", seed=9,
               codes_a=a.tolist(), codes_b=b.tolist(), ref=asdict(ref), cycles_per_sample=cycles_per_sample(spec))
     assert r.ok, f"{r.failed_tests} (see {tmp_path / 'sim'})"

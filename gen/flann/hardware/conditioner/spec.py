@@ -6,8 +6,9 @@ Signal flow (one clock, one sample strobe at the ADC rate ``fs``)::
                                                              first-order sigma-delta bit
     ADC port A, B: offset-binary code -> signed sample (B bits)
     demod A, B:   I += x c[phase + offset], Q += x c[phase + offset + 2^T/4] over M samples
-    rotate:       I' = (I cos d + Q sin d) / 2^R for A and B: the fine reference phase d
-                  within the table's step, (cos, sin) in R fraction bits, calibrated
+    rotate:       I' = I + Q tan(d) for A and B: the fine reference phase d within the
+                  table's step (I cos d + Q sin d without the cos d common to A and B, which
+                  the ratio cancels), tan d in R fraction bits, calibrated
     ratio:        (I'_A - I'_B) / (I'_A + I'_B) by a serial restoring divider, F fraction bits
 
 ``c[k] = round(A cos(2 pi k / 2^T))`` with ``A = 2^(W-1) - 1``.  The carrier is ``fs /
@@ -27,9 +28,9 @@ fraction of the full-scale output) leaks through a reference phase error e as ``
 The table alone sets the phase to half a step (0.7 deg with T = 8: 1.2 % of q); the rotation
 after integration sets it to ``2^-(R+1)`` rad, so ``R = ceil(log2(q / budget)) + ROTATION_GUARD``
 keeps a residual of ``QUADRATURE_FRACTION`` of full scale within ``QUADRATURE_BUDGET`` of it
-with the calibration's own error beside it.  ``(cos, sin)`` hold ``2^R`` at most (R + 2 signed
-bits); ``I cos + Q sin`` can exceed the sums' range by the rounding of ``cos^2 + sin^2``, so the
-rotation saturates at it.  The ratio's quantisation is the ADC's:
+with the calibration's own error beside it.  ``tan d`` within half a step needs few bits
+(8 signed with T = 8, R = 13); ``I + Q tan d`` can exceed the sums' range, so the rotation
+saturates at it.  The ratio's quantisation is the ADC's:
 integrating M samples of a B-bit converter resolves ``~2^-(B-1) / sqrt(M/2)`` of full scale,
 so ``F = B + ceil(log2(M) / 2) + GUARD_BITS`` keeps the divider's LSB below a quarter of it.
 """
@@ -58,7 +59,7 @@ class ConditionerSpec:
     samples_per_period: int   # N: fs / carrier, a power of two
     periods_per_output: int   # K: carrier periods integrated per output
     ratio_frac_bits: int      # F: the ratio's fraction bits
-    rotation_bits: int        # R: fraction bits of the fine rotation's (cos, sin)
+    rotation_bits: int        # R: fraction bits of the fine rotation's tan
 
     @property
     def step(self) -> int:
@@ -88,9 +89,10 @@ class ConditionerSpec:
         return self.acc_bits + 1
 
     @property
-    def coef_bits(self) -> int:
-        """Signed width of the rotation's cos and sin (cos reaches 2^R)."""
-        return self.rotation_bits + 2
+    def tan_bits(self) -> int:
+        """Signed width of the rotation's tan: the tangent of half a table step, in R fraction bits."""
+        most = math.floor((1 << self.rotation_bits) * math.tan(math.pi / (1 << self.table_bits)) + 0.5)
+        return most.bit_length() + 1
 
     @property
     def ratio_bits(self) -> int:
@@ -159,11 +161,10 @@ def bandwidth_hz(spec: ConditionerSpec, carrier_hz: float) -> float:
 @dataclass(frozen=True)
 class Reference:
     """The calibrated reference phase as the hardware holds it: the table's step (``offset``)
-    and the rotation by the rest (``cos``, ``sin`` in R fraction bits)."""
+    and the rotation by the rest (its ``tan`` in R fraction bits)."""
 
     offset: int
-    cos: int
-    sin: int
+    tan: int
 
 
 def calibration_offset(spec: ConditionerSpec, phase_rad: float) -> int:
@@ -177,15 +178,14 @@ def reference(spec: ConditionerSpec, phase_rad: float) -> Reference:
     remainder (within half a step)."""
     offset = calibration_offset(spec, phase_rad)
     rest = math.remainder(phase_rad - 2 * math.pi * offset / (1 << spec.table_bits), 2 * math.pi)
-    one = 1 << spec.rotation_bits
-    return Reference(offset, int(math.floor(one * math.cos(rest) + 0.5)), int(math.floor(one * math.sin(rest) + 0.5)))
+    return Reference(offset, int(math.floor((1 << spec.rotation_bits) * math.tan(rest) + 0.5)))
 
 
 def reference_phase(spec: ConditionerSpec, ref: Reference) -> float:
     """The phase (rad) the registers set: the table's step plus the rotation's angle."""
-    return 2 * math.pi * ref.offset / (1 << spec.table_bits) + math.atan2(ref.sin, ref.cos)
+    return 2 * math.pi * ref.offset / (1 << spec.table_bits) + math.atan(ref.tan / (1 << spec.rotation_bits))
 
 
 def identity(spec: ConditionerSpec, offset: int = 0) -> Reference:
     """The table's step alone, no rotation."""
-    return Reference(int(offset), 1 << spec.rotation_bits, 0)
+    return Reference(int(offset), 0)

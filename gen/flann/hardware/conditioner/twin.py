@@ -108,8 +108,8 @@ class RotateOut(Record):
 
 
 class FlannCondRotate:
-    """The fine reference phase: ``floor((I cos + Q sin) / 2^R)`` of each secondary's window,
-    saturated to the sums' width (``cos^2 + sin^2`` rounds to a little over one)."""
+    """The fine reference phase: ``I + floor(Q tan / 2^R)`` of each secondary's window (the
+    rotation without its cos, common to both secondaries), saturated to the sums' width."""
 
     entity = "flann_cond_rotate"
 
@@ -118,18 +118,18 @@ class FlannCondRotate:
 
     @property
     def latency(self) -> int:
-        """Clocks from the strobe to the result: the operands, one coefficient bit a clock, the
-        shift and saturation."""
-        return self.spec.coef_bits + 2
+        """Clocks from the strobe to the result: the operands, one bit of tan a clock, the sum
+        and saturation."""
+        return self.spec.tan_bits + 2
 
-    def one(self, i: int, q: int, cos: int, sin: int) -> int:
+    def one(self, i: int, q: int, tan: int) -> int:
         s = self.spec
         hi = (1 << (s.acc_bits - 1)) - 1
-        return max(-hi - 1, min(hi, (int(i) * cos + int(q) * sin) >> s.rotation_bits))
+        return max(-hi - 1, min(hi, int(i) + ((int(q) * tan) >> s.rotation_bits)))
 
-    def process(self, i_a, q_a, i_b, q_b, cos: int, sin: int) -> RotateOut:
-        a = [self.one(i, q, cos, sin) for i, q in zip(np.asarray(i_a).tolist(), np.asarray(q_a).tolist())]
-        b = [self.one(i, q, cos, sin) for i, q in zip(np.asarray(i_b).tolist(), np.asarray(q_b).tolist())]
+    def process(self, i_a, q_a, i_b, q_b, tan: int) -> RotateOut:
+        a = [self.one(i, q, tan) for i, q in zip(np.asarray(i_a).tolist(), np.asarray(q_a).tolist())]
+        b = [self.one(i, q, tan) for i, q in zip(np.asarray(i_b).tolist(), np.asarray(q_b).tolist())]
         return RotateOut(np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64))
 
 
@@ -207,6 +207,6 @@ class ConditionerChain:
         xa, xb = self.adc.process(codes_a).out_sample, self.adc.process(codes_b).out_sample
         phases = (np.arange(xa.size, dtype=np.int64) * s.step) & ((1 << s.table_bits) - 1)
         da, db = self.demod.process(xa, phases, ref.offset), self.demod.process(xb, phases, ref.offset)
-        rot = self.rotate.process(da.out_i, da.out_q, db.out_i, db.out_q, ref.cos, ref.sin)
+        rot = self.rotate.process(da.out_i, da.out_q, db.out_i, db.out_q, ref.tan)
         r = self.ratio.process(rot.out_a, rot.out_b)
         return ChainOut(r.out_ratio, r.out_sat, da.out_i, da.out_q, db.out_i, db.out_q, rot.out_a, rot.out_b)

@@ -13,12 +13,12 @@ from flann.verify.benches.flann_bench import write_record
 
 @cocotb.test()
 async def waveform_through_the_chain(dut):
-    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset", "in_cos", "in_sin"])
+    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset", "in_tan"])
     a, b, ref = cfg["codes_a"], cfg["codes_b"], Reference(**cfg["ref"])
     chain = ConditionerChain(spec)
     want = chain.process(a, b, ref)
     table = spec.table()
-    dut.in_offset.value, dut.in_cos.value, dut.in_sin.value = ref.offset, ref.cos, ref.sin
+    dut.in_offset.value, dut.in_tan.value = ref.offset, ref.tan
     got, dac_bad = [], 0
     for k in range(len(a)):
         dut.in_valid.value = 1
