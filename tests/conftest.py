@@ -19,6 +19,8 @@ from flann import cache as flann_cache
 from flann.cli import main
 from flann.golden.thermal_train import fit_thermal
 from flann.golden.train import fit_lstsq
+from flann.hardware.conditioner.datapath import write_conditioner
+from flann.hardware.conditioner.spec import derive_conditioner
 from flann.hardware.seed import render as seed_render
 from flann.hardware.seed.spec import derive_seed_spec
 from flann.production.demo import write_batch
@@ -148,7 +150,8 @@ def small_designs(once) -> dict:
     one-input model, ``rec`` a recording of its sensor, ``thermal`` the two-input model (of
     :func:`thermal_sensor_v`), ``held_thermal`` a held-out recording of that sensor.  Beside them:
     ``seed/`` (the paper's parallel architecture, which flann explore writes for comparison) and
-    ``plain/`` (VHDL with a hand-written manifest, a design flann did not write)."""
+    ``plain/`` (VHDL with a hand-written manifest, a design flann did not write) and
+    ``conditioner/`` (the LVDT conditioner, written from a spec)."""
     return once("small_designs", _small_designs)
 
 
@@ -180,6 +183,8 @@ def _small_designs(d: Path) -> dict:
     held.write_text("displacement_mm,voltage_v,temperature_c\n"
                     + "".join(f"{a:.12g},{b:.12g},{c:g}\n" for a, b, c in zip(xh, thermal_sensor_v(xh, th), th)))
     seed_render.write(derive_seed_spec(model, input_bits=SMALL_DESIGN_BITS), d / "seed")
+    # the conditioner, written from a spec: one carrier period a window (its shortest benches)
+    write_conditioner(derive_conditioner(carrier_hz=5000.0, output_rate_hz=5000.0), d / "conditioner", 5.0)
     shutil.copytree(REPO / "tests" / "implement" / "fixtures" / "synth" / "good", d / "plain")
     return {"dir": d, "model": model, "rec": recs[0], "thermal": thermal, "held_thermal": held}
 
@@ -202,7 +207,8 @@ class SimRun:
 # the one simulation of each small design the tests share: the family's with its mapped netlist
 # (its weight image loaded through the cfg port); the family with temperature with both sensors'
 # images given, the design's last member first
-SIM_FLAGS = {"fixed": (), "float18": (), "family": ("--netlist",), "thermal": (), "family_thermal": "images"}
+SIM_FLAGS = {"fixed": (), "float18": (), "family": ("--netlist",), "thermal": (), "family_thermal": "images",
+             "conditioner": ()}
 
 
 def _captured_figures(run):

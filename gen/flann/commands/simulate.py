@@ -25,6 +25,7 @@ from ..physics.simulate import (fold_back_mm, parse_temperatures, simulate_calib
                                 simulate_recordings)
 from ..recordings import read_recordings, write_recordings
 from .common import add_common, emit_json, info, json_to_stdout, quiet
+from .simulate_waveforms import add_waveform_arguments, run_waveforms, waveform_options_used
 
 HELP = "LVDT physics simulator: write recordings from a sensor file"
 
@@ -76,6 +77,7 @@ def add_arguments(p) -> None:
     p.add_argument("--write-sensor", help="with --fit: write the calibrated sensor TOML")
     add_common(p, output=dict(help="recordings CSV to write (simulation mode)", metavar="OUT.csv"),
                json="the fit report (--fit), the quantities (--describe) or the catalogue (--list-effects)")
+    add_waveform_arguments(p)
 
 
 def _sensor(args):
@@ -143,6 +145,11 @@ def run(args) -> int:
         s = s.without_effects()
     lo = -s.stroke_mm if args.from_mm is None else args.from_mm
     hi = s.stroke_mm if args.to_mm is None else args.to_mm
+    if args.waveforms:
+        return run_waveforms(args, s, (lo, hi))
+    if waveform_options_used(args):
+        raise FlannError("simulate: --carrier-hz, --sample-rate-hz, --adc-*, --trajectory, --excitation-drift-pct "
+                         "and --harmonic-pct need --waveforms")
     if args.temperatures is not None:
         if args.temperature_profile != "const:20":
             raise FlannError("simulate: give either --temperatures or --temperature-profile")

@@ -56,7 +56,9 @@ class Design:
         dp, man = self.datapath, self.manifest
         where = f"cannot rebuild the twin of {self.directory}"
         if not dp.model_field:
-            dp.rebuild(None, man, where)  # says why this datapath has no twin rebuilt from a directory
+            # a datapath written from a spec: its manifest alone rebuilds it (or says why not)
+            spec, options = dp.rebuild(None, man, where)
+            return replace(self, options=options, spec=spec)
         model = design_model(self.directory, man, dp, model)
         spec, options = dp.rebuild(model, man, where)
         _check_top_level(man, spec, self.directory / MANIFEST)

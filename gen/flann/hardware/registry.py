@@ -12,6 +12,7 @@ from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..numeric.fixed import FixedFormat
 from .adc import ADC_BITS, MAX_DESIGN_INPUT_BITS
+from .conditioner.datapath import DATAPATH as CONDITIONER
 from .datapath import Datapath, Field, _int
 from .family_thermal.build import is_thermal_family
 from .family.datapath import DATAPATH as FAMILY
@@ -39,7 +40,7 @@ PLAIN = Datapath(
             Field("spec", (dict,), optional=True)),
     model_field="", lacks=WHY_PLAIN,
 )
-DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, FAMILY_THERMAL, SEED, THERMAL, PLAIN)}
+DATAPATHS: dict[str, Datapath] = {dp.name: dp for dp in (FIXED, FLOAT18, FAMILY, FAMILY_THERMAL, SEED, THERMAL, CONDITIONER, PLAIN)}
 # what `flann gen --format` chooses among (the family is chosen by --family)
 FORMATS = (FIXED.name, FLOAT18.name)
 

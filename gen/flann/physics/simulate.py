@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -54,11 +55,8 @@ def _broadcast(value, shape, fill) -> np.ndarray | None:
     return np.broadcast_to(np.asarray(value, dtype=float), shape)
 
 
-def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
-                      time_s=None, physical: bool = False) -> np.ndarray:
-    """Noiseless output (V) of ``s`` with all its enabled effects (see module docstring);
-    ``physical``: refuse effects that turn a drive, winding or core factor non-positive (a
-    fit's trial parameters may pass through such values, a simulated bench may not)."""
+def _front_stages(s: Sensor, displacement_mm, direction, temperature_c, time_s) -> tuple[Signal, Context]:
+    """The effects' position and transformer stages, in order."""
     x = np.asarray(displacement_mm, dtype=float)
     ctx = Context(
         displacement_mm=x,
@@ -71,8 +69,17 @@ def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=
     for stage in ("position", "transformer"):
         for name in _ordered(s.effects, stage):
             sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
+    return sig, ctx
+
+
+def simulate_output_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
+                      time_s=None, physical: bool = False) -> np.ndarray:
+    """Noiseless output (V) of ``s`` with all its enabled effects (see module docstring);
+    ``physical``: refuse effects that turn a drive, winding or core factor non-positive (a
+    fit's trial parameters may pass through such values, a simulated bench may not)."""
+    sig, ctx = _front_stages(s, displacement_mm, direction, temperature_c, time_s)
     if physical:
-        _check_scales(s, sig, ctx.temperature_c, x.shape)
+        _check_scales(s, sig, ctx.temperature_c, ctx.displacement_mm.shape)
     sig = _transformer(s, sig)
     for name in _ordered(s.effects, "output"):
         sig = EFFECTS[name].apply(s.effects[name], ctx, sig)
@@ -132,24 +139,57 @@ def _inductances(s: Sensor, core_mm, permeability_scale, loop: bool) -> tuple[np
     return tuple(out)
 
 
-def _transformer(s: Sensor, sig: Signal) -> Signal:
-    """Magnetics, primary circuit, (loaded) secondaries and demodulator -> output_v."""
+@dataclass(frozen=True)
+class Secondaries:
+    """The transformer's state for a drive: each secondary's e.m.f. is
+    ``1j w m_h i_p loop_gain`` (complex peak volts), the two in series opposition give the
+    demodulator's input."""
+
+    m1_h: np.ndarray         # primary -> secondary 1, with the effects' balance factor
+    m2_h: np.ndarray         # primary -> secondary 2, likewise
+    i_p: np.ndarray          # complex peak primary current (A)
+    loop_gain: np.ndarray | float   # R_L / Z_loop of loaded secondaries, 1 unloaded
+    omega_rad_s: float
+
+
+def transformer_secondaries(s: Sensor, sig: Signal) -> Secondaries:
+    """Magnetics and primary circuit (with the reflected load of the secondaries) for the
+    core positions and factors of ``sig``."""
     loaded = math.isfinite(sig.load_ohm)
     m1, m2, lp, *rest = _inductances(s, sig.core_mm, sig.permeability_scale, loaded)
     w = s.omega_rad_s
-    m_diff = sig.s1_scale * m1 - sig.s2_scale * m2
+    m1 = sig.s1_scale * m1
+    m2 = sig.s2_scale * m2
+    m_diff = m1 - m2
     z_primary = sig.source_ohm + s.primary_resistance_ohm * sig.resistance_scale + 1j * w * lp
+    loop_gain = 1.0
     if loaded:
         z_loop = (sig.load_ohm + 2 * s.secondary_resistance_ohm * sig.resistance_scale
                   + 1j * w * rest[0])
         # Secondary current reflects an impedance (w M)^2 / Z_loop into the primary.
         z_primary = z_primary + (w * m_diff) ** 2 / z_loop
+        loop_gain = sig.load_ohm / z_loop
     i_p = s.excitation_peak_v * sig.drive_scale / z_primary
-    v_diff = 1j * w * m_diff * i_p
-    if loaded:
-        v_diff = v_diff * (sig.load_ohm / z_loop)
+    return Secondaries(m1, m2, i_p, loop_gain, w)
+
+
+def _transformer(s: Sensor, sig: Signal) -> Signal:
+    """Magnetics, primary circuit, (loaded) secondaries and demodulator -> output_v."""
+    sec = transformer_secondaries(s, sig)
+    v_diff = 1j * sec.omega_rad_s * (sec.m1_h - sec.m2_h) * sec.i_p
+    if math.isfinite(sig.load_ohm):
+        v_diff = v_diff * sec.loop_gain
     out = demodulate_v(s, v_diff, quadrature_v=sig.quadrature_v)
     return _rep(sig, output_v=out)
+
+
+def transformer_signal(s: Sensor, displacement_mm, direction=None, temperature_c=None,
+                       time_s=None) -> Signal:
+    """The effects' position and transformer stages applied to ``displacement_mm`` (the
+    state the magnetics see; see :func:`simulate_output_v` for the arguments)."""
+    sig, ctx = _front_stages(s, displacement_mm, direction, temperature_c, time_s)
+    _check_scales(s, sig, ctx.temperature_c, ctx.displacement_mm.shape)
+    return sig
 
 
 def contributions_v(s: Sensor, displacement_mm, direction=None, temperature_c=None,
