@@ -43,13 +43,14 @@ MAX_SETS = 12
 @dataclass(frozen=True)
 class Confounding:
     """Equally good explanations (each a tuple of effect names, best first), the BIC of
-    each relative to the best, and the effects they all share."""
+    each relative to the best, and the effects they all share; ``fits`` holds each set's fit, in the order of ``sets``."""
 
     sets: tuple[tuple[str, ...], ...]
     delta_bic: tuple[float, ...]
     shared: tuple[str, ...]
     best: Fit | None
     margin: float = CONFOUND_BIC      # the margin used (BIC units)
+    fits: tuple[Fit, ...] = ()
 
     @property
     def confounded(self) -> bool:
@@ -96,7 +97,100 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
         return none_confounded(named)
     sets = tuple(tuple(c for c in candidates if c in key) for _, key in near)
     shared = tuple(c for c in named if all(c in s for s in sets))
-    return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin)
+    return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin,
+                       tuple(fits[key] for _, key in near))
 
 
-__all__ = ["Confounding", "equivalent_sets", "none_confounded", "CONFOUND_BIC"]
+@dataclass(frozen=True)
+class Separation:
+    """A measurement that tells two confounded effects apart (``b`` None: that reveals
+    ``a`` whatever else is there), and why it does."""
+
+    a: str
+    b: str | None
+    measurement: str
+    why: str
+
+
+_SECONDARIES = "record both secondary amplitudes (sec_a_v, sec_b_v) over the travel"
+_QUADRATURE = ("record the quadrature channel (the output demodulated 90 degrees from the "
+               "excitation, or the waveforms exc_v, sec_a_v, sec_b_v)")
+# the physical signal that separates two effects whose DC output curves bend alike
+_PAIRS: dict[frozenset, tuple[str, str]] = {
+    frozenset({"secondary_imbalance", "zero_shift"}): (
+        _SECONDARIES, "an imbalance makes one secondary larger than the other at every "
+        "position; a zero shift moves the position where they are equal and keeps their sizes "
+        "alike"),
+    frozenset({"null_offset", "secondary_imbalance"}): (
+        _SECONDARIES, "an imbalance shows as unequal secondaries; an offset of the demodulator "
+        "or amplifier is in neither secondary"),
+    frozenset({"null_offset", "zero_shift"}): (
+        _SECONDARIES, "a zero shift moves the position where the secondaries are equal; an "
+        "offset leaves it where the core is centred and only adds to the output"),
+    frozenset({"quadrature_null", "null_offset"}): (
+        _QUADRATURE + ", or record at a second excitation frequency",
+        "a quadrature null is 90 degrees out of phase with the excitation (capacitive coupling "
+        "grows with frequency); an offset is in phase or DC"),
+    frozenset({"quadrature_null", "secondary_imbalance"}): (
+        _QUADRATURE, "a quadrature null is 90 degrees out of phase with the excitation; an "
+        "imbalance is in phase with the secondaries"),
+    frozenset({"quadrature_null", "zero_shift"}): (
+        _QUADRATURE, "a quadrature null fills the null in with an out-of-phase voltage; a moved "
+        "null keeps the in-phase output's zero crossing sharp"),
+}
+# what reveals an effect whatever it is confounded with
+_ALONE: dict[str, tuple[str, str]] = {
+    "null_offset": (_SECONDARIES, "an offset is in neither secondary"),
+    "zero_shift": (_SECONDARIES, "a zero shift moves the position where the secondaries are "
+                   "equal"),
+    "secondary_imbalance": (_SECONDARIES, "an imbalance makes one secondary larger at every "
+                            "position"),
+    "quadrature_null": (_QUADRATURE, "a quadrature null is out of phase with the excitation"),
+    "backlash": ("record both directions of travel over the same positions, with a dial gauge "
+                 "on the core", "lost motion makes the two directions differ by the dead band"),
+    "thermal_drift": ("record a second run at constant temperature, or with the temperature "
+                      "changing on the way back", "a thermal drift follows the temperature, "
+                      "not the displacement or the sweep"),
+    "adc_clipping": ("record with the excitation lowered by a known fraction",
+                     "a rail stays at the same voltage while the sensor's curve scales"),
+    "leadscrew_periodic": ("record the core's position with a reference gauge at a step of at "
+                           "most a third of the period", "a lead-screw error is in the "
+                           "actuator's position, not in the sensor's output"),
+}
+
+
+def separations(sets) -> tuple[Separation, ...]:
+    """The measurements that tell the first set from each other one (one per pair of effects
+    they do not share, each pair once)."""
+    if len(sets) < 2:
+        return ()
+    choice = tuple(sets[0])
+    out: list[Separation] = []
+    seen: set = set()
+    for other in sets[1:]:
+        only_a = [e for e in choice if e not in other]
+        only_b = [e for e in other if e not in choice]
+        pairs = [(a, b) for a in only_a for b in only_b] or \
+            [(e, None) for e in only_a + only_b]
+        for a, b in pairs:
+            key = frozenset({a, b} - {None})
+            if key in seen:
+                continue
+            seen.add(key)
+            if b is not None and key in _PAIRS:
+                out.append(Separation(a, b, *_PAIRS[key]))
+            else:
+                # a pair without its own measurement: what reveals the rarer of the two
+                e = a if a in _ALONE and (b is None or a not in _PAIRS_COMMON) else (b or a)
+                m, why = _ALONE.get(e, (_SECONDARIES, ""))
+                out.append(Separation(a, b, m, why))
+    return tuple(out)
+
+
+# effects the plain output curve carries at every position: a pair of one of these with a
+# rarer effect is told apart by what reveals the rarer one
+_PAIRS_COMMON = ("null_offset", "zero_shift", "secondary_imbalance")
+
+
+__all__ = ["Confounding", "Separation", "equivalent_sets", "none_confounded", "separations",
+           "CONFOUND_BIC"]
