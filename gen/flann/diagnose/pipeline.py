@@ -71,6 +71,8 @@ class PlotArrays:
     resid_before: np.ndarray = field(repr=False)
     resid_after: np.ndarray = field(repr=False)
     outlier_mask: np.ndarray = field(repr=False)
+    # each alternative's fitted curve minus the choice's, at every point
+    alternative_diffs: tuple[np.ndarray, ...] = field(repr=False, default=())
 
 
 @dataclass(frozen=True)
@@ -419,16 +421,17 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
 
     for k, name in enumerate(chosen.order):
         effects.append(report(final, name, k))
-    alternatives = []
+    alternatives, diffs = [], []
     if conf.confounded:
-        pred = family.predict(final, fit_idx)
+        pred = family.predict(final, all_idx)
         for names, d_bic, f in zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:]):
-            diff = family.predict(f, fit_idx) - pred
-            at = int(np.argmax(np.abs(diff)))
+            diff = family.predict(f, all_idx) - pred
+            at = fit_idx[int(np.argmax(np.abs(diff[fit_idx])))]
+            diffs.append(diff)
             alternatives.append(Alternative(
                 effects=[report(f, name, None) for name in names],
                 delta_bic=float(d_bic - conf.delta_bic[0]), rms_v=f.rms,
-                differs_most_at_mm=float(x[fit_idx[at]]), difference_v=float(diff[at])))
+                differs_most_at_mm=float(x[at]), difference_v=float(diff[at])))
 
     # -- noise and located mismatch (residual of the baseline: simulation + shape) --------
     passes = shape.passes
@@ -512,7 +515,7 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
         separate_by=list(separations(conf.sets)) if conf.confounded else [],
         trials=sel.trials,
         plot=PlotArrays(x=x, direction=direction, resid_before=before, resid_after=after,
-                        outlier_mask=skip))
+                        outlier_mask=skip, alternative_diffs=tuple(diffs)))
 
 
 def diagnose(rec: Recordings, sensor=None, progress=None,

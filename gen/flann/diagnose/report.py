@@ -201,6 +201,26 @@ def format_text(dg) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _plot_alternatives(ax, dg, x, d, keep) -> None:
+    """Each alternative's fitted curve minus the choice's: where a recording could tell them
+    apart, against the noise of one reading and of a running mean."""
+    first = keep & (d == d[0]) if d is not None else keep    # one pass: the curves repeat
+    o = np.flatnonzero(first)
+    o = o[np.argsort(x[o], kind="stable")]
+    for a, diff in zip(dg.alternatives, dg.plot.alternative_diffs):
+        ax.plot(x[o], diff[o] * 1e3, "-", lw=1.6,
+                label=f"{_set(a.named)} minus {_set(dg.named)} (delta BIC {a.delta_bic:+.1f})")
+    w = window_size(o.size)
+    for k, ls in ((2, "--"), (2 / math.sqrt(w), ":")):
+        for sgn in (-1, 1):
+            ax.axhline(sgn * k * dg.noise_v * 1e3, color="0.5", lw=0.7, ls=ls)
+    ax.axhline(0, color="0.3", lw=0.7)
+    ax.set_title("equally good explanations: their fitted curves apart (dashed: ±2 noise of "
+                 f"a reading; dotted: of a mean of {w})", fontsize=10)
+    ax.set_ylabel("difference (mV)")
+    ax.legend(fontsize=8, loc="best")
+
+
 def plot(dg, path) -> None:
     """Residuals against displacement before and after the added effects, spans shaded."""
     # lazy: matplotlib is only loaded when a plot is asked for
@@ -208,8 +228,9 @@ def plot(dg, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
     arr = dg.plot
+    panels = 3 if dg.alternatives else 2
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 3.25 * panels), sharex=True)
     x, d = arr.x, arr.direction
     keep = ~arr.outlier_mask
     title_after = ("after " + " + ".join(e.name for e in dg.effects)) if dg.effects \
@@ -252,7 +273,9 @@ def plot(dg, path) -> None:
         ax.set_title(f"{title}: RMS {rms * 1e3:.3g} mV", fontsize=10)
         ax.set_ylabel("residual (mV)")
         ax.legend(fontsize=8, loc="best")
-    axes[1].set_xlabel("displacement (mm)")
+    if dg.alternatives:
+        _plot_alternatives(axes[2], dg, x, d, keep)
+    axes[-1].set_xlabel("displacement (mm)")
     fig.suptitle(f"flann diagnose: {dg.source} (shaded: located mismatch, dashed: ±2 noise)",
                  fontsize=10)
     fig.tight_layout()
