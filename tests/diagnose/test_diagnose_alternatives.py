@@ -2,6 +2,7 @@
 not determine, and figures that cannot be computed (never printed as nan)."""
 
 import json
+import math
 import re
 import warnings
 from dataclasses import replace
@@ -11,7 +12,7 @@ import pytest
 
 from flann.cli import main
 from flann.diagnose import diagnose
-from flann.diagnose.confound import paired_z, separations
+from flann.diagnose.confound import bic_spread, separations
 from flann.diagnose.demo import CASES, simulate_case
 from flann.diagnose.report import format_text, to_json
 from flann.diagnose.select import Fit
@@ -55,12 +56,17 @@ def _fit(resid):
     return Fit((), [], np.zeros(0), np.zeros(0), r, np.arange(r.size))
 
 
-def test_paired_z_separates_clearly_better_residuals_only():
+def test_bic_spread_follows_the_noise_of_a_difference():
+    """A set that misses by delta at every reading lies sum(delta^2)/sigma^2 behind, give or
+    take 2 sqrt of that over noise draws; a difference at five readings is not spread."""
     rng = np.random.default_rng(1)
-    r = rng.normal(0, 1, 500)
-    assert paired_z(_fit(r), _fit(r)) == 0.0
-    assert abs(paired_z(_fit(r), _fit(r[::-1]))) < 3          # the same spread, reshuffled
-    assert paired_z(_fit(r), _fit(r * 1.5)) > 10              # clearly larger residuals
+    r = rng.normal(0, 1, 2000)
+    se, readings = bic_spread(_fit(r), _fit(r + 0.1))
+    expected = 2 * math.sqrt(2000 * 0.1 ** 2)
+    assert 0.8 * expected < se < 1.25 * expected and readings > 300
+    bump = r.copy()
+    bump[:5] += 5.0
+    assert bic_spread(_fit(r), _fit(bump))[1] < 10
 
 
 def _filament_rectified(q_v: float, seed: int) -> Recordings:

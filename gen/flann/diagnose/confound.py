@@ -13,8 +13,8 @@ fitted, each with its own shape term.  Sets whose BIC is within the margin of th
 equally good explanations: ``CONFOUND_BIC``, or ``CONFOUND_FRACTION`` of what the best set
 gains over the calibrated simulation alone when that is more (the physics model's own
 imperfection -- geometry calibrated, a smooth shape term -- leaves a misfit that grows with
-the effects it must reproduce); so is a set whose residuals the best set's do not clearly
-beat (``SAME_Z``).  When more than one is, the diagnosis names the best as its choice, ranks
+the effects it must reproduce); so is a set that another recording of the same sensor may
+put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names the best as its choice, ranks
 the others as alternatives, and names the measurement that would tell them apart
 (:func:`separations`).
 """
@@ -40,15 +40,16 @@ CONFOUND_BIC = 6.0
 # draw to the next: any fixed margin near that split them at random.  (The demo's
 # backlash + null_offset, gain ~750, beats its alternative by 9.5: 1 % keeps it named.)
 CONFOUND_FRACTION = 0.01
-# ... or whose residuals the best set's do not beat by this paired z (the per-point
-# differences of squared residuals over their standard error: Vuong's test of two
-# non-nested fits).  The BIC of a set swings by k ln n whenever its shape term takes
-# another number of terms, without its residuals changing: on 8 identical sensors with a
-# 0.5 % imbalance, zero_shift lay 4-28 BIC behind the best (at 0 or 2 shape terms) while
-# |z| < 2.6 on all.  4 asks of "decided" the strength an effect needs to be accepted
-# (BIC_MARGIN: p < 3e-5, z ~ 4); at 3, 3 of 20 identical sensors with a 0.05 mm zero shift
-# (z 0.2-3.6 against an offset) were decided and 17 not.
-SAME_Z = 4.0
+# ... or whose BIC is behind by more than the margin on these recordings, but not so far
+# that another recording of the same sensor would put it there too: ΔBIC - margin must
+# exceed REPEAT_Z standard errors of the difference between two recordings' ΔBIC (sqrt 2
+# times one's, from the per-point differences of squared residuals: the variance Vuong's
+# test of two non-nested fits uses), one-sided 99 %.  On 20 identical sensors with a
+# 0.05 mm zero shift an offset lay 3-35 BIC behind (margin 17): any fixed margin split them.
+REPEAT_Z = 2.33
+# ... judged so only where the differences are spread over at least this many readings
+# (their participation ratio): the spread of a few readings' differences is not known
+SAME_READINGS = 30.0
 # at most this many sets are fitted (a budget: each is one nonlinear fit)
 MAX_SETS = 12
 
@@ -106,7 +107,7 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     margin = max(margin, fraction * (sel.baseline.bic - best_bic))
     best = min(fits.values(), key=lambda f: f.bic)
     near = sorted(((f.bic - best_bic, key) for key, f in fits.items()
-                   if f.bic - best_bic < margin or paired_z(best, f) < SAME_Z),
+                   if f.bic - best_bic < margin or _not_beaten(best, f, margin)),
                   key=lambda t: (t[0], sorted(t[1])))
     if len(near) <= 1:
         return none_confounded(named)
@@ -116,14 +117,25 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
                        tuple(fits[key] for _, key in near))
 
 
-def paired_z(a: Fit, b: Fit) -> float:
-    """How clearly ``a``'s residuals beat ``b``'s on the same points: the mean per-point
-    difference of squared residuals over its standard error (0 when they do not differ)."""
-    if a.resid.size != b.resid.size or a.resid.size < 3:
-        return math.inf
-    d = b.resid ** 2 - a.resid ** 2
-    sd = float(np.std(d, ddof=1))
-    return float(np.mean(d) / (sd / math.sqrt(d.size))) if sd > 0 else 0.0
+def bic_spread(best: Fit, other: Fit) -> tuple[float, float]:
+    """The standard error of ``other``'s BIC behind ``best`` over noise draws (from the
+    per-point differences of squared residuals, in units of ``best``'s residual variance),
+    and the number of readings those differences are spread over (participation ratio)."""
+    n = best.resid.size
+    if other.resid.size != n or n < 3 or best.rss <= 0:
+        return math.inf, 0.0
+    d = (other.resid ** 2 - best.resid ** 2) / (best.rss / n)
+    den = float(d @ d)
+    readings = float(np.sum(np.abs(d))) ** 2 / den if den > 0 else 0.0
+    return math.sqrt(n) * float(np.std(d, ddof=1)), readings
+
+
+def _not_beaten(best: Fit, other: Fit, margin: float) -> bool:
+    """Another recording of the same sensor may put ``other`` within ``margin`` of ``best``."""
+    se, readings = bic_spread(best, other)
+    if readings < SAME_READINGS or not math.isfinite(se) or se <= 0:
+        return False
+    return other.bic - best.bic - margin < REPEAT_Z * math.sqrt(2.0) * se
 
 
 @dataclass(frozen=True)
@@ -217,5 +229,5 @@ def separations(sets) -> tuple[Separation, ...]:
 _PAIRS_COMMON = ("null_offset", "zero_shift", "secondary_imbalance")
 
 
-__all__ = ["Confounding", "Separation", "equivalent_sets", "none_confounded", "separations",
+__all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded", "separations",
            "CONFOUND_BIC"]
