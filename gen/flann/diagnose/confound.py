@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .select import BIC_MARGIN, Fit, Selection
+from .select import BIC_MARGIN, CV_T, Fit, Selection
 
 # Sets within this BIC of the best fit the recordings equally well: a difference below 6 is
 # not "strong" evidence on the Kass-Raftery scale (BIC_MARGIN, 10, is "very strong": what an
@@ -65,6 +65,7 @@ class Confounding:
     best: Fit | None
     margin: float = CONFOUND_BIC      # the margin used (BIC units)
     fits: tuple[Fit, ...] = ()
+    notes: tuple[str, ...] = ()       # per set: why it is listed ("" for the margin's reasons)
 
     @property
     def confounded(self) -> bool:
@@ -136,6 +137,50 @@ def _not_beaten(best: Fit, other: Fit, margin: float) -> bool:
     if readings < SAME_READINGS or not math.isfinite(se) or se <= 0:
         return False
     return other.bic - best.bic - margin < REPEAT_Z * math.sqrt(2.0) * se
+
+
+SHAPE_NOTE = ("BIC prefers it, but cross-validation does not: the smooth shape term draws "
+              "the same readings without it")
+
+
+def with_shape_alternative(family, sel: Selection, idx, conf: Confounding) -> Confounding:
+    """Add "the sensor's shape" as an explanation beside an effect the shape term may draw
+    (:meth:`PhysicsFamily.shape_may_hide`).  Nothing named, but such a candidate lowered BIC
+    by the acceptance margin and failed only cross-validation: it is listed as an
+    alternative to nothing.  The effect named alone: nothing (its shape term) is listed when
+    it is within the margin or another recording may put it there.  Either way identical
+    sensors get the same pair, whichever side of the line their noise puts them."""
+    hides = getattr(family, "shape_may_hide", None)
+    if hides is None or conf.confounded or len(conf.sets[0]) > 1:
+        return conf
+    named = conf.sets[0]
+    if not named:
+        first = sel.trials[0] if sel.trials else []
+        strong = [t for t in first if hides(t.name) and not t.vetoed and not t.accepted
+                  and math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN
+                  and (t.cv_t is None or t.cv_t > CV_T - REPEAT_Z * math.sqrt(2.0))]
+        if not strong:
+            return conf
+        c = strong[0].name
+        f = family.fit([c], idx, start=sel.baseline)
+        if f.ok:
+            f = family.rechoose([c], idx, f)
+        if not f.ok:
+            return conf
+        return Confounding(((), (c,)), (0.0, f.bic - sel.final.bic), (), sel.final,
+                           conf.margin, (sel.final, f), ("", SHAPE_NOTE))
+    if not hides(named[0]):
+        return conf
+    best, base = sel.final, sel.baseline
+    # cross-validation's t, too, moves by about 1 from one recording to the next
+    cv_t = sel.steps[0].cv_t if sel.steps else math.inf
+    if (base.bic - best.bic < conf.margin or _not_beaten(best, base, conf.margin)
+            or cv_t - CV_T < REPEAT_Z * math.sqrt(2.0)):
+        return Confounding((named, ()), (0.0, base.bic - best.bic), (), best, conf.margin,
+                           (best, base), ("", "the smooth shape term draws the same readings "
+                                          "without it, nearly as well (cross-validation t "
+                                          f"{cv_t:.1f})"))
+    return conf
 
 
 @dataclass(frozen=True)

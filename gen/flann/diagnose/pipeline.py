@@ -23,7 +23,8 @@ from ..recordings import Recordings, converter_step, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
-from .confound import Confounding, Separation, equivalent_sets, separations
+from .confound import (Confounding, Separation, equivalent_sets, separations,
+                       with_shape_alternative)
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
 from .select import Fit, Selection, Trial, evidence_chain, forward_select
@@ -56,6 +57,7 @@ class Alternative:
     rms_v: float
     differs_most_at_mm: float
     difference_v: float
+    note: str = ""        # why it is listed beside the choice, when not for its BIC alone
 
     @property
     def named(self) -> list[str]:
@@ -355,6 +357,7 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     if progress:
         progress("testing for equally good explanations")
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
+    conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
     final = sel.final
     if conf.confounded:
         # the choice is the best of the equally good sets; when forward selection built
@@ -424,14 +427,15 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
     alternatives, diffs = [], []
     if conf.confounded:
         pred = family.predict(final, all_idx)
-        for names, d_bic, f in zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:]):
+        notes = conf.notes[1:] or ("",) * (len(conf.sets) - 1)
+        for names, d_bic, f, why in zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes):
             diff = family.predict(f, all_idx) - pred
             at = fit_idx[int(np.argmax(np.abs(diff[fit_idx])))]
             diffs.append(diff)
             alternatives.append(Alternative(
                 effects=[report(f, name, None) for name in names],
                 delta_bic=float(d_bic - conf.delta_bic[0]), rms_v=f.rms,
-                differs_most_at_mm=float(x[at]), difference_v=float(diff[at])))
+                differs_most_at_mm=float(x[at]), difference_v=float(diff[at]), note=why))
 
     # -- noise and located mismatch (residual of the baseline: simulation + shape) --------
     passes = shape.passes

@@ -37,7 +37,8 @@ def to_json(dg) -> dict:
                                        "params": _params(e.params)} for e in a.effects],
                           "delta_bic": _num(a.delta_bic), "rms_v": _num(a.rms_v),
                           "differs_most_at_mm": _num(a.differs_most_at_mm),
-                          "difference_v": _num(a.difference_v)} for a in dg.alternatives],
+                          "difference_v": _num(a.difference_v),
+                          **({"note": a.note} if a.note else {})} for a in dg.alternatives],
         "separate_by": [{"effects": [x for x in (s.a, s.b) if x], "measurement": s.measurement,
                          "why": s.why} for s in dg.separate_by],
         "final": {"rms_v": _num(dg.final_rms)},
@@ -148,12 +149,16 @@ def format_text(dg) -> str:
             lines.append(f"  in recording time: {spans}")
     if dg.alternatives:
         lines.append(f"not decided: {len(dg.alternatives) + 1} explanations fit these recordings "
-                     f"equally well (BIC within {dg.alternatives_margin:.3g} of the best), ranked:")
-        lines.append(f"  1. {_set(dg.named)}: the choice (best BIC), below")
+                     f"equally well (BIC within {dg.alternatives_margin:.3g} of the best, or "
+                     "within what another recording of the same sensor may move it by), "
+                     "ranked:")
+        lines.append(f"  1. {_set(dg.named)}: the choice" + (" (best BIC), below" if dg.named
+                                                             else ""))
         for i, a in enumerate(dg.alternatives, 2):
             lines.append(f"  {i}. {_set(a.named)}: delta BIC {a.delta_bic:+.1f} against the "
                          f"choice, RMS {_mv(a.rms_v)}; its curve differs from the choice's by at "
-                         f"most {_mv(a.difference_v)} (at {a.differs_most_at_mm:.3g} mm)")
+                         f"most {_mv(a.difference_v)} (at {a.differs_most_at_mm:.3g} mm)"
+                         + (f"; {a.note}" if a.note else ""))
             for e in a.effects:
                 lines.append(f"     {e.name}: " + "; ".join(_fmt_param(k, v)
                                                          for k, v in e.params.items()))
@@ -215,8 +220,11 @@ def _plot_alternatives(ax, dg, x, d, keep) -> None:
         for sgn in (-1, 1):
             ax.axhline(sgn * k * dg.noise_v * 1e3, color="0.5", lw=0.7, ls=ls)
     ax.axhline(0, color="0.3", lw=0.7)
-    ax.set_title("equally good explanations: their fitted curves apart (dashed: ±2 noise of "
-                 f"a reading; dotted: of a mean of {w})", fontsize=10)
+    top = max([float(np.max(np.abs(df[o]))) for df in dg.plot.alternative_diffs]
+              + [2 * dg.noise_v / math.sqrt(w)])
+    ax.set_ylim(-1.6 * top * 1e3, 1.6 * top * 1e3)
+    ax.set_title(f"alternatives minus the choice (dotted: ±2 noise of a mean of {w} readings; "
+                 "dashed: of one)", fontsize=10)
     ax.set_ylabel("difference (mV)")
     ax.legend(fontsize=8, loc="best")
 
