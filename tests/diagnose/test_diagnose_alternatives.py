@@ -85,6 +85,11 @@ def test_quadrature_null_at_a_v_tip_is_named():
     assert dg.named == ["quadrature_null"], format_text(dg)
     q = dg.effects[0].params["quadrature_v"]
     assert abs(q["value"] - 0.04) < max(3 * q["stderr"], 0.004)
+    # the shape term alone may draw the same tip: then it is the listed alternative, and the
+    # quadrature channel separates them
+    for a in dg.alternatives:
+        assert a.named == [] and a.note
+        assert "quadrature channel" in dg.separate_by[0].measurement
     # and the same sensor without it: nothing named
     assert _diag(_filament_rectified(0.0, 3001)).named == []
 

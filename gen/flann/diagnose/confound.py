@@ -14,7 +14,8 @@ equally good explanations: ``CONFOUND_BIC``, or ``CONFOUND_FRACTION`` of what th
 gains over the calibrated simulation alone when that is more (the physics model's own
 imperfection -- geometry calibrated, a smooth shape term -- leaves a misfit that grows with
 the effects it must reproduce); so is a set that another recording of the same sensor may
-put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names the best as its choice, ranks
+put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names a choice
+(the set forward selection built, or the best by BIC when that set is not among them), ranks
 the others as alternatives, and names the measurement that would tell them apart
 (:func:`separations`).
 """
@@ -56,7 +57,8 @@ MAX_SETS = 12
 
 @dataclass(frozen=True)
 class Confounding:
-    """Equally good explanations (each a tuple of effect names, best first), the BIC of
+    """Equally good explanations (each a tuple of effect names, the choice first, then by
+    BIC), the BIC of
     each relative to the best, and the effects they all share; ``fits`` holds each set's fit, in the order of ``sets``."""
 
     sets: tuple[tuple[str, ...], ...]
@@ -112,6 +114,10 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
                   key=lambda t: (t[0], sorted(t[1])))
     if len(near) <= 1:
         return none_confounded(named)
+    # the choice is the set forward selection built (each of its effects earned its keep
+    # one at a time, converter-step and rail checks included) when it is among them
+    mine = [t for t in near if t[1] == frozenset(named)]
+    near = mine + [t for t in near if t[1] != frozenset(named)]
     sets = tuple(tuple(c for c in candidates if c in key) for _, key in near)
     shared = tuple(c for c in named if all(c in s for s in sets))
     return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin,

@@ -99,8 +99,8 @@ class Diagnosis:
     noise_method: str = ""
     noise_regions: list = field(default_factory=list)
     ideal_rms: float = math.nan
-    # other sets of effects that explain the recordings as well as ``effects`` (the choice,
-    # best by BIC), ranked; empty when the evidence decides
+    # other sets of effects that explain the recordings as well as ``effects`` (the choice),
+    # ranked by BIC; empty when the evidence decides
     alternatives: list[Alternative] = field(default_factory=list)
     alternatives_margin: float = math.nan
     # the measurements that would tell the choice from each alternative
@@ -360,8 +360,9 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
     final = sel.final
     if conf.confounded:
-        # the choice is the best of the equally good sets; when forward selection built
-        # another, its figures are those of the choice built one effect at a time
+        # the choice is forward selection's set when it is among the equally good ones
+        # (confound.equivalent_sets); otherwise the best, its figures those of the choice
+        # built one effect at a time
         final = conf.fits[0]
         if set(conf.sets[0]) != set(order):
             first = {t.name: t.delta_bic for t in (sel.trials[0] if sel.trials else [])}

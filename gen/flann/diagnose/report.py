@@ -152,8 +152,7 @@ def format_text(dg) -> str:
                      f"equally well (BIC within {dg.alternatives_margin:.3g} of the best, or "
                      "within what another recording of the same sensor may move it by), "
                      "ranked:")
-        lines.append(f"  1. {_set(dg.named)}: the choice" + (" (best BIC), below" if dg.named
-                                                             else ""))
+        lines.append(f"  1. {_set(dg.named)}: the choice" + (", below" if dg.named else ""))
         for i, a in enumerate(dg.alternatives, 2):
             lines.append(f"  {i}. {_set(a.named)}: delta BIC {a.delta_bic:+.1f} against the "
                          f"choice, RMS {_mv(a.rms_v)}; its curve differs from the choice's by at "
