@@ -17,7 +17,7 @@ from flann.diagnose.demo import CASES, simulate_case
 from flann.diagnose.report import format_text, to_json
 from flann.diagnose.select import Fit
 from flann.physics import filament as F
-from flann.recordings import Recordings, write_recordings
+from flann.recordings import Recordings
 
 
 def _diag(rec):
@@ -29,7 +29,8 @@ def _diag(rec):
 @pytest.mark.parametrize("sets, words", [
     ([("zero_shift",), ("secondary_imbalance",)], "both secondary amplitudes"),
     ([("null_offset",), ("zero_shift",)], "both secondary amplitudes"),
-    ([("null_offset", "backlash"), ("secondary_imbalance", "backlash")], "both secondary amplitudes"),
+    ([("null_offset", "backlash"), ("secondary_imbalance", "backlash")],
+     "both secondary amplitudes"),
     ([("quadrature_null",), ("null_offset",)], "quadrature channel"),
     ([("thermal_drift",), ("null_offset",)], "constant temperature"),
 ])

@@ -59,7 +59,8 @@ MAX_SETS = 12
 class Confounding:
     """Equally good explanations (each a tuple of effect names, the choice first, then by
     BIC), the BIC of
-    each relative to the best, and the effects they all share; ``fits`` holds each set's fit, in the order of ``sets``."""
+    each relative to the best, and the effects they all share; ``fits`` holds each set's
+    fit, in the order of ``sets``."""
 
     sets: tuple[tuple[str, ...], ...]
     delta_bic: tuple[float, ...]
@@ -247,6 +248,11 @@ _ALONE: dict[str, tuple[str, str]] = {
 }
 
 
+# effects the plain output curve carries at every position: a pair of one of these with a
+# rarer effect is told apart by what reveals the rarer one
+_PAIRS_COMMON = ("null_offset", "zero_shift", "secondary_imbalance")
+
+
 def separations(sets) -> tuple[Separation, ...]:
     """The measurements that tell the first set from each other one (one per pair of effects
     they do not share, each pair once)."""
@@ -275,10 +281,5 @@ def separations(sets) -> tuple[Separation, ...]:
     return tuple(out)
 
 
-# effects the plain output curve carries at every position: a pair of one of these with a
-# rarer effect is told apart by what reveals the rarer one
-_PAIRS_COMMON = ("null_offset", "zero_shift", "secondary_imbalance")
-
-
-__all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded", "separations",
-           "CONFOUND_BIC"]
+__all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded",
+           "separations", "with_shape_alternative", "CONFOUND_BIC"]
