@@ -58,9 +58,8 @@ MAX_SETS = 12
 @dataclass(frozen=True)
 class Confounding:
     """Equally good explanations (each a tuple of effect names, the choice first, then by
-    BIC), the BIC of
-    each relative to the best, and the effects they all share; ``fits`` holds each set's
-    fit, in the order of ``sets``."""
+    BIC), the BIC of each relative to the best, and the effects they all share; ``fits``
+    holds each set's fit and ``notes`` why it is listed, in the order of ``sets``."""
 
     sets: tuple[tuple[str, ...], ...]
     delta_bic: tuple[float, ...]
