@@ -33,7 +33,7 @@ def test_table1_json_plot(tmp_path, capsys):
     text = capsys.readouterr().out
     d = json.loads(out.read_text())
     assert list(d) == ["baseline", "noise_v", "regions", "outliers", "effects", "alternatives",
-                       "final", "improvement"]
+                       "separate_by", "final", "improvement"]
     assert {"rms_v", "params", "shape_term"} <= set(d["baseline"])
     assert "odd" in d["baseline"]["shape_term"]["description"] or \
         d["baseline"]["shape_term"]["terms"] == 0
@@ -48,7 +48,7 @@ def test_table1_json_plot(tmp_path, capsys):
         assert set(r) == {"from_mm", "to_mm", "direction", "peak_residual_v"}
         assert r["direction"] in ("+", "-", "both")
     for e in d["effects"]:
-        assert set(e) == {"name", "explanation", "params", "rms_v_after", "delta_bic"}
+        assert {"name", "explanation", "params", "rms_v_after", "delta_bic", "cv_t"} <= set(e)
     assert d["improvement"] == pytest.approx(d["baseline"]["rms_v"] / d["final"]["rms_v"])
     assert "row 8 at 10 mm" in text
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -80,22 +80,33 @@ def test_effect_signature_named_and_recovered(prefix, scale, words):
 
 def test_small_zero_shift_is_confounded_with_an_imbalance():
     """Both are even in the displacement; on 600 points a 10 um shift and an imbalance fit
-    within 6 BIC of each other: the report names neither alone and ranks the truth first."""
+    within 6 BIC of each other: the report ranks the truth first as the choice, gives the
+    imbalance as the first alternative with its figures, and says what would tell them
+    apart."""
     dg = _run(_case("zero_shift"), scale=2.0, seed=202)
-    assert dg.named == []
-    assert dg.alternatives == [["zero_shift"], ["secondary_imbalance"]]
-    assert dg.alternatives_delta_bic[0] == 0 and 0 < dg.alternatives_delta_bic[1] < 6
+    assert dg.named == ["zero_shift"]
+    alt = dg.alternatives[0]
+    assert alt.named == ["secondary_imbalance"]
+    assert 0 < alt.delta_bic < 6
+    assert alt.rms_v > 0 and alt.effects[0].params["imbalance_fraction"]["stderr"] > 0
+    assert dg.explanations[:2] == [["zero_shift"], ["secondary_imbalance"]] and dg.shared == []
+    # ranked: every later alternative is further behind
+    assert all(a.delta_bic <= b.delta_bic for a, b in zip(dg.alternatives, dg.alternatives[1:]))
+    sep = dg.separate_by[0]
+    assert {sep.a, sep.b} == {"zero_shift", "secondary_imbalance"}
+    assert "both secondary amplitudes" in sep.measurement
 
 
 def test_two_effects_at_once():
     """The 3 mV offset beside the backlash fits within 6 BIC of an imbalance on these 600
-    points: backlash is named (every explanation has it), the offset is the best of the
-    alternatives."""
+    points: the choice is backlash + null_offset (the truth), every alternative keeps the
+    backlash."""
     case = _case("two at once: backlash")
     dg = _run(case, seed=303)
-    assert dg.named == ["backlash"]
-    assert sorted(dg.alternatives[0]) == ["backlash", "null_offset"]
-    assert all("backlash" in a for a in dg.alternatives)
+    assert sorted(dg.named) == ["backlash", "null_offset"]
+    assert dg.alternatives and all("backlash" in a.named for a in dg.alternatives)
+    assert dg.shared == ["backlash"]
+    assert all(a.delta_bic <= b.delta_bic for a, b in zip(dg.alternatives, dg.alternatives[1:]))
     # the RMS falls at every added effect
     rms = [dg.baseline_rms] + [e.rms_v_after for e in dg.effects]
     assert all(a > b for a, b in zip(rms, rms[1:]))

@@ -72,4 +72,4 @@ def test_no_rail_where_the_readings_still_rise(points):
     assert "thermal_drift" in dg.named
     vetoed = [t for rnd in dg.trials for t in rnd if t.name == "adc_clipping" and t.vetoed]
     assert vetoed and all("rail" in t.note for t in vetoed)
-    assert "adc_clipping" not in {c for s in dg.alternatives for c in s}
+    assert "adc_clipping" not in {c for s in dg.explanations for c in s}

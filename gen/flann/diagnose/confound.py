@@ -13,8 +13,11 @@ fitted, each with its own shape term.  Sets whose BIC is within the margin of th
 equally good explanations: ``CONFOUND_BIC``, or ``CONFOUND_FRACTION`` of what the best set
 gains over the calibrated simulation alone when that is more (the physics model's own
 imperfection -- geometry calibrated, a smooth shape term -- leaves a misfit that grows with
-the effects it must reproduce).  When more than one is, the diagnosis reports them all as ``alternatives`` and
-names only the effects they share.
+the effects it must reproduce); so is a set that another recording of the same sensor may
+put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names a choice
+(the set forward selection built, or the best by BIC when that set is not among them), ranks
+the others as alternatives, and names the measurement that would tell them apart
+(:func:`separations`).
 """
 
 from __future__ import annotations
@@ -23,7 +26,9 @@ import itertools
 import math
 from dataclasses import dataclass
 
-from .select import BIC_MARGIN, Fit, Selection
+import numpy as np
+
+from .select import BIC_MARGIN, CV_T, Fit, Selection
 
 # Sets within this BIC of the best fit the recordings equally well: a difference below 6 is
 # not "strong" evidence on the Kass-Raftery scale (BIC_MARGIN, 10, is "very strong": what an
@@ -36,20 +41,33 @@ CONFOUND_BIC = 6.0
 # draw to the next: any fixed margin near that split them at random.  (The demo's
 # backlash + null_offset, gain ~750, beats its alternative by 9.5: 1 % keeps it named.)
 CONFOUND_FRACTION = 0.01
+# ... or whose BIC is behind by more than the margin on these recordings, but not so far
+# that another recording of the same sensor would put it there too: ΔBIC - margin must
+# exceed REPEAT_Z standard errors of the difference between two recordings' ΔBIC (sqrt 2
+# times one's, from the per-point differences of squared residuals: the variance Vuong's
+# test of two non-nested fits uses), one-sided 99 %.  On 20 identical sensors with a
+# 0.05 mm zero shift an offset lay 3-35 BIC behind (margin 17): any fixed margin split them.
+REPEAT_Z = 2.33
+# ... judged so only where the differences are spread over at least this many readings
+# (their participation ratio): the spread of a few readings' differences is not known
+SAME_READINGS = 30.0
 # at most this many sets are fitted (a budget: each is one nonlinear fit)
 MAX_SETS = 12
 
 
 @dataclass(frozen=True)
 class Confounding:
-    """Equally good explanations (each a tuple of effect names, best first), the BIC of
-    each relative to the best, and the effects they all share."""
+    """Equally good explanations (each a tuple of effect names, the choice first, then by
+    BIC), the BIC of each relative to the best, and the effects they all share; ``fits``
+    holds each set's fit and ``notes`` why it is listed, in the order of ``sets``."""
 
     sets: tuple[tuple[str, ...], ...]
     delta_bic: tuple[float, ...]
     shared: tuple[str, ...]
     best: Fit | None
     margin: float = CONFOUND_BIC      # the margin used (BIC units)
+    fits: tuple[Fit, ...] = ()
+    notes: tuple[str, ...] = ()       # per set: why it is listed ("" for the margin's reasons)
 
     @property
     def confounded(self) -> bool:
@@ -90,13 +108,177 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
             fits[key] = f
     best_bic = min(f.bic for f in fits.values())
     margin = max(margin, fraction * (sel.baseline.bic - best_bic))
-    near = sorted(((f.bic - best_bic, key) for key, f in fits.items() if f.bic - best_bic < margin),
+    best = min(fits.values(), key=lambda f: f.bic)
+    near = sorted(((f.bic - best_bic, key) for key, f in fits.items()
+                   if f.bic - best_bic < margin or _not_beaten(best, f, margin)),
                   key=lambda t: (t[0], sorted(t[1])))
     if len(near) <= 1:
         return none_confounded(named)
+    # the choice is the set forward selection built (each of its effects earned its keep
+    # one at a time, converter-step and rail checks included) when it is among them
+    mine = [t for t in near if t[1] == frozenset(named)]
+    near = mine + [t for t in near if t[1] != frozenset(named)]
     sets = tuple(tuple(c for c in candidates if c in key) for _, key in near)
     shared = tuple(c for c in named if all(c in s for s in sets))
-    return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin)
+    return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin,
+                       tuple(fits[key] for _, key in near))
 
 
-__all__ = ["Confounding", "equivalent_sets", "none_confounded", "CONFOUND_BIC"]
+def bic_spread(best: Fit, other: Fit) -> tuple[float, float]:
+    """The standard error of ``other``'s BIC behind ``best`` over noise draws (from the
+    per-point differences of squared residuals, in units of ``best``'s residual variance),
+    and the number of readings those differences are spread over (participation ratio)."""
+    n = best.resid.size
+    if other.resid.size != n or n < 3 or best.rss <= 0:
+        return math.inf, 0.0
+    d = (other.resid ** 2 - best.resid ** 2) / (best.rss / n)
+    den = float(d @ d)
+    readings = float(np.sum(np.abs(d))) ** 2 / den if den > 0 else 0.0
+    return math.sqrt(n) * float(np.std(d, ddof=1)), readings
+
+
+def _not_beaten(best: Fit, other: Fit, margin: float) -> bool:
+    """Another recording of the same sensor may put ``other`` within ``margin`` of ``best``."""
+    se, readings = bic_spread(best, other)
+    if readings < SAME_READINGS or not math.isfinite(se) or se <= 0:
+        return False
+    return other.bic - best.bic - margin < REPEAT_Z * math.sqrt(2.0) * se
+
+
+SHAPE_NOTE = ("BIC prefers it, but cross-validation does not: the smooth shape term draws "
+              "the same readings without it")
+
+
+def with_shape_alternative(family, sel: Selection, idx, conf: Confounding) -> Confounding:
+    """Add "the sensor's shape" as an explanation beside an effect the shape term may draw
+    (:meth:`PhysicsFamily.shape_may_hide`).  Nothing named, but such a candidate lowered BIC
+    by the acceptance margin and failed only cross-validation: it is listed as an
+    alternative to nothing.  The effect named alone: nothing (its shape term) is listed when
+    it is within the margin or another recording may put it there.  Either way identical
+    sensors get the same pair, whichever side of the line their noise puts them."""
+    hides = getattr(family, "shape_may_hide", None)
+    if hides is None or conf.confounded or len(conf.sets[0]) > 1:
+        return conf
+    named = conf.sets[0]
+    if not named:
+        first = sel.trials[0] if sel.trials else []
+        strong = [t for t in first if hides(t.name) and not t.vetoed and not t.accepted
+                  and math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN
+                  and (t.cv_t is None or t.cv_t > CV_T - REPEAT_Z * math.sqrt(2.0))]
+        if not strong:
+            return conf
+        c = strong[0].name
+        f = family.fit([c], idx, start=sel.baseline)
+        if f.ok:
+            f = family.rechoose([c], idx, f)
+        if not f.ok:
+            return conf
+        return Confounding(((), (c,)), (0.0, f.bic - sel.final.bic), (), sel.final,
+                           conf.margin, (sel.final, f), ("", SHAPE_NOTE))
+    if not hides(named[0]):
+        return conf
+    best, base = sel.final, sel.baseline
+    # cross-validation's t, too, moves by about 1 from one recording to the next
+    cv_t = sel.steps[0].cv_t if sel.steps else math.inf
+    if (base.bic - best.bic < conf.margin or _not_beaten(best, base, conf.margin)
+            or cv_t - CV_T < REPEAT_Z * math.sqrt(2.0)):
+        return Confounding((named, ()), (0.0, base.bic - best.bic), (), best, conf.margin,
+                           (best, base), ("", "the smooth shape term draws the same readings "
+                                          "without it, nearly as well (cross-validation t "
+                                          f"{cv_t:.1f})"))
+    return conf
+
+
+@dataclass(frozen=True)
+class Separation:
+    """A measurement that tells two confounded effects apart (``b`` None: that reveals
+    ``a`` whatever else is there), and why it does."""
+
+    a: str
+    b: str | None
+    measurement: str
+    why: str
+
+
+_SECONDARIES = "record both secondary amplitudes (sec_a_v, sec_b_v) over the travel"
+_QUADRATURE = ("record the quadrature channel (the output demodulated 90 degrees from the "
+               "excitation, or the waveforms exc_v, sec_a_v, sec_b_v)")
+# the physical signal that separates two effects whose DC output curves bend alike
+_PAIRS: dict[frozenset, tuple[str, str]] = {
+    frozenset({"secondary_imbalance", "zero_shift"}): (
+        _SECONDARIES, "an imbalance makes one secondary larger than the other at every "
+        "position; a zero shift moves the position where they are equal and keeps their sizes "
+        "alike"),
+    frozenset({"null_offset", "secondary_imbalance"}): (
+        _SECONDARIES, "an imbalance shows as unequal secondaries; an offset of the demodulator "
+        "or amplifier is in neither secondary"),
+    frozenset({"null_offset", "zero_shift"}): (
+        _SECONDARIES, "a zero shift moves the position where the secondaries are equal; an "
+        "offset leaves it where the core is centred and only adds to the output"),
+    frozenset({"quadrature_null", "null_offset"}): (
+        _QUADRATURE + ", or record at a second excitation frequency",
+        "a quadrature null is 90 degrees out of phase with the excitation (capacitive coupling "
+        "grows with frequency); an offset is in phase or DC"),
+    frozenset({"quadrature_null", "secondary_imbalance"}): (
+        _QUADRATURE, "a quadrature null is 90 degrees out of phase with the excitation; an "
+        "imbalance is in phase with the secondaries"),
+    frozenset({"quadrature_null", "zero_shift"}): (
+        _QUADRATURE, "a quadrature null fills the null in with an out-of-phase voltage; a moved "
+        "null keeps the in-phase output's zero crossing sharp"),
+}
+# what reveals an effect whatever it is confounded with
+_ALONE: dict[str, tuple[str, str]] = {
+    "null_offset": (_SECONDARIES, "an offset is in neither secondary"),
+    "zero_shift": (_SECONDARIES, "a zero shift moves the position where the secondaries are "
+                   "equal"),
+    "secondary_imbalance": (_SECONDARIES, "an imbalance makes one secondary larger at every "
+                            "position"),
+    "quadrature_null": (_QUADRATURE, "a quadrature null is out of phase with the excitation"),
+    "backlash": ("record both directions of travel over the same positions, with a dial gauge "
+                 "on the core", "lost motion makes the two directions differ by the dead band"),
+    "thermal_drift": ("record a second run at constant temperature, or with the temperature "
+                      "changing on the way back", "a thermal drift follows the temperature, "
+                      "not the displacement or the sweep"),
+    "adc_clipping": ("record with the excitation lowered by a known fraction",
+                     "a rail stays at the same voltage while the sensor's curve scales"),
+    "leadscrew_periodic": ("record the core's position with a reference gauge at a step of at "
+                           "most a third of the period", "a lead-screw error is in the "
+                           "actuator's position, not in the sensor's output"),
+}
+
+
+# effects the plain output curve carries at every position: a pair of one of these with a
+# rarer effect is told apart by what reveals the rarer one
+_PAIRS_COMMON = ("null_offset", "zero_shift", "secondary_imbalance")
+
+
+def separations(sets) -> tuple[Separation, ...]:
+    """The measurements that tell the first set from each other one (one per pair of effects
+    they do not share, each pair once)."""
+    if len(sets) < 2:
+        return ()
+    choice = tuple(sets[0])
+    out: list[Separation] = []
+    seen: set = set()
+    for other in sets[1:]:
+        only_a = [e for e in choice if e not in other]
+        only_b = [e for e in other if e not in choice]
+        pairs = [(a, b) for a in only_a for b in only_b] or \
+            [(e, None) for e in only_a + only_b]
+        for a, b in pairs:
+            key = frozenset({a, b} - {None})
+            if key in seen:
+                continue
+            seen.add(key)
+            if b is not None and key in _PAIRS:
+                out.append(Separation(a, b, *_PAIRS[key]))
+            else:
+                # a pair without its own measurement: what reveals the rarer of the two
+                e = a if a in _ALONE and (b is None or a not in _PAIRS_COMMON) else (b or a)
+                m, why = _ALONE.get(e, (_SECONDARIES, ""))
+                out.append(Separation(a, b, m, why))
+    return tuple(out)
+
+
+__all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded",
+           "separations", "with_shape_alternative", "CONFOUND_BIC"]

@@ -187,6 +187,9 @@ class CaseResult:
     seconds: float
     notes: list[str]
     regions: int = 0
+    # the other equally good explanations and the measurements that would separate them
+    alternatives: list[list[str]] = field(default_factory=list)
+    separate_by: list[str] = field(default_factory=list)
 
     @property
     def truth(self) -> list[str]:
@@ -204,7 +207,8 @@ class CaseResult:
                 "recovered": None if self.recovered is None else
                 {"value": self.recovered[0], "stderr": self.recovered[1]},
                 "regions": self.regions, "rms_before_v": self.rms_before, "rms_after_v": self.rms_after,
-                "noise_v": self.noise_v, "seconds": self.seconds}
+                "noise_v": self.noise_v, "seconds": self.seconds,
+                "alternatives": self.alternatives, "separate_by": self.separate_by}
 
 
 def run_case(case: Case, scale: float = 1.0, seed: int | None = None,
@@ -227,7 +231,9 @@ def run_case(case: Case, scale: float = 1.0, seed: int | None = None,
                 v = eff.params[got]
                 recovered = (v["value"], v["stderr"] if v["stderr"] is not None else math.nan)
     return CaseResult(case, dg.named, recovered, true_value, dg.baseline_rms, dg.final_rms,
-                      dg.noise_v, dt, dg.notes, regions=len(dg.regions))
+                      dg.noise_v, dt, dg.notes, regions=len(dg.regions),
+                      alternatives=[a.named for a in dg.alternatives],
+                      separate_by=IND.measurements(dg))
 
 
 @dataclass
@@ -316,7 +322,7 @@ def demo_table(results: DemoResults) -> str:
              "RMS before -> after (mV) | right |",
              "|---|---|---|---|---|---|"]
     for r in results.cases:
-        named = ", ".join(r.named) or "nothing"
+        named = IND.said(r.named, r.alternatives)
         hidden = (", ".join(r.truth) + ": " if r.truth else "") + r.case.hidden
         if r.case.main:
             p = r.case.main[1]

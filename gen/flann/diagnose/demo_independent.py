@@ -139,6 +139,20 @@ def judged_right(truth: list[str], named: list[str], regions: int) -> bool:
     return sorted(named) == truth
 
 
+def measurements(dg) -> list[str]:
+    """The measurements a diagnosis names to separate its alternatives, each once."""
+    return list(dict.fromkeys(sp.measurement for sp in dg.separate_by))
+
+
+def said(named: list[str], alternatives: list[list[str]]) -> str:
+    """A table cell: the named effects, and the alternatives when the evidence does not
+    decide."""
+    text = ", ".join(named) or "nothing"
+    if alternatives:
+        text += " (or " + "; or ".join(", ".join(a) or "nothing" for a in alternatives) + ")"
+    return text
+
+
 @dataclass
 class IndependentResult:
     case: IndependentCase
@@ -151,6 +165,8 @@ class IndependentResult:
     noise_v: float
     regions: int
     seconds: float
+    alternatives: list[list[str]] = field(default_factory=list)
+    separate_by: list[str] = field(default_factory=list)
 
     @property
     def truth(self) -> list[str]:
@@ -168,7 +184,8 @@ class IndependentResult:
                 "recovered": None if self.recovered is None else
                 {"value": self.recovered[0], "stderr": self.recovered[1]},
                 "regions": self.regions, "rms_before_v": self.rms_before,
-                "rms_after_v": self.rms_after, "noise_v": self.noise_v, "seconds": self.seconds}
+                "rms_after_v": self.rms_after, "noise_v": self.noise_v, "seconds": self.seconds,
+                "alternatives": self.alternatives, "separate_by": self.separate_by}
 
 
 def run_case(case: IndependentCase, seed: int | None = None, scale: float = 1.0,
@@ -188,7 +205,8 @@ def run_case(case: IndependentCase, seed: int | None = None, scale: float = 1.0,
                 v = e.params[pname]
                 recovered = (v["value"], v["stderr"] if v["stderr"] is not None else math.nan)
     return IndependentResult(case, d, dg.named, recovered, true, dg.baseline_rms, dg.final_rms,
-                             dg.noise_v, len(dg.regions), dt)
+                             dg.noise_v, len(dg.regions), dt,
+                             [a.named for a in dg.alternatives], measurements(dg))
 
 
 CASES: tuple[IndependentCase, ...] = (
@@ -325,7 +343,7 @@ def table(results: list[IndependentResult]) -> str:
                    else f"{p}: - ({r.true_value:.3g})")
         else:
             rec = "-"
-        lines.append(f"| {r.case.name} | {hidden} | {', '.join(r.named) or 'nothing'} | {rec} | "
+        lines.append(f"| {r.case.name} | {hidden} | {said(r.named, r.alternatives)} | {rec} | "
                      f"{r.rms_before * 1e3:.2f} -> {r.rms_after * 1e3:.2f} | "
                      f"{'yes' if r.right else 'NO'} |")
     lines.append("")

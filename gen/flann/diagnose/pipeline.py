@@ -23,10 +23,11 @@ from ..recordings import Recordings, converter_step, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
-from .confound import Confounding, equivalent_sets
+from .confound import (Confounding, Separation, equivalent_sets, separations,
+                       with_shape_alternative)
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
-from .select import Fit, Selection, Trial, forward_select
+from .select import Fit, Selection, Trial, evidence_chain, forward_select
 
 # the travel is "centred on 0 mm" when |min + max| <= this fraction of the span
 CENTRED = 0.1
@@ -41,6 +42,26 @@ class EffectReport:
     delta_bic: float
     cv_t: float
     alternatives: list[str] = field(default_factory=list)
+    # why delta_bic and cv_t are not computable ("" when they are)
+    evidence_note: str = ""
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """A set of effects that explains the recordings as well as the chosen one: its effects
+    (sentences and parameters from its own fit), its BIC relative to the choice, its RMS,
+    and where its fitted curve differs most from the choice's."""
+
+    effects: list[EffectReport]
+    delta_bic: float
+    rms_v: float
+    differs_most_at_mm: float
+    difference_v: float
+    note: str = ""        # why it is listed beside the choice, when not for its BIC alone
+
+    @property
+    def named(self) -> list[str]:
+        return [e.name for e in self.effects]
 
 
 @dataclass(frozen=True)
@@ -52,6 +73,8 @@ class PlotArrays:
     resid_before: np.ndarray = field(repr=False)
     resid_after: np.ndarray = field(repr=False)
     outlier_mask: np.ndarray = field(repr=False)
+    # each alternative's fitted curve minus the choice's, at every point
+    alternative_diffs: tuple[np.ndarray, ...] = field(repr=False, default=())
 
 
 @dataclass(frozen=True)
@@ -76,11 +99,12 @@ class Diagnosis:
     noise_method: str = ""
     noise_regions: list = field(default_factory=list)
     ideal_rms: float = math.nan
-    # sets of effects that explain the recordings equally well (empty: one explanation);
-    # ``effects`` then holds only the effects every set shares
-    alternatives: list[list[str]] = field(default_factory=list)
-    alternatives_delta_bic: list[float] = field(default_factory=list)
+    # other sets of effects that explain the recordings as well as ``effects`` (the choice),
+    # ranked by BIC; empty when the evidence decides
+    alternatives: list[Alternative] = field(default_factory=list)
     alternatives_margin: float = math.nan
+    # the measurements that would tell the choice from each alternative
+    separate_by: list[Separation] = field(default_factory=list)
     # the candidates tried in each round of the selection (the report names the closest)
     trials: list[list[Trial]] = field(repr=False, default_factory=list)
     plot: PlotArrays | None = field(repr=False, default=None)
@@ -90,6 +114,19 @@ class Diagnosis:
     @property
     def named(self) -> list[str]:
         return [e.name for e in self.effects]
+
+    @property
+    def explanations(self) -> list[list[str]]:
+        """Every set that explains the recordings equally well, the choice first ([] when
+        the evidence decides)."""
+        if not self.alternatives:
+            return []
+        return [self.named] + [a.named for a in self.alternatives]
+
+    @property
+    def shared(self) -> list[str]:
+        """The effects every equally good explanation names."""
+        return [e for e in self.named if all(e in a.named for a in self.alternatives)]
 
     @property
     def improvement(self) -> float:
@@ -142,6 +179,9 @@ class ShapeTermResult:
 
 @dataclass(frozen=True)
 class SelectionResult:
+    """The chosen effects (``order``, with the fit after each and its evidence) and the
+    equally good explanations; ``final`` is the chosen set's fit."""
+
     selection: Selection
     order: tuple[str, ...]
     cumulative: tuple[Fit, ...]
@@ -149,11 +189,18 @@ class SelectionResult:
     cvts: tuple[float, ...]
     alternatives: dict
     confounding: Confounding
+    final: Fit
 
 
-def _param(value, stderr, unit) -> dict:
+def _param(value, stderr, unit, magnitude: bool = True) -> dict:
+    """A fitted parameter.  A magnitude (a length, a gain, an effect's size; not a position
+    or a phase, which may sit near zero) whose uncertainty exceeds its value is not
+    determined by the recordings: marked ``determined: False``."""
     se = float(stderr)
-    return {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
+    out = {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
+    if magnitude and math.isfinite(se) and se > abs(float(value)):
+        out["determined"] = False
+    return out
 
 
 # -- the passes ----------------------------------------------------------------------------
@@ -310,10 +357,25 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     if progress:
         progress("testing for equally good explanations")
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
+    conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
+    final = sel.final
+    if conf.confounded:
+        # the choice is forward selection's set when it is among the equally good ones
+        # (confound.equivalent_sets); otherwise the best, its figures those of the choice
+        # built one effect at a time
+        final = conf.fits[0]
+        if set(conf.sets[0]) != set(order):
+            first = {t.name: t.delta_bic for t in (sel.trials[0] if sel.trials else [])}
+            order = sorted(conf.sets[0], key=lambda e: (
+                order.index(e) if e in order else len(order), first.get(e, math.inf)))
+            if progress:
+                progress(f"the evidence for {'+'.join(order)}")
+            cumulative, deltas, cvts = evidence_chain(family, order, calib.fit_idx,
+                                                      sel.baseline, final)
     return SelectionResult(selection=sel, order=tuple(order), cumulative=tuple(cumulative),
                            deltas=tuple(deltas), cvts=tuple(cvts),
                            alternatives={s.name: s.alternatives for s in sel.steps},
-                           confounding=conf)
+                           confounding=conf, final=final)
 
 
 def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult,
@@ -326,7 +388,7 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
     temp, time = data.temperature_c, data.time_s
     fit_idx, skip = calib.fit_idx, calib.skip
     sel = chosen.selection
-    final = sel.final
+    final = chosen.final
     all_idx = np.arange(x.size)
     before = y - family.predict(sel.baseline, all_idx)
     after = y - family.predict(final, all_idx)
@@ -345,25 +407,36 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
         effects.append(EffectReport("adc_clipping",
                                     explain("adc_clipping", params, contrib, x, direction,
                                             temp, y, slope, null_at),
-                                    params, final.rms, math.nan, math.nan))
+                                    params, final.rms, math.nan, math.nan,
+                                    evidence_note=RAILS_EVIDENCE))
     conf = chosen.confounding
-    for k, name in enumerate(chosen.order):
-        if name not in conf.shared:   # confounded: named only as one of the alternatives
-            continue
-        params = {}
-        for n, v, se in zip(final.names, final.theta, final.stderr):
-            if n.startswith(name + "."):
-                # position effects act in the simulated sensor's mm: back to recorded units
-                k_unit = 1.0 / family.scale if units.get(n) == "mm" else 1.0
-                params[n.split(".", 1)[1]] = _param(v * k_unit, se * k_unit, units.get(n, ""))
-        if name == "thermal_drift":
-            params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
-        contrib = family.predict(final, all_idx) - _without(family, final, name, all_idx)
+
+    def report(fit: Fit, name: str, k: int | None) -> EffectReport:
+        params = _effect_params(family, fit, name, units)
+        contrib = family.predict(fit, all_idx) - _without(family, fit, name, all_idx)
         sentence = explain(name, params, contrib, x, direction, temp, y, slope, null_at)
-        effects.append(EffectReport(name, sentence, params, chosen.cumulative[k].rms,
-                                    chosen.deltas[k],
-                                    chosen.cvts[k] if k < len(chosen.cvts) else math.nan,
-                                    alternatives=chosen.alternatives.get(name, [])))
+        if k is None:   # an alternative: its figures are the set's (Alternative)
+            return EffectReport(name, sentence, params, fit.rms, math.nan, math.nan,
+                                evidence_note="an alternative: see its set's figures")
+        return EffectReport(name, sentence, params, chosen.cumulative[k].rms,
+                            chosen.deltas[k],
+                            chosen.cvts[k] if k < len(chosen.cvts) else math.nan,
+                            alternatives=chosen.alternatives.get(name, []))
+
+    for k, name in enumerate(chosen.order):
+        effects.append(report(final, name, k))
+    alternatives, diffs = [], []
+    if conf.confounded:
+        pred = family.predict(final, all_idx)
+        notes = conf.notes[1:] or ("",) * (len(conf.sets) - 1)
+        for names, d_bic, f, why in zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes):
+            diff = family.predict(f, all_idx) - pred
+            at = fit_idx[int(np.argmax(np.abs(diff[fit_idx])))]
+            diffs.append(diff)
+            alternatives.append(Alternative(
+                effects=[report(f, name, None) for name in names],
+                delta_bic=float(d_bic - conf.delta_bic[0]), rms_v=f.rms,
+                differs_most_at_mm=float(x[at]), difference_v=float(diff[at]), note=why))
 
     # -- noise and located mismatch (residual of the baseline: simulation + shape) --------
     passes = shape.passes
@@ -381,9 +454,10 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
                                         _se(base, "baseline.gain_ratio"), "")}
     if not family.origin_known:
         base_params["origin_mm"] = _param(base.value("baseline.origin_mm"),
-                                          _se(base, "baseline.origin_mm"), "mm")
+                                          _se(base, "baseline.origin_mm"), "mm",
+                                          magnitude=False)
     elif centred:
-        base_params["origin_mm"] = _param(0.0, math.nan, "mm")
+        base_params["origin_mm"] = _param(0.0, math.nan, "mm", magnitude=False)
     if not known:
         for f, v in cal.geometry.items():
             base_params[f] = _param(v, cal.geometry_stderr.get(f, math.nan), "mm")
@@ -441,12 +515,12 @@ def report_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationResult
         shape_description=shape_desc, noise_method=D.NOISE_METHOD,
         noise_regions=noise_regions,
         ideal_rms=float(np.sqrt(np.mean((before + shape_v)[fit_idx] ** 2))),
-        alternatives=[list(s) for s in conf.sets] if conf.confounded else [],
-        alternatives_delta_bic=[float(d) for d in conf.delta_bic] if conf.confounded else [],
+        alternatives=alternatives,
         alternatives_margin=float(conf.margin) if conf.confounded else math.nan,
+        separate_by=list(separations(conf.sets)) if conf.confounded else [],
         trials=sel.trials,
         plot=PlotArrays(x=x, direction=direction, resid_before=before, resid_after=after,
-                        outlier_mask=skip))
+                        outlier_mask=skip, alternative_diffs=tuple(diffs)))
 
 
 def diagnose(rec: Recordings, sensor=None, progress=None,
@@ -470,6 +544,24 @@ def diagnose(rec: Recordings, sensor=None, progress=None,
         dg = replace(dg, notes=[how] + dg.notes,
                      reduced={"points": len(rec), "readings": n_read, "method": how})
     return dg
+
+
+RAILS_EVIDENCE = ("not computable: the rails are read off flat runs of readings at the ends "
+                  "of the travel, not chosen by comparing fits")
+
+
+def _effect_params(family: PhysicsFamily, fit: Fit, name: str, units: dict) -> dict:
+    """``name``'s fitted parameters in ``fit``, in recorded units."""
+    params = {}
+    for n, v, se in zip(fit.names, fit.theta, fit.stderr):
+        if n.startswith(name + "."):
+            # position effects act in the simulated sensor's mm: back to recorded units
+            k_unit = 1.0 / family.scale if units.get(n) == "mm" else 1.0
+            params[n.split(".", 1)[1]] = _param(v * k_unit, se * k_unit, units.get(n, ""),
+                                                magnitude=not n.endswith("phase_rad"))
+    if name == "thermal_drift":
+        params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
+    return params
 
 
 def _se(fit: Fit, name: str) -> float:

@@ -19,7 +19,7 @@ def to_json(dg) -> dict:
     """The issue's JSON, keys exactly as specified (params as {"value", "stderr", "unit"}),
     and "reduced" when a long recording was diagnosed on means of its readings."""
     out = {
-        "baseline": {"rms_v": _num(dg.baseline_rms), "params": dg.baseline_params,
+        "baseline": {"rms_v": _num(dg.baseline_rms), "params": _params(dg.baseline_params),
                      "ideal_rms_v": _num(dg.ideal_rms),
                      "shape_term": _clean(dg.shape_description),
                      "noise_method": dg.noise_method,
@@ -30,17 +30,43 @@ def to_json(dg) -> dict:
                     for r in dg.regions],
         "outliers": [{"row": int(o["row"]), "displacement_mm": _num(o["displacement_mm"]),
                       "residual_v": _num(o["residual_v"])} for o in dg.outliers],
-        "effects": [{"name": e.name, "explanation": e.explanation, "params": e.params,
-                     "rms_v_after": _num(e.rms_v_after), "delta_bic": _num(e.delta_bic)}
-                    for e in dg.effects],
-        # equally good explanations (each a list of effect names); "effects" then holds only
-        # what they all share
-        "alternatives": [list(a) for a in dg.alternatives],
+        "effects": [_effect(e) for e in dg.effects],
+        # other sets of effects that explain the recordings as well as "effects" (the
+        # choice), ranked, and the measurements that would tell them apart
+        "alternatives": [{"effects": [{"name": e.name, "explanation": e.explanation,
+                                       "params": _params(e.params)} for e in a.effects],
+                          "delta_bic": _num(a.delta_bic), "rms_v": _num(a.rms_v),
+                          "differs_most_at_mm": _num(a.differs_most_at_mm),
+                          "difference_v": _num(a.difference_v),
+                          **({"note": a.note} if a.note else {})} for a in dg.alternatives],
+        "separate_by": [{"effects": [x for x in (s.a, s.b) if x], "measurement": s.measurement,
+                         "why": s.why} for s in dg.separate_by],
         "final": {"rms_v": _num(dg.final_rms)},
         "improvement": _num(dg.baseline_rms / dg.final_rms) if dg.final_rms > 0 else None,
     }
     if dg.reduced:
         out["reduced"] = dict(dg.reduced)
+    return out
+
+
+def _effect(e) -> dict:
+    out = {"name": e.name, "explanation": e.explanation, "params": _params(e.params),
+           "rms_v_after": _num(e.rms_v_after), "delta_bic": _num(e.delta_bic),
+           "cv_t": _num(e.cv_t)}
+    if e.evidence_note:
+        out["not_computable"] = e.evidence_note
+    return out
+
+
+def _params(params: dict) -> dict:
+    """Parameters as JSON: one the recordings do not determine has no value, only its fit."""
+    out = {}
+    for k, p in params.items():
+        if p.get("determined", True):
+            out[k] = _clean(p)
+        else:
+            out[k] = {"value": None, "fitted_value": _num(p["value"]), "stderr": _num(p["stderr"]),
+                      "unit": p["unit"], "determined": False}
     return out
 
 
@@ -60,6 +86,9 @@ def _fmt_param(name: str, p: dict) -> str:
     se = p.get("stderr")
     if isinstance(p.get("value"), str):
         return f"{name} = {p['value']}"
+    if not p.get("determined", True):
+        return (f"{name} not determined by these recordings (its uncertainty ±{se:.2g}{unit} "
+                f"exceeds the fitted {p['value']:.3g}{unit})")
     if se is None or not math.isfinite(se):
         return f"{name} = {p['value']:.6g}{unit}"
     return f"{name} = {p['value']:.6g} ± {se:.2g}{unit}"
@@ -67,6 +96,20 @@ def _fmt_param(name: str, p: dict) -> str:
 
 def _mv(v: float) -> str:
     return f"{v * 1e3:.3g} mV"
+
+
+def _set(names) -> str:
+    return "{" + (" + ".join(names) or "nothing") + "}"
+
+
+def _evidence(e) -> str:
+    """delta BIC and cross-validation t, or why they are not computable (never "nan")."""
+    if math.isfinite(e.delta_bic) and math.isfinite(e.cv_t):
+        return f"delta BIC {e.delta_bic:.1f}, cross-validation t = {e.cv_t:.1f}"
+    why = e.evidence_note or "no fit to compare with"
+    if math.isfinite(e.delta_bic):
+        return f"delta BIC {e.delta_bic:.1f}, cross-validation t not computable ({why})"
+    return f"delta BIC and cross-validation t {why}"
 
 
 def format_text(dg) -> str:
@@ -105,12 +148,23 @@ def format_text(dg) -> str:
             spans = ", ".join(f"{a:g}..{b:g} {unit}" for a, b, _ in dg.time_spans)
             lines.append(f"  in recording time: {spans}")
     if dg.alternatives:
-        sets = " | ".join("{" + " + ".join(a) + "}" + f" ({d:+.1f})"
-                          for a, d in zip(dg.alternatives, dg.alternatives_delta_bic))
-        shared = ", ".join(e.name for e in dg.effects) or "none"
-        lines.append(f"confounded: these explanations fit the recordings equally well (delta BIC "
-                     f"within {dg.alternatives_margin:.3g} of the best): {sets}; the recordings cannot tell "
-                     f"them apart, so only what they share is named: {shared}")
+        lines.append(f"not decided: {len(dg.alternatives) + 1} explanations fit these recordings "
+                     f"equally well (BIC within {dg.alternatives_margin:.3g} of the best, or "
+                     "within what another recording of the same sensor may move it by), "
+                     "ranked:")
+        lines.append(f"  1. {_set(dg.named)}: the choice" + (", below" if dg.named else ""))
+        for i, a in enumerate(dg.alternatives, 2):
+            lines.append(f"  {i}. {_set(a.named)}: delta BIC {a.delta_bic:+.1f} against the "
+                         f"choice, RMS {_mv(a.rms_v)}; its curve differs from the choice's by at "
+                         f"most {_mv(a.difference_v)} (at {a.differs_most_at_mm:.3g} mm)"
+                         + (f"; {a.note}" if a.note else ""))
+            for e in a.effects:
+                lines.append(f"     {e.name}: " + "; ".join(_fmt_param(k, v)
+                                                         for k, v in e.params.items()))
+        lines.append("  to tell them apart:")
+        for sp in dg.separate_by:
+            pair = f"{sp.a} or {sp.b}" if sp.b else sp.a
+            lines.append(f"    {pair}: {sp.measurement}" + (f" ({sp.why})" if sp.why else ""))
     if not dg.effects and not dg.alternatives and not dg.regions:
         lines.append(f"nothing missing: the residual ({_mv(dg.final_rms)} RMS) is noise; "
                      "no effect of the catalogue earns its keep")
@@ -118,13 +172,13 @@ def format_text(dg) -> str:
         lines.append("no effect of the catalogue explains the mismatch located above: it is "
                      "physics the catalogue lacks, or a shape the simulated geometry cannot take")
     if dg.effects:
-        lines.append("physics missing from the ideal simulation (most important first):")
+        lines.append("physics missing from the ideal simulation (most important first)" +
+                     (", if the choice is right:" if dg.alternatives else ":"))
         prev = dg.baseline_rms
         for i, e in enumerate(dg.effects, 1):
             lines.append(f"  {i}. {e.name}: {e.explanation}")
             lines.append("     " + "; ".join(_fmt_param(k, v) for k, v in e.params.items()))
-            lines.append(f"     RMS {_mv(prev)} -> {_mv(e.rms_v_after)}, delta BIC "
-                         f"{e.delta_bic:.1f}, cross-validation t = {e.cv_t:.1f}")
+            lines.append(f"     RMS {_mv(prev)} -> {_mv(e.rms_v_after)}, " + _evidence(e))
             if e.alternatives:
                 lines.append(f"     fits these recordings equally well (BIC within 2): "
                              f"{', '.join(e.alternatives)}; named the simplest")
@@ -138,7 +192,10 @@ def format_text(dg) -> str:
         if last:
             lines.append("  closest candidates not earning their keep (delta BIC must be < -10 and "
                          "cross-validation t > 2): " + ", ".join(
-                             f"{t.name} {t.delta_bic:+.1f}" + (f" (CV t {t.cv_t:.1f})"
+                             f"{t.name} " + (f"{t.delta_bic:+.1f}" if math.isfinite(t.delta_bic)
+                                             else "(delta BIC not computable: too few points "
+                                             "for its parameters, or its fit failed)")
+                             + (f" (CV t {t.cv_t:.1f})"
                                                                if t.cv_t is not None else "")
                              + (f" ({t.note})" if t.note else "")
                              for t in last[:3]))
@@ -148,6 +205,29 @@ def format_text(dg) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _plot_alternatives(ax, dg, x, d, keep) -> None:
+    """Each alternative's fitted curve minus the choice's: where a recording could tell them
+    apart, against the noise of one reading and of a running mean."""
+    first = keep & (d == d[0]) if d is not None else keep    # one pass: the curves repeat
+    o = np.flatnonzero(first)
+    o = o[np.argsort(x[o], kind="stable")]
+    for a, diff in zip(dg.alternatives, dg.plot.alternative_diffs):
+        ax.plot(x[o], diff[o] * 1e3, "-", lw=1.6,
+                label=f"{_set(a.named)} minus {_set(dg.named)} (delta BIC {a.delta_bic:+.1f})")
+    w = window_size(o.size)
+    for k, ls in ((2, "--"), (2 / math.sqrt(w), ":")):
+        for sgn in (-1, 1):
+            ax.axhline(sgn * k * dg.noise_v * 1e3, color="0.5", lw=0.7, ls=ls)
+    ax.axhline(0, color="0.3", lw=0.7)
+    top = max([float(np.max(np.abs(df[o]))) for df in dg.plot.alternative_diffs]
+              + [2 * dg.noise_v / math.sqrt(w)])
+    ax.set_ylim(-1.6 * top * 1e3, 1.6 * top * 1e3)
+    ax.set_title(f"alternatives minus the choice (dotted: ±2 noise of a mean of {w} readings; "
+                 "dashed: of one)", fontsize=10)
+    ax.set_ylabel("difference (mV)")
+    ax.legend(fontsize=8, loc="best")
+
+
 def plot(dg, path) -> None:
     """Residuals against displacement before and after the added effects, spans shaded."""
     # lazy: matplotlib is only loaded when a plot is asked for
@@ -155,8 +235,9 @@ def plot(dg, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
     arr = dg.plot
+    panels = 3 if dg.alternatives else 2
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 3.25 * panels), sharex=True)
     x, d = arr.x, arr.direction
     keep = ~arr.outlier_mask
     title_after = ("after " + " + ".join(e.name for e in dg.effects)) if dg.effects \
@@ -199,7 +280,9 @@ def plot(dg, path) -> None:
         ax.set_title(f"{title}: RMS {rms * 1e3:.3g} mV", fontsize=10)
         ax.set_ylabel("residual (mV)")
         ax.legend(fontsize=8, loc="best")
-    axes[1].set_xlabel("displacement (mm)")
+    if dg.alternatives:
+        _plot_alternatives(axes[2], dg, x, d, keep)
+    axes[-1].set_xlabel("displacement (mm)")
     fig.suptitle(f"flann diagnose: {dg.source} (shaded: located mismatch, dashed: ±2 noise)",
                  fontsize=10)
     fig.tight_layout()

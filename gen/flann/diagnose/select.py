@@ -112,6 +112,11 @@ class Family(Protocol):
         """(Optional) why ``fit`` does not show what ``candidate`` names ("" if it may)."""
         ...
 
+    def shape_may_hide(self, candidate: str) -> bool:
+        """(Optional) whether the family's complexity chosen without ``candidate`` may
+        already draw it (the candidate's fit then always has it chosen again)."""
+        ...
+
 
 @dataclass
 class Step:
@@ -161,6 +166,34 @@ def oof_errors(family: Family, effects: Sequence[str], idx: np.ndarray,
         pred = family.predict(f, test)
         out[[pos[int(i)] for i in test]] = family.data_y(test) - pred
     return out
+
+
+def paired_t(e0: np.ndarray, e1: np.ndarray) -> tuple[float, float]:
+    """One-sided t of the paired out-of-fold squared errors of two models (positive: the
+    second predicts better) and the relative drop of the mean squared error."""
+    d = e0 ** 2 - e1 ** 2
+    sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
+    t = float(np.mean(d) / (sd / math.sqrt(d.size))) if sd > 0 else 0.0
+    return t, float(np.mean(d) / max(float(np.mean(e0 ** 2)), 1e-300))
+
+
+def evidence_chain(family: Family, order: Sequence[str], idx: np.ndarray, baseline: Fit,
+                   final: Fit) -> tuple[list[Fit], list[float], list[float]]:
+    """The fits of ``order``'s leading effects (the last is ``final``), and for each effect
+    its ΔBIC and cross-validation t against the fit before it: the figures of a set of
+    effects that forward selection did not build one effect at a time."""
+    folds = make_folds(idx)
+    fits, deltas, ts = [], [], []
+    prev = baseline
+    e_prev = oof_errors(family, [], idx, folds, baseline)
+    for k in range(len(order)):
+        f = final if k == len(order) - 1 else family.fit(list(order[:k + 1]), idx, start=prev)
+        e = oof_errors(family, list(order[:k + 1]), idx, folds, f)
+        fits.append(f)
+        deltas.append(f.bic - prev.bic)
+        ts.append(paired_t(e_prev, e)[0])
+        prev, e_prev = f, e
+    return fits, deltas, ts
 
 
 def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
@@ -213,6 +246,20 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                 g = rechoose(current + [c], idx, f)
                 redone.append((g.bic - best.bic, c, g) if g.ok and g.bic < f.bic else (db, c, f))
             fits = sorted(redone + fits[len(top):], key=lambda t: t[0])
+        hides = getattr(family, "shape_may_hide", None)
+        if rechoose is not None and hides is not None:
+            # a candidate the shape term may already draw is seen only with its complexity
+            # chosen again, however far behind it is at the present one
+            redone = []
+            for db, c, f in fits:
+                if hides(c) and math.isfinite(db):
+                    if progress:
+                        progress(f"re-choosing the shape term with {'+'.join(current + [c])}")
+                    g = rechoose(current + [c], idx, f)
+                    if g.ok and g.bic < f.bic:
+                        db, f = g.bic - best.bic, g
+                redone.append((db, c, f))
+            fits = sorted(redone, key=lambda t: t[0])
         # a fit may lower BIC without showing what the candidate names (a "rail" through
         # readings that still rise): not a candidate, listed with the reason
         implausible = getattr(family, "implausible", None)
@@ -247,9 +294,7 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                     continue
             e0 = oof(current, best)
             e1 = oof(current + [c], f)
-            d = e0 ** 2 - e1 ** 2
-            sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
-            t = float(np.mean(d) / (sd / math.sqrt(d.size))) if sd > 0 else 0.0
+            t, gain = paired_t(e0, e1)
             trials[j].cv_t = t
             if t > cv_t and family.least_evidence(current, c, idx, best, f) >= -bic_margin:
                 trials[j].note = ("a shape term that cross-validates as well makes it "
@@ -257,7 +302,6 @@ def forward_select(family: Family, candidates: Sequence[str], idx: np.ndarray,
                 continue
             if t > cv_t:
                 trials[j].accepted = True
-                gain = float(np.mean(d) / max(np.mean(e0 ** 2), 1e-300))
                 accepted = Step(c, f, db, gain, t,
                                 alternatives=[a for a in tie_names if a != c])
                 break

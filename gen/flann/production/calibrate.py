@@ -247,13 +247,14 @@ def _diagnosis(rec, sensor, points: int | None):
             dg = diagnose(small, sensor=sensor)
         except FlannError as exc:
             return [f"diagnosis not possible: {exc}"], basis, (), ()
-    found = [f"{e.name}: {e.explanation}" for e in dg.effects]
+    # what every equally good explanation names is a finding; the rest is one of the sets
+    found = [f"{e.name}: {e.explanation}" for e in dg.effects if e.name in dg.shared]
     found += list(dg.notes)
     if dg.outliers:
         found.append(f"{len(dg.outliers)} outlier point(s)")
     found += [f"warning: {w.message}" for w in caught]
-    named = tuple(e.name for e in dg.effects)
-    groups = tuple(tuple(g) for g in dg.alternatives)
+    named = tuple(dg.shared)
+    groups = tuple(tuple(g) for g in dg.explanations)
     return found, basis, named, groups
 
 
