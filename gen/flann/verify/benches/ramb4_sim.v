@@ -4,9 +4,9 @@
 // INIT_00..INIT_0F hold the contents, address 0 in the low bits of INIT_00.
 // Every width is one macro call: the contents (RAMB4_MEM) are written once, each port kind
 // (RAMB4_SINGLE, RAMB4_DUAL) once, with the data width W and the address width A as arguments.
-// The contents are W-bit words filled by a loop, not one 4096-bit register set from one constant:
-// Verilator 5.006 sets such a register in 256-bit chunks, and its top chunk's zero fill
-// (VL_CONSTHI_W_*) writes past the register's end by the chunk's offset, which corrupted the heap.
+// The contents are W-bit words filled by a loop, not one 4096-bit register set from one constant,
+// which the simulator (5.006) sets in 256-bit chunks whose top chunk's zero fill (VL_CONSTHI_W_*)
+// writes past the register's end by the chunk's offset: that corrupted the heap.
 
 `define RAMB4_MEM(W) \
   parameter INIT_00 = 256'h0; parameter INIT_01 = 256'h0; parameter INIT_02 = 256'h0; parameter INIT_03 = 256'h0; \
