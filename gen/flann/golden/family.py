@@ -149,10 +149,9 @@ def shared_terms(tried, table, own, steady, describe=lambda t: f"{t} terms"):
 
 # the family design's temperature orders take these expansion sizes (the design needs >= 2)
 THERMAL_TERMS = tuple(n for n in thermal_train.AUTO_TERMS if n >= 2)
-# A family with temperature trains at one ridge: the smaller ones chose 19 terms for
-# bench/thermal_line.py, a netlist that the Verilator sweep of flann synth cannot simulate
-# (docs/temperature.md, "Not done yet").
-THERMAL_RIDGES = (DEFAULT_RIDGE,)
+# A family with temperature takes the one-input family's ridges: on bench/thermal_line.py 1e-10
+# holds out 0.0021 mm with 19 terms, where 1e-6 alone holds out 0.0048 mm with 25.
+THERMAL_RIDGES = FAMILY_RIDGES
 
 
 def family_thermal_terms(members, *, orders: int, temperature_norm: tuple[float, float], norm: str,
