@@ -510,6 +510,12 @@ def _find_header(body: list[tuple[int, str]], required, source: str) -> tuple[in
             continue
         if sep == " ":
             cells = _WS_HEADER.findall(line)
+        try:
+            units = _unit_row(body[k:], sep, len(cells))
+        except RecordingsError:
+            units = None
+        if units is not None:   # names on this line, their units on the next
+            cells = [f"{h} ({u})" if u else h for h, u in zip(cells, units)]
         hits = {hit[0] for hit in map(recognise_header, cells) if hit}
         ex = _extras(cells)
         if all(c in hits or (c == "voltage_v" and ex.a) for c in required):
