@@ -124,7 +124,7 @@ def read_usable(rec: Recordings, outliers: str | None = None, step_v: float | No
         turn = [f"{b:+g} mm" for b, side in ((kx.max(), rec.displacement_mm[rows] > kx.max()),
                                               (kx.min(), rec.displacement_mm[rows] < kx.min())) if side.any()]
         said.append(f"{rec.source}: output turns back at {' and '.join(turn)}: trained on "
-                    f"{kx.min():g}..{kx.max():g} mm ({rows.size} reading(s) beyond left out)")
+                    f"{kx.min():g}..{kx.max():g} mm ({rows.size} reading(s) beyond left out: {_where(rec, rows)})")
         record["fold_back"] = span.message
     if outliers != "keep":
         cur = checked.subset(keep)
