@@ -147,8 +147,9 @@ def run(args) -> int:
         if args.plot:
             raw = raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm
             plot_errors(args.plot, pts["x"], raw, pts["float"], pts["hardware"], pts["limit"],
-                        title=f"{rec.source}: error vs displacement ({spec.input_bits}-bit ADC, "
-                              f"{spec.output_lsb_mm:g} mm output LSB)")
+                        title=f"{rec.source}: error vs displacement ({hw['input_bits']}-bit ADC, "
+                              + (f"{hw['output_lsb_mm']:g} mm output LSB)" if hw.get("output_lsb_mm")
+                                 else f"{hw.get('number_format', 'float18')} output)"))
     if errors is not None:
         errors.setdefault("hardware", None)
         report = temperature_report(errors, rec.displacement_mm, rec.temperature_c, res["full_scale_mm"])
@@ -189,8 +190,10 @@ def run(args) -> int:
         dropped = (f" (a {hw['adc_bits']}-bit ADC x {hw['adc_lsb_v']:g} V, {hw['dropped_low_bits']} low bits "
                    "dropped)" if hw["dropped_low_bits"] else "")
         temp = (f", {hw['temp_bits']}-bit temperature x {hw['temp_lsb_c']:g} degC" if "temp_bits" in hw else "")
-        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, output LSB "
-              f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; {hardware_vs_float(hw)}")
+        out = (f"output LSB {hw['output_lsb_mm']:g} mm" if hw.get("output_lsb_mm") is not None
+               else f"{hw.get('number_format', 'float18')} output")
+        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, {out}, "
+              f"{hw['points_clamped']} point(s) clamped; {hardware_vs_float(hw)}")
         if "weight_image" in hw:
             print(f"hardware weight memories: {hw['weight_image']}")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
