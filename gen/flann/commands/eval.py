@@ -125,11 +125,19 @@ def run(args) -> int:
     outside = None
     if not args.whole and not is_thermal(model):
         # the same reading train made: figures over the usable stroke, the rest counted
-        reading = read_usable(rec, args.outliers)
-        for line in reading.said:
-            warnings.warn(line)
-        outside = len(rec) - len(reading.rec)
-        rec = reading.rec
+        try:
+            reading = read_usable(rec, args.outliers)
+        except FlannError as exc:
+            if args.outliers == "refuse":
+                raise
+            # a recording train would refuse is still one a model can be judged on, whole
+            warnings.warn(f"{exc}; the figures are over every reading")
+            reading = None
+        if reading is not None:
+            for line in reading.said:
+                warnings.warn(line)
+            outside = len(rec) - len(reading.rec)
+            rec = reading.rec
     # a design eval cannot judge is refused before any warning about the recording
     spec = design_spec(args.model, args.design) if args.design else None
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
