@@ -42,6 +42,7 @@ import numpy as np
 
 from ..errors import RecordingsError, one_line
 from ..fileio import atomic_write_text, note_input
+from ..inputs import input_error
 
 REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
@@ -768,12 +769,8 @@ def read_recording_bytes(path: str | Path) -> bytes:
     path = Path(path)
     try:
         fh = open(path, "rb")
-    except FileNotFoundError:
-        raise RecordingsError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise RecordingsError(f"{path}: is a directory, expected a CSV file") from None
     except OSError as exc:
-        raise RecordingsError(f"{path}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
+        raise input_error(path, exc, RecordingsError, "a CSV file") from None
     parts, total, ends, run = [], 0, 0, 0
     longest = 4 * MAX_LINE_CHARS   # a line of MAX_LINE_CHARS characters, four bytes each at most
     with fh:
@@ -781,7 +778,7 @@ def read_recording_bytes(path: str | Path) -> bytes:
             try:
                 chunk = fh.read(_CHUNK)
             except OSError as exc:
-                raise RecordingsError(f"{path}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
+                raise input_error(path, exc, RecordingsError, "a CSV file") from None
             if not chunk:
                 break
             total += len(chunk)
