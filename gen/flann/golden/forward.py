@@ -327,10 +327,15 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
 
 
+NEIGHBOUR_CANDIDATES = 4
+
+
 def _largest_apart(x, new, ar) -> np.ndarray:
     """Of the candidate outliers ``new``, those larger than every candidate at a neighbouring
     position: a gross outlier pulls its neighbours' held-out predictions by as much as half its
     own size, so they wait for the next round, judged without it."""
+    if new.sum() > NEIGHBOUR_CANDIDATES:   # many at once: a bad stretch, not one reading's pull
+        return new
     xs = np.unique(x)
     rank = np.searchsorted(xs, x)
     out = np.zeros_like(new)
