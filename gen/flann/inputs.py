@@ -29,6 +29,15 @@ MAX_INT_DIGITS = 19      # 64-bit integers
 MAX_TEXT_BYTES = 64 << 20  # a model, sensor or manifest is a few kB
 
 
+def input_error(path, exc: OSError, error: type[FlannError], what: str) -> FlannError:
+    """One ``error`` line for an input that cannot be opened or read."""
+    if isinstance(exc, FileNotFoundError):
+        return error(f"{path}: no such file")
+    if isinstance(exc, IsADirectoryError):
+        return error(f"{path}: is a directory, expected {what}")
+    return error(f"{path}: cannot read ({exc.strerror or exc.__class__.__name__})")
+
+
 def read_bytes(path: str | os.PathLike, error: type[FlannError], what: str, limit: int | None = None) -> bytes:
     """The bytes of an input file (noted as an input of the running command), or one
     ``error`` line: missing, a directory, unreadable, or more than ``limit`` bytes."""
@@ -36,12 +45,8 @@ def read_bytes(path: str | os.PathLike, error: type[FlannError], what: str, limi
     try:
         with open(path, "rb") as fh:
             raw = fh.read() if limit is None else fh.read(limit + 1)
-    except FileNotFoundError:
-        raise error(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise error(f"{path}: is a directory, expected {what}") from None
     except OSError as exc:
-        raise error(f"{path}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
+        raise input_error(path, exc, error, what) from None
     if limit is not None and len(raw) > limit:
         raise error(f"{path}: larger than {limit >> 20} MB, not {what}")
     note_input(path)

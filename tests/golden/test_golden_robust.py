@@ -61,7 +61,8 @@ def test_a_glitch_among_repeated_sweeps_is_left_out_not_refused(tmp_path, capsys
     """One reading of 0.9 V among -2.14 V (two sweeps each way, a direction column) was refused
     as a repeat that differs ('give each sweep its direction', which it had): it is a gross
     outlier, left out with one warning, and the model and the converter are those without it.
-    Without the outlier screen (--terms N) it is still refused, and so are two files joined."""
+    --terms N leaves the same reading out (one reading for every command); two files joined
+    are refused."""
     clean, glitched = _two_sweeps(), _two_sweeps(glitch=(30, 0.9))
     a, b = tmp_path / "clean.csv", tmp_path / "glitch.csv"
     a.write_text("\n".join(clean[:31] + clean[32:]) + "\n")   # the glitch's row left out by hand
@@ -74,24 +75,29 @@ def test_a_glitch_among_repeated_sweeps_is_left_out_not_refused(tmp_path, capsys
     v = np.linspace(-3.5, 3.5, 2001)
     assert np.max(np.abs(ma.predict(v) - mb.predict(v))) < 1e-6
     assert mb.training["converter"]["input_bits"] == 12
+    # --terms N reads the recording the same way: the same reading left out
     rc, _, err = run(["train", b, "-o", tmp_path / "c.json", "--terms", "5"], capsys)
-    assert rc == 2 and "lines 32 and 354" in err and "appears twice" in err
+    assert rc == 0 and "line 32 (" in err, err
     joined = tmp_path / "joined.csv"
     joined.write_text("\n".join(_two_sweeps(offset=0.2)) + "\n")
     rc, _, err = run(["train", joined, "-o", tmp_path / "d.json"], capsys)
     assert rc == 2 and "appears twice" in err, err
 
 
-def test_many_wrong_readings_are_refused(tmp_path, capsys):
+def test_many_wrong_readings_are_left_out_or_refused_on_request(tmp_path, capsys):
     rng = np.random.default_rng(1)
     x = np.tile(np.linspace(-10.0, 10.0, 200), 2)
     v = 7.0 * np.tanh(x / 9.0) + rng.normal(0.0, 1e-3, x.size)
     v[rng.choice(x.size, 30, replace=False)] += 0.05      # 7.5 % of the readings, 50 sigma off
     rows = [f"{a:.9g},{b:.9g}" for a, b in zip(x, v)]
-    rc, _, err = run(["train", write(tmp_path / "bad.csv", rows), "-o", tmp_path / "m.json"], capsys)
+    bad = write(tmp_path / "bad.csv", rows)
+    # below the stated share they are left out, named, not refused
+    rc, _, err = run(["train", bad, "-o", tmp_path / "m.json"], capsys)
+    assert rc == 0 and "gross outlier reading(s)" in err and "--outliers keep" in err, err
+    rc, _, err = run(["train", bad, "-o", tmp_path / "r.json", "--outliers", "refuse"], capsys)
     assert rc == 2 and err.startswith("error: ") and len(err.strip().splitlines()) == 1
-    assert "noise units" in err and "5 %" in err and "worst line" in err
-    assert not (tmp_path / "m.json").exists()
+    assert "noise units" in err and "--outliers refuse" in err and "--outliers drop" in err
+    assert not (tmp_path / "r.json").exists()
 
 
 def test_converter_is_read_from_the_recordings_grid_and_gen_warns_for_another(tmp_path, capsys):

@@ -51,7 +51,7 @@ COMMANDS = {
     "explore": lambda d, fx: ("explore", d, "--lanes", 1, "--widths", "budget", "--no-seed"),
 }
 # (datapath, command) that refuse, with a word the one line must hold
-REFUSED = {("float18", "eval"): "no output LSB", ("family", "explore"): "members",
+REFUSED = {("family", "explore"): "members",
            **{("seed", c): "comparison design" for c in ("sim", "trace", "eval", "explore", "ise")},
            ("thermal", "explore"): "two-input",
            ("family_thermal", "explore"): "members",

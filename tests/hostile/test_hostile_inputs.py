@@ -94,6 +94,50 @@ def p_subnormal(w):
     _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i * 5e-324!r},{i * 0.1}\n" for i in range(20)))
 
 
+def p_zero(w):
+    """/dev/zero's kind inside the world: a device that never ends and holds no line end."""
+    try:
+        os.mknod(w / "zero", stat.S_IFCHR | 0o666, os.makedev(1, 5))
+    except PermissionError:
+        pytest.skip("a device node needs root")
+
+
+def p_endless_line(w):
+    """A file with no line end beyond a line's bound (what /dev/urandom gives the reader)."""
+    (w / "bad.csv").write_bytes(b"displacement_mm,voltage_v\n" + b"7" * (5 << 20))
+
+
+def p_cr_rows(w):
+    """More rows than flann reads, ended by a lone CR (the early bound counted LF only)."""
+    (w / "bad.csv").write_bytes(b"displacement_mm,voltage_v\r" + b"1,2\r" * 1_100_000)
+
+
+def p_nel_comment(w):
+    """A Latin-1 comment holding byte 0x85 (NEL, which str.splitlines() takes for a line end)."""
+    (w / "rec.csv").write_bytes(b"# caf\x85 x,y\ndisplacement_mm,voltage_v\n" +
+                                b"".join(f"{i},{0.1 * i}\n".encode() for i in range(10)))
+
+
+def p_underflow(w):
+    _write(w / "bad.csv", "displacement_mm,voltage_v\n0,1e-400\n" + "".join(f"{i},{0.1 * i}\n" for i in range(1, 10)))
+
+
+def p_flat(w):
+    _write(w / "flat.csv", "displacement_mm,voltage_v\n" + "".join(f"{i},1.5\n" for i in range(10)))
+
+
+def p_newline_sensor(w):
+    from flann.physics.sensor import default_sensor, format_sensor
+
+    text = format_sensor(default_sensor()).replace('name = "paper_lvdt"', 'name = "a\\nb"')
+    _write(w / "s.toml", text)
+
+
+def p_temperature_every_row(w):
+    _write(w / "bad.csv", "displacement_mm,voltage_v,temperature_c\n" +
+           "".join(f"{i % 24},{0.1 * (i % 24)},{20 + 0.37 * i}\n" for i in range(723)))
+
+
 def p_degenerate(w):
     """Voltages that differ only in the last digits of a double (the diagnosis crashed)."""
     _write(w / "bad.csv", "displacement_mm,voltage_v\n" + "".join(f"{i},{1 + i * 1e-15!r}\n" for i in range(20)))
@@ -363,6 +407,19 @@ CASES = [
     Case("eval-overflow-unit", "9", ("eval", "m.json", "bad.csv"), 2, "x 1000", (), "p_overflow"),
     Case("predict-huge-voltage", "9", ("predict", "m.json", "bad.csv", "-o", "p.csv"), 2, "outside what flann computes", (), "p_huge_voltage"),
     # 10 subnormal displacements
+    # readers bounded before they allocate; outputs the readers accept; lines that say what is wrong
+    Case("train-dev-zero", "own", ("train", "zero", "-o", "o.json"), 2, "without a line end", (), "p_zero"),
+    Case("diagnose-endless-line", "own", ("diagnose", "bad.csv"), 2, "without a line end", (), "p_endless_line"),
+    Case("train-cr-only-rows", "own", ("train", "bad.csv", "-o", "o.json"), 2, "more than 1,000,000", (), "p_cr_rows"),
+    Case("train-nel-comment", "own", ("train", "rec.csv", "-o", "o.json", "--terms", "1"), 0, "verdict:", ("o.json",),
+         "p_nel_comment"),
+    Case("train-underflow", "own", ("train", "bad.csv", "-o", "o.json"), 2, "outside what flann computes", (), "p_underflow"),
+    Case("simulate-fit-flat", "own", ("simulate", "--fit", "flat.csv", "--json"), 2, "same on every row", (), "p_flat"),
+    Case("simulate-step-rows", "own", ("simulate", "-o", "o.csv", "--step-mm", "1e-4"), 2, "more than flann reads"),
+    Case("simulate-seed-alone", "own", ("simulate", "-o", "o.csv", "--seed", "3"), 2, "every seed writes the same"),
+    Case("simulate-newline-name", "own", ("simulate", "s.toml", "-o", "o.csv"), 0, "", ("o.csv",), "p_newline_sensor"),
+    Case("train-temperature-every-row", "own", ("train", "bad.csv", "--temperature", "-o", "o.json"), 2, "temperatures",
+         (), "p_temperature_every_row"),
     Case("train-subnormal", "10", ("train", "bad.csv", "-o", "o.json", "--terms", "5"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("diagnose-subnormal", "10", ("diagnose", "bad.csv"), 2, "outside what flann computes", (), "p_subnormal"),
     Case("gen-family-subnormal", "10", ("gen", "--family", "bad.csv", "-o", "newfam"), 2, "outside what flann computes", (), "p_subnormal"),

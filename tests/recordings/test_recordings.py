@@ -189,13 +189,13 @@ def test_canonical_file_says_nothing(tmp_path, capsys):
 
 def test_unknown_header_is_one_line_listing_accepted_names(tmp_path):
     p = tmp_path / "bad.csv"
-    p.write_text("Weg (mm);Spannung (V)\n1;2\n")
+    p.write_text("Przemieszczenie (mm);Napiecie (V)\n1;2\n")
     r = subprocess.run([sys.executable, "-m", "flann.cli", "train", str(p), "-o", str(tmp_path / "m.json")],
                        capture_output=True, text=True)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ")
-    assert "'Weg (mm)'" in lines[0] and "Displacement (mm)" in lines[0] and "voltage_mv" in lines[0]
+    assert "'Przemieszczenie (mm)'" in lines[0] and "Displacement (mm)" in lines[0] and "voltage_mv" in lines[0]
     assert "Traceback" not in r.stderr and not (tmp_path / "m.json").exists()
 
 

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from ..argtypes import bounded, png_path
 from ..diagnose import diagnose
-from ..diagnose.data import MAX_POINTS
+from ..diagnose.data import MAX_POINTS, shared_reading
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
 from ..errors import FlannError
@@ -21,7 +22,8 @@ def add_arguments(p) -> None:
     p.add_argument("recordings", nargs="?", help="recordings CSV (displacement_mm, voltage_v, "
                    "optional direction, time_s, temperature_c)")
     p.add_argument("--sensor", metavar="SENSOR.toml",
-                   help="sensor description (flann-sensor/1); its geometry is then taken as "
+                   help="sensor description (flann-sensor/1, a .toml file), or the ID of one sensor in "
+                        "a file of several (its sensor column); a description's geometry is then taken as "
                         "known and only gain and origin are calibrated (default: the paper's "
                         "LVDT with geometry calibrated to the recordings)")
     p.add_argument("--plot", metavar="OUT.png", type=png_path, help="residuals before/after, mismatch shaded")
@@ -68,10 +70,14 @@ def run(args) -> int:
     if not args.recordings:
         raise FlannError("diagnose needs a recordings CSV (or --demo)")
 
-    rec = read_recordings(args.recordings, announce=not args.quiet)
+    # --sensor names a sensor description (a file) or the ID of a sensor in a multi-sensor file
+    sensor_id = args.sensor if args.sensor and not (args.sensor.endswith(".toml") or Path(args.sensor).exists()) \
+        else None
+    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id)
     sensor = None
-    if args.sensor:
+    if args.sensor and sensor_id is None:
         sensor = load_sensor(args.sensor)
+    rec = shared_reading(rec)
     dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
     # both reports are built before any file is written: a failure leaves no output behind

@@ -17,8 +17,11 @@ from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
+from ..golden.reading import read_usable
+from ..golden.verdict import against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
 from .common import add_common, emit_json
+from .train import add_reading_flags
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
@@ -42,7 +45,29 @@ def add_arguments(p) -> None:
     p.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                    help="error vs displacement: raw sensor, float model, hardware (needs --design) "
                         "and the physical limit")
+    add_reading_flags(p)
+    p.add_argument("--whole", action="store_true",
+                   help="figures over every reading (rails, fold-back and outliers included); default: "
+                        "over the usable stroke the shared reading keeps, the rest counted")
+    p.add_argument("--strict", action="store_true",
+                   help="exit 1 when the verdict is bad (compensated worse than the straight line, or the "
+                        "hardware loses the float model's accuracy)")
     add_common(p, json="the figures")
+
+
+def eval_verdict(res: dict):
+    """Against the straight line through the same readings; with a design, the hardware against
+    the float model (max error, and the drift of a two-input model)."""
+    checks = [against_line(res["compensated"]["max_error_mm"], res["raw"]["max_error_mm"])]
+    hw = res.get("hardware")
+    if hw:
+        checks.append(hardware_against_float(hw["max_error_mm"], res["compensated"]["max_error_mm"]))
+        drift = res.get("drift_ppm_fs_per_c") or {}
+        if drift.get("hardware") is not None and drift.get("float") is not None:
+            checks.append(hardware_against_float(drift["hardware"], drift["float"], "drift", "ppm FS/degC",
+                                                 "generate with more --input-bits and --temp-bits (flann gen "
+                                                 "warns with the widths that keep it)"))
+    return combine(*checks)
 
 
 def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
@@ -93,10 +118,26 @@ def run(args) -> int:
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings, announce=not args.quiet)
+    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
+    outside = None
+    if not args.whole and not is_thermal(model):
+        # the same reading train made: figures over the usable stroke, the rest counted
+        try:
+            reading = read_usable(rec, args.outliers)
+        except FlannError as exc:
+            if args.outliers == "refuse":
+                raise
+            # a recording train would refuse is still one a model can be judged on, whole
+            warnings.warn(f"{exc}; the figures are over every reading")
+            reading = None
+        if reading is not None:
+            for line in reading.said:
+                warnings.warn(line)
+            outside = len(rec) - len(reading.rec)
+            rec = reading.rec
     # a design eval cannot judge is refused before any warning about the recording
     spec = design_spec(args.model, args.design) if args.design else None
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
@@ -114,8 +155,9 @@ def run(args) -> int:
         if args.plot:
             raw = raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm
             plot_errors(args.plot, pts["x"], raw, pts["float"], pts["hardware"], pts["limit"],
-                        title=f"{rec.source}: error vs displacement ({spec.input_bits}-bit ADC, "
-                              f"{spec.output_lsb_mm:g} mm output LSB)")
+                        title=f"{rec.source}: error vs displacement ({hw['input_bits']}-bit ADC, "
+                              + (f"{hw['output_lsb_mm']:g} mm output LSB)" if hw.get("output_lsb_mm")
+                                 else f"{hw.get('number_format', 'float18')} output)"))
     if errors is not None:
         errors.setdefault("hardware", None)
         report = temperature_report(errors, rec.displacement_mm, rec.temperature_c, res["full_scale_mm"])
@@ -125,10 +167,16 @@ def run(args) -> int:
             if report["by_temperature"][name] is not None and section in res:
                 res[section]["by_temperature"] = report["by_temperature"][name]
         res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
+    if outside is not None:
+        res["readings_left_out"] = outside
+    verdict = eval_verdict(res)
+    res["verdict"] = verdict.to_json()
     if emit_json(args, res):
-        return 0
+        return exit_code(verdict, args.strict)
     fs = res["full_scale_mm"]
-    print(f"{rec.source}: {res['points']} points, full scale {fs:g} mm "
+    left = (f" ({outside} reading(s) left out as train does, --whole keeps them)"
+            if outside else "")
+    print(f"{rec.source}: {res['points']} points{left}, full scale {fs:g} mm "
           f"(linearity tol +-{args.tol:g} % FS = {args.tol * fs / 100:g} mm, "
           f"band +-{args.band:g} % FS = {args.band * fs / 100:g} mm)")
     rows = [("max error (mm)", "max_error_mm", "{:.4g}"),
@@ -150,8 +198,10 @@ def run(args) -> int:
         dropped = (f" (a {hw['adc_bits']}-bit ADC x {hw['adc_lsb_v']:g} V, {hw['dropped_low_bits']} low bits "
                    "dropped)" if hw["dropped_low_bits"] else "")
         temp = (f", {hw['temp_bits']}-bit temperature x {hw['temp_lsb_c']:g} degC" if "temp_bits" in hw else "")
-        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, output LSB "
-              f"{hw['output_lsb_mm']:g} mm, {hw['points_clamped']} point(s) clamped; {hardware_vs_float(hw)}")
+        out = (f"output LSB {hw['output_lsb_mm']:g} mm" if hw.get("output_lsb_mm") is not None
+               else f"{hw.get('number_format', 'float18')} output")
+        print(f"hardware: {hw['input_bits']}-bit ADC x {hw['input_lsb_v']:g} V{dropped}{temp}, {out}, "
+              f"{hw['points_clamped']} point(s) clamped; {hardware_vs_float(hw)}")
         if "weight_image" in hw:
             print(f"hardware weight memories: {hw['weight_image']}")
         print(f"physical limit (1/2 ADC LSB / slope): {lim['min']:.3g} .. {lim['max']:.3g} mm; "
@@ -168,4 +218,5 @@ def run(args) -> int:
             f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
     if args.plot:
         print(f"plot: {args.plot}")
-    return 0
+    print(verdict.line())
+    return exit_code(verdict, args.strict)

@@ -14,16 +14,19 @@ from __future__ import annotations
 import re
 import warnings
 
+import numpy as np
+
 from ..argtypes import bounded, png_path
 from ..errors import FlannError
 from ..fileio import atomic_write_text
 from ..physics.effects import EFFECTS, thermal_coefficient_from_copper
 from ..physics.fit import DEFAULT_FIT_PARAMS, fit_sensor
 from ..physics.lvdt import describe
-from ..physics.sensor import default_sensor, format_sensor, load_sensor
+from ..physics.sensor import default_sensor, format_sensor, load_sensor, spread_unit
 from ..physics.simulate import (fold_back_mm, parse_temperatures, simulate_calibration,
                                 simulate_recordings)
 from ..recordings import read_recordings, write_recordings
+from ..recordings.csvio import MAX_ROWS
 from .common import add_common, emit_json, info, json_to_stdout, quiet
 from .simulate_waveforms import add_waveform_arguments, run_waveforms, waveform_options_used
 
@@ -50,7 +53,13 @@ def add_arguments(p) -> None:
                    help="time per step (default 1 s)")
     p.add_argument("--noise-v", type=float, default=0.0,
                    help="white Gaussian noise, V rms, before the ADC (default 0)")
-    p.add_argument("--seed", type=bounded(int, 0, 2**32 - 1), default=0, help="noise seed (default 0)")
+    p.add_argument("--seed", type=bounded(int, 0, 2**32 - 1), default=None,
+                   help="seed of the noise (--noise-v) and of the unit drawn by --spread (default 0); "
+                        "refused without either, where it would change nothing")
+    p.add_argument("--spread", type=bounded(float, 0, 0.2), default=0.0, metavar="SIGMA",
+                   help="unit-to-unit spread of the construction (windings, core and coil geometry, gain): "
+                        "each parameter times (1 + N(0, SIGMA)), the unit drawn by --seed; one seed per "
+                        "sensor of a production batch (default 0: the nominal sensor)")
     p.add_argument("--temperature-profile", default="const:20",
                    help="const:T | ramp:T0:T1 (over the run) | sine:MEAN:AMP:PERIOD_S "
                         "(degC; default const:20)")
@@ -140,9 +149,17 @@ def run(args) -> int:
                          "writes its recordings to -o)")
 
 
+    if args.seed is not None and not args.noise_v and not args.spread:
+        raise FlannError("simulate: --seed draws the noise (--noise-v) or the unit (--spread); without "
+                         "either every seed writes the same rows")
+    seed = 0 if args.seed is None else args.seed
     s = _sensor(args)
     if args.no_effects:
         s = s.without_effects()
+    drawn = ""
+    if args.spread:
+        s, factors = spread_unit(s, args.spread, seed)
+        drawn = ", ".join(f"{k} x{v:.4f}" for k, v in factors.items())
     lo = -s.stroke_mm if args.from_mm is None else args.from_mm
     hi = s.stroke_mm if args.to_mm is None else args.to_mm
     if args.waveforms:
@@ -150,17 +167,26 @@ def run(args) -> int:
     if waveform_options_used(args):
         raise FlannError("simulate: --carrier-hz, --sample-rate-hz, --adc-*, --trajectory, --excitation-drift-pct "
                          "and --harmonic-pct need --waveforms")
+    if not args.step_mm > 0:
+        raise FlannError(f"simulate: --step-mm must be > 0, got {args.step_mm:g}")
+    per_sweep = 2 * (abs(hi - lo) / args.step_mm) + 1   # a sweep goes out and back
+    n_temps = len(parse_temperatures(args.temperatures)) if args.temperatures is not None else 1
+    if per_sweep * max(args.sweeps, 1) * n_temps > MAX_ROWS:
+        raise FlannError(f"simulate: {abs(hi - lo):g} mm at --step-mm {args.step_mm:g}, {args.sweeps} sweep(s)"
+                         f"{f', {n_temps} temperatures' if n_temps > 1 else ''} is about "
+                         f"{per_sweep * max(args.sweeps, 1) * n_temps:,.0f} rows, more than flann reads "
+                         f"({MAX_ROWS:,}): use a larger --step-mm")
     if args.temperatures is not None:
         if args.temperature_profile != "const:20":
             raise FlannError("simulate: give either --temperatures or --temperature-profile")
         temps = parse_temperatures(args.temperatures)
         rec = simulate_calibration(s, temps, sweeps=args.sweeps, step_mm=args.step_mm,
-                                   noise_v=args.noise_v, seed=args.seed, travel_mm=(lo, hi),
+                                   noise_v=args.noise_v, seed=seed, travel_mm=(lo, hi),
                                    step_time_s=args.step_time_s, progress=not quiet(args))
         temperature = "calibration at " + ", ".join(f"{t:g}" for t in temps) + " degC"
     else:
         rec = simulate_recordings(s, sweeps=args.sweeps, step_mm=args.step_mm, noise_v=args.noise_v,
-                                  seed=args.seed, temperature_profile=args.temperature_profile,
+                                  seed=seed, temperature_profile=args.temperature_profile,
                                   travel_mm=(lo, hi), step_time_s=args.step_time_s, progress=not quiet(args))
         temperature = args.temperature_profile
     fold = fold_back_mm(s, (lo, hi))
@@ -172,10 +198,10 @@ def run(args) -> int:
     comments = (
         f"simulated by flann simulate: sensor {s.name} ({args.sensor or 'default'})",
         f"travel {lo:g}..{hi:g} mm, step {args.step_mm:g} mm, sweeps {args.sweeps}, "
-        f"step time {args.step_time_s:g} s, noise {args.noise_v:g} V rms, seed {args.seed}, "
+        f"step time {args.step_time_s:g} s, noise {args.noise_v:g} V rms, seed {seed}, "
         f"temperature {temperature}",
         f"effects: {effects}",
-    )
+    ) + ((f"unit drawn with --spread {args.spread:g}, seed {seed}: {drawn}",) if drawn else ())
     if args.plot:
         from ..physics.plots import plot_simulation  # matplotlib: loaded only to plot
 
@@ -194,7 +220,12 @@ def _run_fit(args) -> int:
     params = DEFAULT_FIT_PARAMS
     if args.params:
         params = tuple(p.strip() for p in args.params.split(",") if p.strip())
+    if not float(np.ptp(rec.voltage_v)) > 0:
+        raise FlannError(f"{args.fit}: the voltage is the same on every row: no sensor to calibrate")
     fit = fit_sensor(rec, sensor=s, params=params)
+    if not all(np.isfinite(v) for v in (*fit.values.values(), fit.rms_v, fit.noise_v)):
+        raise FlannError(f"{args.fit}: the fit did not converge to finite values (a recording with no "
+                         "usable slope?): nothing written")
     if not json_to_stdout(args):
         print(f"calibrated {s.name} to {args.fit} ({len(rec)} points, ideal model, no effects):")
         for line in fit.summary_lines():

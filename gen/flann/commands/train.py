@@ -11,10 +11,12 @@ import numpy as np
 
 from ..argtypes import bounded, checked, terms_or_auto
 from ..errors import FlannError
-from ..recordings import converter_of, converter_step, prepare_for_fit, read_recordings
+from ..recordings import converter_of, converter_step, read_recordings
+from ..recordings.csvio import AB_FORMS
+from ..golden.metrics import raw_output_mm
 from ..golden.model import MAX_TERMS
-from ..golden.forward import screens
-from ..golden.screen import screen_recording
+from ..golden.reading import OUTLIER_MODES, read_usable
+from ..golden.verdict import against_line, combine, exit_code
 from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
@@ -53,7 +55,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--input-scale-v", type=bounded(float, -1e6, 1e6, nonzero_abs=1e-9), default=None,
                    help="explicit normalisation scale (V); needs --input-offset-v")
     p.add_argument("--trim", action="store_true",
-                   help="keep only the monotonic span when the voltage folds back")
+                   help="keep only the monotonic span when the voltage folds back (the default: the "
+                        "usable stroke kept is said)")
+    add_reading_flags(p)
+    p.add_argument("--strict", action="store_true",
+                   help="exit 1 when the verdict is bad (compensated worse than the straight line)")
     p.add_argument("--temperature", action="store_true",
                    help="a two-input model x(voltage, temperature) from a calibration at several "
                         "temperatures (the temperature_c column; docs/temperature.md)")
@@ -64,6 +70,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="--terms auto: volts per code of that converter (default: the grid's step, "
                         "or flann gen's default for --input-bits)")
     add_common(p, output=dict(help="model.json to write", metavar="MODEL.json", required=True))
+
+
+def add_reading_flags(p, outliers: bool = True) -> None:
+    """The flags of how a recording is read, the same in train, eval and diagnose."""
+    p.add_argument("--sensor-id", "--sensor", dest="sensor_id", metavar="ID", default=None,
+                   help="the sensor of that ID in the file's sensor column (a file of several sensors)")
+    p.add_argument("--ab", choices=AB_FORMS, default="ratio",
+                   help="two secondary amplitude columns A, B as voltage_v: (A-B)/(A+B) (ratio, the "
+                        "default) or A-B (difference)")
+    if outliers:
+        p.add_argument("--outliers", choices=OUTLIER_MODES, default=None,
+                       help="gross outliers: drop (leave out, however many), keep (fit every reading), "
+                            "refuse; default: left out unless more than 20 %% of the readings")
 
 
 def converter(args, rec) -> dict | None:
@@ -81,13 +100,14 @@ def converter(args, rec) -> dict | None:
             "from": "the recording's converter grid"}
 
 
-def _heldout_text(rec, terms, norm, ridge, explicit) -> str:
-    """'; held-out ...' from the same cross-validation as auto (printed, not stored)."""
+def _heldout(rec, terms, norm, ridge, explicit) -> tuple[str, float | None]:
+    """('; held-out ...', its max error) from the same cross-validation as auto (printed, not
+    stored); ('', None) where it cannot be made."""
     if explicit is not None or len(rec) < 4:
-        return ""
+        return "", None
     (res,) = cross_validate(rec.voltage_v, rec.displacement_mm, (terms,), (norm,), (ridge,))
     return (f"; held-out (cross-validation): RMS {res.rms_mm:.4g} mm, "
-            f"max {res.max_mm:.4g} mm")
+            f"max {res.max_mm:.4g} mm"), float(res.max_mm)
 
 
 def _check_generatable(model) -> None:
@@ -127,16 +147,10 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         raise FlannError(f"{rec.source}: {positions} distinct positions are too few for --terms auto "
                          f"(the spline through them and its check by leaving each out need at least "
                          f"{MIN_POSITIONS}): give --terms 1 (a line) or --terms 2")
+    # the readings the shared reading kept (a glitch is on no converter's grid)
     conv = converter(args, rec)
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)
-    _stage(f"{len(rec)} readings at {positions} positions: screening for gross outliers")
-    rec, record, outlier_text = screen_recording(rec, step_v)
-    if outlier_text:
-        warnings.warn(outlier_text)
-        # a glitch is on no converter's grid: the grid is the readings' without it
-        conv = converter(args, rec)
-    provenance.update(record)
     if args.input_bits is not None:
         # the user's converter, by gen's own rule, before any fit: one it cannot carry would
         # otherwise surface as "no candidate builds" or a derived width out of range
@@ -184,18 +198,31 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
         said.append(f"auto: {t['selected_by']}: {t['traded']}")
     elif "hardware_why" in t:
         said.append(_Verdict(f"auto: no candidate builds in fixed point ({t['hardware_why']})"))
-    return model, said
+    return model, said, choice.max_mm
+
+
+def train_verdict(model, rec, heldout_max_mm: float | None):
+    """The model's error against the straight line through the same readings: held out when
+    cross-validated (a model that only follows its training points is judged as it generalises),
+    else at the training readings."""
+    line = float(np.max(np.abs(raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm)))
+    if heldout_max_mm is not None:
+        return combine(against_line(heldout_max_mm, line, "held-out max error"))
+    own = float(np.max(np.abs(model.predict(rec.voltage_v) - rec.displacement_mm)))
+    return combine(against_line(own, line, "max error"))
 
 
 def run(args) -> int:
-    rec = read_recordings(args.recordings, announce=not args.quiet)
+    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if args.temperature:
         return run_thermal(args, rec)
     hint = compensation_hint(rec)
     if hint:   # before the checks: a multi-temperature recording may not pass them as one
         info(args, hint)
-    # --terms auto screens gross outliers: a glitch among repeated readings is left to it
-    rec = prepare_for_fit(rec, trim=args.trim, lone_glitches=args.terms == "auto" and screens(rec.displacement_mm))
+    reading = read_usable(rec, args.outliers)
+    for line in reading.said:
+        warnings.warn(line)
+    rec = reading.rec
     explicit = None
     if (args.input_offset_v is None) != (args.input_scale_v is None):
         raise FlannError("--input-offset-v and --input-scale-v must be given together")
@@ -209,12 +236,16 @@ def run(args) -> int:
                   "data_sha256": rec.sha256}
     if rec.comments:
         provenance["data_provenance"] = rec.comments[0]
+    if rec.sensor_id:
+        provenance["sensor_id"] = rec.sensor_id
+    provenance.update(reading.record)
     said = []   # printed once the model is known to be writable
+    heldout_max = None
     if args.terms == "auto":
         if args.method != "lstsq" or explicit is not None or args.normalise or args.ridge:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
-        model, said = _train_auto(args, rec, provenance)
+        model, said, heldout_max = _train_auto(args, rec, provenance)
     else:
         if args.input_bits is not None or args.input_lsb_v is not None:
             raise FlannError("--input-bits/--input-lsb-v choose among --terms auto's candidates; "
@@ -230,10 +261,12 @@ def run(args) -> int:
         else:
             model = fit_lstsq(rec.voltage_v, rec.displacement_mm, args.terms, norm=norm,
                               offset_scale=explicit, ridge=args.ridge, training=provenance)
+            heldout, heldout_max = _heldout(rec, args.terms, norm, args.ridge, explicit)
             said.append(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
-                        f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)"
-                        + _heldout_text(rec, args.terms, norm, args.ridge, explicit))
+                        f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)" + heldout)
     _check_generatable(model)
+    verdict = train_verdict(model, rec, heldout_max)
+    model.training["verdict"] = verdict.to_json()
     model.save(args.output)   # first: the summary's reader (`| head`) may be gone
     for line in said:
         if isinstance(line, _Verdict) or not quiet(args):
@@ -243,4 +276,6 @@ def run(args) -> int:
         if not hw["buildable"]:
             warnings.warn(f"this model cannot be built in fixed point ({hw['why']}); "
                           "--terms auto selects a buildable one")
-    return 0
+    lo, hi = reading.stroke_mm
+    print(f"{verdict.line()}; usable stroke {lo:g}..{hi:g} mm", file=sys.stderr)
+    return exit_code(verdict, args.strict)

@@ -9,7 +9,8 @@ import numpy as np
 from ..errors import FlannError
 from ..golden.thermal_train import MIN_TEMPERATURES, compensable, fit_thermal_auto
 from ..golden.thermal import temperature_groups
-from ..recordings import prepare_for_fit
+from ..recordings import MIN_FIT_POINTS, prepare_for_fit
+from ..recordings.checks import TEMPERATURE_RESOLUTION_C
 from .common import info
 
 
@@ -26,6 +27,15 @@ def compensation_hint(rec) -> str | None:
 def _prepare(rec, trim: bool):
     """The fit's checks (span, duplicates, fold-back) at each temperature on its own."""
     levels, labels = temperature_groups(rec.temperature_c)
+    counts = np.bincount(labels, minlength=levels.size)
+    few = np.flatnonzero(counts < MIN_FIT_POINTS)
+    if few.size:
+        g = int(few[0])
+        raise FlannError(
+            f"{rec.source}: {few.size} of {levels.size} temperatures (to {TEMPERATURE_RESOLUTION_C:g} degC) hold "
+            f"fewer than {MIN_FIT_POINTS} readings, e.g. {int(counts[g])} at {levels[g]:g} degC of {len(rec)} rows: "
+            "a calibration at several temperatures holds a sweep at each; a temperature that changes on "
+            "every row is a drift, not a calibration (round the temperature_c column to the soak's setting)")
     parts = [prepare_for_fit(rec.subset(labels == g), trim=trim) for g in range(levels.size)]
     cat = np.concatenate
     return (cat([p.voltage_v for p in parts]), cat([p.temperature_c for p in parts]),

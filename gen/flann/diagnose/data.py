@@ -554,3 +554,27 @@ def find_rails(x: np.ndarray, y: np.ndarray, passes: Passes) -> list[dict]:
         rails.append({"side": side, "level_v": level, "stderr_v": se, "n": int(on.sum()),
                       "mask": on})
     return rails
+
+
+def shared_reading(rec: Recordings) -> Recordings:
+    """The recording with the readings every command leaves out as gross outliers left out,
+    said in the same line as train's (:func:`flann.golden.reading.read_usable`); rails and a
+    fold-back stay, they are physics the diagnosis names.  A recording the shared reading
+    refuses is diagnosed whole."""
+    import warnings
+
+    from ..errors import FlannError
+    from ..golden.reading import read_usable
+
+    try:
+        reading = read_usable(rec)
+    except FlannError:
+        return rec
+    outliers = [i for i, lo in enumerate(reading.left_out) if lo.why == "outlier"]
+    for line in reading.said:
+        warnings.warn(line, stacklevel=2)
+    if not outliers or rec.lines is None:
+        return rec
+    gone = {reading.left_out[i].line for i in outliers}
+    keep = np.array([rec.line_of(k) not in gone for k in range(len(rec))])
+    return rec.subset(keep)

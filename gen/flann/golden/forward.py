@@ -274,7 +274,8 @@ def _reading_residuals(x, v, keep, pos: Positions, pred_pos, fitted_pos) -> np.n
     return r
 
 
-def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
+def robust_forward(x, v, direction=None, step_v: float = 0.0,
+                   max_share: float = MAX_OUTLIER_SHARE) -> ForwardFit:
     """The forward fit of v(x) chosen by cross-validation, gross outliers left out (the fit
     only says what each reading should have been: it need not be monotonic).
 
@@ -282,7 +283,7 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
     other data say, robust noise (repeats when there are enough, else the residuals' MAD),
     outliers beyond ``OUTLIER_K`` noise units out; until no new outlier.  The final choice
     is by held-out error in x (the slope of the fit converts).  Raises when more than
-    ``MAX_OUTLIER_SHARE`` of the readings are outliers.
+    ``max_share`` of the readings are outliers.
     """
     x = np.asarray(x, float)
     v = np.asarray(v, float)
@@ -307,23 +308,44 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0) -> ForwardFit:
             judge = sigma
         # the largest first: a gross outlier also pulls its neighbours' held-out predictions
         ar = np.abs(np.nan_to_num(r))
-        new = keep & (ar > max(OUTLIER_K * judge, 0.5 * float(np.max(ar[keep]))))
+        new = _largest_apart(x, keep & (ar > max(OUTLIER_K * judge, 0.5 * float(np.max(ar[keep])))), ar)
         if not new.any():
             break
         for i in np.flatnonzero(new):
             outliers[int(i)] = float(abs(r[i]))   # volts; in noise units once the noise is known
         keep &= ~new
-        if (~keep).sum() > MAX_OUTLIER_SHARE * x.size:
+        if (~keep).sum() > max_share * x.size:
             break
     outliers = {i: r_v / sigma for i, r_v in outliers.items()}
     share = float((~keep).sum()) / x.size
-    if share > MAX_OUTLIER_SHARE:
+    if share > max_share:
         worst = max(outliers, key=outliers.get)
         raise OutlierShareError(worst, outliers[worst], int((~keep).sum()), x.size, sigma)
     pos = _with_index(_positions(x, v, keep), x, keep)
     sm, _pred, score = choose(pos, monotonic=False)
     coef = sm.solve(pos)
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
+
+
+NEIGHBOUR_CANDIDATES = 4
+
+
+def _largest_apart(x, new, ar) -> np.ndarray:
+    """Of the candidate outliers ``new``, those larger than every candidate at a neighbouring
+    position: a gross outlier pulls its neighbours' held-out predictions by as much as half its
+    own size, so they wait for the next round, judged without it."""
+    if new.sum() > NEIGHBOUR_CANDIDATES:   # many at once: a bad stretch, not one reading's pull
+        return new
+    xs = np.unique(x)
+    rank = np.searchsorted(xs, x)
+    out = np.zeros_like(new)
+    taken: set[int] = set()
+    for i in sorted(np.flatnonzero(new), key=lambda i: -ar[i]):
+        if taken & {int(rank[i]) - 1, int(rank[i]) + 1}:
+            continue
+        taken.add(int(rank[i]))
+        out[i] = True
+    return out
 
 
 class OutlierShareError(RecordingsError):
@@ -378,11 +400,12 @@ def screens(x) -> bool:
     return MIN_SCREEN_POSITIONS <= npos <= MAX_SCREEN_POSITIONS
 
 
-def screen_outliers(x, v, direction=None, step_v: float = 0.0) -> Screen | None:
+def screen_outliers(x, v, direction=None, step_v: float = 0.0,
+                    max_share: float = MAX_OUTLIER_SHARE) -> Screen | None:
     """Gross outliers against the cross-validated forward fit (:func:`robust_forward`);
     None when the recording has too few or too many distinct positions to judge them this way.
-    Raises :class:`OutlierShareError` above ``MAX_OUTLIER_SHARE``."""
+    Raises :class:`OutlierShareError` above ``max_share``."""
     if not screens(x):
         return None
-    ff = robust_forward(x, v, direction, step_v)
+    ff = robust_forward(x, v, direction, step_v, max_share)
     return Screen(ff.keep, tuple(ff.outliers), ff.noise_v, ff.noise_from, int(ff.positions.x.size))

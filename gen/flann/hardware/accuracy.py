@@ -22,6 +22,7 @@ from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
 from .fixed.twin import FlannTop
+from .float18.spec import F18Spec, FlannF18Top
 from .family_thermal.spec import FamilyThermalSpec
 from .family_thermal.twin import FlannFamilyThermalTop
 from .thermal.spec import ThermalSpec
@@ -120,15 +121,24 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
     """
     if type(spec) in TWO_INPUT_TWINS:
         return thermal_accuracy(spec, rec, tol=tol, band=band, fs_mm=fs_mm)
-    adc_bits, adc_lsb = adc if adc is not None else (spec.input_bits, spec.input_lsb_v)
+    # a float18 design shares the fixed front end (input, clamp, the float reference); its
+    # output is a float18 number in mm, with no output LSB
+    front = spec.front if isinstance(spec, F18Spec) else spec
+    adc_bits, adc_lsb = adc if adc is not None else (front.input_bits, front.input_lsb_v)
     x = rec.displacement_mm
-    codes = adc_codes(spec, rec.voltage_v, (adc_bits, adc_lsb))
+    codes = adc_codes(front, rec.voltage_v, (adc_bits, adc_lsb))
     # the twin once per distinct code: a logger's million rows hold at most 2^16 of them,
     # and the twin's per-term intermediates would otherwise take gigabytes
     distinct, back = np.unique(codes, return_inverse=True)
-    out, sat = FlannTop(spec).process(distinct)
-    out, sat = out[back], sat[back]
-    hw_mm = out * spec.output_lsb_mm
+    if isinstance(spec, F18Spec):
+        twin = FlannF18Top(spec)
+        out_mm, sat = twin.out_mm(distinct), np.asarray(twin.process(distinct).out_sat)
+        output_lsb = None
+    else:
+        out, sat = FlannTop(spec).process(distinct)
+        out_mm, output_lsb = out * spec.output_lsb_mm, spec.output_lsb_mm
+    at_codes = out_mm
+    hw_mm, sat = out_mm[back], sat[back]
     # the float model as eval's compensated column gives it: clamped to the trained range, as
     # the hardware does (unclamped, its sum beyond the range put 0.045 mm into hardware - float)
     fl_mm = spec.model.predict(spec.model.clamp(rec.voltage_v)[0])
@@ -137,14 +147,14 @@ def hardware_accuracy(spec: Spec, rec, *, tol, band, fs_mm, adc: tuple[int, floa
     rep = error_report(hw_mm, x, tol, band, fs_mm, rec.direction)
     lim_max = float(limit.max())
     rep.update({
-        "input_bits": spec.input_bits, "input_lsb_v": spec.input_lsb_v,
-        "adc_bits": adc_bits, "adc_lsb_v": adc_lsb, "dropped_low_bits": adc_bits - spec.input_bits,
-        "output_lsb_mm": spec.output_lsb_mm,
+        "input_bits": front.input_bits, "input_lsb_v": front.input_lsb_v,
+        "adc_bits": adc_bits, "adc_lsb_v": adc_lsb, "dropped_low_bits": adc_bits - front.input_bits,
+        "output_lsb_mm": output_lsb, "number_format": getattr(spec, "number_format", "fixed"),
         "points_clamped": int(np.count_nonzero(sat)),
         "max_abs_hardware_minus_float_mm": float(np.max(np.abs(hw_mm - fl_mm))),
         # the datapath's own error: the float model at the same (clamped) ADC codes
         "max_abs_hardware_minus_float_at_codes_mm": float(np.max(np.abs(
-            hw_mm - spec.float_reference(distinct)[back]))),
+            at_codes - front.float_reference(distinct)))),
         "physical_limit_mm": {"max": lim_max, "median": float(np.median(limit)),
                               "min": float(limit.min())},
         "ratio_to_limit": float(np.max(np.abs(e_hw)) / lim_max),

@@ -73,6 +73,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
+import numpy as np
+
 from ..errors import SensorError
 from ..inputs import parse_toml, read_text
 from .effect_params import SPECS, validate_effects
@@ -239,6 +241,26 @@ def _frozen_effects(effects) -> MappingProxyType:
 
 _RADIAL_FIELDS = frozenset(("core_inner_diameter_mm", "core_outer_diameter_mm", "coil_inner_diameter_mm",
                             "coil_outer_diameter_mm", "housing_inner_diameter_mm"))
+
+
+# The construction parameters a production batch varies from unit to unit (windings, core and
+# coil geometry, the conditioner's gain); ``flann simulate --spread`` draws them
+SPREAD_FIELDS = ("core_length_mm", "core_permeability_ratio", "primary_turns", "primary_length_mm",
+                 "secondary_turns", "secondary_length_mm", "secondary_gap_mm", "demodulator_gain_ratio")
+
+
+def spread_unit(s: Sensor, spread: float, seed: int) -> tuple[Sensor, dict[str, float]]:
+    """One unit of a production batch of ``s``: each of :data:`SPREAD_FIELDS` times
+    (1 + N(0, ``spread``)), drawn from ``seed`` (the same seed, the same unit), and the
+    factors drawn.  Refused (SensorError) when a draw leaves the sensor's valid range."""
+    rng = np.random.default_rng([int(seed), 0x5eed])
+    factors = {f: float(1.0 + spread * rng.standard_normal()) for f in SPREAD_FIELDS}
+    try:
+        unit = s.replace(**{f: getattr(s, f) * k for f, k in factors.items()})
+    except SensorError as exc:
+        raise SensorError(f"--spread {spread:g} with seed {seed} draws a unit outside the sensor's valid "
+                          f"range ({exc}): use a smaller spread") from None
+    return unit, factors
 
 
 def _validate(s: Sensor, changed=None) -> None:

@@ -32,6 +32,7 @@ import io
 import math
 import re
 import sys
+import unicodedata
 import warnings
 from array import array
 from dataclasses import dataclass, field
@@ -40,8 +41,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RecordingsError, one_line
-from ..fileio import atomic_write_text
-from ..inputs import read_bytes
+from ..fileio import atomic_write_text, note_input
+from ..inputs import input_error
 
 REQUIRED = ("displacement_mm", "voltage_v")
 OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
@@ -51,20 +52,45 @@ OPTIONAL = ("direction", "time_s", "temperature_c", "excitation_hz")
 # style), "<name>, <unit>" or "<name> <unit>", any case; units may be spelled out.
 QUANTITIES: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
     "displacement_mm": (("displacement", "position", "x", "disp", "pos", "travel", "stroke",
-                         "distance", "dist"),
+                         "distance", "dist",
+                         # German, French, Spanish, Italian, Portuguese (accents folded)
+                         "weg", "verschiebung", "auslenkung", "hub", "wegstrecke",
+                         "deplacement", "course", "desplazamiento", "posicion", "recorrido",
+                         "carrera", "spostamento", "posizione", "corsa", "deslocamento",
+                         "posicao", "curso"),
                         {"mm": 1.0, "millimeter": 1.0, "millimeters": 1.0, "millimetre": 1.0,
                          "millimetres": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "microns": 1e-3,
                          "cm": 10.0, "m": 1000.0, "in": 25.4, "in.": 25.4, "inch": 25.4,
                          "inches": 25.4, "mil": 0.0254}),
     "voltage_v": (("voltage", "volt", "v", "u", "vout", "output", "output voltage", "lvdt output",
-                   "signal", "sensor output", "lvdt voltage", "lvdt"),
+                   "signal", "sensor output", "lvdt voltage", "lvdt",
+                   "spannung", "ausgangsspannung", "ausgang", "tension", "tension de sortie",
+                   "sortie", "voltaje", "salida", "tensione", "uscita", "tensao", "saida"),
                   {"v": 1.0, "volt": 1.0, "volts": 1.0, "mv": 1e-3, "millivolt": 1e-3,
                    "millivolts": 1e-3, "uv": 1e-6, "µv": 1e-6}),
-    "direction": (("direction", "dir"), {"": 1.0}),
-    "time_s": (("time", "t"), {"s": 1.0, "ms": 1e-3, "min": 60.0}),
-    "temperature_c": (("temperature", "temp"), {"c": 1.0, "°c": 1.0, "degc": 1.0}),
-    "excitation_hz": (("excitation", "frequency", "freq"), {"hz": 1.0, "khz": 1e3}),
+    "direction": (("direction", "dir", "richtung", "sens", "direccion", "sentido", "direzione",
+                   "verso", "direcao"), {"": 1.0}),
+    "time_s": (("time", "t", "zeit", "temps", "tiempo", "tempo"), {"s": 1.0, "ms": 1e-3, "min": 60.0}),
+    "temperature_c": (("temperature", "temp", "temperatur", "temperatura"),
+                      {"c": 1.0, "°c": 1.0, "degc": 1.0}),
+    "excitation_hz": (("excitation", "frequency", "freq", "frequenz", "frequence", "frecuencia",
+                       "frequenza", "frequencia"), {"hz": 1.0, "khz": 1e3}),
 }
+# A sensor column (a rig that records several LVDTs in one file): its values are names, not
+# numbers; ``--sensor ID`` selects one
+SENSOR_NAMES = ("sensor", "sensor id", "sensor_id", "sensorid", "sensor no", "sensor nr", "sensor sn",
+                "serial", "serial no", "serial number", "sn", "s/n", "lvdt id", "lvdt_id",
+                "channel", "device", "unit id", "sensor name", "fuhler", "capteur", "sensore")
+# The two secondary amplitudes (the raw form a bench records): voltage_v is their ratio
+# (A - B) / (A + B), the ratiometric LVDT output, unless the difference is asked for
+SECONDARY_NAMES = {"a": ("a", "va", "v a", "v_a", "secondary a", "sec a", "amplitude a", "amp a", "vsa",
+                         "ua", "u a", "vs1", "secondary 1", "sec 1", "s1", "amplitude 1", "v1"),
+                   "b": ("b", "vb", "v b", "v_b", "secondary b", "sec b", "amplitude b", "amp b", "vsb",
+                         "ub", "u b", "vs2", "secondary 2", "sec 2", "s2", "amplitude 2", "v2")}
+AB_FORMS = ("ratio", "difference")
+# lines above the header a title or metadata block may take (the header is the first line
+# that names both required columns)
+MAX_PREAMBLE_LINES = 64
 _WITH_UNIT = (re.compile(r"^(?P<q>.+?)\s*[(\[]\s*(?P<u>[^)\]]*?)\s*[)\]]$"),
               re.compile(r"^(?P<q>[^_]+(?:_[^_]+)*?)_(?P<u>[^_\s]+)$"),
               re.compile(r"^(?P<q>.+?)\s*[/,]\s*(?P<u>[^/,]+)$"),
@@ -97,9 +123,19 @@ def accepted_names() -> str:
             f"unit {units('voltage_v')}); optional {', '.join(OPTIONAL)}")
 
 
+def _fold(name: str) -> str:
+    """A header cell as names are compared: lower case, single spaces, accents dropped
+    ('Déplacement' is 'deplacement', 'Tensão' 'tensao'; the degree sign and micro stay)."""
+    h = " ".join(name.strip().strip('"').strip("'").split()).lower()
+    if h.isascii():
+        return h
+    return "".join(c for c in unicodedata.normalize("NFKD", h)
+                   if not unicodedata.combining(c)).replace("μ", "µ")
+
+
 def recognise_header(name: str) -> tuple[str, float] | None:
     """(canonical column, factor) for a header cell, or None when it is not understood."""
-    h = " ".join(name.strip().strip('"').strip("'").split()).lower()
+    h = _fold(name)
     if h in QUANTITIES:
         return h, 1.0
     candidates = [(h, "")] + [(m["q"].strip(), m["u"].strip()) for m in
@@ -136,6 +172,7 @@ class Recordings:
     comments: tuple[str, ...] = field(default_factory=tuple)
     lines: np.ndarray | None = field(default=None, repr=False)
     recognised: str = ""
+    sensor_id: str = ""
 
     def __len__(self) -> int:
         return int(self.voltage_v.size)
@@ -156,7 +193,7 @@ class Recordings:
               for name, arr in ((n, getattr(self, n)) for n in REQUIRED + OPTIONAL)}
         lines = None if self.lines is None else np.asarray(self.lines)[mask_or_index]
         return Recordings(**kw, source=self.source, sha256=self.sha256, comments=self.comments,
-                          lines=lines, recognised=self.recognised)
+                          lines=lines, recognised=self.recognised, sensor_id=self.sensor_id)
 
 
 # a number as written in ASCII (the decimal comma is already a point here); inf/nan pass to
@@ -176,6 +213,10 @@ def _parse_float(text: str, column: str, where: str, source: str, factor: float 
     value = float(text)   # the pattern is a subset of what float() reads
     if not math.isfinite(value):
         raise RecordingsError(f"{source}: {where}, column '{column}': value {text} is not finite")
+    if value == 0 and _NONZERO_MANTISSA.match(text.split("e")[0].split("E")[0]):
+        raise RecordingsError(   # '1e-400': below every double, read as 0 by float()
+            f"{source}: {where}, column '{column}': value {text[:40]} is outside what flann computes "
+            f"with (0 or {VALUE_RANGE[0]:g} <= |value| <= {VALUE_RANGE[1]:g})")
     value *= factor
     lo, hi = VALUE_RANGE
     if value != 0 and not lo <= abs(value) <= hi:
@@ -305,13 +346,56 @@ def _unit_row(body, sep: str, width: int) -> list[str] | None:
     return None
 
 
-def _header_map(header: list[str], required, source: str):
+def recognise_extra(name: str) -> tuple[str, float] | None:
+    """('sensor', 1) for a sensor column, ('a' or 'b', factor to volts) for a secondary
+    amplitude column, or None."""
+    h = _fold(name)
+    if h.replace("_", " ") in SENSOR_NAMES or h in SENSOR_NAMES:
+        return "sensor", 1.0
+    units = QUANTITIES["voltage_v"][1]
+    candidates = [(h, "v")] + [(m["q"].strip(), m["u"].strip()) for m in
+                               (rx.match(h) for rx in _WITH_UNIT) if m]
+    for q, u in candidates:
+        q = q.replace("_", " ")
+        for side, names in SECONDARY_NAMES.items():
+            if (q in names or q.replace(" ", "") in names) and u in units:
+                return side, units[u]
+    return None
+
+
+@dataclass(frozen=True)
+class _Extras:
+    """Columns beside the quantities: the sensor column, the two secondary amplitudes
+    (index, factor to volts)."""
+
+    sensor: int | None = None
+    a: tuple[int, float] | None = None
+    b: tuple[int, float] | None = None
+
+
+def _extras(header: list[str]) -> _Extras:
+    found: dict[str, tuple[int, float]] = {}
+    for i, h in enumerate(header):
+        if recognise_header(h) is None and (hit := recognise_extra(h)) is not None:
+            found.setdefault(hit[0], (i, hit[1]))
+    a, b = found.get("a"), found.get("b")
+    if a is None or b is None:
+        a = b = None
+    return _Extras(sensor=found["sensor"][0] if "sensor" in found else None, a=a, b=b)
+
+
+def _header_map(header: list[str], required, source: str, line_no: int | None = None,
+                extras: _Extras | None = None):
     """{canonical column: (index, factor)}, notes on conversions, unknown headers."""
+    extras = extras or _Extras()
+    taken = {i for i in (extras.sensor, extras.a and extras.a[0], extras.b and extras.b[0]) if i is not None}
     found: dict[str, tuple[int, float]] = {}
     also: dict[str, tuple[int, float]] = {}   # a second column of the same quantity
     notes, unknown = [], []
     for i, h in enumerate(header):
         hit = recognise_header(h)
+        if i in taken:
+            continue
         if hit is None:
             if h:   # an unnamed column (a trailing separator) holds nothing to warn about
                 unknown.append(h)
@@ -336,12 +420,13 @@ def _header_map(header: list[str], required, source: str):
         h = header[i]
         if h != col:
             notes.append(f"'{h}' as {col}" + (f" (x {factor:g})" if factor != 1.0 else ""))
-    missing = [c for c in required if c not in found]
+    missing = [c for c in required if c not in found and not (c == "voltage_v" and extras.a)]
     if missing:
         what = f"; not understood: {', '.join(repr(u) for u in unknown)}" if unknown else ""
+        where = f"line {line_no}: " if line_no is not None else ""
         raise RecordingsError(
-            f"{source}: missing column(s) {', '.join(missing)} (header has: {', '.join(header)}"
-            f"{what}); accepted: {accepted_names()}"
+            f"{source}: {where}missing column(s) {', '.join(missing)} (header has: {', '.join(header)}"
+            f"{what}); accepted: {accepted_names()}, or two secondary amplitudes A and B"
         )
     return found, also, notes, unknown
 
@@ -388,12 +473,70 @@ def _looks_cut(source: str, line_no: int, last: list[str], width: int, shortest:
         "every other line): copied while being written? complete it or delete that line")
 
 
+_LINE_END = re.compile(r"\r\n|\r|\n")
+# a written number whose mantissa is not zero ('1e-400' underflows to 0.0 in float())
+_NONZERO_MANTISSA = re.compile(r"[+-]?[0-9.]*[1-9]")
+
+
+def split_lines(text: str) -> list[str]:
+    """Lines ended by LF, CRLF or a lone CR only: str.splitlines() also splits at NEL (byte
+    0x85 of a Latin-1 file, an ellipsis in Windows-1252), form feeds and separators, which a
+    spreadsheet's cell may hold."""
+    lines = _LINE_END.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+def count_line_ends(text: str) -> int:
+    return text.count("\n") + text.count("\r") - text.count("\r\n")
+
+
+def _find_header(body: list[tuple[int, str]], required, source: str) -> tuple[int, str | None]:
+    """(index in ``body`` of the header line, the separator named by a ``sep=`` line or None).
+
+    The header is the first line, among the first :data:`MAX_PREAMBLE_LINES`, that names every
+    required column (a title or a block of metadata may stand above it); when none does, the
+    first line, which the error then names."""
+    for k, (_n, line) in enumerate(body[:MAX_PREAMBLE_LINES]):
+        if len(line) > MAX_LINE_CHARS:
+            break
+        m = _EXCEL_SEP.match(line)
+        if m:   # Excel's "sep=;" line names the separator; the header follows it
+            return k + 1, m.group("sep")
+        sep = _sniff_separator(line)
+        try:
+            cells = [h.strip() for h in _cells(line, sep)]
+        except RecordingsError:
+            continue
+        if sep == " ":
+            cells = _WS_HEADER.findall(line)
+        try:
+            units = _unit_row(body[k:], sep, len(cells))
+        except RecordingsError:
+            units = None
+        if units is not None:   # names on this line, their units on the next
+            cells = [f"{h} ({u})" if u else h for h, u in zip(cells, units)]
+        hits = {hit[0] for hit in map(recognise_header, cells) if hit}
+        ex = _extras(cells)
+        if all(c in hits or (c == "voltage_v" and ex.a) for c in required):
+            return k, None
+    return 0, None
+
+
 def parse_recordings(text: str, source: str = "<memory>",
-                     required: tuple[str, ...] = REQUIRED, encoding_note: str = "") -> Recordings:
+                     required: tuple[str, ...] = REQUIRED, encoding_note: str = "",
+                     sensor: str | None = None, ab: str = "ratio") -> Recordings:
     """Parse CSV text.  ``required=("voltage_v",)`` lets ``displacement_mm`` be absent
-    (then ``None``): only for commands that do not need it (``flann predict``)."""
+    (then ``None``): only for commands that do not need it (``flann predict``).
+
+    ``sensor``: the rows of that ID in the file's sensor column (a file of several sensors is
+    refused without it).  ``ab``: two secondary amplitude columns A, B (and no voltage column)
+    become ``voltage_v`` = (A - B) / (A + B) ("ratio") or A - B ("difference")."""
+    if ab not in AB_FORMS:
+        raise RecordingsError(f"the secondaries' form must be one of {', '.join(AB_FORMS)}, not {ab!r}")
     # the bound first, on the text: the lists below cost ~100 bytes a row
-    if text.count("\n") - text.count("\n#") > MAX_ROWS + 2:
+    if count_line_ends(text) - text.count("\n#") > MAX_ROWS + MAX_PREAMBLE_LINES + 2:
         raise RecordingsError(f"{source}: more than {MAX_ROWS:,} data rows, more than flann reads: "
                               "average or decimate the recording first")
     sha = hashlib.sha256(text.encode()).hexdigest()
@@ -402,7 +545,7 @@ def parse_recordings(text: str, source: str = "<memory>",
         text = text[1:]
         notes.append("UTF-8 byte-order mark")
     comments, body = [], []   # body: (file line number, text)
-    for line_no, line in enumerate(text.splitlines(), start=1):
+    for line_no, line in enumerate(split_lines(text), start=1):
         stripped = line.strip()
         if not stripped:
             continue
@@ -412,12 +555,17 @@ def parse_recordings(text: str, source: str = "<memory>",
         body.append((line_no, line))
     if not body:
         raise RecordingsError(f"{source}: no header line (expected columns {', '.join(REQUIRED)})")
-    excel_sep = _EXCEL_SEP.match(body[0][1])
-    if excel_sep:   # Excel's "sep=;" first line names the separator; it is not the header
-        body = body[1:]
+    start, excel = _find_header(body, required, source)
+    if start:   # a title or metadata above the header: kept as provenance, said
+        above = body[:start]
+        if excel is None or start > 1:
+            notes.append(f"header on line {body[start][0] if start < len(body) else above[-1][0]} "
+                         f"below {len([a for a in above if not _EXCEL_SEP.match(a[1])])} title/metadata line(s)")
+        comments += [" ".join(line.split()) for _n, line in above if not _EXCEL_SEP.match(line)]
+        body = body[start:]
         if not body:
-            raise RecordingsError(f"{source}: no header line after '{excel_sep.group(0).strip()}'")
-    sep = excel_sep.group("sep") if excel_sep else _sniff_separator(body[0][1])
+            raise RecordingsError(f"{source}: no header line after line {above[-1][0]}")
+    sep = excel or _sniff_separator(body[0][1])
     for n, line in body[:2]:   # the header and a possible unit line, before they are split
         _check_line(source, n, line)
     try:
@@ -429,17 +577,27 @@ def parse_recordings(text: str, source: str = "<memory>",
         header = _WS_HEADER.findall(body[0][1])
         units = _unit_row(body, sep, len(header))
     if units is not None:   # loggers: names on one line, units on the next
-        header = [f"{h} ({u})" if u and recognise_header(h) is None else h
+        header = [f"{h} ({u})" if u and recognise_header(h) is None and recognise_extra(h) is None else h
                   for h, u in zip(header, units)]
         body = body[:1] + body[2:]
-    found, also, col_notes, unknown = _header_map(header, required, source)
+    extras = _extras(header)
+    kinds = {hit[0] for hit in map(recognise_header, header) if hit}
+    if extras.a is not None and "time_s" in kinds and "displacement_mm" not in kinds:
+        raise _waveform(source, f"'{header[extras.a[0]]}', '{header[extras.b[0]]}'")
+    found, also, col_notes, unknown = _header_map(header, required, source, body[0][0], extras)
     if unknown:
         warnings.warn(f"{source}: ignoring unknown column(s) {', '.join(unknown)}", stacklevel=2)
+    secondaries = extras.a is not None and "voltage_v" not in found
+    if extras.a is not None and not secondaries:
+        col_notes.append(f"'{header[extras.a[0]]}' and '{header[extras.b[0]]}' not used (voltage_v given)")
     wanted = [c for c in REQUIRED + OPTIONAL if c in found]
     columns = {c: found[c] for c in wanted} | {"+" + c: also[c] for c in also}
+    if secondaries:
+        columns |= {"_a": extras.a, "_b": extras.b}
     data: dict[str, list[float]] = {c: [] for c in columns}
     line_numbers: list[int] = []
     marks = _DecimalMarks()
+    sensor_col, ids_seen = extras.sensor, {}
     # one pass, row by row (no list of split rows: ~100 bytes a row less at the peak)
     cut_candidate = not text.endswith(("\n", "\r")) and len(body) > 3
     shortest_last = None   # the shortest last cell of a full row so far (for a cut-off last line)
@@ -461,6 +619,15 @@ def parse_recordings(text: str, source: str = "<memory>",
             )
         n_last = len(row[-1].strip())
         shortest_last = n_last if shortest_last is None else min(shortest_last, n_last)
+        if sensor_col is not None:
+            sid = row[sensor_col].strip()
+            if sid not in ids_seen:
+                if len(ids_seen) >= MAX_SENSORS:
+                    raise RecordingsError(f"{source}: {where}: more than {MAX_SENSORS} sensor IDs in column "
+                                          f"'{header[sensor_col]}': not a sensor column")
+                ids_seen[sid] = line_no
+            if sensor is not None and sid != sensor:
+                continue
         for c, (i, factor) in columns.items():
             cell = row[i].strip()
             if c == "direction":
@@ -482,12 +649,25 @@ def parse_recordings(text: str, source: str = "<memory>",
     if len(line_numbers) > MAX_ROWS:
         raise RecordingsError(f"{source}: {len(line_numbers):,} data rows, more than flann reads ({MAX_ROWS:,}): "
                               "average or decimate the recording first")
-    if not data["voltage_v"]:
+    sensor_note = _sensor_choice(source, header, sensor_col, ids_seen, sensor)
+    if sensor_note:
+        notes.append(sensor_note)
+    first = "_a" if secondaries else "voltage_v"
+    if not data[first]:
         raise RecordingsError(f"{source}: no data rows")
     marks.settle(data, {c: factor for c, (_i, factor) in columns.items()}, sep, source)
     arrays = {c: np.asarray(v, dtype=float) for c, v in data.items()}
     del data
     lines = np.asarray(line_numbers, dtype=np.int64)
+    if secondaries:
+        a_v, b_v = arrays.pop("_a"), arrays.pop("_b")
+        names = f"'{header[extras.a[0]]}', '{header[extras.b[0]]}'"
+        if "time_s" in arrays and (np.any(a_v < 0) or np.any(b_v < 0)):
+            # amplitudes are never negative: these are the secondaries' samples over time
+            raise _waveform(source, names)
+        arrays["voltage_v"] = _from_secondaries(source, a_v, b_v, lines, ab)
+        col_notes.append("voltage_v = " + ("(A - B)/(A + B), the ratiometric output," if ab == "ratio"
+                                            else "A - B") + f" of the secondary amplitudes {names}")
     for c in REQUIRED:
         _check_span(source, c, arrays.get(c))
     for c in also:
@@ -506,27 +686,148 @@ def parse_recordings(text: str, source: str = "<memory>",
     notes += col_notes
     arrays.setdefault("displacement_mm", None)
     return Recordings(**arrays, source=source, sha256=sha, comments=tuple(comments), lines=lines,
-                      recognised=", ".join(notes))
+                      recognised=", ".join(notes), sensor_id=sensor or (next(iter(ids_seen)) if ids_seen else ""))
 
 
-def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
-                    announce: bool = True) -> Recordings:
-    """Read a recordings file; when it is not in the canonical form, one stderr line says
-    how it was read (``announce``)."""
-    path = Path(path)
-    note = ""
-    raw = read_bytes(path, RecordingsError, "a CSV file")   # no byte cap: MAX_ROWS bounds a recording
+_LIST = "\x00"   # the sensor asked for by sensor_ids: every ID, no rows
+# more distinct values than this in a sensor column: not sensor IDs (a logger's row counter)
+MAX_SENSORS = 10_000
+
+
+def sensor_ids(source: str, text: str) -> list[str]:
+    """The sensor IDs of a recording's sensor column, in the order they first appear ([] when
+    it has no sensor column)."""
     try:
-        text = raw.decode("utf-8")
+        parse_recordings(text, source, sensor=_LIST)
+    except MultipleSensors as exc:
+        return list(exc.ids)
+    return []   # not reached: the listing always ends in MultipleSensors
+
+
+class MultipleSensors(RecordingsError):
+    """A file of several sensors read without choosing one."""
+
+    def __init__(self, message: str, ids: tuple[str, ...]):
+        super().__init__(message)
+        self.ids = ids
+
+
+def _sensor_choice(source, header, col, ids_seen: dict, sensor: str | None) -> str:
+    """The note on the sensor read ('' without a sensor column); refused: several sensors and
+    none chosen, or the chosen one absent."""
+    if sensor == _LIST:
+        raise MultipleSensors(f"{source}: sensors {', '.join(ids_seen)}", tuple(ids_seen))
+    if sensor is not None and col is None:
+        raise RecordingsError(f"{source}: --sensor {sensor}: the file has no sensor column "
+                              f"(header: {', '.join(header)}; accepted: {', '.join(SENSOR_NAMES[:3])}, ...)")
+    if col is None:
+        return ""
+    ids = tuple(ids_seen)
+    shown = ", ".join(ids[:12]) + (f", ... ({len(ids)} in all)" if len(ids) > 12 else "")
+    if sensor is None:
+        if len(ids) > 1:
+            raise MultipleSensors(
+                f"{source}: column '{header[col]}' holds {len(ids)} sensors ({shown}): one model is one "
+                "sensor; give --sensor ID (flann calibrate takes each as a sensor of its own)", ids)
+        return f"sensor {ids[0]} (column '{header[col]}')" if ids else ""
+    if sensor not in ids_seen:
+        raise RecordingsError(f"{source}: --sensor {sensor}: no such ID in column '{header[col]}' "
+                              f"(it holds {shown})")
+    return f"sensor {sensor} of {len(ids)} (column '{header[col]}', line {ids_seen[sensor]} on)"
+
+
+def _waveform(source: str, names: str) -> RecordingsError:
+    return RecordingsError(
+        f"{source}: a waveform recording (time_s with sampled secondary voltages {names}): its "
+        "amplitudes come from demodulating it, the conditioner flow's work (docs/recordings.md, "
+        "'Waveform recordings'), not from reading it as positions and voltages")
+
+
+def _from_secondaries(source: str, a, b, lines, ab: str):
+    if ab == "difference":
+        return a - b
+    total = a + b
+    bad = np.flatnonzero(~(np.abs(total) > 0))
+    if bad.size:
+        k = int(bad[0])
+        raise RecordingsError(f"{source}: line {lines[k]}: the secondary amplitudes sum to 0, no ratio "
+                              "(A - B)/(A + B); read them as the difference A - B (--ab difference)")
+    return (a - b) / total
+
+
+# the bytes a recording may take before it is refused unread: MAX_ROWS rows of a few columns
+# (~60 bytes a row in the widest exports seen) and a margin
+MAX_RECORDING_BYTES = 256 << 20
+_CHUNK = 1 << 20
+
+
+def read_recording_bytes(path: str | Path) -> bytes:
+    """The bytes of a recordings file, bounded before they are held: at most
+    :data:`MAX_RECORDING_BYTES`, :data:`MAX_ROWS` line ends (LF, CRLF or a lone CR) and no
+    stretch longer than a line may be (``/dev/zero``, ``/dev/urandom``, a binary file end in one
+    line, without reading them whole)."""
+    path = Path(path)
+    try:
+        fh = open(path, "rb")
+    except OSError as exc:
+        raise input_error(path, exc, RecordingsError, "a CSV file") from None
+    parts, total, ends, run = [], 0, 0, 0
+    longest = 4 * MAX_LINE_CHARS   # a line of MAX_LINE_CHARS characters, four bytes each at most
+    with fh:
+        while True:
+            try:
+                chunk = fh.read(_CHUNK)
+            except OSError as exc:
+                raise input_error(path, exc, RecordingsError, "a CSV file") from None
+            if not chunk:
+                break
+            total += len(chunk)
+            if total > MAX_RECORDING_BYTES:
+                raise RecordingsError(f"{path}: larger than {MAX_RECORDING_BYTES >> 20} MB, more than a "
+                                      f"recording flann reads ({MAX_ROWS:,} rows): average or decimate it first")
+            # LF, CRLF and a lone CR each end a line (a CRLF split by the chunk counts twice)
+            ends += chunk.count(b"\n") + chunk.count(b"\r") - chunk.count(b"\r\n")
+            if ends > MAX_ROWS + MAX_PREAMBLE_LINES + 2 + total // _CHUNK:
+                raise RecordingsError(f"{path}: more than {MAX_ROWS:,} lines, more than flann reads: "
+                                      "average or decimate the recording first")
+            last = max(chunk.rfind(b"\n"), chunk.rfind(b"\r"))
+            run = run + len(chunk) if last < 0 else len(chunk) - last - 1
+            if run > longest:
+                raise RecordingsError(f"{path}: {run:,} bytes without a line end (a line holds at most "
+                                      f"{MAX_LINE_CHARS:,} characters): not a recordings file")
+            parts.append(chunk)
+    note_input(path)
+    return b"".join(parts)
+
+
+def decode_recording(raw: bytes, path) -> tuple[str, str]:
+    """(text, how it was decoded: '' for UTF-8)."""
+    try:
+        return raw.decode("utf-8"), ""
     except UnicodeDecodeError:
         if b"\x00" in raw:
             raise RecordingsError(f"{path}: binary or UTF-16 file, expected CSV text "
                                   "(export as CSV UTF-8)") from None
-        text, note = raw.decode("latin-1"), "Latin-1 text"   # spreadsheets on Windows
-    rec = parse_recordings(text, source=str(path), required=required, encoding_note=note)
+        return raw.decode("latin-1"), "Latin-1 text"   # spreadsheets on Windows
+
+
+def read_recordings(path: str | Path, required: tuple[str, ...] = REQUIRED,
+                    announce: bool = True, sensor: str | None = None, ab: str = "ratio") -> Recordings:
+    """Read a recordings file; when it is not in the canonical form, one stderr line says
+    how it was read (``announce``).  ``sensor``, ``ab``: :func:`parse_recordings`."""
+    path = Path(path)
+    text, note = decode_recording(read_recording_bytes(path), path)
+    rec = parse_recordings(text, source=str(path), required=required, encoding_note=note,
+                           sensor=sensor, ab=ab)
     if announce and rec.recognised:
         print(one_line(f"{path}: read {rec.recognised}"), file=sys.stderr)
     return rec
+
+
+def recording_sensors(path: str | Path) -> list[str]:
+    """The sensor IDs in a recordings file's sensor column ([] without one)."""
+    text, _note = decode_recording(read_recording_bytes(path), path)
+    return sensor_ids(str(path), text)
 
 
 def format_recordings(rec: Recordings, comments: tuple[str, ...] | list[str] = (),
@@ -537,7 +838,10 @@ def format_recordings(rec: Recordings, comments: tuple[str, ...] | list[str] = (
         cols.update(extra)
     out = io.StringIO()
     for c in comments:
-        out.write(f"# {c}\n")
+        # a comment of several lines (a sensor name holding a line break) stays comment lines:
+        # a bare second line would read as the header
+        for part in split_lines(str(c)) or [""]:
+            out.write(f"# {part}\n")
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(list(cols))
     for i in range(len(rec)):

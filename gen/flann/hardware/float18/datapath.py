@@ -6,7 +6,7 @@ import math
 import warnings
 
 from ...golden.model import load_model, model_sha256
-from ..datapath import Datapath, Field, _int, rebuild_matching
+from ..datapath import Datapath, Field, _int, check_design_model, rebuild_matching
 from ..fixed.render import _format_bits, model_text
 from ..fixed.spec import table_brams
 from ..options import GenOptions
@@ -67,6 +67,13 @@ def _options(man: dict, clamp: bool) -> dict:
                 term_frac_bits=_format_bits(s["term"], "term")[1])
 
 
+def _eval_spec(model, man: dict, directory):
+    """The design's F18Spec for ``model``, which must be the model it was generated from."""
+    load_model(model)  # a file that is not a model says so before the hash is compared
+    check_design_model(model, man, directory)
+    return rebuild(model, man, directory)[0]
+
+
 def rebuild(model, man: dict, where="design"):
     """The F18Spec that reproduces the manifest's spec (clamping on or off, as generated)."""
     fmodel, sha = load_model(model), model_sha256(model)
@@ -106,8 +113,7 @@ DATAPATH = Datapath(
     # compared with the fixed design, fixed-only options are meant for that one
     derive_options=lambda options, compared=False: float18_options(options, fixed_too=compared),
     summary=summary, derive=derive_f18_spec, number_format=render.DATAPATH,
-    lacks="flann eval --design compares a fixed-point output LSB with the ADC's physical limit; "
-          "a float18 design has no output LSB: see its accuracy with flann sim DIR or flann trace DIR",
+    eval_spec=lambda model, man, directory: _eval_spec(model, man, directory),
 )
 
 __all__ = ["DATAPATH"]
