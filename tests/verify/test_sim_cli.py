@@ -58,6 +58,10 @@ def test_plot_is_written_for_every_datapath(small_sims, datapath):
     run = small_sims(datapath)
     s = run.summary
     assert run.rc == 0 and s["mismatches"] == 0 and s["all_passed"], run.err
+    # the verdict: against the twin, and where the design states a bound, against the float model
+    assert s["verdict"]["status"] == "good" and s["verdict"]["line"] in run.out
+    bounded = [c for c in s["verdict"]["checks"] if c["name"] == "hdl_vs_float_bound"]
+    assert len(bounded) == (datapath in ("fixed", "thermal")) and all(c["ok"] for c in bounded)
     if datapath == "family":   # its mapped netlist too, its weight image loaded through the cfg port
         assert s["netlist"]["codes_tested"] == 2 ** BITS and s["netlist"]["mismatches"] == 0
     assert _is_png(run.png) and f"plot: {run.png}" in run.out
@@ -110,6 +114,7 @@ def test_netlist_flag_runs_the_mapped_netlist_sweep_for_every_datapath(designs, 
     s = json.loads(out)
     assert calls == [(datapath, image)] and s["netlist"]["mismatches"] == 1
     assert rc == 1 and not s["all_passed"] and s["mismatches"] == 0
+    assert s["verdict"]["status"] == "bad" and "disagrees with its twin" in s["verdict"]["line"]
     # with --json too, stderr says why in one line (the JSON on stdout stays parseable)
     assert err.strip().splitlines()[-1] == "error: co-simulation failed (mapped netlist: 1 mismatches)", err
 

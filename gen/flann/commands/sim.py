@@ -127,7 +127,8 @@ def run(args) -> int:
         images = image_names(args.image or [])
         res = simulate(design, build, seed=args.seed, netlist=args.netlist, engine=args.engine,
                        progress=None if quiet(args) else terminal_progress, images=images or None)
-        s = {**res.summary, **clock_fields()}
+        verdict = res.verdict()
+        s = {**res.summary, **clock_fields(), "verdict": verdict.to_json()}
         if args.post_route:
             # a family design's routed netlist computes with the last image given, as its bench ends
             check = checker(design, image=images[-1] if images else None)
@@ -188,6 +189,7 @@ def run(args) -> int:
         if plotted:
             print(f"plot: {args.plot}")
         print(f"simulated in {s['seconds']:.0f} s")
+        print(verdict.line())
     if args.plot and not plotted:
         print(f"{args.plot}: not written, the simulation gave no outputs to plot", file=sys.stderr)
     # on stderr with --json too: a script sees why beside the exit code, its JSON stays clean

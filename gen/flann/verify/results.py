@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..golden.verdict import Check, Verdict, combine
 from ..hardware.design import Design
 from .runner import throughput
 
@@ -21,6 +22,7 @@ class SimResult:
     curve: object | None
     spec: object
     passed: bool
+    bound_lsb: float | None = None   # the design's stated bound on |HDL - float model| (output LSBs)
 
     def judged_with(self, name: str, about: dict, passed: bool) -> "SimResult":
         """This result with one more check (its summary entry ``name``) folded into the verdict."""
@@ -30,8 +32,27 @@ class SimResult:
         return self
 
     @classmethod
-    def from_summary(cls, summary: dict, curve, spec) -> "SimResult":
-        return cls(summary, curve, spec, bool(summary["all_passed"]))
+    def from_summary(cls, summary: dict, curve, spec, bound_lsb: float | None = None) -> "SimResult":
+        return cls(summary, curve, spec, bool(summary["all_passed"]), bound_lsb)
+
+    def verdict(self) -> Verdict:
+        """Judged against the twin (bit for bit, every bench) and, where the design states one,
+        against its bound on the error from the float model."""
+        s = self.summary
+        n, bad = s.get("codes_tested") or 0, s.get("mismatches")
+        exact = self.passed and bad == 0 and n > 0
+        twin = Check("hdl_vs_twin", exact,
+                     f"{bad} mismatches with the twin over {n} samples, every bench passed" if exact else
+                     f"the HDL disagrees with its twin ({bad} mismatches over {n} samples) or a bench failed",
+                     "" if exact else "see the failed benches above; regenerate the design with flann gen")
+        err = s.get("max_err_lsb")
+        bound = None
+        if self.bound_lsb is not None and err is not None:
+            ok = err <= self.bound_lsb + 1e-9
+            bound = Check("hdl_vs_float_bound", ok,
+                          f"max |HDL - float model| {err:.4g} LSB {'within' if ok else 'beyond'} the design's "
+                          f"stated bound {self.bound_lsb:.4g} LSB", "" if ok else "regenerate with wider widths")
+        return combine(twin, bound)
 
 
 def summary(design: Design, codes: int, mismatches, max_err_mm, benches: dict, ok: bool, lsb=None) -> dict:

@@ -125,7 +125,7 @@ def bench(design: Design, build_dir, *, seed: int = 1, benches=tuple(BENCHES), e
     summary["output_lsb_mm"] = man["output_lsb_mm"]
     summary["model_sha256"] = man["model_sha256"]
     summary["design"] = str(design.directory)
-    return SimResult(summary, curve, spec, summary["all_passed"])
+    return SimResult(summary, curve, spec, summary["all_passed"], max(1.0, float(spec.analysis["bound_total_lsb"])))
 
 
 def netlist(design: Design, image=None):

@@ -67,7 +67,7 @@ def bench(design: Design, build_dir, *, seed=1, codes=None, engine="auto", progr
     got = sweep_rows(out_file, samples)
     curve = None if got is None else _thermal_curve(design, *got[:3], *_against_model(spec, *got), temps,
                                                     f"GHDL, {backend}")
-    return SimResult(s, curve, spec, bool(s["all_passed"]))
+    return SimResult(s, curve, spec, bool(s["all_passed"]), error_bound_lsb(design))
 
 
 def _thermal_vhdl(design: Design, build_dir: Path, temps, codes: tuple[int, int], *, seed=1, progress=None):
@@ -118,7 +118,7 @@ def _thermal_netlist(design: Design, build_dir: Path, temps, every: bool, *, see
                                   "bench_ok": res.ok, "mismatches": rec.get("mismatches")}}
     temperature_fields(s, temps, every, spec.code_max - spec.code_min + 1)
     curve = _thermal_curve(design, c, t, out, ref, inside, temps, "Verilator, GHDL's synthesised netlist")
-    return SimResult(s, curve, spec, bool(s["all_passed"]))
+    return SimResult(s, curve, spec, bool(s["all_passed"]), error_bound_lsb(design))
 
 
 def _against_model(spec, c, t, out, sat):
@@ -128,9 +128,15 @@ def _against_model(spec, c, t, out, sat):
     return ref, ~(sat & (np.abs(ref) > spec.out_fmt.max_int))
 
 
+def error_bound_lsb(design: Design) -> float:
+    """The design's stated bound on |HDL - float model| (output LSBs): the error before the
+    output rounding, and the rounding."""
+    return design.manifest["analysis"]["pre_rounding_lsb"] + 0.5
+
+
 def _thermal_curve(design: Design, c, t, out, ref, valid, temps, simulator: str):
-    spec, man = design.spec, design.manifest
-    bound = man["analysis"]["pre_rounding_lsb"] + 0.5
+    spec = design.spec
+    bound = error_bound_lsb(design)
     return plots.two_input([{"name": "", "codes": c, "temps": t, "hdl": out, "ref": ref, "valid": valid}],
                            temps, spec.temp_lsb_c, ref=plots.GOLDEN, simulator=simulator,
                            bound={"value": bound, "label": f"±{bound:.3g} LSB (the design's error bound)"},
