@@ -14,6 +14,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+from .widths import widths_warning
 from ...errors import FlannError
 from ...golden.model import model_sha256
 from ...golden.thermal import ThermalModel, load_any_model
@@ -131,6 +132,9 @@ def generate(model, out_dir, options: GenOptions | None = None) -> dict:
     """Derive, render and write the design directory as a whole (VHDL, manifest.json, model)."""
     m, sha, text = _load(model)
     spec = derive(m, GenOptions.of(options))
+    lost = widths_warning(spec)
+    if lost:
+        warnings.warn(lost)   # said before the design is written
     texts = render(spec, sha)
     return write_design({**texts, MODEL_FILE: text}, manifest(spec, list(texts), sha), out_dir)
 
