@@ -9,9 +9,11 @@ from ..diagnose import diagnose
 from ..diagnose.data import MAX_POINTS
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
+from ..diagnose.waveform import diagnose_waveforms, format_wave_text, is_waveform_csv, plot_wave, wave_to_json
 from ..errors import FlannError
 from ..physics.sensor import load_sensor
 from ..recordings import read_recordings
+from ..recordings.waveform import read_waveforms
 from .common import add_common, emit_json, json_to_stdout, json_word_as_input, on_terminal
 
 HELP = "locate and name the physics missing between simulation and recordings"
@@ -19,7 +21,8 @@ HELP = "locate and name the physics missing between simulation and recordings"
 
 def add_arguments(p) -> None:
     p.add_argument("recordings", nargs="?", help="recordings CSV (displacement_mm, voltage_v, "
-                   "optional direction, time_s, temperature_c)")
+                   "optional direction, time_s, temperature_c), or a waveform recording "
+                   "(time_s, sec_a_v, sec_b_v, displacement_mm, optional exc_v; docs/waveforms.md)")
     p.add_argument("--sensor", metavar="SENSOR.toml",
                    help="sensor description (flann-sensor/1); its geometry is then taken as "
                         "known and only gain and origin are calibrated (default: the paper's "
@@ -68,10 +71,18 @@ def run(args) -> int:
     if not args.recordings:
         raise FlannError("diagnose needs a recordings CSV (or --demo)")
 
+    sensor = load_sensor(args.sensor) if args.sensor else None
+    if is_waveform_csv(args.recordings):
+        wave = read_waveforms(args.recordings, announce=not args.quiet)
+        wd = diagnose_waveforms(wave, sensor=sensor)
+        obj, text = wave_to_json(wd), format_wave_text(wd)
+        if args.plot:
+            plot_wave(wd, args.plot)
+        if not emit_json(args, obj):
+            print(text, end="")
+        return 0
+
     rec = read_recordings(args.recordings, announce=not args.quiet)
-    sensor = None
-    if args.sensor:
-        sensor = load_sensor(args.sensor)
     dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
     # both reports are built before any file is written: a failure leaves no output behind

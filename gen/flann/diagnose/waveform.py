@@ -418,7 +418,7 @@ def wave_to_json(dg: WaveDiagnosis) -> dict:
 
 def _evidence_json(x: Evidence) -> dict:
     out = {"effect": x.name, "figure": x.figure, "value": _num(x.value), "stderr": _num(x.stderr),
-           "unit": x.unit, "threshold": _num(x.threshold), "found": x.found}
+           "unit": x.unit, "threshold": _num(x.threshold), "found": bool(x.found)}
     if x.reason:
         out["not_computable"] = x.reason
     return out
