@@ -481,11 +481,13 @@ def plot_wave(dg: WaveDiagnosis, path) -> None:
     ax.legend(fontsize=8)
     ax = axes[2]
     if dg.dwells[0].exc is not None:
-        ax.plot(t, [abs(d.exc) for d in dg.dwells], "o-", label="excitation")
-        ax.set_ylabel("excitation (V peak)")
+        e = np.array([abs(d.exc) for d in dg.dwells])
+        ax.plot(t, 100 * (e / e[0] - 1), "o-", label=f"excitation (first dwell {e[0]:.4g} V peak)")
+        ax.set_ylabel("excitation change (%)")
     else:
         ax.plot(t, dg.a_i + dg.b_i, "o", label="A + B in phase (no excitation recorded)")
         ax.set_ylabel("A + B (V peak)")
+    ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=8)
     fig.suptitle(f"waveform diagnosis: {', '.join(e.name for e in dg.effects) or 'no effect found'}")
