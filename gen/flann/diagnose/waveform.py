@@ -100,6 +100,8 @@ class WaveDiagnosis:
     b_i: np.ndarray
     b_q: np.ndarray
     null_mm: float | None          # where A_I = B_I
+    phase_a_deg: float             # each secondary's phase (median where it is above half its peak)
+    phase_b_deg: float
     evidence: tuple[Evidence, ...]
     effects: tuple[WaveEffect, ...]
     not_in_waveforms: tuple[tuple[str, str], ...]
@@ -211,7 +213,9 @@ def _imbalance_shift(u, ai, bi, sig) -> tuple[Evidence, Evidence, dict]:
                     "1", Z_FOUND * float(se), abs(e) > Z_FOUND * se)
     ev_s = Evidence("zero_shift", "null shift s (core centred at)", float(s), float(ss), "mm",
                     Z_FOUND * float(ss), abs(s) > Z_FOUND * ss)
+    ratio = (1 + e / 2) / (1 - e / 2)
     return ev_e, ev_s, {"imbalance_fraction": (float(e), float(se), "1"),
+                        "sensitivity_ratio": (float(ratio), float(se * ratio / (1 - e * e / 4)), "1"),
                         "shift_mm": (float(s), float(ss), "mm")}
 
 
@@ -367,7 +371,7 @@ def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
     evidence += ex_ev
     params.update(ex_params)
 
-    keys = {"secondary_imbalance": ("imbalance_fraction",), "zero_shift": ("shift_mm",),
+    keys = {"secondary_imbalance": ("imbalance_fraction", "sensitivity_ratio"), "zero_shift": ("shift_mm",),
             "quadrature_null": ("quadrature_v",), "phase_shift": ("phase_deg",),
             "excitation_drift": ("drift_pct",)}
     verdict: dict[str, bool] = {}
@@ -382,9 +386,11 @@ def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
     notes = []
     if wave.exc_v is None:
         notes.append("no excitation recorded: the carrier and the phases are taken from the secondaries' sum")
+    strong_a, strong_b = np.abs(a) > 0.5 * np.max(np.abs(a)), np.abs(b) > 0.5 * np.max(np.abs(b))
     return WaveDiagnosis(source=wave.source, carrier_hz=fc, sample_rate_hz=fs, reference_deg=math.degrees(phi),
                          noise_v=noise, dwells=tuple(dw), a_i=ar.real, a_q=ar.imag, b_i=br.real, b_q=br.imag,
-                         null_mm=null_mm, evidence=tuple(evidence), effects=effects,
+                         null_mm=null_mm, phase_a_deg=float(np.degrees(np.median(np.angle(a[strong_a])))),
+                         phase_b_deg=float(np.degrees(np.median(np.angle(b[strong_b])))), evidence=tuple(evidence), effects=effects,
                          not_in_waveforms=absent, notes=tuple(notes))
 
 
@@ -399,6 +405,7 @@ def wave_to_json(dg: WaveDiagnosis) -> dict:
         "kind": "waveform", "source": dg.source, "carrier_hz": _num(dg.carrier_hz),
         "sample_rate_hz": _num(dg.sample_rate_hz), "reference_deg": _num(dg.reference_deg),
         "noise_v": _num(dg.noise_v), "null_mm": _num(dg.null_mm),
+        "phase_a_deg": _num(dg.phase_a_deg), "phase_b_deg": _num(dg.phase_b_deg),
         "effects": [{"name": e.name, "explanation": e.explanation,
                      "params": {k: {"value": _num(v), "stderr": _num(s), "unit": un}
                                 for k, (v, s, un) in e.params.items()},
@@ -430,6 +437,8 @@ def format_wave_text(dg: WaveDiagnosis) -> str:
              f"  reference (phase of A - B's slope at the null) {dg.reference_deg:.3f} deg against the "
              + ("excitation" if dg.dwells[0].exc is not None else "secondaries' sum")
              + (f"; null (A_I = B_I) at {dg.null_mm:+.4f} mm" if dg.null_mm is not None else "; no null in the travel"),
+             f"  phase of A {dg.phase_a_deg:.3f} deg, of B {dg.phase_b_deg:.3f} deg (median where each is "
+             "above half its peak)",
              "", "evidence (found when |value| > threshold; thresholds "
              f"{Z_FOUND:g} standard errors, phase at least {PHASE_TOLERANCE_DEG:g} deg, "
              f"drift at least {DRIFT_FLOOR_PCT:g} %):"]
