@@ -90,14 +90,14 @@ def test_figures_agree_with_the_concealed_sizes(waves):
     quad = waves["quadrature"][1]["effects"][0]["params"]["quadrature_v"]["value"]
     assert quad == pytest.approx(0.05, rel=0.05)
     drift = waves["drift"][1]["effects"][0]["params"]["drift_pct"]["value"]
-    assert drift == pytest.approx(10.0, rel=0.05)
+    assert drift == pytest.approx(10.0, rel=0.02)
 
 
 def test_the_ratio_cancels_the_excitation_drift(waves):
     ev = {e["figure"]: e for e in waves["drift"][1]["evidence"] if e["effect"] == "excitation_drift"}
     diff = ev["A - B change over the run"]
     ratio = ev["ratio (A - B)/(A + B) change over the run"]
-    assert diff["found"] and diff["value"] == pytest.approx(10.0, rel=0.05)
+    assert diff["found"] and diff["value"] == pytest.approx(10.0, rel=0.02)
     assert not ratio["found"]
 
 

@@ -267,8 +267,13 @@ def _drift_within_positions(pos, t, v):
     return k, math.sqrt(float(np.sum((r - k * tt) ** 2)) / dof / den)
 
 
-def _excitation(dw, t, pos, ai, bi, span) -> tuple[list[Evidence], dict]:
-    """Changes over the recording's ``span`` seconds."""
+def _excitation(dw, t, pos, ai, bi, t0, span) -> tuple[list[Evidence], dict]:
+    """Changes over the recording (``span`` seconds from ``t0``), in % of the start's value."""
+
+    def pct(k, sk):   # k: relative change per second about the dwells' mean time
+        at_start = 1.0 + k * (t0 - float(np.mean(t)))
+        return 100 * k * span / at_start, 100 * sk * span / abs(at_start)
+
     if t.size < 2:
         why = "one dwell: no time to drift in"
         return [Evidence("excitation_drift", "excitation amplitude change over the run", None, None,
@@ -278,14 +283,14 @@ def _excitation(dw, t, pos, ai, bi, span) -> tuple[list[Evidence], dict]:
         X = np.column_stack([np.ones_like(t), t - t.mean()])
         resid_sig = max(float(np.std(e)) * 1e-9, 1e-12)
         (e0, k), (_, sk) = _fit(X, e, np.full(t.size, resid_sig))
-        drift, sdrift = 100 * k * span / e0, 100 * sk * span / e0
+        drift, sdrift = pct(k / e0, sk / e0)
         figure = "excitation amplitude change over the run"
     else:
         hit = _drift_within_positions(pos, t, ai + bi)
         if hit is None:
             return [Evidence("excitation_drift", "secondaries' sum change over the run", None, None, "%",
                              None, False, "no excitation recorded and no position recorded twice")], {}
-        drift, sdrift = 100 * hit[0] * span, 100 * hit[1] * span
+        drift, sdrift = pct(*hit)
         figure = "secondaries' sum change over the run (no excitation recorded)"
     threshold = max(Z_FOUND * sdrift, DRIFT_FLOOR_PCT)
     out = [Evidence("excitation_drift", figure, float(drift), float(sdrift), "%", threshold,
@@ -300,10 +305,9 @@ def _excitation(dw, t, pos, ai, bi, span) -> tuple[list[Evidence], dict]:
             out.append(Evidence("excitation_drift", name, None, None, "%", None, False,
                                 "no position recorded twice"))
         else:
-            sd = 100 * hit[1] * span
-            out.append(Evidence("excitation_drift", name, 100 * hit[0] * span, sd, "%",
-                                max(Z_FOUND * sd, DRIFT_FLOOR_PCT), abs(100 * hit[0] * span)
-                                > max(Z_FOUND * sd, DRIFT_FLOOR_PCT)))
+            v, sd = pct(*hit)
+            thr = max(Z_FOUND * sd, DRIFT_FLOOR_PCT)
+            out.append(Evidence("excitation_drift", name, v, sd, "%", thr, abs(v) > thr))
     return out, {"drift_pct": (float(drift), float(sdrift), "%")}
 
 
@@ -366,7 +370,7 @@ def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
         evidence.append(Evidence("phase_shift", f"reference phase {math.degrees(phi):.3f} deg against the "
                                  f"sensor model's ({s.name})", dphi, sphi, "deg", thr, abs(dphi) > thr))
         params["phase_deg"] = (dphi, sphi, "deg")
-    ex_ev, ex_params = _excitation(dw, t, pos, ar.real, br.real,
+    ex_ev, ex_params = _excitation(dw, t, pos, ar.real, br.real, float(wave.time_s[0]),
                                     float(wave.time_s[-1] - wave.time_s[0]))
     evidence += ex_ev
     params.update(ex_params)
