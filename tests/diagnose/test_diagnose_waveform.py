@@ -46,9 +46,9 @@ def waves(tmp_path_factory, flann):
                   "--step-mm", "5", "--trajectory", "steps:0.003", "--noise-v", "0.004", *extra)
         assert r.returncode == 0, r.stderr
         js = root / f"{name}.json"
-        r = flann("diagnose", wave, "--json", js)
+        r = flann("diagnose", wave, "--sensor", toml, "--json", js)
         assert r.returncode == 0, r.stderr
-        text = flann("diagnose", wave)
+        text = flann("diagnose", wave, "--sensor", toml)
         assert text.returncode == 0, text.stderr
         out[name] = (wave, json.loads(js.read_text()), text.stdout)
     return out
@@ -123,6 +123,16 @@ def test_without_excitation_the_quadrature_is_still_found_and_the_phase_is_not_c
     assert _named(obj) == {"quadrature_null"}
     phase = next(e for e in obj["evidence"] if e["effect"] == "phase_shift")
     assert phase["value"] is None and phase["not_computable"]
+
+
+def test_without_a_sensor_description_the_phase_is_not_judged(waves, tmp_path, flann):
+    js = tmp_path / "phase.json"
+    r = flann("diagnose", waves["phase"][0], "--json", js)
+    assert r.returncode == 0, r.stderr
+    obj = json.loads(js.read_text())
+    assert _named(obj) == set()
+    phase = next(e for e in obj["evidence"] if e["effect"] == "phase_shift")
+    assert phase["value"] is None and "--sensor" in phase["not_computable"]
 
 
 def test_plot_is_written(waves, tmp_path, flann):

@@ -26,7 +26,8 @@ def add_arguments(p) -> None:
     p.add_argument("--sensor", metavar="SENSOR.toml",
                    help="sensor description (flann-sensor/1); its geometry is then taken as "
                         "known and only gain and origin are calibrated (default: the paper's "
-                        "LVDT with geometry calibrated to the recordings)")
+                        "LVDT with geometry calibrated to the recordings); for a waveform recording, the "
+                        "phase its secondaries should have")
     p.add_argument("--plot", metavar="OUT.png", type=png_path, help="residuals before/after, mismatch shaded")
     p.add_argument("--demo", action="store_true",
                    help="run the concealed-effect demonstration (simulated recordings) and "

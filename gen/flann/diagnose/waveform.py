@@ -313,7 +313,8 @@ def _excitation(dw, t, pos, ai, bi, t0, span) -> tuple[list[Evidence], dict]:
 
 def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
     """Lock in on each dwell of ``wave`` and weigh the evidence (module docstring).  ``sensor``
-    (default: the seed paper's LVDT) gives the phase and demodulator gain to compare with."""
+    gives the phase to compare with (without it the phase is not judged) and the demodulator
+    gain that refers the quadrature to the output (default: the seed paper's LVDT's)."""
     fs = wave.sample_rate_hz
     carrier_src = wave.exc_v if wave.exc_v is not None else wave.sec_a_v + wave.sec_b_v
     fc = _carrier_hz(carrier_src, fs)
@@ -359,10 +360,11 @@ def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
     # phase: the slope's standard error across its direction
     sel = pos[near]
     s_slope = float(np.sqrt(2.0) * np.mean(sig_dw[near]) / math.sqrt(max(1e-30, np.sum((sel - sel.mean()) ** 2))))
-    if dw[0].exc is None:
-        evidence.append(Evidence("phase_shift", "reference phase against the excitation", None, None, "deg",
-                                 None, False, "no excitation recorded: the phases are relative to the "
-                                 "secondaries' sum"))
+    if dw[0].exc is None or sensor is None:
+        why = ("no excitation recorded: the phases are relative to the secondaries' sum" if dw[0].exc is None
+               else "no sensor description (--sensor): the phase this sensor should have is unknown")
+        evidence.append(Evidence("phase_shift", "reference phase against the sensor model's", None, None,
+                                 "deg", None, False, why))
     else:
         dphi = math.degrees(math.remainder(phi - reference_phase_rad(s), 2 * math.pi))
         sphi = math.degrees(s_slope / abs(slope))
