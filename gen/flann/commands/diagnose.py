@@ -10,9 +10,11 @@ from ..diagnose import diagnose
 from ..diagnose.data import MAX_POINTS, shared_reading
 from ..diagnose.demo import demo_table, run_demo
 from ..diagnose.report import format_text, plot, to_json
+from ..diagnose.waveform import diagnose_waveforms, format_wave_text, is_waveform_csv, plot_wave, wave_to_json
 from ..errors import FlannError
 from ..physics.sensor import load_sensor
 from ..recordings import read_recordings
+from ..recordings.waveform import read_waveforms
 from .common import add_common, emit_json, json_to_stdout, json_word_as_input, on_terminal
 
 HELP = "locate and name the physics missing between simulation and recordings"
@@ -20,12 +22,14 @@ HELP = "locate and name the physics missing between simulation and recordings"
 
 def add_arguments(p) -> None:
     p.add_argument("recordings", nargs="?", help="recordings CSV (displacement_mm, voltage_v, "
-                   "optional direction, time_s, temperature_c)")
+                   "optional direction, time_s, temperature_c), or a waveform recording "
+                   "(time_s, sec_a_v, sec_b_v, displacement_mm, optional exc_v; docs/waveforms.md)")
     p.add_argument("--sensor", metavar="SENSOR.toml",
                    help="sensor description (flann-sensor/1, a .toml file), or the ID of one sensor in "
                         "a file of several (its sensor column); a description's geometry is then taken as "
                         "known and only gain and origin are calibrated (default: the paper's "
-                        "LVDT with geometry calibrated to the recordings)")
+                        "LVDT with geometry calibrated to the recordings); for a waveform recording, the "
+                        "phase its secondaries should have")
     p.add_argument("--plot", metavar="OUT.png", type=png_path, help="residuals before/after, mismatch shaded")
     p.add_argument("--demo", action="store_true",
                    help="run the concealed-effect demonstration (simulated recordings) and "
@@ -73,11 +77,17 @@ def run(args) -> int:
     # --sensor names a sensor description (a file) or the ID of a sensor in a multi-sensor file
     sensor_id = args.sensor if args.sensor and not (args.sensor.endswith(".toml") or Path(args.sensor).exists()) \
         else None
-    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id)
-    sensor = None
-    if args.sensor and sensor_id is None:
-        sensor = load_sensor(args.sensor)
-    rec = shared_reading(rec)
+    sensor = load_sensor(args.sensor) if args.sensor and sensor_id is None else None
+    if is_waveform_csv(args.recordings):
+        wave = read_waveforms(args.recordings, announce=not args.quiet)
+        wd = diagnose_waveforms(wave, sensor=sensor)
+        obj, text = wave_to_json(wd), format_wave_text(wd)
+        if args.plot:
+            plot_wave(wd, args.plot)
+        if not emit_json(args, obj):
+            print(text, end="")
+        return 0
+    rec = shared_reading(read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id))
     dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
     # both reports are built before any file is written: a failure leaves no output behind
