@@ -105,6 +105,12 @@ def run_cli(argv) -> tuple:
 
 
 @pytest.fixture(scope="session")
+def in_process():
+    """:func:`run_cli` as a fixture: ``in_process(argv)`` -> (exit code, stdout, stderr)."""
+    return run_cli
+
+
+@pytest.fixture(scope="session")
 def flann():
     """flann in process, as the command line runs it: ``flann(*args)`` -> a
     ``subprocess.CompletedProcess`` (returncode, stdout, stderr), without a new interpreter."""

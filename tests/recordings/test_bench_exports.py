@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import run_cli
 from flann.golden.screen import ready_for_fit
 from flann.recordings import read_recordings
 
@@ -34,18 +33,18 @@ def _lines_named(text: str) -> set[int]:
 
 
 @pytest.fixture(scope="module")
-def trained(tmp_path_factory):
+def trained(tmp_path_factory, in_process):
     out = {}
     d = tmp_path_factory.mktemp("bench")
     for name in CASES:
         model = d / (name + ".json")
-        out[name] = (model, run_cli(["train", DATA / name, "-o", model]))
+        out[name] = (model, in_process(["train", DATA / name, "-o", model]))
     return out
 
 
 @pytest.mark.parametrize("command", ["train", "eval", "diagnose", "calibrate"])
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_commands_share_one_reading(trained, name, command):
+def test_commands_share_one_reading(trained, name, command, in_process):
     must, stroke = CASES[name]
     model, (rc, _out, err) = trained[name]
     assert rc == 0, err
@@ -56,12 +55,12 @@ def test_commands_share_one_reading(trained, name, command):
         assert (lo, hi) == stroke
         assert len(re.findall(r"^verdict: ", err, re.MULTILINE)) == 1
     elif command == "eval":
-        rc, out, text = run_cli(["eval", model, DATA / name])
+        rc, out, text = in_process(["eval", model, DATA / name])
         assert rc == 0, text
         named = _lines_named(text)
         assert len(re.findall(r"^verdict: GOOD", out, re.MULTILINE)) == 1
     elif command == "diagnose":
-        rc, _out, text = run_cli(["diagnose", DATA / name, "--max-points", "0"])
+        rc, _out, text = in_process(["diagnose", DATA / name, "--max-points", "0"])
         assert rc == 0, text
         named = _lines_named(text)
     else:   # calibrate's members are made ready by this one function
@@ -81,10 +80,10 @@ def _all_listed(text: str, must: set[int]) -> set[int]:
     return must if re.search(r"and \d+ more", text) else set()
 
 
-def test_four_sensors_select_by_id(tmp_path):
-    rc, _o, err = run_cli(["train", DATA / "four_sensors.csv", "-o", tmp_path / "m.json"])
+def test_four_sensors_select_by_id(tmp_path, in_process):
+    rc, _o, err = in_process(["train", DATA / "four_sensors.csv", "-o", tmp_path / "m.json"])
     assert rc == 2 and "4 sensors" in err and "--sensor" in err and len(err.strip().splitlines()) == 1
-    rc, _o, err = run_cli(["train", DATA / "four_sensors.csv", "--sensor", "LV-103", "-o", tmp_path / "m.json"])
+    rc, _o, err = in_process(["train", DATA / "four_sensors.csv", "--sensor", "LV-103", "-o", tmp_path / "m.json"])
     assert rc == 0, err
     assert "sensor LV-103 of 4" in err
 
@@ -96,23 +95,23 @@ def test_ab_is_the_ratiometric_output():
     assert "(A - B)/(A + B)" in rec.recognised
 
 
-def test_eval_warns_when_compensation_is_worse_than_the_line(tmp_path):
+def test_eval_warns_when_compensation_is_worse_than_the_line(tmp_path, in_process):
     """A model of another sensor (LV-101) on the A/B export's ratio: compensated worse than the
     straight line through the same readings, said, and exit 1 under --strict."""
     m = tmp_path / "m.json"
-    assert run_cli(["train", DATA / "four_sensors.csv", "--sensor", "LV-101", "-o", m])[0] == 0
-    rc, out, err = run_cli(["eval", m, DATA / "ab_export.csv", "--json"])
+    assert in_process(["train", DATA / "four_sensors.csv", "--sensor", "LV-101", "-o", m])[0] == 0
+    rc, out, err = in_process(["eval", m, DATA / "ab_export.csv", "--json"])
     import json
 
     res = json.loads(out)
     assert res["compensated"]["max_error_mm"] > res["raw"]["max_error_mm"]
     assert res["verdict"]["status"] == "bad" and rc == 0
-    rc, out, _err = run_cli(["eval", m, DATA / "ab_export.csv", "--strict"])
+    rc, out, _err = in_process(["eval", m, DATA / "ab_export.csv", "--strict"])
     assert rc == 1 and "compensated worse than the straight line" in out
 
 
-def test_paper_exact_fit_verdict_is_bad(tmp_path):
+def test_paper_exact_fit_verdict_is_bad(tmp_path, in_process):
     root = Path(__file__).parents[2]
-    rc, _o, err = run_cli(["train", root / "data" / "paper_table1.csv", "--terms", "51", "-o", tmp_path / "m.json",
+    rc, _o, err = in_process(["train", root / "data" / "paper_table1.csv", "--terms", "51", "-o", tmp_path / "m.json",
                            "--strict"])
     assert rc == 1 and "verdict: BAD" in err

@@ -572,7 +572,8 @@ def shared_reading(rec: Recordings) -> Recordings:
         return rec
     outliers = [i for i, lo in enumerate(reading.left_out) if lo.why == "outlier"]
     for line in reading.said:
-        warnings.warn(line, stacklevel=2)
+        if " gross outlier" in line:   # rails and a fold-back are named by the diagnosis itself
+            warnings.warn(line, stacklevel=2)
     if not outliers or rec.lines is None:
         return rec
     gone = {reading.left_out[i].line for i in outliers}

@@ -17,6 +17,8 @@ GOOD, BAD, NOT_JUDGED = "good", "bad", "not judged"
 # the hardware may lose this much of the float model's accuracy (max error, drift) before
 # it is said to lose the compensation
 HARDWARE_FACTOR = 1.5
+# errors below this (mm) are float rounding: a line the recordings fit exactly is no worse
+EXACT_MM = 1e-9
 
 
 @dataclass(frozen=True)
@@ -66,7 +68,7 @@ def combine(*checks: Check) -> Verdict:
 
 def against_line(model_mm: float, line_mm: float, what: str = "max error") -> Check:
     """The compensated error against the straight line through the same readings: worse is bad."""
-    ok = model_mm < line_mm
+    ok = model_mm < line_mm or model_mm <= EXACT_MM   # an exact line: both at rounding level
     text = (f"compensated {what} {model_mm:.4g} mm {'below' if ok else 'above'} the straight line's "
             f"{line_mm:.4g} mm on the same readings")
     if not ok:
