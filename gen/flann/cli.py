@@ -195,7 +195,8 @@ def _main(argv: list[str] | None) -> int:
         parser.exit(2, f"error: {prog}: unrecognized arguments: {one_line(' '.join(extra))} "
                        f"(see {prog} --help)\n")
     if args.command is None:
-        parser.print_help()
+        parser.print_usage(sys.stderr)
+        print(f"error: flann: no command given: one of {', '.join(COMMANDS)} (see flann --help)", file=sys.stderr)
         return 2
     _one_line_warnings()
     try:

@@ -50,6 +50,19 @@ def is_design(directory: Path) -> bool:
     return (Path(directory) / MANIFEST).is_file()
 
 
+def refuse_design_directory(path, flag: str) -> None:
+    """A build or work directory (``--build``, ``--work``) must not be a design directory or lie
+    inside one: its build files would make the design one that ``flann gen`` no longer replaces."""
+    if path is None:
+        return
+    p = Path(os.path.abspath(path))
+    for d in (p, *p.parents):
+        if is_design(d):
+            where = "is" if d == p else f"lies inside {d},"
+            raise FlannError(f"{flag} {path}: {where} a flann design directory; build files go beside the "
+                             "design, not into it (give another directory)")
+
+
 def foreign_entries(directory: Path) -> list[str]:
     """What a design directory holds beyond what flann gen wrote into it (its manifest's files,
     model and weight images): a user's notes, calibrate's certificates.  Replacing the design
@@ -189,4 +202,4 @@ def _kept_files(path: Path, directory: Path, data: dict) -> None:
             _listed_file(path, directory, im["model"], "json", f"model of image {im['name']!r}", must_exist=False)
 
 
-__all__ = ["MANIFEST", "Manifest", "is_design", "read_manifest", "write_design"]
+__all__ = ["MANIFEST", "Manifest", "is_design", "refuse_design_directory", "read_manifest", "write_design"]
