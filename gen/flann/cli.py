@@ -166,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _main(argv)
     except Terminated:
+        _end_children()
         print("error: terminated", file=sys.stderr)
         return 128 + signal.SIGTERM
     except KeyboardInterrupt:
@@ -183,6 +184,14 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGINT, previous)
         if previous_term is not None:
             signal.signal(signal.SIGTERM, previous_term)
+
+
+def _end_children() -> None:
+    """SIGTERM reaches flann alone (a terminal's Ctrl-C reaches its whole process group): the
+    tools it started (GHDL shards, Yosys, Verilator) end with it, not run on as orphans."""
+    from .verify.shards import end_children
+
+    end_children()
 
 
 def _main(argv: list[str] | None) -> int:

@@ -32,6 +32,7 @@ import io
 import math
 import os
 import signal
+import stat
 import sys
 import time
 import warnings
@@ -478,6 +479,19 @@ def _progress(done: int, total: int, failed: int, t0: float) -> None:
     sys.stderr.flush()
 
 
+def special_file(path: Path) -> str:
+    """'' for a regular file or a missing one (the reader says so), else what it is."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return ""
+    if stat.S_ISREG(mode):
+        return ""
+    return ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a directory" if stat.S_ISDIR(mode)
+            else "a character device" if stat.S_ISCHR(mode) else "a block device" if stat.S_ISBLK(mode)
+            else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+
+
 def _calibrate_item(item, one=calibrate_one, **kw) -> Result:
     return one(item[1], **kw)
 
@@ -543,7 +557,10 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
                  f"sensor name {name!r} already used by {paths[seen[name.casefold()]]} (one folder "
                  "per name, letter case ignored); rename this recording"
                  if name.casefold() in seen else "")
-        if clash:
+        kind = special_file(p)
+        if kind:   # opening a FIFO nobody writes would block its worker for good
+            results[i] = refused(p, f"{p}: is {kind}; flann reads recordings from regular files")
+        elif clash:
             results[i] = refused(p, clash)
         else:
             seen[name.casefold()] = i
