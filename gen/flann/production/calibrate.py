@@ -37,7 +37,7 @@ import sys
 import time
 import warnings
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
@@ -67,7 +67,7 @@ from .certificate import render_certificate, render_certificate_thermal, render_
 from .spec import ProductionSpec
 from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
-from .verdict import FAIL, PASS, Verdict, judge, rejected, require_positions, uncertainty
+from .verdict import FAIL, Verdict, judge, rejected, require_positions, uncertainty
 
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
 # nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
@@ -117,7 +117,7 @@ class Result:
     def kept_model_sha256(self) -> str:
         """The model's sha256 where its model.json is kept (a passed sensor); a failed or
         rejected sensor's row and certificate name none, as its folder holds no model."""
-        return self.model_sha256 if self.verdict is not None and self.verdict.passed else ""
+        return self.model_sha256 if self.verdict is not None and self.verdict.shipped else ""
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -300,7 +300,7 @@ def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, sp
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         _reject(res, f"{exc.__class__.__name__}: {exc}", path, seen.get("rec"), out_dir, fam, dhash, spec, station)
         return
-    if res.verdict.verdict == PASS:
+    if res.verdict.shipped:
         res.status, res.reason = "ok", ""
     else:
         res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
@@ -415,7 +415,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
-        if res.verdict.passed:
+        if res.verdict.shipped:
             (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(chk["words"], head), newline="")
     res.written = True
@@ -432,8 +432,7 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
     try:
         res.trace = traceability(path, rec, station)
     except FlannError:
-        res.trace = traceability(path, None, Station(station.station, station.operator,
-                                                     station.fixture, station.temperature_c))
+        res.trace = traceability(path, None, replace(station, serial_column=""))
     try:
         sha = rec.sha256 if rec is not None else hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError:
@@ -461,7 +460,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
-        if res.verdict.passed:
+        if res.verdict.shipped:
             (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(words, head), newline="")
             (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
