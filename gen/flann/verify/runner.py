@@ -57,11 +57,20 @@ def sim_dir() -> Path:
     return BENCH_DIR
 
 
-@functools.lru_cache(maxsize=None)
-def ghdl_backend() -> str:
-    """'llvm' when ghdl-llvm is installed and the ghdl wrapper honours GHDL_BACKEND, else 'mcode'."""
+def need_ghdl() -> None:
+    """GHDL missing: said as such (as synth says it), not as a build whose log was never written."""
     if shutil.which("ghdl") is None:
         raise FlannError("ghdl not found on PATH (Debian package ghdl; `make tools` installs it)")
+
+
+def ghdl_backend() -> str:
+    """'llvm' when ghdl-llvm is installed and the ghdl wrapper honours GHDL_BACKEND, else 'mcode'."""
+    need_ghdl()
+    return _backend()
+
+
+@functools.lru_cache(maxsize=None)
+def _backend() -> str:
     if shutil.which("ghdl-llvm") is None:
         return "mcode"
     r = subprocess.run(["ghdl", "--version"], capture_output=True, text=True,
@@ -128,7 +137,7 @@ def build(sources, toplevel: str, build_dir, backend: str | None = None) -> str:
     """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used
     (default mcode: the cocotb benches are short, and mcode compiles in a second)."""
     backend = backend or "mcode"
-    ghdl_backend()   # GHDL missing: said as such, not as a build that left no log
+    need_ghdl()
     build_dir = Path(build_dir).resolve()
     build_dir.mkdir(parents=True, exist_ok=True)
     args = ["--std=93c"] + (["-O2"] if backend == "llvm" else [])
