@@ -50,6 +50,7 @@ from ..errors import FlannError, Terminated
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm, ridge_ladder
 from ..golden.metrics import raw_output_mm
+from ..golden.train import fit_auto, fit_lstsq
 from ..golden.model import text_sha256
 from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
@@ -170,18 +171,70 @@ def train_for_design(rec, fam: FamilySpec):
     raise last
 
 
-def reach_flag(rec, fam: FamilySpec, max_error_mm: float) -> tuple[float, str | None]:
-    """(what the sensor's own design reaches on its recording, the flag or None): its own
-    ``--terms auto`` fit at the design's converter, asked at the voltages that converter hands
-    on (as the hardware is), against the hardware's ``max_error_mm``."""
+@dataclass(frozen=True)
+class OwnDesign:
+    """The structure of a sensor's own design (``--terms auto``'s choice at the family design's
+    converter), chosen once per batch on its first readable recording: every sensor of a
+    family is then fitted with it in one least-squares solve, not a cross-validation each."""
+
+    terms: int
+    norm: str
+    ridge: float
+    chosen_on: str
+
+
+def _own_cost(fam: FamilySpec):
     s = fam.spec
-    reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
-                                    cost=lambda m: fixed_point_cost(m, (s.input_bits, s.input_lsb_v)),
-                                    received=lambda v: adc_codes(s, v) * s.input_lsb_v)
+    return lambda m: fixed_point_cost(m, (s.input_bits, s.input_lsb_v))
+
+
+def own_design_for(rec, fam: FamilySpec, name: str) -> OwnDesign:
+    """The own design's structure, chosen by ``--terms auto`` on ``rec`` (the expensive step, once)."""
+    _model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, cost=_own_cost(fam))
+    return OwnDesign(int(choice.terms), str(choice.norm), float(choice.ridge), name)
+
+
+def first_own_design(paths, fam: FamilySpec) -> OwnDesign | None:
+    """:func:`own_design_for` on the first recording that reads and passes the screens (None:
+    none does; each sensor then chooses its own)."""
+    for path in paths:
+        if special_file(Path(path)):
+            continue
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                rec = read_recordings(path)
+                if outside_input(fam, rec.voltage_v):
+                    continue
+                rec, _said = ready_for_fit(rec)
+                return own_design_for(rec, fam, sensor_name(path))
+        except (FlannError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+            continue
+    return None
+
+
+def reach_flag(rec, fam: FamilySpec, max_error_mm: float,
+               own: OwnDesign | None = None) -> tuple[float, str | None]:
+    """(what the sensor's own design reaches on its recording, the flag or None): its own fit
+    (the batch's :class:`OwnDesign` structure, else its own ``--terms auto`` choice) at the
+    design's converter, asked at the voltages that converter hands on (as the hardware is),
+    against the hardware's ``max_error_mm``."""
+    s = fam.spec
+
+    def received(v):
+        return adc_codes(s, v) * s.input_lsb_v
+
+    if own is None:
+        reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm, cost=_own_cost(fam), received=received)
+        how = f"{own_terms} terms"
+    else:
+        model = fit_lstsq(rec.voltage_v, rec.displacement_mm, own.terms, norm=own.norm, ridge=own.ridge)
+        reach = float(np.max(np.abs(model.predict(received(rec.voltage_v)) - rec.displacement_mm)))
+        own_terms, how = own.terms, f"{own.terms} terms as chosen on {own.chosen_on}"
     if max_error_mm <= REACH_FACTOR * reach:
         return reach, None
     return reach, (f"hardware max error {max_error_mm:.4g} mm is {max_error_mm / reach:.2f} x what this "
-                   f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms, at the design's "
+                   f"sensor's own design reaches ({reach:.4g} mm, {how}, at the design's "
                    f"{s.input_bits}-bit input; flagged above {REACH_FACTOR:g} x): the family design costs it accuracy")
 
 
@@ -308,9 +361,11 @@ def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, sp
 
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
-                  spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
+                  spec: ProductionSpec | None = None, station: Station | None = None,
+                  own: OwnDesign | None = None) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
-    that fails its spec or is rejected gets a certificate saying why and no weights."""
+    that fails its spec or is rejected gets a certificate saying why and no weights.  ``own``:
+    the batch's own-design structure for the reach judgement (None: chosen for this sensor)."""
     path = Path(path)
     res, spec, station = _start(path, dhash, spec, max_error_mm, station)
     seen: dict = {}
@@ -336,7 +391,7 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
         res.model_sha256 = text_sha256(chk["model"].to_json())
-        res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm)
+        res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm, own)
         if res.costs_accuracy:
             res.warnings.append(res.costs_accuracy)
         reversed_output = polarity_warning(rec, fam)
@@ -577,9 +632,12 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if progress:
             _progress(len(results), len(paths), failed, t0)
 
-    one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
+    if dp is FAMILY_THERMAL:
+        one, extra = calibrate_one_thermal, {}
+    else:   # the reach judgement's structure, chosen once for the batch
+        one, extra = calibrate_one, {"own": first_own_design([paths[i] for i in todo], fam)}
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
-                 max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
+                 max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station, **extra)
     stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record,
                            lambda item, why: record(item, refused(item[1], why)))
     if progress:
@@ -614,6 +672,6 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
+__all__ = ["OwnDesign", "first_own_design", "own_design_for", "reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
            "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS",
            "DIAGNOSIS_POINTS"]
