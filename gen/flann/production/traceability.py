@@ -165,7 +165,7 @@ def traceability(path, rec, station: Station) -> Traceability:
                         temperature_c=temp, temperature_from=temp_from,
                         calibrated_at=(at := now_iso()),
                         certificate_number=certificate_number(station.certificate_prefix, at,
-                                                              rec.sha256 if rec is not None else path.name),
+                                                              getattr(rec, "sha256", "") or path.name),
                         reference_standard=station.reference_standard, reference_due=station.reference_due)
 
 
