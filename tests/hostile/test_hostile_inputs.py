@@ -265,8 +265,9 @@ def p_repeats(w):
     _write(w / "bad.csv", "\n".join(rows + rows[1:]) + "\n")
 
 
-def _edited_manifest(w, edit):
-    shutil.copytree(w / "design", w / "edited")
+def _edited_manifest(w, edit, design="design"):
+    """A copy of ``design`` as w/edited with its manifest changed by ``edit``."""
+    shutil.copytree(w / design, w / "edited")
     man = json.loads((w / "edited" / "manifest.json").read_text())
     edit(man)
     (w / "edited" / "manifest.json").write_text(json.dumps(man))
@@ -317,10 +318,7 @@ def p_sparse(w):
 
 
 def _edited_family(w, edit):
-    shutil.copytree(w / "fam", w / "edited")
-    man = json.loads((w / "edited" / "manifest.json").read_text())
-    edit(man)
-    (w / "edited" / "manifest.json").write_text(json.dumps(man))
+    _edited_manifest(w, edit, "fam")
 
 
 def p_top_renamed(w):
