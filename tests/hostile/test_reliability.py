@@ -257,3 +257,28 @@ def test_the_extreme_images_the_loader_accepts_agree_and_saturate(small_designs,
         assert rc == 0, capsys.readouterr().err
         assert summary["mismatches"] == 0 and summary["all_passed"]
         assert summary["netlist"]["mismatches"] == 0 and summary["netlist"]["codes_tested"] > 0
+
+
+IMAGE_CASES = [   # (datapath, the word every weight of the first memory holds, the error line)
+    ("family", lambda bits: (1 << (bits - 1)) - 1, "could overflow the hardware"),
+    ("family", lambda bits: (1 << 32) - (1 << (bits - 1)), "could overflow the hardware"),
+    ("family", lambda bits: 0x7FFFFFFF, "does not fit the field's sint<"),
+    ("family_thermal", lambda bits: (1 << (bits - 1)) - 1, "(temperature order 0)"),
+    ("family_thermal", lambda bits: 0x7FFFFFFF, "does not fit the field's sint<"),
+]
+
+
+@pytest.mark.parametrize("datapath, word, says", IMAGE_CASES,
+                         ids=[f"{c[0]}-{k}" for k, c in enumerate(IMAGE_CASES)])
+def test_the_loader_refuses_an_image_the_hardware_would_wrap_with(small_designs, tmp_path, capsys,
+                                                                    datapath, word, says):
+    d = small_designs["dir"] / datapath
+    man = json.loads((d / "manifest.json").read_text())
+    field = next(f for f in man["family"]["memory"]["fields"] if f["name"] == "weights")
+    words = read_image(d / man["images"][0]["hex"])
+    words[field["addr"]:field["addr"] + field["words"]] = [word(field["bits"])] * field["words"]
+    (tmp_path / "big.hex").write_text(hex_text(words))
+    rc = main(["sim", str(d), "--image", str(tmp_path / "big.hex"), "--build", str(tmp_path / "b")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("error:")]
+    assert rc == 2 and len(err) == 1 and says in err[0], err
+    assert not (tmp_path / "b").exists() or not any((tmp_path / "b").iterdir())
