@@ -138,13 +138,10 @@ def _clamp_codes(path: Path, data: dict) -> None:
     """``clamp_codes``: the lowest and highest input code the design uses, as its spec says."""
     if "clamp_codes" not in data:
         return
-    c, bits = data["clamp_codes"], data.get("input_bits")
+    c = data["clamp_codes"]
     if (not isinstance(c, list) or len(c) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) for x in c)
             or c[0] > c[1]):
         raise FlannError(f"{path}: field 'clamp_codes' must be [lowest, highest] input code, got {c!r}")
-    if isinstance(bits, int) and not isinstance(bits, bool) and 2 <= bits <= 64 and \
-            not -(1 << (bits - 1)) <= c[0] <= c[1] < (1 << (bits - 1)):
-        raise FlannError(f"{path}: field 'clamp_codes' {c} lies outside the {bits}-bit input codes")
     spec = data.get("spec")
     if isinstance(spec, dict) and "clamp_codes" in spec and spec["clamp_codes"] != c:
         raise FlannError(f"{path}: field 'clamp_codes' {c} differs from the design's spec "
