@@ -166,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _main(argv)
     except Terminated:
+        _end_children()
         print("error: terminated", file=sys.stderr)
         return 128 + signal.SIGTERM
     except KeyboardInterrupt:
@@ -185,6 +186,14 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGTERM, previous_term)
 
 
+def _end_children() -> None:
+    """SIGTERM reaches flann alone (a terminal's Ctrl-C reaches its whole process group): the
+    tools it started (GHDL shards, Yosys, Verilator) end with it, not run on as orphans."""
+    from .verify.shards import end_children
+
+    end_children()
+
+
 def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     selected = next((a for a in argv if a in COMMANDS), None)
@@ -195,7 +204,8 @@ def _main(argv: list[str] | None) -> int:
         parser.exit(2, f"error: {prog}: unrecognized arguments: {one_line(' '.join(extra))} "
                        f"(see {prog} --help)\n")
     if args.command is None:
-        parser.print_help()
+        parser.print_usage(sys.stderr)
+        print(f"error: flann: no command given: one of {', '.join(COMMANDS)} (see flann --help)", file=sys.stderr)
         return 2
     _one_line_warnings()
     try:

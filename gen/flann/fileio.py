@@ -21,6 +21,7 @@ out as one :class:`FlannError` line naming the output.
 from __future__ import annotations
 
 import contextlib
+import glob
 import io
 import json
 import os
@@ -28,6 +29,7 @@ import re
 import shutil
 import stat
 import tempfile
+import warnings
 from pathlib import Path
 
 from .errors import FlannError
@@ -193,6 +195,48 @@ def check_output_directory(path: str | os.PathLike, replaceable=_nobody_else_s, 
     return path
 
 
+def _swap_prefix(path: Path, kind: str) -> str:
+    """The name of a swap's temporary sibling: the process that owns it is in the name, so a
+    later run can tell an abandoned one (its process gone) from one being written now."""
+    return f".{path.name}.{kind}.{os.getpid()}."
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def recover_swap(path: str | os.PathLike) -> list[str]:
+    """Undo what a killed run left of :func:`atomic_directory`'s swap beside ``path``: a process
+    killed between its two renames leaves no ``path``, the old directory at
+    ``.<name>.old.<pid>.*/d`` and the new one at ``.<name>.new.<pid>.*``.  The old one goes back
+    (the last complete output), then every sibling of a process that is gone is removed.
+    Returns what was done, one phrase each (said on stderr by the caller's warning)."""
+    path = Path(os.path.abspath(path))
+    try:
+        siblings = list(path.parent.glob(f".{glob.escape(path.name)}.[no][el][wd].*"))
+    except OSError:
+        return []
+    done = []
+    for sib in sorted(siblings):
+        m = re.fullmatch(rf"\.{re.escape(path.name)}\.(new|old)\.(\d+)\.[^/]+", sib.name)
+        if m is None or not sib.is_dir() or sib.is_symlink() or _alive(int(m[2])):
+            continue
+        if m[1] == "old" and (sib / "d").is_dir() and not os.path.lexists(path):
+            os.replace(sib / "d", path)
+            done.append(f"restored {path.name} from an interrupted replacement")
+        shutil.rmtree(sib, ignore_errors=True)
+        done.append(f"removed {sib.name}")
+    if done:
+        warnings.warn(f"{path}: a run killed while replacing it left its swap behind: {'; '.join(done)}")
+    return done
+
+
 @contextlib.contextmanager
 def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: str = "directory"):
     """Yield a fresh temporary directory that replaces ``path`` as a whole on success.
@@ -207,9 +251,10 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
     replaced); a directory holding one of the command's inputs is refused.
     """
     shown = Path(path)
+    recover_swap(path)
     path = check_output_directory(path, replaceable, what)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.new.", dir=path.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_swap_prefix(path, "new"), dir=path.parent))
     except OSError as exc:
         raise _cannot_write(path, exc) from None
     aside = None
@@ -221,7 +266,7 @@ def atomic_directory(path: str | os.PathLike, replaceable=_nobody_else_s, what: 
         try:
             os.chmod(tmp, 0o777 & ~_umask())
             if path.exists():
-                aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.old.", dir=path.parent))
+                aside = Path(tempfile.mkdtemp(prefix=_swap_prefix(path, "old"), dir=path.parent))
                 os.replace(path, aside / "d")
             try:
                 os.replace(tmp, path)
@@ -241,9 +286,10 @@ def remove_output_directory(path: str | os.PathLike, replaceable) -> None:
     """Remove ``path`` if it is an earlier output ``replaceable`` accepts (a result that is no
     longer true must not survive beside a report that says so); anything else is left."""
     path = Path(path)
+    recover_swap(path)
     if path.is_dir() and not path.is_symlink() and replaceable(path):
         try:
-            aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.old.", dir=path.parent))
+            aside = Path(tempfile.mkdtemp(prefix=_swap_prefix(path, "old"), dir=path.parent))
             os.replace(path, aside / "d")
         except OSError as exc:
             raise _cannot_write(path, exc) from None
@@ -252,4 +298,4 @@ def remove_output_directory(path: str | os.PathLike, replaceable) -> None:
 
 __all__ = ["check_output_directory", "atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_save_figure",
            "atomic_directory", "note_input", "guarding_inputs", "safe_name", "child",
-           "remove_output_directory"]
+           "remove_output_directory", "recover_swap"]

@@ -6,9 +6,11 @@ both: a terminal sends SIGINT, and ``timeout`` or a job scheduler SIGTERM, to th
 group), so no KeyboardInterrupt can land in the middle of recording a result: the parent
 submits nothing more, lets the items already running finish (each writes its output whole or
 not at all), and returns the signal that stopped it, so the caller can still write its
-summary before exiting 130 (143: SIGTERM).  A worker that dies all the same (SIGKILL, the
-system out of memory) loses only the items it had in flight: each is reported through
-``on_lost`` and the batch goes on in a new pool.
+summary before exiting 130 (143: SIGTERM).  SIGTERM, or a second Ctrl-C, does not wait: the
+items in flight are abandoned (their workers killed; in this process the item is left by an
+exception), so an item that never finishes (a read from a FIFO nobody writes) cannot hold the
+batch.  A worker that dies all the same (SIGKILL, the system out of memory) loses only the
+items it had in flight: each is reported through ``on_lost`` and the batch goes on in a new pool.
 """
 
 from __future__ import annotations
@@ -22,6 +24,15 @@ from typing import Callable, Iterable
 POLL_S = 0.1   # how often the parent looks at the Ctrl-C flag while workers run
 LOST = ("its worker process died before it finished (killed, or the system ran out of "
         "memory); run it again")
+
+
+class _StopNow(BaseException):
+    """Raised in this process's item when the batch must end without waiting for it."""
+
+
+def _now(stop: list) -> bool:
+    """End the batch without waiting for the items in flight: SIGTERM, or a second signal."""
+    return signal.SIGTERM in stop or len(stop) > 1
 
 
 def _worker_init() -> None:
@@ -38,9 +49,12 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
     worker died; the signal that stopped the batch early (SIGINT, SIGTERM), else 0."""
     items = list(items)
     stop = []
+    busy = []   # non-empty while this process runs an item (jobs == 1)
 
     def on_signal(signum, frame) -> None:
         stop.append(signum)
+        if busy and _now(stop):
+            raise _StopNow
 
     previous = {}
     for sig in (signal.SIGINT, signal.SIGTERM):
@@ -53,7 +67,14 @@ def run_batch(fn: Callable, items: Iterable, jobs: int, on_result: Callable[[obj
             for item in items:
                 if stop:
                     break
-                on_result(item, fn(item))
+                busy.append(item)
+                try:
+                    res = fn(item)
+                except _StopNow:
+                    break
+                finally:
+                    busy.clear()
+                on_result(item, res)
         else:
             _pool(fn, items, jobs, on_result, on_lost, stop)
     finally:
@@ -84,6 +105,9 @@ def _one_pool(fn, pending, end, jobs, on_result, on_lost, stop) -> bool:
         try:
             fill()
             while running:
+                if _now(stop):   # the items in flight are abandoned, their workers ended
+                    _end_workers(pool)
+                    return False
                 done, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
                 for fut in done:
                     res = fut.result()   # a broken pool raises here, the item still in running
@@ -96,6 +120,15 @@ def _one_pool(fn, pending, end, jobs, on_result, on_lost, stop) -> bool:
                 on_lost(item, LOST)
             return True
     return False
+
+
+def _end_workers(pool: ProcessPoolExecutor) -> None:
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    for proc in procs:
+        proc.kill()
+    for proc in procs:
+        proc.join()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 __all__ = ["run_batch"]

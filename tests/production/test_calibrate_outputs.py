@@ -208,3 +208,23 @@ def test_the_family_costs_accuracy_flag_reaches_the_summary_and_the_console(line
         assert ("warning: s1: hardware max error" in err) is flagged, err
         html = (out / "s1" / "certificate.html").read_text()
         assert ("the family design costs it accuracy" in html) is flagged
+
+
+def test_a_certificate_without_a_spec_is_not_judged_and_names_its_reference(line, tmp_path, capsys):
+    """No specification: NOT JUDGED on the certificate, in the summary and in the last line
+    (never PASS); the certificate number, the reference standard and its due date, page numbers."""
+    out = tmp_path / "cal"
+    capsys.readouterr()
+    rc, rows = _calibrate(line, out, line["rec"]["one"], "--reference-standard", "gauge block set GB-7",
+                          "--reference-due", "2099-12-31", "--certificate-prefix", "QA")
+    printed = capsys.readouterr().out
+    assert rc == 0
+    assert rows[0]["verdict"] == "NOT JUDGED" and rows[0]["status"] == "ok"
+    assert "1 of 1 sensor(s) calibrated and NOT JUDGED" in printed and "PASS" not in printed
+    html = (out / "one" / "certificate.html").read_text()
+    assert "NOT JUDGED: no specification given" in html and "PASS:" not in html
+    number = re.search(r"Certificate no\. (QA-\d{8}-\d{6}-[0-9a-f]{8})", html).group(1)
+    assert number[-8:] == hashlib.sha256((line["rec"]["one"]).read_bytes()).hexdigest()[:8]
+    assert "gauge block set GB-7" in html and "2099-12-31" in html
+    assert 'counter(page) " of " counter(pages)' in html
+    assert (out / "one" / "weights.hex").is_file()   # calibrated: its weights are written

@@ -104,7 +104,7 @@ def test_calibrate_certificates_per_temperature(line):
     spec = from_directory(line["design"]).spec
     for name, params in SENSORS.items():
         r = rows[name]
-        assert r["verdict"] == "PASS", r
+        assert r["verdict"] == "NOT JUDGED" and r["status"] == "ok", r   # no specification given
         # the drift column is the hardware's: recompute it from the written image and the twin
         rec = recording(params, seed=list(SENSORS).index(name))
         words = parse_hex((out / name / "weights.hex").read_text())

@@ -12,7 +12,7 @@ from scipy.special import erf
 from flann.cli import main
 from flann.golden.family import REACH_FACTOR, own_reach_mm
 from flann.hardware.family.render import load_design
-from flann.production.calibrate import check_sensor, reach_flag
+from flann.production.calibrate import check_sensor, first_own_design, reach_flag
 from flann.recordings import Recordings, read_recordings, write_recordings
 
 
@@ -53,3 +53,24 @@ def test_the_flag_still_names_a_sensor_the_design_serves_badly(family):
     rec = read_recordings(paths[0])
     reach, flag = reach_flag(rec, fam, 10.0)
     assert flag is not None and "at the design's 10-bit input" in flag and f"{10.0 / reach:.2f} x" in flag
+
+
+def test_the_batch_chooses_the_own_design_once_and_each_sensor_fits_it(family, tmp_path):
+    """calibrate chooses the own design's structure once (``--terms auto`` on the first
+    recording that reads, skipping a FIFO), then each sensor is one fit with it: its reach
+    within 10 % of its own choice's, and a member still unflagged."""
+    fam, paths = family
+    import os
+
+    os.mkfifo(tmp_path / "pipe.csv")
+    own = first_own_design([tmp_path / "pipe.csv", tmp_path / "missing.csv", *paths], fam)
+    assert own is not None and own.chosen_on == paths[0].stem
+    for p in paths[1:]:
+        rec = read_recordings(p)
+        hw = float(np.max(np.abs(check_sensor(rec, fam)["hw_err_mm"])))
+        reach, flag = reach_flag(rec, fam, hw, own)
+        its_own, _flag = reach_flag(rec, fam, hw)
+        assert reach == pytest.approx(its_own, rel=0.1)
+        assert flag is None, flag
+        _r, named = reach_flag(rec, fam, 10.0, own)
+        assert f"as chosen on {own.chosen_on}" in named

@@ -5,12 +5,15 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+from datetime import date
+
 import pytest
 
 from flann.errors import FlannError
 from flann.production.spec import ProductionSpec, build_spec, load_spec
 from flann.production.traceability import Station, comment_fields, traceability
-from flann.production.verdict import FAIL, PASS, judge, noise_v, rejected, uncertainty
+from flann.production.traceability import certificate_number, parse_due
+from flann.production.verdict import FAIL, NOT_JUDGED, NOT_JUDGED_WHY, PASS, judge, noise_v, rejected, uncertainty
 
 X = np.linspace(-10, 10, 201)
 
@@ -60,8 +63,13 @@ def test_ratio_and_named_effects_and_confounded_alternatives():
     assert judge(spec, X, _err(0, 0.01), 5.0, ("null_offset",)).verdict == PASS
 
 
-def test_no_spec_passes_a_calibrated_sensor_and_rejected_is_a_fail():
-    assert judge(ProductionSpec(), X, _err(0, 5.0), 100.0, ("backlash",)).verdict == PASS
+def test_no_spec_judges_nothing_and_rejected_is_a_fail():
+    """Without a specification a calibrated sensor is NOT JUDGED (its weights still written),
+    never PASS: a certificate reading PASS against nothing would be signed as a pass."""
+    v = judge(ProductionSpec(), X, _err(0, 5.0), 100.0, ("backlash",))
+    assert v.verdict == NOT_JUDGED and not v.passed and v.shipped
+    assert v.reasons == (NOT_JUDGED_WHY,)
+    assert judge(ProductionSpec(max_error_mm=10.0), X, _err(0, 5.0), 100.0, ()).verdict == PASS
     r = rejected(ProductionSpec(max_error_mm=0.1), "no voltage column")
     assert r.verdict == FAIL and r.rejected and r.reasons == ("rejected: no voltage column",)
 
@@ -185,3 +193,21 @@ def test_two_sweeps_far_from_the_tolerance_are_not_marginal():
     v = judge(ProductionSpec(max_error_mm=0.1), x, np.full(x.size, 0.05), None, (), expanded_mm=u.expanded_mm)
     assert v.verdict == PASS and v.reasons == ()
     assert "along each pass" in u.method and "direction of travel" not in u.method
+
+
+@pytest.mark.parametrize("prefix, at, key, number", [
+    ("FLANN", "2026-12-03T17:15:27+00:00", "8f5dccad16b547ab", "FLANN-20261203-171527-8f5dccad"),
+    ("QA.7", "2027-01-31T08:00:05-05:00", "0123456789abcdef", "QA.7-20270131-080005-01234567"),
+])
+def test_certificate_numbers(prefix, at, key, number):
+    assert certificate_number(prefix, at, key) == number
+
+
+@pytest.mark.parametrize("text, words", [
+    ("2026-01-01", "calibration expired"),
+    ("31.12.2030", "expected a date YYYY-MM-DD"),
+])
+def test_a_reference_standard_past_its_due_date_is_refused(text, words):
+    with pytest.raises(FlannError, match=words):
+        parse_due(text, today=date(2026, 6, 1))
+    assert parse_due("2026-06-01", today=date(2026, 6, 1)) == date(2026, 6, 1)

@@ -1,5 +1,5 @@
 """``flann calibrate REC.csv... -o OUTDIR --design DIR [-j N] [--spec SPEC.toml]``: per-sensor
-weights, certificates with a PASS/FAIL verdict, and a summary."""
+weights, certificates with a PASS/FAIL verdict (NOT JUDGED without a specification), and a summary."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ from ..argtypes import bounded
 from ..errors import one_line
 from ..production.calibrate import DIAGNOSIS_POINTS, calibrate_batch, summary_path
 from ..production.spec import build_spec
-from ..production.traceability import Station
+from ..production.traceability import Station, parse_due
+from ..production.verdict import NOT_JUDGED
 from .common import add_common, quiet
 
 HELP = "calibrate sensors for a family design: weight images and certificates"
@@ -47,6 +48,21 @@ def add_arguments(p) -> None:
                    help="calibration temperature (default: the recording's, if it says)")
     t.add_argument("--serial-column", default="", metavar="NAME",
                    help="read each sensor's serial from this CSV column (default: the file name)")
+    t.add_argument("--certificate-prefix", default="FLANN", type=_prefix, metavar="TEXT",
+                   help="certificate numbers are TEXT-YYYYMMDD-HHMMSS-<recording sha256, 8 digits> (default FLANN)")
+    t.add_argument("--reference-standard", default="", metavar="TEXT",
+                   help="the displacement reference standard the recordings were taken against (name, serial)")
+    t.add_argument("--reference-due", default=None, metavar="YYYY-MM-DD",
+                   help="the reference standard's calibration due date (a past date is refused)")
+
+
+def _prefix(text: str) -> str:
+    import argparse
+    import re
+
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,31}", text):
+        raise argparse.ArgumentTypeError(f"{text!r}: letters, digits, '_', '.', '-' (at most 32)")
+    return text
 
 
 def run(args) -> int:
@@ -54,7 +70,9 @@ def run(args) -> int:
                       working_range=args.working_range, max_ratio_to_limit=args.max_ratio_to_limit,
                       fail_on_effects=args.fail_on_effect)
     station = Station(station=args.station, operator=args.operator, fixture=args.fixture,
-                      temperature_c=args.temperature_c, serial_column=args.serial_column)
+                      temperature_c=args.temperature_c, serial_column=args.serial_column,
+                      certificate_prefix=args.certificate_prefix, reference_standard=" ".join(args.reference_standard.split()),
+                      reference_due=parse_due(args.reference_due) if args.reference_due is not None else None)
     results = calibrate_batch(args.recordings, args.output, args.design, jobs=args.jobs, sensor_toml=args.sensor,
                               diagnosis_points=args.diagnosis_points, spec=spec, station=station,
                               progress=False if quiet(args) else None)
@@ -68,6 +86,10 @@ def run(args) -> int:
         for w in r.warnings:
             print(f"warning: {r.sensor}: {one_line(w)}", file=sys.stderr)
     passed = len(results) - len(rejected) - len(failed)
-    print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
-          f"{len(rejected)} rejected; summary {summary_path(args.output)}")
+    if not spec.judges:   # calibrated, but against nothing: never a PASS
+        print(f"{passed} of {len(results)} sensor(s) calibrated and {NOT_JUDGED} (no specification given: "
+              f"--spec or --tolerance-mm), {len(rejected)} rejected; summary {summary_path(args.output)}")
+    else:
+        print(f"{passed} of {len(results)} sensor(s) PASS, {len(failed)} FAIL the specification, "
+              f"{len(rejected)} rejected; summary {summary_path(args.output)}")
     return 2 if rejected else 1 if failed else 0

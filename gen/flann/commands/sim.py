@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..argtypes import TOOL_SEED, png_path
 from ..errors import FlannError
+from ..hardware.manifest import refuse_design_directory
 from ..fileio import atomic_write_json, check_output_directory
 from ..hardware.family.images import IMAGE_FILE
 from ..hardware.target import DEFAULT_ICE40_PART, parse_ice40
@@ -116,6 +117,7 @@ def run(args) -> int:
         # a file (or FIFO) where the build directory goes: one line now, not a traceback later;
         # a directory already holding files (an earlier build) is reused
         check_output_directory(args.build, lambda _earlier: True, "build directory")
+        refuse_design_directory(args.build, "--build")
     if args.post_route:
         parse_ice40(args.post_route_device)  # refuse a bad part before any slow step
     t0 = time.monotonic()

@@ -14,6 +14,7 @@ from ..implement import ice40, synth
 from ..hardware.target import (DEFAULT_ICE40_PART, DEFAULT_PART, DEVICES, ICE40_PARTS, is_ice40,
                                parse_ice40, parse_part)
 from ..hardware.design import Design, open_directory
+from ..hardware.manifest import refuse_design_directory
 from ..verify.netlist import check_synthesized, has_sweep_driver, require_sweep_driver, sweep_datapaths
 from ..verify.post_route import checker
 from .common import add_common, cores_limited, emit_json, json_to_stdout, quiet
@@ -89,8 +90,39 @@ def post_route_check(design: Design, model):
     return checker(design.with_twin(model), refuse=True)
 
 
+VSG_CONFIG_MAX_BYTES = 1 << 20
+
+
+def check_vsg_config(path) -> None:
+    """A --vsg-config VSG would choke on, refused in one line before it runs: YAML aliases (an
+    alias bomb expands without bound), tags that build Python objects, or not a mapping."""
+    if path is None:
+        return
+    import yaml   # VSG's own dependency: needed only with a lint
+
+    p = Path(path)
+    if not p.is_file():
+        raise FlannError(f"--vsg-config {path}: no such file" if not p.exists() else f"--vsg-config {path}: not a regular file")
+    if p.stat().st_size > VSG_CONFIG_MAX_BYTES:
+        raise FlannError(f"--vsg-config {path}: larger than {VSG_CONFIG_MAX_BYTES >> 20} MB, not a VSG configuration")
+    text = p.read_text(errors="replace")
+    try:
+        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+            if isinstance(event, yaml.AliasEvent):
+                raise FlannError(f"--vsg-config {path}: uses a YAML alias (*{event.anchor}); a VSG configuration "
+                                 "needs none: write the values out")
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        first = " ".join(str(exc).split())
+        raise FlannError(f"--vsg-config {path}: not a VSG configuration: {first}") from None
+    if not isinstance(data, dict):
+        raise FlannError(f"--vsg-config {path}: not a VSG configuration (expected a YAML mapping of rules)")
+
+
 def run_ice40(args) -> int:
     parse_ice40(args.device)  # refuse a bad part before any slow step
+    refuse_design_directory(args.work, "--work")
+    check_vsg_config(args.vsg_config)
     design = open_directory(args.directory)   # read once, handed to every step
     if not args.no_lint:
         synth.check_lint(design.files, args.vsg_config, start=args.directory)
@@ -128,6 +160,8 @@ def _run(args) -> int:
         parse_part(args.device)  # refuse a bad part before any slow step
     if args.work and Path(args.work).exists() and not Path(args.work).is_dir():
         raise FlannError(f"--work {args.work}: exists and is not a directory")
+    refuse_design_directory(args.work, "--work")
+    check_vsg_config(args.vsg_config)
     # read once (a tampered manifest refused before any slow step), handed to every step
     design = open_directory(args.directory)
     if not args.no_lint:

@@ -50,6 +50,19 @@ def is_design(directory: Path) -> bool:
     return (Path(directory) / MANIFEST).is_file()
 
 
+def refuse_design_directory(path, flag: str) -> None:
+    """A build or work directory (``--build``, ``--work``) must not be a design directory or lie
+    inside one: its build files would make the design one that ``flann gen`` no longer replaces."""
+    if path is None:
+        return
+    p = Path(os.path.abspath(path))
+    for d in (p, *p.parents):
+        if is_design(d):
+            where = "is" if d == p else f"lies inside {d},"
+            raise FlannError(f"{flag} {path}: {where} a flann design directory; build files go beside the "
+                             "design, not into it (give another directory)")
+
+
 def foreign_entries(directory: Path) -> list[str]:
     """What a design directory holds beyond what flann gen wrote into it (its manifest's files,
     model and weight images): a user's notes, calibrate's certificates.  Replacing the design
@@ -60,8 +73,8 @@ def foreign_entries(directory: Path) -> list[str]:
     except FlannError:
         man = {}
     man = man if isinstance(man, dict) else {}
-    own = {MANIFEST, man.get("model")} | set(f for f in man.get("files", []) if isinstance(f, str))
-    own |= {im.get("hex") for im in man.get("images", []) if isinstance(im, dict)}
+    own = {MANIFEST, man.get("model"), man.get("init_model")} | set(f for f in man.get("files", []) if isinstance(f, str))
+    own |= {im.get(k) for im in man.get("images", []) if isinstance(im, dict) for k in ("hex", "model")}
     return sorted(p.name + ("/" if p.is_dir() else "") for p in directory.iterdir() if p.name not in own)
 
 
@@ -107,7 +120,32 @@ def read_manifest(directory) -> Manifest:
         if paths.count(paths[-1]) > 1:
             raise FlannError(f"{path}: field 'files' lists {f!r} twice")
     _kept_files(path, directory, data)
+    _top_declared(path, top, paths)
+    _clamp_codes(path, data)
     return Manifest(directory, top, tuple(paths), data)
+
+
+def _top_declared(path: Path, top: str, files) -> None:
+    """The top entity must be declared in a listed file: a harness instantiates it as a
+    component, and an unbound component simulates without an error and never answers."""
+    pattern = re.compile(rf"^\s*entity\s+{re.escape(top)}\s+is\b", re.I | re.M)
+    if not any(pattern.search(f.read_text(errors="replace")) for f in files):
+        raise FlannError(f"{path}: top entity {top!r} is declared in none of the files it lists "
+                         "(renamed by hand?): regenerate the design with flann gen")
+
+
+def _clamp_codes(path: Path, data: dict) -> None:
+    """``clamp_codes``: the lowest and highest input code the design uses, as its spec says."""
+    if "clamp_codes" not in data:
+        return
+    c = data["clamp_codes"]
+    if (not isinstance(c, list) or len(c) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) for x in c)
+            or c[0] > c[1]):
+        raise FlannError(f"{path}: field 'clamp_codes' must be [lowest, highest] input code, got {c!r}")
+    spec = data.get("spec")
+    if isinstance(spec, dict) and "clamp_codes" in spec and spec["clamp_codes"] != c:
+        raise FlannError(f"{path}: field 'clamp_codes' {c} differs from the design's spec "
+                         f"{spec['clamp_codes']!r}: regenerate the design with flann gen")
 
 
 # VHDL names go to GHDL and ISE command lines; a kept model or image is named after the user's
@@ -140,11 +178,13 @@ def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str,
 def _kept_files(path: Path, directory: Path, data: dict) -> None:
     """The model and weight images a design keeps beside its VHDL, confined like its files (a
     missing one is the reader's to report: a design may be checked in without its model)."""
-    model = data.get("model")
-    if model is not None:
-        if not isinstance(model, str):
-            raise FlannError(f"{path}: field 'model' must be a file name, got {model!r}")
-        _listed_file(path, directory, model, "json", "kept model", must_exist=False)
+    for key in ("model", "init_model"):
+        model = data.get(key)
+        if model is not None:
+            if not isinstance(model, str):
+                raise FlannError(f"{path}: field {key!r} must be a file name, got {model!r}")
+            _listed_file(path, directory, model, "json", "kept model" if key == "model" else "initial model",
+                         must_exist=False)
     images = data.get("images")
     if images is None:
         return
@@ -153,6 +193,10 @@ def _kept_files(path: Path, directory: Path, data: dict) -> None:
         raise FlannError(f"{path}: field 'images' must be a list of {{\"name\", \"hex\"}} objects")
     for im in images:
         _listed_file(path, directory, im["hex"], "hex", "kept weight image")
+        if im.get("model") is not None:
+            if not isinstance(im["model"], str):
+                raise FlannError(f"{path}: field 'images[].model' must be a file name, got {im['model']!r}")
+            _listed_file(path, directory, im["model"], "json", f"model of image {im['name']!r}", must_exist=False)
 
 
-__all__ = ["MANIFEST", "Manifest", "is_design", "read_manifest", "write_design"]
+__all__ = ["MANIFEST", "Manifest", "is_design", "refuse_design_directory", "read_manifest", "write_design"]

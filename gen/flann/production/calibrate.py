@@ -32,11 +32,12 @@ import io
 import math
 import os
 import signal
+import stat
 import sys
 import time
 import warnings
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache, partial
 from pathlib import Path
 
@@ -49,6 +50,7 @@ from ..errors import FlannError, Terminated
 from ..fileio import atomic_directory, atomic_write_text, child, remove_output_directory, safe_name
 from ..golden.family import REACH_FACTOR, own_reach_mm, ridge_ladder
 from ..golden.metrics import raw_output_mm
+from ..golden.train import fit_auto, fit_lstsq
 from ..golden.model import text_sha256
 from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
@@ -66,7 +68,7 @@ from .certificate import render_certificate, render_certificate_thermal, render_
 from .spec import ProductionSpec
 from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
-from .verdict import FAIL, PASS, Verdict, judge, rejected, require_positions, uncertainty
+from .verdict import FAIL, Verdict, judge, rejected, require_positions, uncertainty
 
 # The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
 # nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
@@ -116,7 +118,7 @@ class Result:
     def kept_model_sha256(self) -> str:
         """The model's sha256 where its model.json is kept (a passed sensor); a failed or
         rejected sensor's row and certificate name none, as its folder holds no model."""
-        return self.model_sha256 if self.verdict is not None and self.verdict.passed else ""
+        return self.model_sha256 if self.verdict is not None and self.verdict.shipped else ""
 
     def fail(self, reason: str) -> None:
         """Mark failed; the reason goes into a CSV cell and one stderr line: printable, one line."""
@@ -169,18 +171,70 @@ def train_for_design(rec, fam: FamilySpec):
     raise last
 
 
-def reach_flag(rec, fam: FamilySpec, max_error_mm: float) -> tuple[float, str | None]:
-    """(what the sensor's own design reaches on its recording, the flag or None): its own
-    ``--terms auto`` fit at the design's converter, asked at the voltages that converter hands
-    on (as the hardware is), against the hardware's ``max_error_mm``."""
+@dataclass(frozen=True)
+class OwnDesign:
+    """The structure of a sensor's own design (``--terms auto``'s choice at the family design's
+    converter), chosen once per batch on its first readable recording: every sensor of a
+    family is then fitted with it in one least-squares solve, not a cross-validation each."""
+
+    terms: int
+    norm: str
+    ridge: float
+    chosen_on: str
+
+
+def _own_cost(fam: FamilySpec):
     s = fam.spec
-    reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm,
-                                    cost=lambda m: fixed_point_cost(m, (s.input_bits, s.input_lsb_v)),
-                                    received=lambda v: adc_codes(s, v) * s.input_lsb_v)
+    return lambda m: fixed_point_cost(m, (s.input_bits, s.input_lsb_v))
+
+
+def own_design_for(rec, fam: FamilySpec, name: str) -> OwnDesign:
+    """The own design's structure, chosen by ``--terms auto`` on ``rec`` (the expensive step, once)."""
+    _model, choice = fit_auto(rec.voltage_v, rec.displacement_mm, cost=_own_cost(fam))
+    return OwnDesign(int(choice.terms), str(choice.norm), float(choice.ridge), name)
+
+
+def first_own_design(paths, fam: FamilySpec) -> OwnDesign | None:
+    """:func:`own_design_for` on the first recording that reads and passes the screens (None:
+    none does; each sensor then chooses its own)."""
+    for path in paths:
+        if special_file(Path(path)):
+            continue
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                rec = read_recordings(path)
+                if outside_input(fam, rec.voltage_v):
+                    continue
+                rec, _said = ready_for_fit(rec)
+                return own_design_for(rec, fam, sensor_name(path))
+        except (FlannError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+            continue
+    return None
+
+
+def reach_flag(rec, fam: FamilySpec, max_error_mm: float,
+               own: OwnDesign | None = None) -> tuple[float, str | None]:
+    """(what the sensor's own design reaches on its recording, the flag or None): its own fit
+    (the batch's :class:`OwnDesign` structure, else its own ``--terms auto`` choice) at the
+    design's converter, asked at the voltages that converter hands on (as the hardware is),
+    against the hardware's ``max_error_mm``."""
+    s = fam.spec
+
+    def received(v):
+        return adc_codes(s, v) * s.input_lsb_v
+
+    if own is None:
+        reach, own_terms = own_reach_mm(rec.voltage_v, rec.displacement_mm, cost=_own_cost(fam), received=received)
+        how = f"{own_terms} terms"
+    else:
+        model = fit_lstsq(rec.voltage_v, rec.displacement_mm, own.terms, norm=own.norm, ridge=own.ridge)
+        reach = float(np.max(np.abs(model.predict(received(rec.voltage_v)) - rec.displacement_mm)))
+        own_terms, how = own.terms, f"{own.terms} terms as chosen on {own.chosen_on}"
     if max_error_mm <= REACH_FACTOR * reach:
         return reach, None
     return reach, (f"hardware max error {max_error_mm:.4g} mm is {max_error_mm / reach:.2f} x what this "
-                   f"sensor's own design reaches ({reach:.4g} mm, {own_terms} terms, at the design's "
+                   f"sensor's own design reaches ({reach:.4g} mm, {how}, at the design's "
                    f"{s.input_bits}-bit input; flagged above {REACH_FACTOR:g} x): the family design costs it accuracy")
 
 
@@ -300,7 +354,7 @@ def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, sp
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         _reject(res, f"{exc.__class__.__name__}: {exc}", path, seen.get("rec"), out_dir, fam, dhash, spec, station)
         return
-    if res.verdict.verdict == PASS:
+    if res.verdict.shipped:
         res.status, res.reason = "ok", ""
     else:
         res.fail("; ".join(r for r in res.verdict.reasons if not r.startswith("marginal")))
@@ -308,9 +362,11 @@ def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, sp
 
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
-                  spec: ProductionSpec | None = None, station: Station | None = None) -> Result:
+                  spec: ProductionSpec | None = None, station: Station | None = None,
+                  own: OwnDesign | None = None) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
-    that fails its spec or is rejected gets a certificate saying why and no weights."""
+    that fails its spec or is rejected gets a certificate saying why and no weights.  ``own``:
+    the batch's own-design structure for the reach judgement (None: chosen for this sensor)."""
     path = Path(path)
     res, spec, station = _start(path, dhash, spec, max_error_mm, station)
     seen: dict = {}
@@ -336,7 +392,7 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                              f"the bound {chk['bound_lsb']:.3g} LSB")
         res.trace = traceability(path, rec, station)
         res.model_sha256 = text_sha256(chk["model"].to_json())
-        res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm)
+        res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm, own)
         if res.costs_accuracy:
             res.warnings.append(res.costs_accuracy)
         reversed_output = polarity_warning(rec, fam)
@@ -415,7 +471,7 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     html = render_certificate_thermal(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
-        if res.verdict.passed:
+        if res.verdict.shipped:
             (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(chk["words"], head), newline="")
     res.written = True
@@ -432,8 +488,7 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
     try:
         res.trace = traceability(path, rec, station)
     except FlannError:
-        res.trace = traceability(path, None, Station(station.station, station.operator,
-                                                     station.fixture, station.temperature_c))
+        res.trace = traceability(path, None, replace(station, serial_column=""))
     try:
         sha = rec.sha256 if rec is not None else hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError:
@@ -461,7 +516,7 @@ def _write_sensor(dest: Path, res: Result, chk: dict, fam: FamilySpec, dhash: st
     html = render_certificate(res, chk, fam, dhash, mhash, findings, basis, **extra)
     with atomic_directory(dest, _is_sensor_output, "sensor calibration") as tmp:
         (tmp / "certificate.html").write_text(html, newline="")
-        if res.verdict.passed:
+        if res.verdict.shipped:
             (tmp / images.MODEL_FILE).write_text(model_json, newline="")
             (tmp / images.IMAGE_FILE).write_text(images.hex_text(words, head), newline="")
             (tmp / "weights.mem").write_text(images.mem_text(words, head), newline="")
@@ -477,6 +532,19 @@ def _progress(done: int, total: int, failed: int, t0: float) -> None:
     sys.stderr.write(f"\r[{'#' * k}{'.' * (width - k)}] {done}/{total} sensors, {failed} failed, "
                      f"{rate:.0f}/min")
     sys.stderr.flush()
+
+
+def special_file(path: Path) -> str:
+    """'' for a regular file or a missing one (the reader says so), else what it is."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return ""
+    if stat.S_ISREG(mode):
+        return ""
+    return ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a directory" if stat.S_ISDIR(mode)
+            else "a character device" if stat.S_ISCHR(mode) else "a block device" if stat.S_ISBLK(mode)
+            else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
 
 
 def _calibrate_item(item, one=calibrate_one, **kw) -> Result:
@@ -544,7 +612,10 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
                  f"sensor name {name!r} already used by {paths[seen[name.casefold()]]} (one folder "
                  "per name, letter case ignored); rename this recording"
                  if name.casefold() in seen else "")
-        if clash:
+        kind = special_file(p)
+        if kind:   # opening a FIFO nobody writes would block its worker for good
+            results[i] = refused(p, f"{p}: is {kind}; flann reads recordings from regular files")
+        elif clash:
             results[i] = refused(p, clash)
         else:
             seen[name.casefold()] = i
@@ -562,9 +633,12 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if progress:
             _progress(len(results), len(paths), failed, t0)
 
-    one = calibrate_one_thermal if dp is FAMILY_THERMAL else calibrate_one
+    if dp is FAMILY_THERMAL:
+        one, extra = calibrate_one_thermal, {}
+    else:   # the reach judgement's structure, chosen once for the batch
+        one, extra = calibrate_one, {"own": first_own_design([paths[i] for i in todo], fam)}
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
-                 max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station)
+                 max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station, **extra)
     stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record,
                            lambda item, why: record(item, refused(item[1], why)))
     if progress:
@@ -599,6 +673,6 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
+__all__ = ["OwnDesign", "first_own_design", "own_design_for", "reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
            "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS",
            "DIAGNOSIS_POINTS"]

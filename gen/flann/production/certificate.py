@@ -9,7 +9,7 @@ from __future__ import annotations
 from .. import __version__
 from ..textgen import template
 from .plot import error_plot_svg, error_plot_temperatures_svg
-from .verdict import PASS
+from .verdict import NOT_JUDGED, PASS
 
 TEMPLATE = "production/templates/certificate.html.j2"
 DECISION_RULE = ("simple acceptance (ILAC-G8 shared risk): PASS when the measured max error is "
@@ -20,6 +20,7 @@ DECISION_RULE = ("simple acceptance (ILAC-G8 shared risk): PASS when the measure
 def _identification(res, dhash: str, mhash: str, rec_sha: str) -> tuple:
     t = res.trace
     return ("Identification", [
+        ("certificate number", t.certificate_number if t else "-"),
         ("serial", f"{t.serial} (from the {t.serial_from})" if t else res.sensor),
         ("recording", res.recording),
         ("recording sha256", rec_sha or "-"),
@@ -38,6 +39,8 @@ def _traceability(res) -> tuple:
         ("operator", (t.operator if t else "") or blank),
         ("fixture", (t.fixture if t else "") or blank),
         ("calibration temperature", t.temperature_text() if t else blank),
+        ("displacement reference standard", t.reference_text() if t else blank),
+        ("reference standard calibration due", t.due_text() if t else blank),
     ])
 
 
@@ -178,19 +181,20 @@ def render_rejection(res, fam, dhash: str, spec, rec_sha: str = "") -> str:
 
 def _render(res, trace, verdict, tables, plot, basis, findings, diagnosis_head, shipped, after=(),
             weights="model.json, weights.hex, weights.mem, weights.bmm") -> str:
-    passed = verdict.verdict == PASS
     serial = trace.serial if trace else res.sensor
-    if passed:
-        banner = f"PASS: {verdict.tolerance}"
+    if verdict.verdict == PASS:
+        banner, kind = f"PASS: {verdict.tolerance}", "pass"
+    elif verdict.verdict == NOT_JUDGED:
+        banner, kind = f"NOT JUDGED: {verdict.reasons[0]}", "notjudged"
     else:
-        banner = "FAIL: " + "; ".join(r for r in verdict.reasons if not r.startswith("marginal"))
+        banner, kind = "FAIL: " + "; ".join(r for r in verdict.reasons if not r.startswith("marginal")), "fail"
     notes = [r for r in verdict.reasons if r.startswith("marginal")]
     return template(TEMPLATE).render(
-        sensor=serial, verdict_class="pass" if passed else "fail", banner=banner, notes=notes,
+        sensor=serial, number=trace.certificate_number if trace else "", verdict_class=kind, banner=banner, notes=notes,
         plot=plot, tables=tables, after_tables=list(after), diagnosis_basis=basis, diagnosis_head=diagnosis_head,
         findings=(list(findings) or ["no missing physics found"]) if basis else [],
         warnings=res.warnings,
-        shipped=(f"weights written: {weights}" if shipped and passed
+        shipped=(f"weights written: {weights}" if shipped and verdict.shipped
                  else "no weights written for this sensor"),
     )
 

@@ -7,16 +7,21 @@ Each field comes from, in this order: the recording's own ``#`` comment lines
 first data row when that flag is given, else the comment, else the file name's stem.  The
 calibration temperature falls back to the mean of the recording's ``temperature_c`` column.
 ``calibrated_at`` is the local time with its UTC offset (ISO 8601), taken per sensor.
+The displacement reference standard and its calibration due date come from the flags
+(``--reference-standard``, ``--reference-due``); the certificate number is
+``PREFIX-YYYYMMDD-HHMMSS-xxxxxxxx`` (``--certificate-prefix``, the calibration time and the
+first 8 hex digits of the recording's sha256): a sensor calibrated again gets a new number.
 """
 
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import math
 import re
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import date, datetime
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +44,9 @@ class Station:
     fixture: str = ""
     temperature_c: float | None = None
     serial_column: str = ""
+    certificate_prefix: str = "FLANN"
+    reference_standard: str = ""
+    reference_due: date | None = None
 
 
 @dataclass(frozen=True)
@@ -51,11 +59,42 @@ class Traceability:
     temperature_c: float | None
     temperature_from: str       # "comment", "flag", "recording's temperature_c column (mean)"
     calibrated_at: str          # ISO 8601 with offset
+    certificate_number: str = ""
+    reference_standard: str = ""
+    reference_due: date | None = None
+
+    def reference_text(self) -> str:
+        return self.reference_standard or "not stated (give --reference-standard)"
+
+    def due_text(self) -> str:
+        return self.reference_due.isoformat() if self.reference_due else "not stated (give --reference-due)"
 
     def temperature_text(self) -> str:
         if self.temperature_c is None:
             return "not stated"
         return f"{self.temperature_c:.1f} degC ({self.temperature_from})"
+
+
+def certificate_number(prefix: str, calibrated_at: str, key: str) -> str:
+    """``PREFIX-YYYYMMDD-HHMMSS-xxxxxxxx``: the calibration time and 8 hex digits of ``key``
+    (the recording's sha256, else its name)."""
+    stamp = re.sub(r"[^0-9T]", "", calibrated_at[:19]).replace("T", "-")
+    tail = key[:8] if re.fullmatch(r"[0-9a-f]{8,}", key) else hashlib.sha256(key.encode()).hexdigest()[:8]
+    return f"{prefix}-{stamp}-{tail}"
+
+
+def parse_due(text: str, today: date | None = None) -> date:
+    """``--reference-due``: an ISO date (YYYY-MM-DD) not yet past; a standard past its
+    calibration due date cannot make a certificate traceable."""
+    try:
+        due = date.fromisoformat(text.strip())
+    except ValueError:
+        raise FlannError(f"--reference-due {text!r}: expected a date YYYY-MM-DD") from None
+    today = today or date.today()
+    if due < today:
+        raise FlannError(f"--reference-due {due.isoformat()}: the reference standard's calibration expired "
+                         f"(today is {today.isoformat()}); recalibrate it before certifying sensors")
+    return due
 
 
 def now_iso() -> str:
@@ -124,8 +163,11 @@ def traceability(path, rec, station: Station) -> Traceability:
                         operator=found.get("operator", station.operator),
                         fixture=found.get("fixture", station.fixture),
                         temperature_c=temp, temperature_from=temp_from,
-                        calibrated_at=now_iso())
+                        calibrated_at=(at := now_iso()),
+                        certificate_number=certificate_number(station.certificate_prefix, at,
+                                                              getattr(rec, "sha256", "") or path.name),
+                        reference_standard=station.reference_standard, reference_due=station.reference_due)
 
 
-__all__ = ["Station", "Traceability", "traceability", "comment_fields", "serial_from_column",
+__all__ = ["certificate_number", "parse_due", "Station", "Traceability", "traceability", "comment_fields", "serial_from_column",
            "now_iso", "FIELDS"]

@@ -1,5 +1,7 @@
 """PASS or FAIL against a :class:`~flann.production.spec.ProductionSpec`, with the reasons,
-and the expanded uncertainty of the figures the verdict rests on.
+and the expanded uncertainty of the figures the verdict rests on.  Without a specification
+(no tolerance, no limit, no effect ruled out) a calibrated sensor is NOT JUDGED, never PASS:
+its weights are written, and the certificate says nothing was judged.
 
 Decision rule: simple acceptance (ILAC-G8 "shared risk"): a sensor passes when its measured
 max error is within the tolerance; the expanded uncertainty U (k = 2) is stated beside it and
@@ -26,7 +28,8 @@ from ..golden.metrics import full_scale_of_span
 from ..recordings.checks import MIN_REPEAT_PAIRS, estimate_noise_v, repeat_noise_v
 from .spec import ProductionSpec
 
-PASS, FAIL = "PASS", "FAIL"
+PASS, FAIL, NOT_JUDGED = "PASS", "FAIL", "NOT JUDGED"
+NOT_JUDGED_WHY = "no specification given: nothing judged (give --spec or --tolerance-mm)"
 COVERAGE = 2.0
 # the working range must lie inside the recorded displacements to within this (mm)
 RANGE_SLACK_MM = 1e-6
@@ -60,7 +63,7 @@ class Uncertainty:
 
 @dataclass(frozen=True)
 class Verdict:
-    verdict: str                         # PASS | FAIL
+    verdict: str                         # PASS | FAIL | NOT JUDGED
     reasons: tuple[str, ...]
     tolerance: str                       # the spec as one cell
     max_error_mm: float | None           # over the working range
@@ -72,6 +75,11 @@ class Verdict:
     @property
     def passed(self) -> bool:
         return self.verdict == PASS
+
+    @property
+    def shipped(self) -> bool:
+        """The sensor's weights are written: it passed, or was calibrated with nothing to judge."""
+        return self.verdict in (PASS, NOT_JUDGED)
 
 
 def _passes(x: np.ndarray, direction) -> list[np.ndarray]:
@@ -191,6 +199,9 @@ def judge(spec: ProductionSpec, x_mm, err_mm, ratio_to_limit: float | None,
                            f"{', '.join(n for n in group if n not in maybe)}), which the spec "
                            "does not allow")
     failed = [r for r in reasons if not r.startswith("marginal")]
+    if not failed and not spec.judges:
+        return Verdict(verdict=NOT_JUDGED, reasons=(NOT_JUDGED_WHY,), tolerance=spec.tolerance_text(),
+                       max_error_mm=max_err, max_error_pct_fs=pct, full_scale_mm=fs, range_text=rng)
     return Verdict(verdict=FAIL if failed else PASS, reasons=tuple(reasons),
                    tolerance=spec.tolerance_text(), max_error_mm=max_err, max_error_pct_fs=pct,
                    full_scale_mm=fs, range_text=rng)
@@ -203,5 +214,5 @@ def rejected(spec: ProductionSpec, reason: str) -> Verdict:
                    rejected=True)
 
 
-__all__ = ["PASS", "FAIL", "POSITIONS_PER_TERM", "Verdict", "Uncertainty", "judge", "rejected", "require_positions", "uncertainty",
+__all__ = ["PASS", "FAIL", "NOT_JUDGED", "NOT_JUDGED_WHY", "POSITIONS_PER_TERM", "Verdict", "Uncertainty", "judge", "rejected", "require_positions", "uncertainty",
            "noise_v", "UNCERTAINTY_METHOD"]

@@ -32,7 +32,7 @@ from ..errors import FlannError
 from ..hardware.target import CLOCK_HZ
 from .benches import BENCH_DIR, CLK_NS, CONFIG_ENV
 from ..hardware.design import Design
-from .shards import count_lines, cores, merge, read_results, split
+from .shards import count_lines, cores, end_children, merge, read_results, split
 
 HARNESSES = {"flann_sweep": "flann_sweep.vhd", "flann_harness": "flann_harness.vhd"}
 BENCH_PACKAGE = "flann.verify.benches"
@@ -43,11 +43,20 @@ def sim_dir() -> Path:
     return BENCH_DIR
 
 
-@functools.lru_cache(maxsize=None)
-def ghdl_backend() -> str:
-    """'llvm' when ghdl-llvm is installed and the ghdl wrapper honours GHDL_BACKEND, else 'mcode'."""
+def need_ghdl() -> None:
+    """GHDL missing: said as such (as synth says it), not as a build whose log was never written."""
     if shutil.which("ghdl") is None:
         raise FlannError("ghdl not found on PATH (Debian package ghdl; `make tools` installs it)")
+
+
+def ghdl_backend() -> str:
+    """'llvm' when ghdl-llvm is installed and the ghdl wrapper honours GHDL_BACKEND, else 'mcode'."""
+    need_ghdl()
+    return _backend()
+
+
+@functools.lru_cache(maxsize=None)
+def _backend() -> str:
     if shutil.which("ghdl-llvm") is None:
         return "mcode"
     r = subprocess.run(["ghdl", "--version"], capture_output=True, text=True,
@@ -114,6 +123,7 @@ def build(sources, toplevel: str, build_dir, backend: str | None = None) -> str:
     """Analyse and elaborate ``sources`` for ``toplevel`` (VHDL-93); returns the backend used
     (default mcode: the cocotb benches are short, and mcode compiles in a second)."""
     backend = backend or "mcode"
+    need_ghdl()
     build_dir = Path(build_dir).resolve()
     build_dir.mkdir(parents=True, exist_ok=True)
     args = ["--std=93c"] + (["-O2"] if backend == "llvm" else [])
@@ -235,9 +245,11 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
 
     files = [Path(s["file"]) for s in shard_cfg]
     t1 = time.monotonic()
+    stops = [stop_time(len(s["codes"]) if "codes" in s else s["hi"] - s["lo"] + 1, man["cycles_per_sample"])
+             for s in shard_cfg]
     results = _run_shards(build_dir, "test_sweep", backend,
                           [(build_dir / f"bench_config_{k}.json", params(s)) for k, s in enumerate(shard_cfg)],
-                          1, files, total, progress)
+                          1, files, total, progress, stops)
     seconds = time.monotonic() - t1
     bench = _result("sweep", results, records, time.monotonic() - t0)
     got = merge([read_results(f) for f in files])
@@ -245,26 +257,38 @@ def sweep(design: Design, build_dir, *, codes=None, shards: int | None = None,
             "build_seconds": t_build}
 
 
+def stop_time(samples: int, cycles_per_sample: int) -> str:
+    """The ``--stop-time`` of a harness offering ``samples`` inputs: three times the cycles they
+    take plus a start-up margin.  A design that never answers (its top entity renamed, so the
+    harness's component stays unbound) ends there and its missing lines fail the bench."""
+    return f"--stop-time={(3 * (samples + 8) * cycles_per_sample + 10000) * CLK_NS}ns"
+
+
 def _run_shards(build_dir: Path, module: str, backend: str, shards: list[tuple[Path, dict]], seed: int,
-                files: list[Path], total: int, progress) -> list[Path]:
+                files: list[Path], total: int, progress, stops: list[str]) -> list[Path]:
     """The built sweep harness run once per shard ((bench configuration, generics) each), side by
-    side; ``progress(done, total, elapsed_s)`` about twice a second from the lines in ``files``.
-    Returns the shards' results files, one per shard in order (a shard that wrote none is
-    counted failed when they are read)."""
+    side, each to its stop time ``stops[k]``; ``progress(done, total, elapsed_s)`` about twice a
+    second from the lines in ``files``.  Returns the shards' results files, one per shard in order
+    (a shard that wrote none is counted failed when they are read).  Interrupted (Ctrl-C,
+    SIGTERM), the simulators end with flann: none runs on into a deleted build directory."""
     results = [_results_file(build_dir, str(k)) for k in range(len(shards))]
 
     def one(k: int) -> None:
-        results[k] = _test(build_dir, "flann_sweep", module, backend, shards[k][0], str(k), shards[k][1], [], None,
-                           seed)
+        results[k] = _test(build_dir, "flann_sweep", module, backend, shards[k][0], str(k), shards[k][1],
+                           [stops[k]] if stops[k] else [], None, seed)
 
     threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(shards))]
     t1 = time.monotonic()
-    for t in threads:
-        t.start()
-    while any(t.is_alive() for t in threads):
-        next(t for t in threads if t.is_alive()).join(0.5)
-        if progress:
-            progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    try:
+        for t in threads:
+            t.start()
+        while any(t.is_alive() for t in threads):
+            next(t for t in threads if t.is_alive()).join(0.5)
+            if progress:
+                progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
+    except BaseException:
+        end_children()
+        raise
     if progress:  # the last figure, whatever the timing: a terminal's line ends at done
         progress(sum(count_lines(f) for f in files), total, time.monotonic() - t1)
     return results
@@ -294,8 +318,11 @@ def sweep_temperatures(sources, module: str, build_dir, config: dict, parameters
         cfg_path.write_text(json.dumps(cfg))
         shards.append((cfg_path, {**parameters, "temps_file_g": str(temps_file), "out_file_g": str(out_file)}))
         files.append(out_file)
-    total = len(temps) * (sweep_cfg["code_hi"] - sweep_cfg["code_lo"] + 1)
-    results = _run_shards(build_dir, module, backend, shards, seed, files, total, progress)
+    per_temp = sweep_cfg["code_hi"] - sweep_cfg["code_lo"] + 1
+    total = len(temps) * per_temp
+    cycles = int(config.get("manifest", {}).get("cycles_per_sample", 0)) or None
+    stops = [stop_time(len(c) * per_temp, cycles) if cycles else "" for c in chunks]
+    results = _run_shards(build_dir, module, backend, shards, seed, files, total, progress, stops)
     with open(sweep_cfg["file"], "wb") as joined:
         for f in files:
             if f.is_file():

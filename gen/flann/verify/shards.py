@@ -4,7 +4,9 @@ and the netlist simulation)."""
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +14,54 @@ import numpy as np
 
 def cores() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
+
+
+GRACE_S = 2.0   # a simulator told to stop has this long before it is killed
+
+
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (Linux /proc; none elsewhere)."""
+    kids = []
+    for entry in Path("/proc").glob("[0-9]*"):
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        # the command name in parentheses may hold spaces: the fields follow its last ')'
+        if int(stat[stat.rfind(")") + 2:].split()[1]) == pid:
+            kids.append(int(entry.name))
+    return kids
+
+
+def end_children() -> None:
+    """End every process this one started (the simulators of an interrupted run) and theirs:
+    SIGTERM, then SIGKILL after :data:`GRACE_S`.  A shard left running would write into a build
+    directory flann deletes as it exits."""
+    todo = [pid for pid in _children(os.getpid())]
+    for pid in list(todo):
+        todo += _children(pid)
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        alive = []
+        for pid in todo:
+            try:
+                os.kill(pid, sig)
+                alive.append(pid)
+            except (ProcessLookupError, PermissionError):
+                pass
+        if not alive or sig == signal.SIGKILL:
+            return
+        end = time.monotonic() + GRACE_S
+        while time.monotonic() < end and any(Path(f"/proc/{pid}").exists() and not _zombie(pid) for pid in alive):
+            time.sleep(0.05)
+        todo = [pid for pid in alive if Path(f"/proc/{pid}").exists() and not _zombie(pid)]
+
+
+def _zombie(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return True
+    return stat[stat.rfind(")") + 2] == "Z"
 
 
 def split(lo: int, hi: int, n: int) -> list[tuple[int, int]]:

@@ -11,7 +11,7 @@ from ..fixed.datapath import DATAPATH as FIXED
 from ..options import GenOptions
 from . import render
 from .build import DEFAULT_TERMS, generate_family
-from .spec import DEFAULT_MARGIN, family_from_dict, member_spec
+from .spec import DEFAULT_MARGIN, check_against, family_from_dict, member_spec
 from .twin import FlannFamilyTop
 
 
@@ -25,7 +25,9 @@ def rebuild(model, man: dict, where="design"):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return family_from_dict(man["family"], load_model(model)), {}
+            fam = family_from_dict(man["family"], load_model(model))
+        check_against(fam, man)
+        return fam, {}
     except SpecError as exc:
         raise FlannError(f"{where}: {exc}") from None
 

@@ -21,8 +21,10 @@ import re
 
 from ...errors import FlannError
 from ...inputs import read_text
+from ..fixed.spec import acc_bound_for, lin_acc_reach
 from .render import image_text
 from .spec import DATA_BITS, HALF_BITS, FamilySpec, bram_image
+from .twin import FlannFamilyMem
 
 HEX_DIGITS = DATA_BITS // 4
 MEM_DIGITS = HALF_BITS // 4
@@ -50,6 +52,48 @@ def parse_hex(text: str, source: str = "<hex>") -> list[int]:
             raise FlannError(f"{source}:{n}: {line} does not fit {DATA_BITS} bits")
         words.append(w)
     return words
+
+
+def check_image(fam: FamilySpec, words: list[int], source: str = "<hex>") -> None:
+    """Refuse, in one line, an image the design cannot compute with: a word holding more than
+    its field (a field's words hold its value sign-extended), or values whose worst case (every
+    term at its largest, as the design's widths were sized) overflows a format the hardware
+    does not saturate in (the linear accumulator, the products, the running sum): the
+    hardware would wrap where its twin saturates.  Every image flann calibrate or flann gen
+    writes passes (their sensors were fitted to these formats)."""
+    if len(words) > fam.mem_depth:
+        raise FlannError(f"{source}: {len(words)} words, the design's memory holds {fam.mem_depth}")
+    words = list(words) + [0] * (fam.mem_depth - len(words))
+    for f in fam.fields:
+        per = 1 if f.name == "weights" else f.words   # a weight is one word each
+        for k in range(0, f.words, per):
+            v = 0
+            for w in words[f.addr + k:f.addr + k + per]:
+                v = (v << DATA_BITS) | w
+            top = per * DATA_BITS
+            fits = (v < (1 << (f.bits - 1)) or v >= (1 << top) - (1 << (f.bits - 1))) if f.signed else v < (1 << f.bits)
+            if not fits:
+                raise FlannError(f"{source}: word {f.addr + k} ({f.name}) 0x{v:0{per * HEX_DIGITS}X} does not fit the "
+                                 f"field's {'s' if f.signed else 'u'}int<{f.bits}> (the bits above it must repeat its sign)")
+    s = FlannFamilyMem(fam, words).spec()
+    e = fam.spec
+    weights = [w for lane in s.weight_rom for w in lane]
+    Gl = s.lin_guard
+    lin_peak = max(abs((s.k1 * c + s.k0 + (1 << (Gl - 1))) >> Gl) for c in (s.clamp_lo, s.clamp_hi)) + 1
+    wmax = max(abs(w) for w in weights)
+    checks = (
+        ("the clamp codes", 0 if e.code_min <= s.clamp_lo <= s.clamp_hi <= e.code_max else 1, 0),
+        ("the linear accumulator", lin_acc_reach(s.k1, s.k0, e.input_bits), (1 << (e.lin_width - 2)) - 1),
+        ("the linear part", lin_peak, e.lin_fmt.max_int),
+        ("a product", (e.term_bound * wmax + (1 << (e.product_shift - 1))) >> e.product_shift, e.product_fmt.max_int),
+        ("the running sum", acc_bound_for(lin_peak, weights, e.term_bound, e.product_shift), e.acc_fmt.max_int),
+    )
+    for what, need, have in checks:
+        if need > have:
+            why = (f"clamp codes {s.clamp_lo}..{s.clamp_hi} are not within the input codes {e.code_min}..{e.code_max}"
+                   if what == "the clamp codes" else
+                   f"{what} could reach {need}, the design holds {have}: its weights could overflow the hardware")
+            raise FlannError(f"{source}: {why}; load only images flann calibrate wrote for this design")
 
 
 # the provenance lines of the ``#`` header flann calibrate writes: the design, the word count
@@ -115,4 +159,4 @@ def bmm_text(fam: FamilySpec, header: list[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["IMAGE_FILE", "MODEL_FILE", "hex_text", "header_fields", "header_model_sha256", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]
+__all__ = ["check_image", "IMAGE_FILE", "MODEL_FILE", "hex_text", "header_fields", "header_model_sha256", "provenance_header", "parse_hex", "read_image", "mem_text", "bmm_text", "HEX_DIGITS", "MEM_DIGITS"]

@@ -27,6 +27,8 @@ with the family's widths and the sensor's constants) and says why a sensor does 
 
 from __future__ import annotations
 
+import json
+
 import math
 import warnings
 from dataclasses import dataclass, field, replace
@@ -354,6 +356,37 @@ def _check_memory(fam: FamilySpec) -> None:
                         "bits: fewer terms")
 
 
+def check_against(fam: "FamilySpec", man: dict) -> None:
+    """The manifest fields a family design's readers take as they are (``family`` with its memory
+    map and formats, the members, ``cfg_port``, ``clamp_codes``) must be what the design derived
+    again from its options and initial model says: SpecError naming the first that is not."""
+    got = json.loads(json.dumps(fam.to_dict()))
+    had = man.get("family", {})
+    for key in sorted(set(got) | set(had)):
+        if got.get(key) != had.get(key):
+            sub = ""
+            if isinstance(got.get(key), dict) and isinstance(had.get(key), dict):
+                sub = next((f".{k}" for k in sorted(set(got[key]) | set(had[key])) if got[key].get(k) != had[key].get(k)), "")
+            raise SpecError(f"manifest field 'family.{key}{sub}' is not what the design derives again: "
+                            "edited by hand? regenerate the design with flann gen --family")
+    images = man.get("images")
+    if isinstance(images, list) and images and [im.get("name") for im in images if isinstance(im, dict)][:len(fam.members)] \
+            != list(fam.members)[:len(images)]:
+        raise SpecError("manifest field 'family.members' does not name the design's weight images "
+                        "in order: regenerate the design with flann gen --family")
+    ports = man.get("cfg_port", {}).get("ports") if isinstance(man.get("cfg_port"), dict) else None
+    want = {"cfg_addr": fam.addr_bits, "cfg_data": DATA_BITS}
+    for name, width in want.items():
+        port = ports.get(name) if isinstance(ports, dict) else None
+        if not isinstance(port, dict) or port.get("width") != width:
+            raise SpecError(f"manifest field 'cfg_port.ports.{name}' must be {width} bits wide, as the design's "
+                            f"memory is, got {port!r}: regenerate the design with flann gen --family")
+    clamp = man.get("clamp_codes")
+    if clamp is not None and clamp != [fam.spec.clamp_lo, fam.spec.clamp_hi]:
+        raise SpecError(f"manifest field 'clamp_codes' {clamp!r} is not the design's "
+                        f"[{fam.spec.clamp_lo}, {fam.spec.clamp_hi}]: regenerate the design with flann gen --family")
+
+
 def family_from_dict(d: dict, init_model: FlannModel) -> FamilySpec:
     """Rebuild the FamilySpec of a manifest's ``family`` entry (and the initial model)."""
     try:
@@ -433,5 +466,5 @@ def member_spec(fam: FamilySpec, model: FlannModel, model_sha256: str = "") -> S
                    analysis={**s.analysis, "estimate": f.analysis.get("estimate")})
 
 
-__all__ = ["clamp_codes", "FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
+__all__ = ["check_against", "clamp_codes", "FamilySpec", "Field", "FitError", "derive_family", "family_from_dict", "member_spec",
            "bram_image", "headroom", "DATA_BITS", "HALF_BITS", "DEFAULT_MARGIN", "FORCED", "SPREAD"]

@@ -61,6 +61,9 @@ def _offset_bits(phase_bits: int, table_addr_bits: int) -> int:
 
 def nice_125(x: float, up: bool) -> float:
     """Nearest value of the 1-2-5 series at or above (up) / at or below x."""
+    if not (math.isfinite(x) and x > 0):
+        raise SpecError(f"cannot size a step from {x!r}: the model's output does not vary (weights all zero?); "
+                        "give --output-lsb-mm")
     e = math.floor(math.log10(x))
     cands = [k * 10.0 ** p for p in (e - 1, e, e + 1) for k in (1, 2, 5)]
     cands = sorted(float(f"{c:.12g}") for c in cands)

@@ -300,7 +300,8 @@ def derive_thermal_spec(model: ThermalModel, *, input_bits: int, input_lsb_v: fl
         step = float(np.ptp(model.displacement_range_mm)) / max(1, chi - clo)
         acc = float(model.training.get("cv_rms_error_mm", 0.0) or 0.0)
         q = nice_125(max(step, acc) / 4, up=False)
-        q = max(q, nice_125(curvature_mm / SHARE["curvature"], up=True))
+        if curvature_mm > 0:   # a model without curvature (all weights zero) sets no floor
+            q = max(q, nice_125(curvature_mm / SHARE["curvature"], up=True))
     else:
         q = output_lsb_mm
     if not (isinstance(q, (int, float)) and math.isfinite(q) and q > 0):
