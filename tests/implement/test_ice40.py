@@ -107,8 +107,12 @@ def test_post_route_of_a_design_without_a_twin_is_refused_before_any_tool(tmp_pa
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: "), err
-    assert {"sim": "no twin", "synth": "the netlist sweep has a driver and twin for fixed, float18, family, "
-                                      "thermal and family_thermal designs only"}[command] in err[0], err
+    if command == "sim":
+        assert "no twin" in err[0], err
+    else:
+        named = re.search(r"the netlist sweep has a driver and twin for (.+) designs only", err[0])
+        assert named and set(re.split(r", | and ", named.group(1))) == {
+            "fixed", "float18", "family", "thermal", "family_thermal"}, err
     assert not (tmp_path / "o").exists() and not (tmp_path / "b").exists()
 
 

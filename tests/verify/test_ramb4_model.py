@@ -55,4 +55,4 @@ def test_block_ram_contents_load_without_writing_outside_the_model(tmp_path, mon
     exe = compile_netlist(tmp_path / "top.v", tmp_path / "verilator", sweep, models=[str(BENCH_DIR / RAM_MODELS)])
     got = run_netlist(exe, sweep, tmp_path, shards=1)
     res = compare(sweep, got)
-    assert res["codes_tested"] == 256 and res["mismatches"] == 0, res
+    assert res.codes_tested == 256 and res.mismatches == 0, res

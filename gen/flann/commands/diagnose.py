@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 
 from ..argtypes import bounded, png_path
@@ -87,9 +88,11 @@ def run(args) -> int:
         if not emit_json(args, obj):
             print(text, end="")
         return 0
-    rec = shared_reading(read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id))
+    rec, said = shared_reading(read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id))
     dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
+    for line in said:   # what train says of the same readings, once the recording is diagnosed
+        warnings.warn(line)
     # both reports are built before any file is written: a failure leaves no output behind
     obj, text = to_json(dg), format_text(dg)
     if args.plot:

@@ -148,6 +148,7 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
                          f"(the spline through them and its check by leaving each out need at least "
                          f"{MIN_POSITIONS}): give --terms 1 (a line) or --terms 2")
     # the readings the shared reading kept (a glitch is on no converter's grid)
+    _stage(f"{len(rec)} readings at {positions} positions kept by the screen (rails, fold-back, gross outliers)")
     conv = converter(args, rec)
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)

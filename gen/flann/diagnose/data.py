@@ -556,26 +556,22 @@ def find_rails(x: np.ndarray, y: np.ndarray, passes: Passes) -> list[dict]:
     return rails
 
 
-def shared_reading(rec: Recordings) -> Recordings:
-    """The recording with the readings every command leaves out as gross outliers left out,
-    said in the same line as train's (:func:`flann.golden.reading.read_usable`); rails and a
-    fold-back stay, they are physics the diagnosis names.  A recording the shared reading
-    refuses is diagnosed whole."""
-    import warnings
-
+def shared_reading(rec: Recordings) -> tuple[Recordings, tuple[str, ...]]:
+    """(the recording with the readings every command leaves out as gross outliers left out,
+    the lines train says of the same reading: :func:`flann.golden.reading.read_usable`); rails
+    and a fold-back stay in, they are physics the diagnosis names.  The caller says the lines
+    once the diagnosis has run (a refused recording is one line).  A recording the shared
+    reading refuses is diagnosed whole."""
     from ..errors import FlannError
     from ..golden.reading import read_usable
 
     try:
         reading = read_usable(rec)
     except FlannError:
-        return rec
+        return rec, ()
     outliers = [i for i, lo in enumerate(reading.left_out) if lo.why == "outlier"]
-    for line in reading.said:
-        if " gross outlier" in line:   # rails and a fold-back are named by the diagnosis itself
-            warnings.warn(line, stacklevel=2)
     if not outliers or rec.lines is None:
-        return rec
+        return rec, reading.said
     gone = {reading.left_out[i].line for i in outliers}
     keep = np.array([rec.line_of(k) not in gone for k in range(len(rec))])
-    return rec.subset(keep)
+    return rec.subset(keep), reading.said

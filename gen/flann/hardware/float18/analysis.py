@@ -61,12 +61,12 @@ def hdl(model_path, options: dict, build_dir: Path, stage_codes, design_model) -
 
 def measure(model_path, device: str = DEFAULT_PART, abc: str = "full", **options) -> dict:
     with tempfile.TemporaryDirectory(prefix="flann-f18-") as tmp:
-        out = Path(tmp) / FLOAT18.name
+        out = Path(tmp) / DATAPATH.name
         man = generate(model_path, out, **options)
         rep = synth.synthesize(out, device, progress=False, abc=abc).to_dict()
-    tr = run_trace(load_model(model_path), FLOAT18.name, **options)
+    tr = run_trace(load_model(model_path), DATAPATH.name, **options)
     return {
-        "format": FLOAT18.number_format, "top": man["top"], "device": device,
+        "format": DATAPATH.number_format, "top": man["top"], "device": device,
         "luts": rep["luts"], "ffs": rep["ffs"], "brams": rep["brams"], "fits": rep["fits"],
         "cycles_per_sample": man["cycles_per_sample"],
         "samples_per_s_at_50mhz": round(CLOCK_HZ / man["cycles_per_sample"], 1),
