@@ -82,21 +82,20 @@ def run(args) -> int:
     if is_waveform_csv(args.recordings):
         wave = read_waveforms(args.recordings, announce=not args.quiet)
         wd = diagnose_waveforms(wave, sensor=sensor)
-        obj, text = wave_to_json(wd), format_wave_text(wd)
-        if args.plot:
-            plot_wave(wd, args.plot)
-        if not emit_json(args, obj):
-            print(text, end="")
-        return 0
+        return _report(args, wave_to_json(wd), format_wave_text(wd), lambda path: plot_wave(wd, path))
     rec, said = shared_reading(read_recordings(args.recordings, announce=not args.quiet, sensor=sensor_id))
     dg = diagnose(rec, sensor=sensor, progress=_progress(args),
                   max_points=args.max_points)
     for line in said:   # what train says of the same readings, once the recording is diagnosed
         warnings.warn(line)
-    # both reports are built before any file is written: a failure leaves no output behind
-    obj, text = to_json(dg), format_text(dg)
+    return _report(args, to_json(dg), format_text(dg), lambda path: plot(dg, path))
+
+
+def _report(args, obj: dict, text: str, draw) -> int:
+    """The plot, then the JSON or the text; both reports are built before any file is written,
+    so a failure leaves no output behind."""
     if args.plot:
-        plot(dg, args.plot)
+        draw(args.plot)
     if not emit_json(args, obj):
         print(text, end="")
     return 0
