@@ -12,10 +12,12 @@ import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
+# flann first: it keeps numpy's BLAS to one thread, which only takes before numpy loads (two
+# workers of two BLAS threads each on two cores spin-wait: lstsq ran tens of times slower)
+from flann import cache as flann_cache  # isort: skip
 import numpy as np
 import pytest
 
-from flann import cache as flann_cache
 from flann.cli import main
 from flann.golden.thermal_train import fit_thermal
 from flann.golden.train import fit_lstsq

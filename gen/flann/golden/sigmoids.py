@@ -528,10 +528,11 @@ def _closest(fitted: list[Units], shape, linear: bool, units: int) -> np.ndarray
 
 
 def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS, more_units: int = MORE_UNITS,
-                step_v: float = 0.0) -> SigmoidForward | None:
+                step_v: float = 0.0, spreads: bool = True) -> SigmoidForward | None:
     """The averaged forward curve, or None with fewer than :data:`MIN_POSITIONS` positions or
     no monotone member.  Units past ``max_units``, up to ``more_units``, are grown while the
-    members miss the readings (:func:`_misfit`; ``step_v`` the converter's step, 0 off-grid)."""
+    members miss the readings (:func:`_misfit`; ``step_v`` the converter's step, 0 off-grid).
+    ``spreads``: whether the :data:`SPREADS` members are among them."""
     x = np.asarray(displacement_mm, float)
     v = np.asarray(voltage_v, float)
     v_mid, v_half = 0.5 * (v.max() + v.min()), 0.5 * (v.max() - v.min())
@@ -552,8 +553,9 @@ def fit_forward(displacement_mm, voltage_v, max_units: int = MAX_UNITS, more_uni
     # the odd members' null starts where the free units' curve is steepest
     null = float(np.clip(_CHECK[np.argmax(np.abs(np.gradient(free.normalised(_CHECK))))], *NULL))
     fitted += [u for linear in (False, True) for u in _odd_path(d.xn, d.y, d.sw, range(1, kmax + 1), linear, null)]
-    fitted += [u for linear in (False, True)
-               for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
+    if spreads:
+        fitted += [u for linear in (False, True)
+                   for u in _spread_members(d.xn, d.y, d.sw, kmax, linear, null)]
     floor = noise_floor_v(v, step_v) / v_half
     for k in range(kmax + 1, min(more_units, most) + 1):
         if not _misfit(fitted, d, floor):
