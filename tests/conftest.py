@@ -261,3 +261,16 @@ def small_sims(small_designs, once):
                 "summary": json.loads(summary.read_text()) if summary.is_file() else None}
 
     return lambda datapath: SimRun(**once(f"sim_{datapath}", lambda d: make(datapath, d)))
+
+
+@pytest.fixture(scope="session")
+def small_synths(small_designs, once):
+    """``small_synths(datapath)``: ``flann synth DIR --json FILE`` of that small design (lint on, the
+    mapped netlist checked against the twin), run once per test run: (exit code, text, stderr,
+    the JSON report or None)."""
+    def make(datapath: str, d: Path) -> tuple:
+        report = d / "synth.json"
+        rc, out, err = run_cli(["synth", small_designs["dir"] / datapath, "--json", report])
+        return rc, out, err, json.loads(report.read_text()) if report.is_file() else None
+
+    return lambda datapath: once(f"synth_{datapath}", lambda d: make(datapath, d))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
 import sys
 
 from pathlib import Path
@@ -65,14 +66,18 @@ REFUSED = {("family", "explore"): "members",
 @pytest.mark.parametrize("datapath", ["fixed", "float18", "family", "seed", "thermal", "family_thermal",
                                       "conditioner"])
 @pytest.mark.parametrize("command", sorted(COMMANDS))
-def test_command_on_datapath(designs, datapath, command, small_sims, flann):
+def test_command_on_datapath(designs, datapath, command, small_sims, small_synths, flann):
     why = REFUSED.get((datapath, command))
     if command == "sim" and not why:
         # each design's one simulation of the run (tests/verify/test_sim_cli.py looks at its outputs)
         run = small_sims(datapath)
         assert run.rc == 0 and run.summary["all_passed"], run.err
         return
-    r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))
+    if command == "synth" and not why:
+        # each design's one synthesis of the run (tests/verify/test_netlist_split.py looks at its report)
+        r = subprocess.CompletedProcess(["flann", "synth"], *small_synths(datapath)[:3])
+    else:
+        r = flann(*COMMANDS[command](designs["dir"] / datapath, designs))
     if why:
         one_line_refusal(r)
         assert why in r.stderr

@@ -32,14 +32,13 @@ def _lines_named(text: str) -> set[int]:
     return named
 
 
-@pytest.fixture(scope="module")
-def trained(tmp_path_factory, in_process):
-    out = {}
-    d = tmp_path_factory.mktemp("bench")
-    for name in CASES:
-        model = d / (name + ".json")
-        out[name] = (model, in_process(["train", DATA / name, "-o", model]))
-    return out
+@pytest.fixture(scope="session")
+def trained(once, in_process):
+    """Each export trained once per run (every worker shares it): {name: (model, (rc, out, err))}."""
+    def make(d):
+        return {name: (d / (name + ".json"), in_process(["train", DATA / name, "-o", d / (name + ".json")]))
+                for name in CASES}
+    return once("bench-exports-trained", make)
 
 
 @pytest.mark.parametrize("command", ["train", "eval", "diagnose", "calibrate"])
