@@ -20,15 +20,27 @@ TOOLS = ("ghdl", "yosys", "nextpnr-ice40", "icepack", "icebox_vlog", "verilator"
 needs_tools = pytest.mark.skipif(not all(shutil.which(t) for t in TOOLS), reason="needs " + ", ".join(TOOLS))
 
 
-@pytest.fixture(scope="module")
-def small(tmp_path_factory):
-    """A 5-term model and its design with 8 input bits (256 codes)."""
-    d = tmp_path_factory.mktemp("small")
-    model = d / "m.json"
-    assert main(["train", str(REPO / "data" / "paper_table1.csv"), "--terms", "5", "--method", "lstsq",
-                 "-o", str(model)]) == 0
-    assert main(["gen", str(model), "-o", str(d / "hdl"), "--input-bits", "8"]) == 0
-    return model, d / "hdl"
+@pytest.fixture(scope="session")
+def small(once, in_process):
+    """A 5-term model and its design with 8 input bits (256 codes), made once per run."""
+    def make(d):
+        model = d / "m.json"
+        if in_process(["train", REPO / "data" / "paper_table1.csv", "--terms", 5, "--method", "lstsq", "-o", model])[0] \
+                or in_process(["gen", model, "-o", d / "hdl", "--input-bits", 8])[0]:
+            raise RuntimeError("train or gen of the small design failed")
+        return model, d / "hdl"
+    return once("ice40_small", make)
+
+
+@pytest.fixture(scope="session")
+def hx1k(small, once, in_process):
+    """The small design placed and routed on an HX1K once per run (``synth -o``): the output
+    directory.  flann's tool cache then gives ``sim --post-route`` the same routed design."""
+    def make(d):
+        if in_process(["synth", small[1], "--device", "ice40-hx1k-tq144", "--no-lint", "-o", d / "o"])[0]:
+            raise RuntimeError("synth of the small design on an HX1K failed")
+        return d / "o"
+    return once("ice40_small_hx1k", make)
 
 
 @pytest.mark.synth
@@ -69,11 +81,8 @@ def test_hx8k_place_route_bitstream_and_post_route(small, tmp_path, capsys):
 @pytest.mark.synth
 @pytest.mark.pnr
 @needs_tools
-def test_post_route_sees_a_wrong_design(small, tmp_path, capsys):
-    model, hdl = small
-    out = tmp_path / "ice40"
-    assert main(["synth", str(hdl), "--device", "ice40-hx1k-tq144", "--json", "--no-lint", "-o", str(out)]) == 0
-    capsys.readouterr()
+def test_post_route_sees_a_wrong_design(hx1k, tmp_path):
+    out = hx1k
     # the twin of another model (7 terms) against the 5-term design's routed bitstream
     other = tmp_path / "m7.json"
     assert main(["train", str(REPO / "data" / "paper_table1.csv"), "--terms", "7", "--method", "lstsq",
@@ -143,7 +152,7 @@ def test_non_ansi_header():
 @pytest.mark.sim
 @pytest.mark.pnr
 @needs_tools
-def test_flann_sim_post_route(small, tmp_path, capsys):
+def test_flann_sim_post_route(small, hx1k, capsys):
     model, hdl = small
     assert main(["sim", str(hdl), "--model", str(model), "--post-route", "--post-route-device", "ice40-hx1k-tq144",
                  "--json", "--engine", "verilator"]) == 0
