@@ -1,0 +1,72 @@
+"""``flann train wave.csv``: a waveform recording read through the conditioner's twin.
+
+The conditioner is calibrated on the record (:func:`flann.hardware.conditioner.settings.calibrate`),
+its ratio averaged per dwell gives the readings the FLANN is fitted to, and the model keeps the
+conditioner's settings (docs/conditioner.md, "Training from waveforms").
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from ..argtypes import bounded
+from ..errors import FlannError
+from ..hardware.conditioner.settings import DEFAULT_OUTPUT_RATE_HZ, ConditionerSettings, calibrate, dwell_readings
+from ..recordings.waveform import is_waveform_csv, read_waveforms
+from .common import info
+
+FLAGS = ("output_rate_hz", "adc_bits", "adc_range_v")
+
+
+def add_waveform_arguments(p) -> None:
+    g = p.add_argument_group("a waveform recording (time_s, sec_a_v, sec_b_v; docs/waveforms.md)")
+    g.add_argument("--output-rate-hz", type=bounded(float, 0, lo_open=True), default=None,
+                   help=f"the conditioner's ratio rate, whole carrier periods a ratio (default {DEFAULT_OUTPUT_RATE_HZ:g})")
+    g.add_argument("--adc-bits", type=bounded(int, 4, 24), default=None,
+                   help="the secondaries' converters (default: from the samples' grid)")
+    g.add_argument("--adc-range-v", type=bounded(float, 0, lo_open=True), default=None,
+                   help="their range +-V (default: from the samples' grid)")
+
+
+def is_waveform(args) -> bool:
+    """``args.recordings`` is a waveform recording; the waveform flags are refused for any other."""
+    if is_waveform_csv(args.recordings):
+        return True
+    given = [f"--{f.replace('_', '-')}" for f in FLAGS if getattr(args, f, None) is not None]
+    if given:
+        raise FlannError(f"{', '.join(given)}: set the conditioner of a waveform recording; "
+                         f"{args.recordings} holds demodulated readings")
+    return False
+
+
+def read_conditioned(args) -> tuple:
+    """(readings, settings): the record through the conditioner calibrated on it, one reading per
+    dwell; the line saying what was found is printed (unless --quiet)."""
+    for flag, value, default in (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None),
+                                 ("--input-bits", args.input_bits, None), ("--input-lsb-v", args.input_lsb_v, None)):
+        if value != default:
+            raise FlannError(f"{flag}: a model trained from waveforms takes the conditioner's ratio "
+                             "(A-B)/(A+B) as its input; leave it out")
+    if args.temperature:
+        raise FlannError("--temperature: a two-input model is trained from demodulated recordings at "
+                         "several temperatures, not yet from waveforms")
+    wave = read_waveforms(args.recordings, announce=not args.quiet)
+    rate = args.output_rate_hz if args.output_rate_hz is not None else DEFAULT_OUTPUT_RATE_HZ
+    settings, conditioned = calibrate(wave, rate, args.adc_bits, args.adc_range_v)
+    sha = hashlib.sha256(Path(args.recordings).read_bytes()).hexdigest()
+    dw = dwell_readings(conditioned, wave, settings.spec.window, sha)
+    rec = dw.recordings
+    positions = len(set(rec.displacement_mm.tolist()))
+    info(args, f"{args.recordings}: waveforms: {settings.line()}; {positions} positions, {len(rec)} dwells "
+               f"averaged over {dw.windows} windows ({dw.left_out} left out: moving or saturated)")
+    return rec, settings
+
+
+def converter_of_ratio(settings: ConditionerSettings) -> dict:
+    """The converter in front of the FLANN: the conditioner's ratio code."""
+    return {"input_bits": settings.spec.ratio_bits, "input_lsb_v": settings.ratio_lsb,
+            "from": "the conditioner's ratio"}
+
+
+__all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "converter_of_ratio"]
