@@ -65,8 +65,8 @@ def read_conditioned(args) -> tuple:
 
 def converter_of_ratio(settings: ConditionerSettings) -> dict:
     """The converter in front of the FLANN: the conditioner's ratio code."""
-    return {"input_bits": settings.spec.ratio_bits, "input_lsb_v": settings.ratio_lsb,
-            "from": "the conditioner's ratio"}
+    bits, lsb = settings.ratio_converter
+    return {"input_bits": bits, "input_lsb_v": lsb, "from": "the conditioner's ratio"}
 
 
 __all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "converter_of_ratio"]

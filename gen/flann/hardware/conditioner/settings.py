@@ -13,7 +13,8 @@ its first sample, which only a record taken from the NCO's phase zero matches.
 
 Public API: :class:`ConditionerSettings` (``to_dict``/``from_dict``, ``spec``, ``reference_for``),
 :func:`calibrate` (waveforms -> settings, conditioned windows), :func:`dwell_readings`,
-:func:`of_model` (a model's settings, or None).
+:func:`of_model` (a model's settings, or None), :func:`flann_options` (the FLANN's generator
+options behind the conditioner).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from ...errors import FlannError, ModelFileError
 from ...recordings import converter_of
 from ...recordings.csvio import Recordings
 from ...recordings.waveform import Waveforms, carrier_hz
+from ..options import GenOptions
 from .condition import Conditioned, condition
 from .spec import ConditionerSpec, Reference, derive_conditioner, reference
 
@@ -79,6 +81,11 @@ class ConditionerSettings:
     @property
     def ratio_lsb(self) -> float:
         return 2.0 ** -self.spec.ratio_frac_bits
+
+    @property
+    def ratio_converter(self) -> tuple[int, float]:
+        """(bits, value per code) of the ratio code: the converter in front of the FLANN."""
+        return self.spec.ratio_bits, self.ratio_lsb
 
     @property
     def window_rate_hz(self) -> float:
@@ -148,6 +155,22 @@ def of_model(model, source: str = "model.json") -> ConditionerSettings | None:
     """The conditioner a model was trained behind, or None (a model of demodulated recordings)."""
     d = getattr(model, "conditioner", None)
     return None if d is None else ConditionerSettings.from_dict(d, source)
+
+
+def flann_options(model, options: GenOptions, given=(), source: str = "model.json") -> GenOptions:
+    """The generator options of the FLANN behind the conditioner: its input is the ratio code
+    (the converter in front of it); ``options`` unchanged for a model of demodulated readings.
+    A converter given (``given`` holds the options named on the command line) is refused."""
+    settings = of_model(model, source)
+    if settings is None:
+        return options
+    named = [n for n in ("input_bits", "input_lsb_v") if n in given]
+    if named:
+        raise FlannError(f"{', '.join('--' + n.replace('_', '-') for n in named)}: {source} was trained from "
+                         "waveforms; its input is the conditioner's ratio, "
+                         f"{settings.spec.ratio_bits} bits x 2^-{settings.spec.ratio_frac_bits}")
+    bits, lsb = settings.ratio_converter
+    return replace(options, input_bits=bits, input_lsb_v=lsb)
 
 
 def _converter(wave: Waveforms, adc_bits, adc_range_v) -> tuple[int, float]:
@@ -225,4 +248,4 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
 
 
 __all__ = ["ConditionerSettings", "DwellReadings", "DEFAULT_OUTPUT_RATE_HZ", "calibrate", "dwell_readings",
-           "excitation_phase", "of_model"]
+           "excitation_phase", "flann_options", "of_model"]
