@@ -18,20 +18,23 @@ from ..golden.thermal import is_thermal, load_any_model
 from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
 from ..golden.reading import read_usable
-from ..golden.verdict import against_line, combine, exit_code, hardware_against_float
+from ..golden.verdict import Check, against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
 from .common import add_common, emit_json
 from .train import add_reading_flags
+from .train_waveforms import is_waveform, read_held_out
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
+AD598_LINEARITY_PCT_FS = 0.05   # the analog LVDT conditioner's data-sheet linearity, max
 # (figure name of drift_ppm_fs_per_c, the JSON section whose by_temperature it is)
 SECTIONS = (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware"))
 
 
 def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
-    p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v")
+    p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v, or a waveform recording "
+                                      "held out from a model trained from waveforms (linearity_pct_fs)")
     p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
                    help="linearity tolerance in %% of full scale (default %(default)g)")
     p.add_argument("--band", type=float, default=DEFAULT_BAND_PCT_FS, metavar="PCT_FS",
@@ -59,6 +62,15 @@ def eval_verdict(res: dict):
     """Against the straight line through the same readings; with a design, the hardware against
     the float model (max error, and the drift of a two-input model)."""
     checks = [against_line(res["compensated"]["max_error_mm"], res["raw"]["max_error_mm"])]
+    lin = res.get("linearity_pct_fs")
+    if lin:
+        ok = lin["float"] <= lin["reference_pct_fs"]
+        checks.append(Check("linearity_vs_ad598", ok,
+                            f"linearity {lin['float']:.4f} % FS (the conditioner's twin and the float FLANN, "
+                            f"per dwell) {'within' if ok else 'beyond'} the {lin['reference']} of "
+                            f"{lin['reference_pct_fs']:g} % FS",
+                            "" if ok else "more positions or a longer dwell in the training waveforms, "
+                                          "or --terms auto (the default)"))
     hw = res.get("hardware")
     if hw:
         checks.append(hardware_against_float(hw["max_error_mm"], res["compensated"]["max_error_mm"]))
@@ -68,6 +80,13 @@ def eval_verdict(res: dict):
                                                  "generate with more --input-bits and --temp-bits (flann gen "
                                                  "warns with the widths that keep it)"))
     return combine(*checks)
+
+
+def linearity(res: dict) -> dict:
+    """The chain's linearity in a data sheet's terms: the largest deviation of the compensated
+    output from the true displacement, % of full scale, against the AD598's limit."""
+    return {"float": res["compensated"]["max_error_pct_fs"], "hardware": None,
+            "reference_pct_fs": AD598_LINEARITY_PCT_FS, "reference": "AD598's linearity (max)"}
 
 
 def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
@@ -118,7 +137,14 @@ def run(args) -> int:
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
+    settings = None
+    if is_waveform(args):
+        rec, settings = read_held_out(args, model)
+    elif getattr(model, "conditioner", None) is not None:
+        raise FlannError(f"{args.recordings}: demodulated readings, but {args.model} was trained from waveforms "
+                         "(its input is the conditioner's ratio): evaluate it on a waveform recording")
+    else:
+        rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
@@ -169,6 +195,8 @@ def run(args) -> int:
         res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
     if outside is not None:
         res["readings_left_out"] = outside
+    if settings is not None:
+        res["linearity_pct_fs"] = linearity(res)
     verdict = eval_verdict(res)
     res["verdict"] = verdict.to_json()
     if emit_json(args, res):
@@ -216,6 +244,10 @@ def run(args) -> int:
             + (f", hardware {h['max_error_mm']:.4g}" if h else "") for r, c, h in rows))
         print("drift (ppm FS/degC): " + ", ".join(
             f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
+    lin = res.get("linearity_pct_fs")
+    if lin:
+        print(f"linearity_pct_fs        {lin['float']:.4f} (float chain: the conditioner's twin, the FLANN in "
+              f"float; {lin['reference']}: {lin['reference_pct_fs']:g})")
     if args.plot:
         print(f"plot: {args.plot}")
     print(verdict.line())

@@ -1,8 +1,10 @@
-"""``flann train wave.csv``: a waveform recording read through the conditioner's twin.
+"""``flann train wave.csv`` and ``flann eval model.json wave.csv``: a waveform recording read
+through the conditioner's twin.
 
-The conditioner is calibrated on the record (:func:`flann.hardware.conditioner.settings.calibrate`),
+Training calibrates the conditioner on the record (:func:`flann.hardware.conditioner.settings.calibrate`),
 its ratio averaged per dwell gives the readings the FLANN is fitted to, and the model keeps the
-conditioner's settings (docs/conditioner.md, "Training from waveforms").
+conditioner's settings; evaluation reads a held-out record at the model's settings, the same
+readings (docs/conditioner.md, "Training from waveforms").
 """
 
 from __future__ import annotations
@@ -12,7 +14,8 @@ from pathlib import Path
 
 from ..argtypes import bounded
 from ..errors import FlannError
-from ..hardware.conditioner.settings import DEFAULT_OUTPUT_RATE_HZ, ConditionerSettings, calibrate, dwell_readings
+from ..hardware.conditioner.settings import (DEFAULT_OUTPUT_RATE_HZ, ConditionerSettings, calibrate, condition_with,
+                                              dwell_readings, of_model)
 from ..recordings.waveform import is_waveform_csv, read_waveforms
 from .common import info
 
@@ -40,27 +43,48 @@ def is_waveform(args) -> bool:
     return False
 
 
-def read_conditioned(args) -> tuple:
-    """(readings, settings): the record through the conditioner calibrated on it, one reading per
-    dwell; the line saying what was found is printed (unless --quiet)."""
-    for flag, value, default in (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None),
-                                 ("--input-bits", args.input_bits, None), ("--input-lsb-v", args.input_lsb_v, None)):
+def _refuse_flags(args, flags) -> None:
+    for flag, value, default in flags:
         if value != default:
             raise FlannError(f"{flag}: a model trained from waveforms takes the conditioner's ratio "
                              "(A-B)/(A+B) as its input; leave it out")
+
+
+def _readings(args, wave, settings, conditioned, found: str):
+    """The conditioned windows averaged per dwell, and the line saying so (unless --quiet)."""
+    sha = hashlib.sha256(Path(args.recordings).read_bytes()).hexdigest()
+    dw = dwell_readings(conditioned, wave, settings.spec.window, sha)
+    rec = dw.recordings
+    positions = len(set(rec.displacement_mm.tolist()))
+    info(args, f"{args.recordings}: waveforms{found}: {settings.line()}; {positions} positions, {len(rec)} dwells "
+               f"averaged over {dw.windows} windows ({dw.left_out} left out: moving or saturated)")
+    return rec
+
+
+def read_conditioned(args) -> tuple:
+    """(readings, settings): the record through the conditioner calibrated on it, one reading per
+    dwell; the line saying what was found is printed (unless --quiet)."""
+    _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None),
+                         ("--input-bits", args.input_bits, None), ("--input-lsb-v", args.input_lsb_v, None)))
     if args.temperature:
         raise FlannError("--temperature: a two-input model is trained from demodulated recordings at "
                          "several temperatures, not yet from waveforms")
     wave = read_waveforms(args.recordings, announce=not args.quiet)
     rate = args.output_rate_hz if args.output_rate_hz is not None else DEFAULT_OUTPUT_RATE_HZ
     settings, conditioned = calibrate(wave, rate, args.adc_bits, args.adc_range_v)
-    sha = hashlib.sha256(Path(args.recordings).read_bytes()).hexdigest()
-    dw = dwell_readings(conditioned, wave, settings.spec.window, sha)
-    rec = dw.recordings
-    positions = len(set(rec.displacement_mm.tolist()))
-    info(args, f"{args.recordings}: waveforms: {settings.line()}; {positions} positions, {len(rec)} dwells "
-               f"averaged over {dw.windows} windows ({dw.left_out} left out: moving or saturated)")
-    return rec, settings
+    return _readings(args, wave, settings, conditioned, ""), settings
+
+
+def read_held_out(args, model) -> tuple:
+    """(readings, settings) of a waveform recording at the conditioner settings ``model`` keeps
+    (``flann eval``): the record is not calibrated on, its reference turned by its excitation."""
+    settings = of_model(model, args.model)
+    if settings is None:
+        raise FlannError(f"{args.recordings}: a waveform recording, but {args.model} was trained from demodulated "
+                         "readings (its input is a voltage, not the conditioner's ratio): train it from waveforms")
+    _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None)))
+    wave = read_waveforms(args.recordings, announce=not args.quiet)
+    return _readings(args, wave, settings, condition_with(settings, wave), " at the model's conditioner"), settings
 
 
 def converter_of_ratio(settings: ConditionerSettings) -> dict:
@@ -69,4 +93,4 @@ def converter_of_ratio(settings: ConditionerSettings) -> dict:
     return {"input_bits": bits, "input_lsb_v": lsb, "from": "the conditioner's ratio"}
 
 
-__all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "converter_of_ratio"]
+__all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "read_held_out", "converter_of_ratio"]

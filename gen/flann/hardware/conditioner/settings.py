@@ -215,6 +215,18 @@ def calibrate(wave: Waveforms, output_rate_hz: float = DEFAULT_OUTPUT_RATE_HZ, a
     return settings, c
 
 
+def condition_with(settings: ConditionerSettings, wave: Waveforms) -> Conditioned:
+    """``wave`` through the conditioner at ``settings`` (a record held out from its calibration):
+    its carrier and sample rate must be the settings'; the reference turned by its excitation."""
+    found = carrier_hz(wave)
+    fs = float(f"{wave.sample_rate_hz:.9g}")
+    if abs(found - settings.carrier_hz) > CARRIER_TOLERANCE * settings.carrier_hz or \
+            not math.isclose(fs, settings.sample_rate_hz, rel_tol=1e-6):
+        raise FlannError(f"{wave.source}: carrier {found:.6g} Hz at {fs:.6g} samples/s, but the conditioner was "
+                         f"calibrated at {settings.carrier_hz:g} Hz and {settings.sample_rate_hz:g} samples/s")
+    return condition(wave, settings.spec, settings.adc_range_v, settings.reference_for(wave))
+
+
 @dataclass(frozen=True)
 class DwellReadings:
     """One reading per dwell: the mean ratio over its steady, unsaturated windows."""
@@ -247,5 +259,5 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
     return DwellReadings(rec, int(idx.size), int(c.ratio.size - idx.size))
 
 
-__all__ = ["ConditionerSettings", "DwellReadings", "DEFAULT_OUTPUT_RATE_HZ", "calibrate", "dwell_readings",
+__all__ = ["ConditionerSettings", "DwellReadings", "DEFAULT_OUTPUT_RATE_HZ", "calibrate", "condition_with", "dwell_readings",
            "excitation_phase", "flann_options", "of_model"]
