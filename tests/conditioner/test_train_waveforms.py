@@ -79,3 +79,75 @@ def test_a_rate_not_a_power_of_two_per_period_is_refused(tmp_path, in_process, d
 def test_waveform_flags_on_demodulated_readings_are_refused(tmp_path, in_process, table1_csv):
     rc, _out, err = in_process(["train", table1_csv, "-o", tmp_path / "m.json", "--output-rate-hz", 250])
     assert rc == 2 and "--output-rate-hz" in err and "demodulated" in err
+
+
+@pytest.fixture(scope="module")
+def held_out(trained, in_process, data_dir):
+    d, _err = trained
+    return simulate(in_process, data_dir, d / "held_out.csv", seed=2)
+
+
+def test_eval_on_held_out_waveforms_judges_linearity_against_the_ad598(trained, held_out, in_process):
+    d, _err = trained
+    rc, out, err = in_process(["eval", d / "model.json", held_out, "--json"])
+    assert rc == 0, err
+    res = json.loads(out)
+    lin = res["linearity_pct_fs"]
+    # the same figure as the compensated max error over the 25 mm full scale, per dwell
+    assert lin["float"] == pytest.approx(100 * res["compensated"]["max_error_mm"] / 25.0)
+    assert 0 < lin["float"] < 0.05 and lin["reference_pct_fs"] == 0.05
+    check = next(c for c in res["verdict"]["checks"] if c["name"] == "linearity_vs_ad598")
+    assert check["ok"] is True
+    assert "at the model's conditioner" in err
+    rc, out, _err = in_process(["eval", d / "model.json", held_out])
+    assert rc == 0 and "linearity_pct_fs" in out and "within the AD598" in out
+
+
+def test_eval_refuses_a_mismatched_pair(trained, in_process, table1_csv, default_model_json, held_out):
+    d, _err = trained
+    rc, _out, err = in_process(["eval", d / "model.json", table1_csv])
+    assert rc == 2 and "trained from waveforms" in err
+    rc, _out, err = in_process(["eval", default_model_json, held_out])
+    assert rc == 2 and "demodulated readings" in err
+
+
+def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, in_process):
+    from flann.hardware.conditioner.verify import flann_design
+    from flann.hardware.design import from_directory
+
+    d, _err = trained
+    rc, out, err = in_process(["gen", d / "model.json", "-o", d / "design"])
+    assert rc == 0, err
+    design = from_directory(d / "design")
+    assert design.datapath.name == "conditioner" and design.top == "flann_cond_top"
+    settings = of_model(load_model(d / "model.json"))
+    assert design.spec == settings.spec
+    assert design.manifest["reference"] == {"offset": settings.reference.offset, "tan": settings.reference.tan}
+    flann = flann_design(design)
+    # the FLANN's converter is the ratio code, its top 16 bits
+    assert flann.manifest["adc_bits"] == settings.spec.ratio_bits and flann.manifest["input_bits"] == 16
+    assert flann.manifest["input_lsb_v"] == settings.ratio_lsb * 2 ** (settings.spec.ratio_bits - 16)
+    assert {p.name for p in flann.files} < {p.name for p in design.files}
+    assert "not joined" in out
+    # a converter of its own is refused: the input is the conditioner's ratio
+    rc, _out, err = in_process(["gen", d / "model.json", "-o", d / "other", "--input-bits", 12])
+    assert rc == 2 and "ratio" in err and not (d / "other").exists()
+    rc, _out, err = in_process(["sim", d / "model.json"])
+    assert rc == 2 and "flann gen" in err
+
+
+def test_a_tampered_flann_manifest_is_refused(trained, in_process, tmp_path):
+    import shutil
+
+    from flann.hardware.conditioner.verify import flann_design
+    from flann.hardware.design import open_directory
+
+    d, _err = trained
+    rc, _out, err = in_process(["gen", d / "model.json", "-o", tmp_path / "design"])
+    assert rc == 0, err
+    man = json.loads((tmp_path / "design" / "manifest.json").read_text())
+    man["flann"]["files"].append("flann_cond_top_copy.vhd")
+    shutil.copy(tmp_path / "design" / "flann_cond_top.vhd", tmp_path / "design" / "flann_cond_top_copy.vhd")
+    (tmp_path / "design" / "manifest.json").write_text(json.dumps(man))
+    with pytest.raises(FlannError, match="does not list"):
+        flann_design(open_directory(tmp_path / "design").with_twin())

@@ -33,7 +33,8 @@ from ... import __version__
 
 NAME = "conditioner"
 FLANN = "flann"   # the manifest field holding the FLANN design's own manifest
-LACKS = "it is verified by its benches (flann sim) and synthesised (flann synth); the FLANN behind it is not joined to it"
+LACKS = ("written from a spec, or beside a FLANN not joined to it, it has the conditioner's benches and the "
+         "FLANN's (flann sim) and synthesis (flann synth) only")
 
 
 def latency_cycles(spec: ConditionerSpec) -> int:
