@@ -5,6 +5,7 @@ model.json and read back through one typed object."""
 import json
 import math
 
+import numpy as np
 import pytest
 
 from flann.golden.model import load_model
@@ -96,7 +97,7 @@ def test_eval_on_held_out_waveforms_judges_linearity_against_the_ad598(trained, 
     # the same figure as the compensated max error over the 25 mm full scale, per dwell
     assert lin["float"] == pytest.approx(100 * res["compensated"]["max_error_mm"] / 25.0)
     assert 0 < lin["float"] < 0.05 and lin["reference_pct_fs"] == 0.05
-    check = next(c for c in res["verdict"]["checks"] if c["name"] == "linearity_vs_ad598")
+    check = next(c for c in res["verdict"]["checks"] if c["name"] == "linearity_vs_ad598_float")
     assert check["ok"] is True
     assert "at the model's conditioner" in err
     rc, out, _err = in_process(["eval", d / "model.json", held_out])
@@ -111,13 +112,20 @@ def test_eval_refuses_a_mismatched_pair(trained, in_process, table1_csv, default
     assert rc == 2 and "demodulated readings" in err
 
 
-def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, in_process):
+@pytest.fixture(scope="module")
+def generated(trained, in_process):
+    d, _err = trained
+    rc, out, err = in_process(["gen", d / "model.json", "-o", d / "design"])
+    assert rc == 0, err
+    return d / "design", out
+
+
+def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, generated, in_process):
     from flann.hardware.conditioner.verify import flann_design
     from flann.hardware.design import from_directory
 
     d, _err = trained
-    rc, out, err = in_process(["gen", d / "model.json", "-o", d / "design"])
-    assert rc == 0, err
+    _design, out = generated
     design = from_directory(d / "design")
     assert design.datapath.name == "conditioner" and design.top == "flann_cond_top"
     settings = of_model(load_model(d / "model.json"))
@@ -151,3 +159,29 @@ def test_a_tampered_flann_manifest_is_refused(trained, in_process, tmp_path):
     (tmp_path / "design" / "manifest.json").write_text(json.dumps(man))
     with pytest.raises(FlannError, match="does not list"):
         flann_design(open_directory(tmp_path / "design").with_twin())
+
+
+def test_eval_with_the_design_gives_the_hardware_linearity(trained, generated, held_out, in_process):
+    from flann.hardware.conditioner.settings import condition_with, dwell_readings
+    from flann.hardware.conditioner.verify import flann_design
+    from flann.hardware.design import open_directory
+    from flann.recordings.waveform import read_waveforms
+
+    d, _err = trained
+    design, _out = generated
+    rc, out, err = in_process(["eval", d / "model.json", held_out, "--design", design, "--json", "--outliers", "keep"])
+    assert rc == 0, err
+    lin = json.loads(out)["linearity_pct_fs"]
+    # the same chain built here: each window's ratio code, its top 16 bits wired to the FLANN's twin
+    settings = of_model(load_model(d / "model.json"))
+    wave = read_waveforms(held_out, announce=False)
+    c = condition_with(settings, wave)
+    dw = dwell_readings(c, wave, settings.spec.window)
+    flann = flann_design(open_directory(design).with_twin())
+    codes = np.round(c.ratio * 2 ** settings.spec.ratio_frac_bits).astype(np.int64) >> (settings.spec.ratio_bits - 16)
+    mm = flann.twin().process(codes).out_data * flann.spec.output_lsb_mm
+    per = np.array([mm[g].mean() for g in dw.groups])
+    want = 100 * np.max(np.abs(per - dw.recordings.displacement_mm)) / 25.0
+    assert lin["hardware"] == pytest.approx(want, rel=1e-9)
+    # the hardware's output LSB and input bits cost little against the float chain
+    assert abs(lin["hardware"] - lin["float"]) < 0.01 and lin["hardware"] < 0.05

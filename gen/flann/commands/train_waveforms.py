@@ -58,7 +58,7 @@ def _readings(args, wave, settings, conditioned, found: str):
     positions = len(set(rec.displacement_mm.tolist()))
     info(args, f"{args.recordings}: waveforms{found}: {settings.line()}; {positions} positions, {len(rec)} dwells "
                f"averaged over {dw.windows} windows ({dw.left_out} left out: moving or saturated)")
-    return rec
+    return dw
 
 
 def read_conditioned(args) -> tuple:
@@ -72,19 +72,21 @@ def read_conditioned(args) -> tuple:
     wave = read_waveforms(args.recordings, announce=not args.quiet)
     rate = args.output_rate_hz if args.output_rate_hz is not None else DEFAULT_OUTPUT_RATE_HZ
     settings, conditioned = calibrate(wave, rate, args.adc_bits, args.adc_range_v)
-    return _readings(args, wave, settings, conditioned, ""), settings
+    return _readings(args, wave, settings, conditioned, "").recordings, settings
 
 
 def read_held_out(args, model) -> tuple:
-    """(readings, settings) of a waveform recording at the conditioner settings ``model`` keeps
-    (``flann eval``): the record is not calibrated on, its reference turned by its excitation."""
+    """(dwell readings, settings, conditioned windows) of a waveform recording at the conditioner
+    settings ``model`` keeps (``flann eval``): the record is not calibrated on, its reference
+    turned by its excitation."""
     settings = of_model(model, args.model)
     if settings is None:
         raise FlannError(f"{args.recordings}: a waveform recording, but {args.model} was trained from demodulated "
                          "readings (its input is a voltage, not the conditioner's ratio): train it from waveforms")
     _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None)))
     wave = read_waveforms(args.recordings, announce=not args.quiet)
-    return _readings(args, wave, settings, condition_with(settings, wave), " at the model's conditioner"), settings
+    conditioned = condition_with(settings, wave)
+    return _readings(args, wave, settings, conditioned, " at the model's conditioner"), settings, conditioned
 
 
 def converter_of_ratio(settings: ConditionerSettings) -> dict:

@@ -234,6 +234,7 @@ class DwellReadings:
     recordings: Recordings
     windows: int        # windows averaged, over every dwell
     left_out: int       # windows moving or saturated
+    groups: tuple = ()  # the windows of each dwell (index arrays), in the readings' order
 
 
 def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "") -> DwellReadings:
@@ -256,7 +257,7 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
         temp = np.array([np.mean(per[g]) for g in groups])
     rec = Recordings(displacement_mm=x, voltage_v=v, temperature_c=temp, source=wave.source, sha256=sha256,
                      comments=wave.comments)
-    return DwellReadings(rec, int(idx.size), int(c.ratio.size - idx.size))
+    return DwellReadings(rec, int(idx.size), int(c.ratio.size - idx.size), tuple(groups))
 
 
 __all__ = ["ConditionerSettings", "DwellReadings", "DEFAULT_OUTPUT_RATE_HZ", "calibrate", "condition_with", "dwell_readings",
