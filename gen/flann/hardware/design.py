@@ -84,7 +84,11 @@ def is_design_dir(path) -> bool:
 
 def from_model(model, build_dir, options: dict | None = None) -> Design:
     """Generate the fixed-point design of ``model`` with ``options`` into ``build_dir/hdl``."""
-    if getattr(load_any_model(model), "conditioner", None) is not None:
+    try:
+        conditioned = getattr(load_any_model(model), "conditioner", None) is not None
+    except FlannError:
+        conditioned = False   # the generator names what is wrong with the file
+    if conditioned:
         raise FlannError(f"{model}: trained from waveforms, its design holds the conditioner too: "
                          f"flann gen {model} -o DIR, then flann sim DIR")
     options = dict(options or {})
