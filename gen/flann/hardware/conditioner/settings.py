@@ -94,8 +94,10 @@ class ConditionerSettings:
 
     def reference_for(self, wave: Waveforms) -> Reference:
         """The registers that demodulate ``wave`` as the hardware would: the reference phase
-        turned by the excitation's phase at the record's first sample."""
-        return reference(self.spec, self.phase_rad + excitation_phase(wave, self.spec.samples_per_period))
+        turned by the excitation's phase at the record's first sample (a phase calibrated
+        against a record's first sample is taken as it is)."""
+        turn = excitation_phase(wave, self.spec.samples_per_period) if self.against_excitation else 0.0
+        return reference(self.spec, self.phase_rad + turn)
 
     def line(self) -> str:
         s, ref = self.spec, self.reference
