@@ -35,7 +35,7 @@ def test_bad_choices_are_refused_naming_the_option(kw, words):
         derive_conditioner(**kw)
 
 
-def test_design_directory_and_its_manifest(tmp_path):
+def test_design_directory_and_its_manifest(tmp_path, default_model_json):
     s = derive_conditioner()
     man = write_conditioner(s, tmp_path / "d", adc_range_v=5.0)
     on_disk = json.loads((tmp_path / "d" / "manifest.json").read_text())
@@ -45,5 +45,5 @@ def test_design_directory_and_its_manifest(tmp_path):
     on_disk["output_bits"] += 1
     with pytest.raises(FlannError, match="output_bits"):
         rebuild(None, on_disk, "d")
-    with pytest.raises(FlannError, match="not yet from a model"):
-        DATAPATH.generate("model.json", tmp_path / "e")
+    with pytest.raises(FlannError, match="has no conditioner"):
+        DATAPATH.generate(default_model_json, tmp_path / "e")

@@ -16,22 +16,29 @@ from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_rep
 from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..golden.thermal_metrics import temperature_report
-from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
+from ..hardware.accuracy import adc_codes, design_adc, design_spec, hardware_accuracy, plot_errors
+from ..hardware.datapath import check_design_model
+from ..hardware.design import open_directory
+from ..hardware.conditioner.verify import flann_design
+from ..hardware.fixed.twin import FlannTop
 from ..golden.reading import read_usable
-from ..golden.verdict import against_line, combine, exit_code, hardware_against_float
+from ..golden.verdict import Check, against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
 from .common import add_common, emit_json
 from .train import add_reading_flags
+from .train_waveforms import is_waveform, read_held_out
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
+AD598_LINEARITY_PCT_FS = 0.05   # the analog LVDT conditioner's data-sheet linearity, max
 # (figure name of drift_ppm_fs_per_c, the JSON section whose by_temperature it is)
 SECTIONS = (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware"))
 
 
 def add_arguments(p) -> None:
     p.add_argument("model", help="model.json")
-    p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v")
+    p.add_argument("recordings", help="recordings CSV with displacement_mm and voltage_v, or a waveform recording "
+                                      "held out from a model trained from waveforms (linearity_pct_fs)")
     p.add_argument("--tol", type=float, default=DEFAULT_TOL_PCT_FS, metavar="PCT_FS",
                    help="linearity tolerance in %% of full scale (default %(default)g)")
     p.add_argument("--band", type=float, default=DEFAULT_BAND_PCT_FS, metavar="PCT_FS",
@@ -41,7 +48,8 @@ def add_arguments(p) -> None:
     p.add_argument("--design", metavar="DIR", default=None,
                    help="also the accuracy of the design `flann gen MODEL -o DIR` wrote: its bit-true "
                         "twin on the voltages as ADC codes, and the physical limit (half an ADC LSB "
-                        "over the local slope)")
+                        "over the local slope); with waveforms, the conditioner's ratio codes into the "
+                        "FLANN's twin (linearity_pct_fs.hardware)")
     p.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                    help="error vs displacement: raw sensor, float model, hardware (needs --design) "
                         "and the physical limit")
@@ -59,6 +67,19 @@ def eval_verdict(res: dict):
     """Against the straight line through the same readings; with a design, the hardware against
     the float model (max error, and the drift of a two-input model)."""
     checks = [against_line(res["compensated"]["max_error_mm"], res["raw"]["max_error_mm"])]
+    lin = res.get("linearity_pct_fs")
+    for chain in ("float", "hardware") if lin else ():
+        if lin[chain] is None:
+            continue
+        ok = lin[chain] <= lin["reference_pct_fs"]
+        what = ("the conditioner's twin and the float FLANN" if chain == "float" else
+                "the conditioner's twin and the FLANN's, as the design computes")
+        checks.append(Check(f"linearity_vs_ad598_{chain}", ok,
+                            f"linearity {lin[chain]:.4f} % FS ({what}, per dwell) "
+                            f"{'within' if ok else 'beyond'} the {lin['reference']} of {lin['reference_pct_fs']:g} % FS",
+                            "" if ok else "more positions or a longer dwell in the training waveforms, "
+                                          "or --terms auto (the default)"
+                            + ("" if chain == "float" else "; a finer --output-lsb-mm")))
     hw = res.get("hardware")
     if hw:
         checks.append(hardware_against_float(hw["max_error_mm"], res["compensated"]["max_error_mm"]))
@@ -68,6 +89,37 @@ def eval_verdict(res: dict):
                                                  "generate with more --input-bits and --temp-bits (flann gen "
                                                  "warns with the widths that keep it)"))
     return combine(*checks)
+
+
+def conditioned_flann(model, design_dir):
+    """The FLANN design behind the conditioner in ``design_dir`` (flann gen of ``model``), with its
+    twin; one line when the directory holds none or was generated from another model."""
+    design = open_directory(design_dir)
+    check_design_model(model, design.manifest, design_dir)
+    flann = flann_design(design.with_twin())
+    if flann is None:
+        raise FlannError(f"{design_dir}: holds no FLANN behind a conditioner (flann gen {model} -o DIR writes one)")
+    return flann
+
+
+def chain_outputs_mm(flann, settings, conditioned, dwells, rec) -> np.ndarray:
+    """The design's output per reading of ``rec``: each window's ratio code into the FLANN's twin
+    (its top input bits, as wired), averaged over the dwell as the float chain's ratio is."""
+    spec = flann.spec
+    codes = adc_codes(spec, conditioned.ratio, settings.ratio_converter)
+    out = FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
+    full = dwells.recordings
+    per = {(float(x), float(v)): float(np.mean(out[g]))
+           for x, v, g in zip(full.displacement_mm, full.voltage_v, dwells.groups)}
+    # the readings the shared reading kept: the dwells by their (position, ratio)
+    return np.array([per[(float(x), float(v))] for x, v in zip(rec.displacement_mm, rec.voltage_v)])
+
+
+def linearity(res: dict) -> dict:
+    """The chain's linearity in a data sheet's terms: the largest deviation of the compensated
+    output from the true displacement, % of full scale, against the AD598's limit."""
+    return {"float": res["compensated"]["max_error_pct_fs"], "hardware": None,
+            "reference_pct_fs": AD598_LINEARITY_PCT_FS, "reference": "AD598's linearity (max)"}
 
 
 def evaluate(model, rec, tol=DEFAULT_TOL_PCT_FS, band=DEFAULT_BAND_PCT_FS, fs_mm=None) -> dict:
@@ -118,7 +170,18 @@ def run(args) -> int:
     if args.plot and not args.design:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
+    settings = None
+    if is_waveform(args):
+        if args.plot:
+            raise FlannError("--plot: draws demodulated recordings; for a waveform recording the figures are "
+                             "linearity_pct_fs (flann diagnose --plot draws the waveforms)")
+        dwells, settings, conditioned = read_held_out(args, model)
+        rec = dwells.recordings
+    elif getattr(model, "conditioner", None) is not None:
+        raise FlannError(f"{args.recordings}: demodulated readings, but {args.model} was trained from waveforms "
+                         "(its input is the conditioner's ratio): evaluate it on a waveform recording")
+    else:
+        rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
@@ -139,13 +202,16 @@ def run(args) -> int:
             outside = len(rec) - len(reading.rec)
             rec = reading.rec
     # a design eval cannot judge is refused before any warning about the recording
-    spec = design_spec(args.model, args.design) if args.design else None
+    chain = conditioned_flann(args.model, args.design) if args.design and settings is not None else None
+    spec = design_spec(args.model, args.design) if args.design and chain is None else None
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
                        temperature_c=rec.temperature_c)
     warn_outside_stroke(model, rec)
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     errors = res.pop("_errors", None)
-    if args.design:
+    if chain is not None:
+        hardware_mm = chain_outputs_mm(chain, settings, conditioned, dwells, rec)
+    elif args.design:
         hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
                                adc=design_adc(args.design))
         pts = hw.pop("_points")
@@ -169,6 +235,11 @@ def run(args) -> int:
         res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
     if outside is not None:
         res["readings_left_out"] = outside
+    if settings is not None:
+        res["linearity_pct_fs"] = linearity(res)
+        if chain is not None:
+            res["linearity_pct_fs"]["hardware"] = float(100 * np.max(np.abs(hardware_mm - rec.displacement_mm))
+                                                        / res["full_scale_mm"])
     verdict = eval_verdict(res)
     res["verdict"] = verdict.to_json()
     if emit_json(args, res):
@@ -216,6 +287,13 @@ def run(args) -> int:
             + (f", hardware {h['max_error_mm']:.4g}" if h else "") for r, c, h in rows))
         print("drift (ppm FS/degC): " + ", ".join(
             f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
+    lin = res.get("linearity_pct_fs")
+    if lin:
+        print(f"linearity_pct_fs        {lin['float']:.4f} (float chain: the conditioner's twin, the FLANN in "
+              f"float; {lin['reference']}: {lin['reference_pct_fs']:g})")
+        if lin["hardware"] is not None:
+            print(f"linearity_pct_fs        {lin['hardware']:.4f} (hardware: the conditioner's twin, the FLANN's twin "
+                  f"of {args.design})")
     if args.plot:
         print(f"plot: {args.plot}")
     print(verdict.line())

@@ -12,6 +12,7 @@ from ..errors import FlannError
 from ..golden.thermal import load_any_model
 from ..golden.train import converter_mismatch, converter_text, judged_converter, same_converter
 from ..hardware import options as gen_options
+from ..hardware.conditioner.settings import flann_options
 from ..hardware.manifest import is_design
 from ..hardware.registry import FORMATS, datapath_for_model, family_datapath
 from .common import add_common, emit_json, info, json_word_as_input
@@ -64,6 +65,7 @@ def run(args) -> int:
     else:
         dp, source, extra = datapath_for_model(args.model, args.format), args.model, {}
         model = load_any_model(args.model)
+        opts = flann_options(model, opts, _given, args.model)
         other = converter_mismatch(model, opts.input_bits, opts.input_lsb_v)
         if other:
             warnings.warn(other)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -26,12 +27,14 @@ from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .common import add_common, info, on_terminal, quiet
 from .train_thermal import compensation_hint, run_thermal
+from .train_waveforms import add_waveform_arguments, converter_of_ratio, is_waveform, read_conditioned
 
 HELP = "train a FLANN inverse model on recordings"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...)")
+    p.add_argument("recordings", help="recordings CSV (displacement_mm, voltage_v, ...), or a waveform "
+                   "recording (time_s, sec_a_v, sec_b_v, displacement_mm: through the conditioner)")
     p.add_argument("--terms", type=terms_or_auto(1, MAX_TERMS), default="auto",
                    help="expansion terms N (paper: %s) or 'auto' (default): the forward curve "
                         "v(x) fitted where the noise is, inverted, and the FLANN (terms, "
@@ -69,6 +72,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--input-lsb-v", type=bounded(float, 0, lo_open=True), default=None,
                    help="--terms auto: volts per code of that converter (default: the grid's step, "
                         "or flann gen's default for --input-bits)")
+    add_waveform_arguments(p)
     add_common(p, output=dict(help="model.json to write", metavar="MODEL.json", required=True))
 
 
@@ -134,7 +138,7 @@ class _Verdict(str):
     """A line of the fit's summary that judges the model: said under --quiet too."""
 
 
-def _train_auto(args, rec, provenance: dict) -> tuple:
+def _train_auto(args, rec, provenance: dict, settings=None) -> tuple:
     """(model, lines to print) of --terms auto: the FLANN fitted to the inverse of the forward
     curve (:mod:`flann.golden.inverse`), or the direct fit's cross-validated choice."""
     said = []
@@ -149,7 +153,7 @@ def _train_auto(args, rec, provenance: dict) -> tuple:
                          f"{MIN_POSITIONS}): give --terms 1 (a line) or --terms 2")
     # the readings the shared reading kept (a glitch is on no converter's grid)
     _stage(f"{len(rec)} readings at {positions} positions kept by the screen (rails, fold-back, gross outliers)")
-    conv = converter(args, rec)
+    conv = converter(args, rec) if settings is None else converter_of_ratio(settings)
     # readings on a converter's grid differ by whole steps: the noise is at least its quantisation
     step_v = converter_step(rec.voltage_v)
     if args.input_bits is not None:
@@ -214,7 +218,11 @@ def train_verdict(model, rec, heldout_max_mm: float | None):
 
 
 def run(args) -> int:
-    rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
+    settings = None
+    if is_waveform(args):
+        rec, settings = read_conditioned(args)
+    else:
+        rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if args.temperature:
         return run_thermal(args, rec)
     hint = compensation_hint(rec)
@@ -246,7 +254,7 @@ def run(args) -> int:
         if args.method != "lstsq" or explicit is not None or args.normalise or args.ridge:
             raise FlannError("--terms auto chooses normalisation and ridge itself (lstsq); "
                              "give --terms N to set --method/--normalise/--ridge")
-        model, said, heldout_max = _train_auto(args, rec, provenance)
+        model, said, heldout_max = _train_auto(args, rec, provenance, settings)
     else:
         if args.input_bits is not None or args.input_lsb_v is not None:
             raise FlannError("--input-bits/--input-lsb-v choose among --terms auto's candidates; "
@@ -265,6 +273,8 @@ def run(args) -> int:
             heldout, heldout_max = _heldout(rec, args.terms, norm, args.ridge, explicit)
             said.append(f"lstsq: {args.terms} terms, ridge {args.ridge:g}, training RMS error "
                         f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)" + heldout)
+    if settings is not None:
+        model = replace(model, conditioner=settings.to_dict())
     _check_generatable(model)
     verdict = train_verdict(model, rec, heldout_max)
     model.training["verdict"] = verdict.to_json()

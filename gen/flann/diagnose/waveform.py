@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..physics.lvdt import reference_phase_rad
+from ..recordings.waveform import carrier_hz, is_waveform_csv
 from ..physics.sensor import default_sensor
 
 Z_FOUND = 5.0                  # standard errors for a figure to name an effect
@@ -108,33 +109,7 @@ class WaveDiagnosis:
     notes: tuple[str, ...] = field(default_factory=tuple)
 
 
-def is_waveform_csv(path) -> bool:
-    """True when the file's header has a ``time_s`` column and both secondaries."""
-    from ..recordings.waveform import _channel_of, _header_at
-    try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            head = [fh.readline() for _ in range(64)]
-        line = head[_header_at(head)]
-    except (OSError, FlannError):
-        return False
-    cells = [c.strip().strip('"').lower() for c in line.replace(";", ",").replace("\t", ",").split(",")]
-    channels = {hit[0] for hit in map(_channel_of, cells) if hit}
-    has_time = any(c == "time_s" or c.startswith("time") for c in cells)
-    return has_time and {"sec_a_v", "sec_b_v"} <= channels
-
-
 # -- the lock-in --------------------------------------------------------------------------
-
-def _carrier_hz(v: np.ndarray, fs: float) -> float:
-    """The strongest line of ``v``, interpolated between FFT bins."""
-    spec = np.abs(np.fft.rfft(v - np.mean(v)))
-    k = int(np.argmax(spec[1:])) + 1
-    if 1 <= k < spec.size - 1:   # parabolic interpolation of the log spectrum
-        lo, mid, hi = np.log(spec[k - 1:k + 2] + 1e-300)
-        den = lo - 2 * mid + hi
-        k = k + (0.5 * (lo - hi) / den if den != 0 else 0.0)
-    return float(k * fs / v.size)
-
 
 def _lockin(t: np.ndarray, w_rad_s: float, *chans: np.ndarray) -> tuple[list[complex], np.ndarray]:
     """Peak phasors ``P`` (``v = Re(P e^{jwt})``) of the carrier on each channel, by least
@@ -316,8 +291,7 @@ def diagnose_waveforms(wave, sensor=None) -> WaveDiagnosis:
     gives the phase to compare with (without it the phase is not judged) and the demodulator
     gain that refers the quadrature to the output (default: the seed paper's LVDT's)."""
     fs = wave.sample_rate_hz
-    carrier_src = wave.exc_v if wave.exc_v is not None else wave.sec_a_v + wave.sec_b_v
-    fc = _carrier_hz(carrier_src, fs)
+    fc = carrier_hz(wave)
     if not (0 < fc < fs / 2):
         raise FlannError(f"{wave.source}: no carrier found in the waveforms")
     dw = _dwells(wave, fc)

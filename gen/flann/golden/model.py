@@ -120,6 +120,10 @@ class FlannModel(ModelFile):
     voltage_range_v: tuple[float, float] = (-1.0, 1.0)
     displacement_range_mm: tuple[float, float] = (-1.0, 1.0)
     training: dict = field(default_factory=dict)
+    # a model trained from waveforms: the conditioner whose ratio is its input, as
+    # flann.hardware.conditioner.settings.ConditionerSettings writes and reads it (kept as
+    # written here: the golden model computes on the ratio and needs none of it)
+    conditioner: dict | None = None
 
     @property
     def terms(self) -> int:
@@ -148,7 +152,7 @@ class FlannModel(ModelFile):
 
     # -- file -----------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {
+        out = {
             "format": FORMAT,
             "terms": self.terms,
             "input_offset_v": self.input_offset_v,
@@ -159,6 +163,9 @@ class FlannModel(ModelFile):
             "displacement_range_mm": list(self.displacement_range_mm),
             "training": self.training,
         }
+        if self.conditioner is not None:
+            out["conditioner"] = self.conditioner
+        return out
 
     @classmethod
     def from_dict(cls, d: dict, source: str = "<dict>") -> "FlannModel":
@@ -185,13 +192,16 @@ class FlannModel(ModelFile):
             training = d.get("training", {})
             if not isinstance(training, dict):
                 raise ModelFileError(f"{source}: 'training' must be an object")
+            conditioner = d.get("conditioner")
+            if conditioner is not None and not isinstance(conditioner, dict):
+                raise ModelFileError(f"{source}: 'conditioner' must be an object")
             model = cls(
                 weights=weights,
                 bias=number(d["bias"], "bias", source, ModelFileError),
                 input_offset_v=number(d["input_offset_v"], "input_offset_v", source, ModelFileError),
                 input_scale_v=number(d["input_scale_v"], "input_scale_v", source, ModelFileError,
                                      lo=-SCALE_V[1], hi=SCALE_V[1], tiny=SCALE_V[0]),
-                training=dict(training), **ranges,
+                training=dict(training), conditioner=conditioner, **ranges,
             )
         except KeyError as exc:
             raise ModelFileError(f"{source}: missing field {exc.args[0]!r}") from None

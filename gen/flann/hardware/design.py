@@ -17,6 +17,7 @@ from typing import Any
 
 from ..errors import FlannError
 from ..golden.model import model_sha256
+from ..golden.thermal import load_any_model
 from .datapath import Datapath
 from .fixed.render import generate, load, manifest_options
 from .manifest import MANIFEST, Manifest
@@ -83,6 +84,13 @@ def is_design_dir(path) -> bool:
 
 def from_model(model, build_dir, options: dict | None = None) -> Design:
     """Generate the fixed-point design of ``model`` with ``options`` into ``build_dir/hdl``."""
+    try:
+        conditioned = getattr(load_any_model(model), "conditioner", None) is not None
+    except FlannError:
+        conditioned = False   # the generator names what is wrong with the file
+    if conditioned:
+        raise FlannError(f"{model}: trained from waveforms, its design holds the conditioner too: "
+                         f"flann gen {model} -o DIR, then flann sim DIR")
     options = dict(options or {})
     hdl = Path(build_dir).resolve() / "hdl"
     man = generate(model, hdl, **options)

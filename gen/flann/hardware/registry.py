@@ -59,11 +59,19 @@ def family_datapath(sources) -> Datapath:
 
 def datapath_for_model(model, format_name: str) -> Datapath:
     """The datapath ``flann gen MODEL --format F`` builds: a two-input model has its own (the
-    model file says which it is); a one-input model the format's."""
+    model file says which it is), a model trained from waveforms the conditioner's; a one-input
+    model the format's."""
     try:
-        two_inputs = is_thermal(load_any_model(model))
+        loaded = load_any_model(model)
+        two_inputs = is_thermal(loaded)
     except FlannError:
-        two_inputs = False  # the format's datapath names what is wrong with the file
+        loaded, two_inputs = None, False  # the format's datapath names what is wrong with the file
+    if getattr(loaded, "conditioner", None) is not None:
+        # trained from waveforms: the conditioner at its settings and the FLANN behind it
+        if format_name != FIXED.name:
+            raise FlannError(f"--format {format_name}: a model trained from waveforms is generated with its "
+                             f"conditioner in fixed point only (--format {FIXED.name})")
+        return CONDITIONER
     if not two_inputs:
         return datapath(format_name)
     if format_name != THERMAL.number_format:

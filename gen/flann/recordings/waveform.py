@@ -11,6 +11,8 @@ Public API:
 
 * :class:`Waveforms` (frozen dataclass of equal-length float arrays; ``exc_v`` and
   ``temperature_c`` may be ``None``), ``sample_rate_hz``, ``len()``.
+* :func:`is_waveform_csv` (path): its header names time and both secondaries;
+  :func:`carrier_hz` (Waveforms): the carrier's frequency.
 * :func:`read_waveforms` (path) / :func:`parse_waveforms` (text, source) -> Waveforms.
 * :func:`format_waveforms` / :func:`write_waveforms` (path, waveforms, comments).
 """
@@ -188,6 +190,34 @@ def _notes(first: str, cells: list[str], found: dict[str, tuple[int, str]]) -> s
             factor = _VOLT_UNITS.get(unit or "v", 1.0)
             notes.append(f"'{cells[i]}' as {channel}" + (f" (x {factor:g})" if factor != 1.0 else ""))
     return ", ".join(notes)
+
+
+def is_waveform_csv(path) -> bool:
+    """True when the file's header has a ``time_s`` column and both secondaries."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            head = [fh.readline() for _ in range(64)]
+        line = head[_header_at(head)]
+    except (OSError, RecordingsError):
+        return False
+    cells = [c.strip().strip('"').lower() for c in line.replace(";", ",").replace("\t", ",").split(",")]
+    channels = {hit[0] for hit in map(_channel_of, cells) if hit}
+    has_time = any(c == "time_s" or c.startswith("time") for c in cells)
+    return has_time and {"sec_a_v", "sec_b_v"} <= channels
+
+
+def carrier_hz(wave: Waveforms) -> float:
+    """The carrier: the strongest line of the excitation (of A + B without it), interpolated
+    between FFT bins."""
+    v = wave.exc_v if wave.exc_v is not None else wave.sec_a_v + wave.sec_b_v
+    fs = wave.sample_rate_hz
+    spec = np.abs(np.fft.rfft(v - np.mean(v)))
+    k = int(np.argmax(spec[1:])) + 1
+    if 1 <= k < spec.size - 1:   # parabolic interpolation of the log spectrum
+        lo, mid, hi = np.log(spec[k - 1:k + 2] + 1e-300)
+        den = lo - 2 * mid + hi
+        k = k + (0.5 * (lo - hi) / den if den != 0 else 0.0)
+    return float(k * fs / v.size)
 
 
 def read_waveforms(path: str | Path, announce: bool = True) -> Waveforms:

@@ -1,7 +1,10 @@
 """The conditioner's verification (``flann sim DIR``): each block under GHDL and cocotb against
 its twin (the converter port on every code, the NCO over every phase it visits, seeded random and
 boundary cases for the demodulator, the rotation and the divider), then a waveform through the
-whole chain (``flann_cond_top`` against :class:`~.twin.ConditionerChain`), 0 mismatches.
+whole chain (``flann_cond_top`` against :class:`~.twin.ConditionerChain`), 0 mismatches.  A
+directory ``flann gen`` wrote from a model trained from waveforms also holds the FLANN behind the
+conditioner: its own benches (every input code against its twin) run after the conditioner's,
+one summary for both.
 
 The waveform is an LVDT's in closed form (the verify layer sits below the physics simulator):
 the secondaries ``(1 +- u) / 2`` of the carrier at a phase off the table's steps, a quadrature
@@ -17,10 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import FlannError
 from ...verify.plugin import Verification
 from ...verify.results import SimResult, bench_entry, summary
 from ...verify.runner import BenchResult, run_cocotb
 from ..design import Design
+from ..fixed.verify import VERIFICATION as FIXED_VERIFICATION
+from ..manifest import MANIFEST, Manifest
+from ..registry import FIXED, check_widths
+from .datapath import FLANN
 from .condition import calibrate_reference
 from .render import cycles_per_sample
 from .spec import ConditionerSpec, identity
@@ -74,7 +82,28 @@ def run_chain(files, spec: ConditionerSpec, build_dir, *, seed: int = 1) -> tupl
     return res, int(a.size)
 
 
-def bench(design: Design, build_dir, *, seed=1, **_) -> SimResult:
+def flann_design(design: Design) -> Design | None:
+    """The FLANN design a conditioner's directory holds behind it (``flann gen`` of a model
+    trained from waveforms), with its twin; None for a conditioner written from a spec."""
+    fman = design.manifest.get(FLANN)
+    if fman is None:
+        return None
+    where = design.directory / MANIFEST
+    if not isinstance(fman, dict):
+        raise FlannError(f"{where}: field {FLANN!r} must be an object (the FLANN design's manifest)")
+    FIXED.check(fman, f"{where}: field {FLANN!r}")
+    check_widths(fman, f"{where}: field {FLANN!r}")
+    if not set(fman["files"]) <= set(design.manifest["files"]) or fman.get("model") != design.manifest.get("model"):
+        raise FlannError(f"{where}: field {FLANN!r} names files or a model the design does not list: "
+                         "regenerate the design with flann gen")
+    files = tuple(design.directory / f for f in fman["files"])
+    return Design(design.directory, Manifest(design.directory, fman["top"], files, fman), datapath=FIXED).with_twin()
+
+
+def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
+    """The conditioner's benches; with a FLANN behind it, then the FLANN's own (its every code
+    against its twin): one summary, the FLANN's sweep and the conditioner's chain together."""
+    flann = flann_design(design)   # a tampered FLANN manifest is refused before any simulation
     spec, files, build_dir = design.spec, design.files, Path(build_dir)
     results = {name: run_block(files, spec, entity, module, build_dir / name, seed=seed, **make(spec))
                for name, (entity, module, make) in BLOCKS.items()}
@@ -83,9 +112,23 @@ def bench(design: Design, build_dir, *, seed=1, **_) -> SimResult:
     ok = all(r.ok for r in results.values()) and bool(rec)
     s = summary(design, samples, rec.get("mismatches"), None, {n: bench_entry(r) for n, r in results.items()}, ok)
     s["windows"], s["saturated_windows"] = rec.get("windows"), rec.get("saturated")
-    return SimResult(s, None, spec, ok)
+    if flann is None:
+        return SimResult(s, None, spec, ok)
+    fres = FIXED_VERIFICATION.bench(flann, build_dir / FLANN, seed=seed, **options)
+    f = fres.summary
+    cond = {"samples": samples, "mismatches": s["mismatches"], "windows": s["windows"],
+            "saturated_windows": s["saturated_windows"]}
+    bad = None if s["mismatches"] is None or f["mismatches"] is None else s["mismatches"] + f["mismatches"]
+    merged = {**f, "codes_tested": samples + f["codes_tested"], "mismatches": bad, "conditioner": cond,
+              "flann": {k: f[k] for k in ("codes_tested", "mismatches", "max_err_lsb", "max_err_mm",
+                                          "cycles_per_sample", "latency_cycles")},
+              "cycles_per_sample": s["cycles_per_sample"], "latency_cycles": s["latency_cycles"],
+              "benches": {**s["benches"], **{f"{FLANN}_{n}": b for n, b in f["benches"].items()}},
+              "all_passed": ok and fres.passed}
+    merged.update({k: s[k] for k in s if k.startswith("samples_per_s") or k == "clock_hz"})
+    return SimResult(merged, fres.curve, spec, merged["all_passed"], fres.bound_lsb)
 
 
 VERIFICATION = Verification(bench=bench)
 
-__all__ = ["VERIFICATION", "BLOCKS", "run_block", "run_chain", "lvdt_codes"]
+__all__ = ["VERIFICATION", "BLOCKS", "run_block", "run_chain", "lvdt_codes", "flann_design"]
