@@ -17,18 +17,23 @@ from flann.hardware.family.images import header_fields, parse_hex
 from flann.recordings import read_recordings
 
 
-@pytest.fixture(scope="module")
-def batch(tmp_path_factory):
-    d = tmp_path_factory.mktemp("batch")
-    good = write_batch(d / "rec", 3, seed=7, points=600)
-    bad = bad_files(d / "rec")
-    design = d / "design"
-    assert main(["gen", "--family", *map(str, good[:2]), "-o", str(design), "--input-bits", "10"]) == 0
-    out = d / "out"
-    rc = main(["calibrate", *map(str, good + bad), "-o", str(out), "--design", str(design), "-j", "2"])
-    with open(out / "summary.csv", newline="") as fh:
-        rows = {r["sensor"]: r for r in csv.DictReader(fh)}
-    return {"good": good, "bad": bad, "design": design, "out": out, "rc": rc, "rows": rows}
+@pytest.fixture(scope="session")
+def batch(once, in_process):
+    """Three good recordings and the bad files, the family designed from two of them and the
+    batch calibrated, once per test run."""
+    def make(d):
+        good = write_batch(d / "rec", 3, seed=7, points=600)
+        bad = bad_files(d / "rec")
+        design = d / "design"
+        rc, _out, err = in_process(["gen", "--family", *good[:2], "-o", design, "--input-bits", 10])
+        if rc != 0:
+            raise RuntimeError(f"flann gen --family failed: {err}")
+        out = d / "out"
+        rc = in_process(["calibrate", *good, *bad, "-o", out, "--design", design, "-j", 2])[0]
+        with open(out / "summary.csv", newline="") as fh:
+            rows = {r["sensor"]: r for r in csv.DictReader(fh)}
+        return {"good": good, "bad": bad, "design": design, "out": out, "rc": rc, "rows": rows}
+    return once("calibrate_batch", make)
 
 
 def test_batch_reports_bad_rows_and_goes_on(batch):

@@ -9,7 +9,6 @@ import csv
 import numpy as np
 import pytest
 
-from flann.cli import main
 from flann.hardware.family.render import load_design
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.family.images import parse_hex
@@ -38,19 +37,22 @@ def sweep(amp_v, asym, seed, steps=300):
 SENSORS = {"s0": (3.0, 0.02), "s1": (3.15, -0.01), "s2": (2.9, 0.0), "s3": (3.1, 0.03), "big": (9.0, 0.0)}
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory):
-    d = tmp_path_factory.mktemp("scurve")
-    paths = {}
-    for k, (name, (amp, asym)) in enumerate(SENSORS.items()):
-        paths[name] = d / f"{name}.csv"
-        write_recordings(paths[name], sweep(amp, asym, seed=k))
-    assert main(["gen", "--family", str(paths["s0"]), str(paths["s1"]), "-o", str(d / "design")]) == 0
-    rc = main(["calibrate", *map(str, paths.values()), "-o", str(d / "out"), "--design", str(d / "design"),
-               "-j", "2"])
-    with open(d / "out" / "summary.csv", newline="") as fh:
-        rows = {r["sensor"]: r for r in csv.DictReader(fh)}
-    return {"dir": d, "rc": rc, "rows": rows}
+@pytest.fixture(scope="session")
+def run(once, in_process):
+    """The family designed from two sensors and every sensor calibrated, once per test run."""
+    def make(d):
+        paths = {}
+        for k, (name, (amp, asym)) in enumerate(SENSORS.items()):
+            paths[name] = d / f"{name}.csv"
+            write_recordings(paths[name], sweep(amp, asym, seed=k))
+        rc, _out, err = in_process(["gen", "--family", paths["s0"], paths["s1"], "-o", d / "design"])
+        if rc != 0:
+            raise RuntimeError(f"flann gen --family failed: {err}")
+        rc = in_process(["calibrate", *paths.values(), "-o", d / "out", "--design", d / "design", "-j", "2"])[0]
+        with open(d / "out" / "summary.csv", newline="") as fh:
+            rows = {r["sensor"]: r for r in csv.DictReader(fh)}
+        return {"dir": d, "rc": rc, "rows": rows}
+    return once("calibrate_closed_form", make)
 
 
 def test_members_and_sensors_like_them_calibrate(run):

@@ -22,20 +22,23 @@ from flann.recordings import read_recordings
 NOISE_V = 0.002
 
 
-@pytest.fixture(scope="module")
-def line(tmp_path_factory, data_dir):
+@pytest.fixture(scope="session")
+def line(once, in_process, data_dir):
     """Two-sweep recordings of the paper's LVDT (2 mV noise), a one-sweep one, and the
-    family design sized from the two-sweep ones."""
-    d = tmp_path_factory.mktemp("line")
-    lvdt = data_dir / "sensors" / "paper_lvdt.toml"
-    rec = {}
-    for name, sweeps, seed in (("s1", 2, 1), ("s2", 2, 2), ("one", 1, 3)):
-        rec[name] = d / f"{name}.csv"
-        assert main(["simulate", str(lvdt), "--sweeps", str(sweeps), "--step-mm", "0.5", "--noise-v",
-                     str(NOISE_V), "--seed", str(seed), "-o", str(rec[name])]) == 0
-    design = d / "fam12"
-    assert main(["gen", "--family", str(rec["s1"]), str(rec["s2"]), "-o", str(design)]) == 0
-    return {"dir": d, "rec": rec, "design": design}
+    family design sized from the two-sweep ones, made once per test run."""
+    def make(d):
+        lvdt = data_dir / "sensors" / "paper_lvdt.toml"
+        rec = {}
+        for name, sweeps, seed in (("s1", 2, 1), ("s2", 2, 2), ("one", 1, 3)):
+            rec[name] = d / f"{name}.csv"
+            if in_process(["simulate", lvdt, "--sweeps", sweeps, "--step-mm", 0.5, "--noise-v", NOISE_V,
+                           "--seed", seed, "-o", rec[name]])[0]:
+                raise RuntimeError(f"flann simulate of {name} failed")
+        design = d / "fam12"
+        if in_process(["gen", "--family", rec["s1"], rec["s2"], "-o", design])[0]:
+            raise RuntimeError("flann gen --family failed")
+        return {"dir": d, "rec": rec, "design": design}
+    return once("calibrate_outputs_line", make)
 
 
 def _calibrate(line, out, *args):
