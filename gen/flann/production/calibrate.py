@@ -56,7 +56,8 @@ from ..hardware.accuracy import adc_codes, physical_limit_mm
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.family.build import train_model
 from ..hardware.family.render import design_hash
-from ..hardware.registry import FAMILY, FAMILY_THERMAL, read_design
+from ..hardware.design import as_design
+from ..hardware.registry import FAMILY, FAMILY_THERMAL
 from ..hardware.family.spec import FamilySpec, FitError, member_spec, outside_input
 from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..physics.sensor import load_sensor
@@ -560,11 +561,12 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     Ctrl-C stops the batch promptly (:func:`flann.pool.run_batch`): the sensors already
     running finish, the rest are ``interrupted`` rows, summary.csv is written, and then
     KeyboardInterrupt goes on up (exit 130)."""
-    man, dp = read_design(design_dir)  # the manifest's own datapath, its fields checked
+    design = as_design(design_dir)  # the manifest's own datapath, its fields checked
+    dp = design.datapath
     if dp not in (FAMILY, FAMILY_THERMAL):
-        raise FlannError(f"{design_dir}: a {dp.name} design; flann calibrate writes weight images for a family "
-                         "design (flann gen --family)")
-    fam, _ = dp.rebuild(dp.model_path(design_dir, man), man, design_dir)
+        raise FlannError(f"{design_dir}: a {dp.name} design; flann calibrate writes weight images "
+                         "for a family design (flann gen --family)")
+    fam = design.with_twin().spec
     if diagnosis_points is not None and diagnosis_points < 0:
         raise FlannError(f"--diagnosis-points {diagnosis_points}: must be >= 0 (0 = every point)")
     if sensor_toml is not None:  # a bad sensor file stops the batch before it starts
