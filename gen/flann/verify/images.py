@@ -7,10 +7,11 @@ from pathlib import Path
 
 from ..errors import FlannError
 from ..golden.model import FlannModel, load_model, text_sha256
-from ..hardware.family.images import MODEL_FILE, check_image, header_fields, header_model_sha256, parse_hex
+from ..hardware.family.images import MODEL_FILE, header_fields, header_model_sha256, parse_hex
 from ..hardware.family.render import design_hash
 from ..inputs import read_text
 from ..hardware.design import Design
+from .plugin import verification
 
 
 def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[int]]:
@@ -26,13 +27,9 @@ def checked_image(design: Design, image: dict, words: int) -> tuple[dict, list[i
     if len(got) != words:
         raise FlannError(f"{image['hex']}: {len(got)} words, {design.directory}'s weight image is {words} words "
                          "(an image of another design?)")
-    if design.datapath.name == "family":   # an image the hardware would wrap with is refused
-        check_image(design.with_twin().spec, got, image["hex"])
-    elif design.datapath.name == "family_thermal":   # each temperature order's memory in turn
-        spec = design.with_twin().spec
-        depth = spec.fam.mem_depth
-        for j in range(spec.orders):
-            check_image(spec.fam, got[j * depth:(j + 1) * depth], f"{image['hex']} (temperature order {j})")
+    found = verification(design.datapath)
+    if found is not None and found.check_words is not None:   # an image the hardware would wrap with
+        found.check_words(design.with_twin().spec, got, image["hex"])
     if named is not None and named != (ours := design_hash(design.directory)):
         raise FlannError(f"{image['hex']}: calibrated for another design (design sha256 {named[:12]}..., "
                          f"{design.directory} is {ours[:12]}...): calibrate the sensor for this design "

@@ -25,6 +25,7 @@ class Verification:
     fuzz_options: Callable | None = None  # rng -> its own generator options drawn at random
     engines: tuple = ("ghdl",)            # with "verilator": GHDL's netlist compiled by Verilator can replace its VHDL sweep
     loads_images: bool = False            # its bench loads weight images (flann sim --image)
+    check_words: Callable | None = None   # (spec, words, source): an image's words the hardware would wrap with refused
 
 
 def folder_module(dp, layer: str):

@@ -16,6 +16,7 @@ from ...verify.plugin import Verification
 from ...verify.results import SimResult, summary
 from ...verify.runner import BenchResult, run_cocotb
 from ..design import Design, as_design
+from .images import check_image
 from .spec import member_spec
 from .twin import FlannFamilyTop
 
@@ -99,6 +100,6 @@ def netlist(design: Design, image=None):
                      cfg_addr_bits=design.spec.addr_bits)
 
 
-VERIFICATION = Verification(bench=bench, netlist=netlist, loads_images=True)
+VERIFICATION = Verification(bench=bench, netlist=netlist, loads_images=True, check_words=check_image)
 
 __all__ = ["VERIFICATION", "bench", "netlist", "run_family_bench"]

@@ -17,6 +17,7 @@ from ...verify.plugin import Verification
 from ...verify.results import SimResult, summary, sweep_about, sweep_rows
 from ...verify.runner import backend_for, sweep_temperatures
 from ..design import Design
+from ..family.images import check_image
 from .twin import FlannFamilyThermalTop
 
 # every voltage code at both ends of the temperature code range and this many codes evenly
@@ -95,6 +96,13 @@ def netlist(design: Design, image=None):
                      cfg_addr_bits=spec.cfg_addr_bits, temps=tuple(temperature_codes(spec)), temp_bits=spec.temp_bits)
 
 
-VERIFICATION = Verification(bench=bench, netlist=netlist, loads_images=True)
+def check_words(spec, words: list[int], source) -> None:
+    """Each temperature order's memory in turn, as the one-input family's image is checked."""
+    depth = spec.fam.mem_depth
+    for j in range(spec.orders):
+        check_image(spec.fam, words[j * depth:(j + 1) * depth], f"{source} (temperature order {j})")
+
+
+VERIFICATION = Verification(bench=bench, netlist=netlist, loads_images=True, check_words=check_words)
 
 __all__ = ["VERIFICATION", "bench", "netlist", "temperature_codes", "FAMILY_THERMAL_TEMPS"]
