@@ -37,7 +37,7 @@ from ..numeric.fixed import nearest_codes
 from ..verify.datapaths import simulate as simulate_design
 from ..hardware.design import Design
 from .plugin import insight, traced
-from .two_input_trace import ThermalTraceResult, plot_thermal_trace
+from .two_input_trace import ThermalTraceResult
 
 
 STAGES = ("expansion", "convert", "weights", "products", "adder", "linear", "output")
@@ -180,6 +180,9 @@ class TraceResult:
     identity_residual_mm: float = 0.0
     input_lsb_v: float = 0.0
     hdl: dict | None = None        # set by check_hdl(): the simulated HDL's own outputs
+
+    def plot(self, path, title: str = "") -> None:
+        plot_one_input_trace(self, path, title)
 
     def at_voltages(self, voltages) -> list[dict]:
         """Golden, hardware and error at the (clamped) input codes nearest to ``voltages``."""
@@ -342,9 +345,12 @@ def _ulp(x: float, sig_bits: int) -> float:
 
 # -- plot ---------------------------------------------------------------------------------
 def plot_trace(result: TraceResult | ThermalTraceResult, path, title: str = "") -> None:
+    """Error per stage vs input voltage (PNG), as the result draws itself."""
+    result.plot(path, title)
+
+
+def plot_one_input_trace(result: TraceResult, path, title: str = "") -> None:
     """Error per stage vs input voltage (PNG)."""
-    if isinstance(result, ThermalTraceResult):
-        return plot_thermal_trace(result, path, title)
     # matplotlib is heavy and only needed for plots: imported when one is drawn
     import matplotlib
     matplotlib.use("Agg")

@@ -28,6 +28,9 @@ class ThermalTraceResult:
     beyond_limits: int = 0   # samples left out: the float model beyond the output limits there
     stage_text: dict = field(repr=False, default_factory=dict)   # stage -> what it is, in words
 
+    def plot(self, path, title: str = "") -> None:
+        plot_thermal_trace(self, path, title)
+
     def to_dict(self) -> dict:
         d = {"format": self.fmt, "points": self.n_points, "voltage_codes": self.voltage_codes,
              "temperature_codes": self.temperature_codes, "total": self.total, "stages": self.stages,
