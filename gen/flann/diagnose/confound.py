@@ -9,7 +9,11 @@ the slope rolls off.  Picking one by chance is worse than saying so.
 
 After selection, every set of the same size drawn from the named effects and the candidates
 that were strong on their own (lowered BIC by the acceptance margin in the first round) is
-fitted, each with its own shape term.  Sets whose BIC is within the margin of the best are
+fitted, each with its own shape term, and so is every set one effect larger that forward
+selection did not build (a pair neither of whose effects was its first choice).  A larger set
+takes part only when each of its effects earns the acceptance margin over the set without it
+(BIC charges every parameter), so a single effect's recording keeps answering one effect; one
+far ahead of every other set becomes the choice.  Sets whose BIC is within the margin of the best are
 equally good explanations: ``CONFOUND_BIC``, or ``CONFOUND_FRACTION`` of what the best set
 gains over the calibrated simulation alone when that is more (the physics model's own
 imperfection -- geometry calibrated, a smooth shape term -- leaves a misfit that grows with
@@ -92,7 +96,13 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     if len(pool) <= len(named):
         return none_confounded(named)
     fits: dict[frozenset, Fit] = {frozenset(named): sel.final}
-    for combo in itertools.combinations(pool, len(named)):
+    # the sets of the same size, then those one effect larger that forward selection never
+    # built: it adds to the set it holds, so a pair neither of whose effects is its first
+    # choice is fitted only here (a set holding its own set it has weighed already, with
+    # cross-validation too)
+    larger = [c for c in itertools.combinations(pool, len(named) + 1)
+              if not frozenset(named) <= frozenset(c)]
+    for combo in list(itertools.combinations(pool, len(named))) + larger:
         key = frozenset(combo)
         if key in fits:
             continue
@@ -106,6 +116,7 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
             f = family.rechoose(list(combo), idx, f)
         if f.ok:
             fits[key] = f
+    fits = {key: f for key, f in fits.items() if _earns_its_size(key, f, fits)}
     best_bic = min(f.bic for f in fits.values())
     margin = max(margin, fraction * (sel.baseline.bic - best_bic))
     best = min(fits.values(), key=lambda f: f.bic)
@@ -113,7 +124,12 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
                    if f.bic - best_bic < margin or _not_beaten(best, f, margin)),
                   key=lambda t: (t[0], sorted(t[1])))
     if len(near) <= 1:
-        return none_confounded(named)
+        # one set left: forward selection's own, or a larger one far ahead of it
+        key = near[0][1]
+        if key == frozenset(named):
+            return none_confounded(named)
+        chosen = tuple(c for c in candidates if c in key)
+        return Confounding((chosen,), (0.0,), chosen, fits[key], margin, (fits[key],))
     # the choice is the set forward selection built (each of its effects earned its keep
     # one at a time, converter-step and rail checks included) when it is among them
     mine = [t for t in near if t[1] == frozenset(named)]
@@ -122,6 +138,22 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     shared = tuple(c for c in named if all(c in s for s in sets))
     return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin,
                        tuple(fits[key] for _, key in near))
+
+
+def _earns_its_size(key: frozenset, fit: Fit, fits: dict) -> bool:
+    """A set is compared with the others only when each of its effects earns its keep: it
+    beats every fitted set of one effect fewer inside it by the margin forward selection asks
+    of an effect (BIC charges each parameter ln n), by more than another recording of the
+    same sensor could take away (``REPEAT_Z``).  A single effect's recording, fitted with a
+    pair that adds an effect the curve does not show, keeps answering one effect: on 20
+    identical sensors with a 0.05 mm zero shift, null_offset + secondary_imbalance beat each
+    alone by the margin on 4 and not on the other 16."""
+    for k, f in fits.items():
+        if len(k) == len(key) - 1 and k < key:
+            se, _ = bic_spread(fit, f)
+            if not f.bic - fit.bic - BIC_MARGIN > REPEAT_Z * math.sqrt(2.0) * se:
+                return False
+    return True
 
 
 def bic_spread(best: Fit, other: Fit) -> tuple[float, float]:
