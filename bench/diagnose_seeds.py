@@ -12,7 +12,9 @@ other end (reverse sweep order).  Per concealed case it prints:
   parameter) and how many of the N sensors gave each; reference: the issue's target, the
   same answer in at least 19 of 20;
 * how many named the concealed set first, and how many offered it at all (the choice or an
-  alternative); reference: every one of them;
+  alternative); reference: every one of them; for a concealed pair, also the pair fitted as
+  the diagnosis fits any set: its BIC against its best single effect and how well its least
+  determined effect is told from none (whether the curve carries the pair at all);
 * per signed parameter of each explanation, the spread of its value across the seeds
   against the median stated uncertainty (ratio); reference: 1 (0.7-1.3 is agreement on 20
   seeds, a chi distribution's 95 % range).
@@ -35,6 +37,8 @@ import numpy as np
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from flann.diagnose import diagnose  # noqa: E402
+from flann.diagnose import pipeline as P  # noqa: E402
+from flann.diagnose.select import BIC_MARGIN  # noqa: E402
 from flann.physics import filament as F  # noqa: E402
 from flann.recordings import Recordings  # noqa: E402
 
@@ -42,6 +46,8 @@ NOISE_V = 0.004
 PER_PASS = 300
 SIGNED = ("offset_v", "shift_mm", "imbalance_fraction")
 TARGET = 19          # of 20: the issue's "same answer" target
+MAIN = {"null_offset": "offset_v", "secondary_imbalance": "imbalance_fraction",
+        "zero_shift": "shift_mm", "quadrature_null": "quadrature_v"}
 SPREAD_OK = (0.7, 1.3)
 # label -> (filament effects, the diagnosis' names of the concealed set)
 CASES = {
@@ -91,6 +97,27 @@ def answer(dg) -> str:
     return " | ".join(sets) + (f"   [{' '.join(signs)}]" if signs else "")
 
 
+def concealed_fit(rec: Recordings, truth: tuple[str, ...]) -> tuple[float, float]:
+    """The concealed set fitted as the diagnosis fits any set (its own shape term): its BIC
+    against the best single effect, and |value| / stated uncertainty of its least determined
+    effect (below 2: the recordings do not tell that effect is there)."""
+    shape = P.shape_pass(rec)
+    rails = P.rails_pass(shape)
+    calib = P.calibration_pass(shape, rails)
+    fam = P.shape_term_pass(shape, calib).family
+    idx = calib.fit_idx
+
+    def fit(effects):
+        f = fam.fit(list(effects), idx)
+        return fam.rechoose(list(effects), idx, f) if f.ok else f
+
+    pair = fit(truth)
+    single = min(fit([e]).bic for e in truth)
+    z = min(abs(pair.value(f"{e}.{MAIN[e]}")) / pair.stderr[pair.names.index(f"{e}.{MAIN[e]}")]
+            for e in truth)
+    return pair.bic - single, z
+
+
 def run_case(label: str, n: int) -> int:
     effects, truth = CASES[label]
     truth = tuple(sorted(truth))
@@ -98,11 +125,15 @@ def run_case(label: str, n: int) -> int:
     seeds_of: dict[str, list[int]] = {}
     first = offered = 0
     values: dict[tuple, list] = {}
+    pair_fits = []
     t0 = time.process_time()
     for k in range(n):
+        rec = recording(effects, k)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            dg = diagnose(recording(effects, k))
+            dg = diagnose(rec)
+            if len(truth) > 1:
+                pair_fits.append(concealed_fit(rec, truth))
         a = answer(dg)
         answers[a] += 1
         seeds_of.setdefault(a, []).append(k)
@@ -124,6 +155,12 @@ def run_case(label: str, n: int) -> int:
         print(f"   {m:2d}  {a}{rare}", flush=True)
     print(f"   concealed set {'+'.join(truth)}: named first {first}/{n}, offered {offered}/{n} "
           f"(reference: {n}/{n})", flush=True)
+    if pair_fits:
+        a = np.array(pair_fits)
+        print(f"   concealed set fitted: BIC {np.median(a[:, 0]):+.1f} against its best single "
+              f"effect (median; BIC_MARGIN {BIC_MARGIN:g} to earn an effect), least determined "
+              f"effect at {np.median(a[:, 1]):.1f} of its stated uncertainty (median; 2 to be "
+              f"told from none)", flush=True)
     for key, vs in sorted(values.items()):
         if len(vs) < 5:
             continue

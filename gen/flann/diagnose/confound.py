@@ -248,9 +248,13 @@ _PAIRS: dict[frozenset, tuple[str, str]] = {
         _SECONDARIES, "a zero shift moves the position where the secondaries are equal; an "
         "offset leaves it where the core is centred and only adds to the output"),
     frozenset({"quadrature_null", "null_offset"}): (
-        _QUADRATURE + ", or record at a second excitation frequency",
+        _QUADRATURE + ", or record at a second excitation frequency, or record densely across "
+        "the null (steps well below the quadrature voltage over the slope there)",
         "a quadrature null is 90 degrees out of phase with the excitation (capacitive coupling "
-        "grows with frequency); an offset is in phase or DC"),
+        "grows with frequency); an offset is in phase or DC.  On the curve alone, a quadrature "
+        "null rounds the tip of a rectified V over about its voltage over the slope on each "
+        "side while an offset lifts the V and keeps its tip sharp: only the readings that "
+        "close to the null tell them apart"),
     frozenset({"quadrature_null", "secondary_imbalance"}): (
         _QUADRATURE, "a quadrature null is 90 degrees out of phase with the excitation; an "
         "imbalance is in phase with the secondaries"),
