@@ -6,7 +6,9 @@
 One sensor drawn from the independent forward model (``flann.physics.filament``, never called
 by the diagnosis; geometry seed 77, travel 90 % of its monotonic half-range, 5 V), 300
 positions per pass out and back, 4 mV noise, seeds 3000+k; odd seeds read the rows from the
-other end (reverse sweep order).  Per concealed case it prints:
+other end (reverse sweep order).  The last case is the project's own simulator (the paper's
+LVDT, no sensor file, 600 positions out and back, 5 mV noise, seeds 500+k), where the
+diagnosis' model is exact.  Per concealed case it prints:
 
 * the answers (the choice and every alternative, order aside, with the sign of each signed
   parameter) and how many of the N sensors gave each; reference: the issue's target, the
@@ -40,6 +42,8 @@ from flann.diagnose import diagnose  # noqa: E402
 from flann.diagnose import pipeline as P  # noqa: E402
 from flann.diagnose.select import BIC_MARGIN  # noqa: E402
 from flann.physics import filament as F  # noqa: E402
+from flann.physics.sensor import default_sensor  # noqa: E402
+from flann.physics.simulate import simulate_recordings  # noqa: E402
 from flann.recordings import Recordings  # noqa: E402
 
 NOISE_V = 0.004
@@ -60,7 +64,13 @@ CASES = {
         ("null_offset", "secondary_imbalance")),
     "quadrature_null 40 mV (rectified)": ({"quadrature": {"quadrature_v": 0.04}},
                                           ("quadrature_null",)),
+    # the diagnosis' own simulator (its model exact), 5 mV noise: an offset with a moved null
+    # bends the curve as an imbalance does, which forward selection takes first
+    "own simulator: null_offset +7 mV + zero_shift -0.013 mm": (
+        {"null_offset": {"offset_v": 0.007}, "zero_shift": {"shift_mm": -0.013}},
+        ("null_offset", "zero_shift")),
 }
+OWN_NOISE_V = 0.005
 
 
 def sensor(rectified: bool):
@@ -71,10 +81,17 @@ def sensor(rectified: bool):
     return (replace(m, rectified=True) if rectified else m), h
 
 
-def recording(effects: dict, k: int) -> Recordings:
-    m, h = sensor("quadrature" in effects)
-    rec = F.simulate_recording(m.with_effects(**effects), (-h, h), 2 * h / (PER_PASS - 1),
-                               NOISE_V, seed=3000 + k)
+def recording(effects: dict, k: int, own: bool = False) -> Recordings:
+    if own:
+        s = default_sensor()
+        for name, params in effects.items():
+            s = s.with_effect(name, **params)
+        rec = simulate_recordings(s, step_mm=2 * s.stroke_mm / (2 * PER_PASS - 1),
+                                  noise_v=OWN_NOISE_V, seed=500 + k)
+    else:
+        m, h = sensor("quadrature" in effects)
+        rec = F.simulate_recording(m.with_effects(**effects), (-h, h), 2 * h / (PER_PASS - 1),
+                                   NOISE_V, seed=3000 + k)
     if k % 2:   # reverse sweep order: the same rows read from the other end
         r = slice(None, None, -1)
         rec = Recordings(rec.displacement_mm[r], rec.voltage_v[r], -rec.direction[r],
@@ -128,7 +145,7 @@ def run_case(label: str, n: int) -> int:
     pair_fits = []
     t0 = time.process_time()
     for k in range(n):
-        rec = recording(effects, k)
+        rec = recording(effects, k, own=label.startswith("own simulator"))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             dg = diagnose(rec)

@@ -74,3 +74,13 @@ def test_a_pair_far_ahead_of_the_single_is_the_choice():
     # forward selection stopped at x (neither y nor z beside it helped); y+z is far better
     sets = _sets(_bics(x=-1300, y=-1260, z=-1250, yz=-1400))
     assert sets == [frozenset({"y", "z"})]
+
+
+def test_a_single_inside_a_pair_that_earned_against_it_is_not_offered():
+    # the baseline 1,310 behind: the margin is 1 % of that (13), so y alone (11 behind the
+    # pair) would be near; but the pair beat it by more than an effect's margin
+    bics = _bics(x=-1300, y=-1299, z=-1250, yz=-1310)
+    bics[()] = 0.0
+    sets = _sets(bics)
+    assert {"y", "z"} in sets and {"x"} in sets
+    assert {"y"} not in sets
