@@ -172,8 +172,16 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
 
 # two geometries fit alike when another recording of the same sensor may reverse which fits
 # better: their squared-residual sums differ by less than this many standard errors of that
-# difference's spread over noise draws (one-sided 99 %, sqrt 2 for two recordings)
+# difference over noise draws (one-sided 99 %, sqrt 2 for two recordings)
 SAME_FIT_Z = 2.33 * math.sqrt(2.0)
+
+
+def _noise_sd(x: np.ndarray, y: np.ndarray) -> float:
+    """The readings' noise from second differences along the displacement (the curve's slope
+    and bend cancel; the fit's misfit, which can be far larger, does not enter)."""
+    order = np.argsort(x, kind="stable")
+    dd = np.diff(y[order], 2)
+    return math.sqrt(float(np.median(dd * dd)) / (6.0 * 0.455)) if dd.size else 0.0
 
 
 def _reproducible(solutions, x, y, g0):
@@ -181,7 +189,12 @@ def _reproducible(solutions, x, y, g0):
     fit as well as it on another recording of the same sensor, the one nearest the sensor's
     own geometry.  Two geometries far apart can draw the same curve (a short primary with a
     wide gap and a long one with a narrow gap); left to the noise, identical sensors landed
-    on either, and an imbalance fitted on top moved by twice its stated uncertainty."""
+    on either, and an imbalance fitted on top moved by twice its stated uncertainty.
+
+    The difference of two fits' squared-residual sums moves between recordings by
+    2 sigma |f_a - f_b| (sigma the readings' noise, f the fitted curves): the misfit both
+    share is the same on every recording (a sensor whose halves differ in gain by 1 % is
+    misfit by 50 mV with 0.5 mV noise: its geometries are told apart)."""
     if not solutions:
         raise FlannError("calibration: no geometry could be simulated")
     best = min(solutions, key=lambda t: t[1][-1])
@@ -190,13 +203,12 @@ def _reproducible(solutions, x, y, g0):
         s, _g, gain, origin_k, _t, _c = out
         resid[id(out)] = y - ideal_output_v(s.replace(demodulator_gain_ratio=gain), x * k - origin_k)
     r0 = resid[id(best[1])]
-    n = r0.size
-    s2 = float(r0 @ r0) / max(n, 1)
+    sigma = _noise_sd(x, y)
     alike = []
     for k, out in solutions:
-        d = (resid[id(out)] ** 2 - r0 ** 2) / max(s2, 1e-300)
-        se = math.sqrt(n) * float(np.std(d, ddof=1)) if n > 2 else math.inf
-        if out is best[1] or float(np.sum(d)) <= SAME_FIT_Z * se:
+        r = resid[id(out)]
+        se = 2.0 * sigma * float(np.linalg.norm(r - r0))
+        if out is best[1] or float(r @ r - r0 @ r0) <= SAME_FIT_Z * se:
             alike.append((k, out))
 
     def distance(t):
