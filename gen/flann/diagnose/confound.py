@@ -119,7 +119,11 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
         f = family.fit(list(combo), idx, start=sel.final)
         if f.ok:
             f = family.rechoose(list(combo), idx, f)
-        if f.ok:
+        # a fit that does not show what one of its effects names (a "rail" through readings
+        # that still move) is no explanation, as in forward selection
+        implausible = getattr(family, "implausible", None)
+        if f.ok and not (len(combo) > len(named) and implausible is not None
+                         and any(implausible(c, f, idx) for c in combo)):
             fits[key] = f
     fits = {key: f for key, f in fits.items() if _earns_its_size(key, f, fits)}
     # a set inside a pair that earned its second effect against it is beaten by that pair
