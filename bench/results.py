@@ -55,6 +55,7 @@ BENCH_SCRIPTS = [
     ("bench/bench_float18.py", "fixed point against float18: resources and accuracy"),
     ("bench/physics_speed.py", "physics model speed"),
     ("bench/bench_diagnose.py", "diagnosis runtime on 2,001 points"),
+    ("bench/diagnose_seeds.py", "identical sensors, 20 noise seeds per concealed effect: the same answer, the concealed set offered, spread against stated uncertainty"),
     ("bench/bench_calibrate.py", "production line with the paper's LVDT: sensors/min, CPU per sensor"),
     ("bench/bench_line.py", "production line without a sensor file, against a spec: verdicts, sensors/min"),
     ("bench/family_reach.py", "a family design's error against each member's own design"),

@@ -123,8 +123,8 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
     shape = None
     if not geometry_known:
         fields = GEOMETRY_FIELDS
-        best = None
-        best_k = 1.0
+        g0 = np.array([getattr(s, f) for f in fields], dtype=float)
+        solutions = []
         # Each start is (k, geometry): k = sensor mm per recorded unit (1 for mm; the grid
         # also tries the scales that map the recorded span onto the rated stroke, which
         # covers recordings in inches or other units).  Everything below works in the
@@ -138,12 +138,12 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
             gn, on, _ = _solve_gain_origin(trial, xk, y, np.ones_like(y), gain, origin * k,
                                            origin_free, rng_k)
             out = _gauss_newton(trial, fields, xk, y, gn, on, origin_free, rng_k, progress)
-            if best is None or out[-1] < best[-1]:
-                best, best_k = out, k
-        s, g, gain, origin_k, tables_gn, _cost = best
-        scale = best_k
+            tables += out[4]
+            solutions.append((k, out))
+        k_best, best = _reproducible(solutions, x, y, g0)
+        s, g, gain, origin_k, _tables, _cost = best
+        scale = k_best
         origin = origin_k / scale
-        tables += tables_gn
         # derivatives at the solution -> shape modes and geometry uncertainty
         base = s.replace(demodulator_gain_ratio=gain)
         u = (x - origin) * scale
@@ -168,6 +168,54 @@ def calibrate(sensor, x: np.ndarray, y: np.ndarray, origin_known: bool, geometry
     return Calibration(sensor=s.replace(demodulator_gain_ratio=gain), gain=gain,
                        origin_mm=origin, geometry=geometry, geometry_stderr=geo_err,
                        shape=shape, resid=resid, tables=tables, scale=scale)
+
+
+# two geometries fit alike when another recording of the same sensor may reverse which fits
+# better: their squared-residual sums differ by less than this many standard errors of that
+# difference over noise draws (one-sided 99 %, sqrt 2 for two recordings)
+SAME_FIT_Z = 2.33 * math.sqrt(2.0)
+
+
+def _noise_sd(x: np.ndarray, y: np.ndarray) -> float:
+    """The readings' noise from second differences along the displacement (the curve's slope
+    and bend cancel; the fit's misfit, which can be far larger, does not enter)."""
+    order = np.argsort(x, kind="stable")
+    dd = np.diff(y[order], 2)
+    return math.sqrt(float(np.median(dd * dd)) / (6.0 * 0.455)) if dd.size else 0.0
+
+
+def _reproducible(solutions, x, y, g0):
+    """The (scale, Gauss-Newton result) to keep: the lowest cost, or, among the solutions that
+    fit as well as it on another recording of the same sensor, the one nearest the sensor's
+    own geometry.  Two geometries far apart can draw the same curve (a short primary with a
+    wide gap and a long one with a narrow gap); left to the noise, identical sensors landed
+    on either, and an imbalance fitted on top moved by twice its stated uncertainty.
+
+    The difference of two fits' squared-residual sums moves between recordings by
+    2 sigma |f_a - f_b| (sigma the readings' noise, f the fitted curves): the misfit both
+    share is the same on every recording (a sensor whose halves differ in gain by 1 % is
+    misfit by 50 mV with 0.5 mV noise: its geometries are told apart)."""
+    if not solutions:
+        raise FlannError("calibration: no geometry could be simulated")
+    best = min(solutions, key=lambda t: t[1][-1])
+    resid = {}
+    for k, out in solutions:
+        s, _g, gain, origin_k, _t, _c = out
+        resid[id(out)] = y - ideal_output_v(s.replace(demodulator_gain_ratio=gain), x * k - origin_k)
+    r0 = resid[id(best[1])]
+    sigma = _noise_sd(x, y)
+    alike = []
+    for k, out in solutions:
+        r = resid[id(out)]
+        se = 2.0 * sigma * float(np.linalg.norm(r - r0))
+        if out is best[1] or float(r @ r - r0 @ r0) <= SAME_FIT_Z * se:
+            alike.append((k, out))
+
+    def distance(t):
+        k, out = t
+        return float(np.sum(np.log(out[1] / g0) ** 2) + math.log(k) ** 2)
+
+    return min(alike, key=distance)
 
 
 def _grid_starts(s, x, y, origin, fields, keep: int = 2):

@@ -359,10 +359,10 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
     conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
     final = sel.final
-    if conf.confounded:
+    if conf.confounded or set(conf.sets[0]) != set(order):
         # the choice is forward selection's set when it is among the equally good ones
-        # (confound.equivalent_sets); otherwise the best, its figures those of the choice
-        # built one effect at a time
+        # (confound.equivalent_sets); otherwise the best (a larger set far ahead of it, too),
+        # its figures those of the choice built one effect at a time
         final = conf.fits[0]
         if set(conf.sets[0]) != set(order):
             first = {t.name: t.delta_bic for t in (sel.trials[0] if sel.trials else [])}
