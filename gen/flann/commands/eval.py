@@ -17,7 +17,7 @@ from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import design_adc, design_spec, hardware_accuracy, plot_errors
-from ..golden.reading import read_usable
+from ..golden.reading import usable_or_every
 from ..golden.verdict import against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
 from .common import add_common, emit_json
@@ -125,19 +125,7 @@ def run(args) -> int:
     outside = None
     if not args.whole and not is_thermal(model):
         # the same reading train made: figures over the usable stroke, the rest counted
-        try:
-            reading = read_usable(rec, args.outliers)
-        except FlannError as exc:
-            if args.outliers == "refuse":
-                raise
-            # a recording train would refuse is still one a model can be judged on, whole
-            warnings.warn(f"{exc}; the figures are over every reading")
-            reading = None
-        if reading is not None:
-            for line in reading.said:
-                warnings.warn(line)
-            outside = len(rec) - len(reading.rec)
-            rec = reading.rec
+        rec, outside = usable_or_every(rec, args.outliers, "the figures are over every reading")
     # a design eval cannot judge is refused before any warning about the recording
     spec = design_spec(args.model, args.design) if args.design else None
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=False,
