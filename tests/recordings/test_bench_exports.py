@@ -123,3 +123,12 @@ def test_paper_exact_fit_verdict_is_bad(tmp_path, in_process):
     rc, _o, err = in_process(["train", root / "data" / "paper_table1.csv", "--terms", "51", "-o", tmp_path / "m.json",
                            "--strict"])
     assert rc == 1 and "verdict: BAD" in err
+
+
+def test_sound_end_readings_of_an_s_curve_are_kept():
+    """The two glitches of the rough S-curve, and only they: its end readings, where a
+    high-degree fit held out swings, are the curve's."""
+    from flann.golden.reading import read_usable
+
+    reading = read_usable(read_recordings(DATA / "rough_s_curve.csv", announce=False))
+    assert {int(line.split()[1]) for line in reading.lines_left_out} == CASES["rough_s_curve.csv"][0]
