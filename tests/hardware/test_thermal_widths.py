@@ -1,5 +1,5 @@
 """flann gen warns before writing a two-input design whose widths lose the model's accuracy, and
-names widths that keep it; the widths it names do (flann eval --design on held-out temperatures)."""
+names widths that keep it (max error and drift); the widths it names do (flann eval --design on held-out temperatures)."""
 
 from __future__ import annotations
 
@@ -41,8 +41,9 @@ def test_gen_warns_and_names_widths_that_keep_the_accuracy(walk_through, flann):
     assert r.returncode == 0 and "warning:" not in r.stderr, r.stderr
     kept = json.loads(flann("eval", d / "model_t.json", d / "held.csv", "--design", d / "kept", "--json").stdout)
     # judged by flann eval on recordings gen never saw: the coarse design loses the compensation
-    # (its max error beyond 1.5x the float model's), the named widths keep it
+    # (its max error and drift beyond 1.5x the float model's), the named widths keep both
+    assert "ppm FS/degC of drift" in warning
     checks = {c["name"]: c["ok"] for c in coarse["verdict"]["checks"]}
-    assert checks["hardware_vs_float_max_error"] is False
+    assert checks["hardware_vs_float_max_error"] is False and checks["hardware_vs_float_drift"] is False
     checks = {c["name"]: c["ok"] for c in kept["verdict"]["checks"]}
-    assert checks["hardware_vs_float_max_error"] is True
+    assert checks["hardware_vs_float_max_error"] is True and checks["hardware_vs_float_drift"] is True

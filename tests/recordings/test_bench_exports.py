@@ -1,7 +1,8 @@
 """Bench exports as a new user has them (tests/recordings/data, written by make_data.py):
-every command reads them, and train, eval, diagnose and calibrate leave out the same readings
+every command reads them, and train, eval, predict, diagnose and calibrate leave out the same readings
 and keep the same usable stroke, each saying so in one line."""
 
+import json
 import re
 from pathlib import Path
 
@@ -41,9 +42,9 @@ def trained(once, in_process):
     return once("bench-exports-trained", make)
 
 
-@pytest.mark.parametrize("command", ["train", "eval", "diagnose", "calibrate"])
+@pytest.mark.parametrize("command", ["train", "eval", "predict", "diagnose", "calibrate"])
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_commands_share_one_reading(trained, name, command, in_process):
+def test_commands_share_one_reading(trained, name, command, in_process, tmp_path):
     must, stroke = CASES[name]
     model, (rc, _out, err) = trained[name]
     assert rc == 0, err
@@ -58,6 +59,15 @@ def test_commands_share_one_reading(trained, name, command, in_process):
         assert rc == 0, text
         named = _lines_named(text)
         assert len(re.findall(r"^verdict: GOOD", out, re.MULTILINE)) == 1
+    elif command == "predict":   # the usable stroke's rows written, the rest counted
+        rc, _out, text = in_process(["predict", model, DATA / name, "-o", tmp_path / "p.csv"])
+        assert rc == 0, text
+        named = _lines_named(text)
+        x = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1, usecols=1)
+        assert (x.min(), x.max()) == stroke
+        rows = len(read_recordings(DATA / name, announce=False))
+        assert x.size == json.loads(model.read_text())["training"]["readings_used"], text
+        assert (f"predicted {x.size} of {rows} readings" in text) == (x.size < rows)
     elif command == "diagnose":
         rc, _out, text = in_process(["diagnose", DATA / name, "--max-points", "0"])
         assert rc == 0, text
@@ -100,8 +110,6 @@ def test_eval_warns_when_compensation_is_worse_than_the_line(tmp_path, in_proces
     m = tmp_path / "m.json"
     assert in_process(["train", DATA / "four_sensors.csv", "--sensor", "LV-101", "-o", m])[0] == 0
     rc, out, err = in_process(["eval", m, DATA / "ab_export.csv", "--json"])
-    import json
-
     res = json.loads(out)
     assert res["compensated"]["max_error_mm"] > res["raw"]["max_error_mm"]
     assert res["verdict"]["status"] == "bad" and rc == 0
@@ -114,3 +122,12 @@ def test_paper_exact_fit_verdict_is_bad(tmp_path, in_process):
     rc, _o, err = in_process(["train", root / "data" / "paper_table1.csv", "--terms", "51", "-o", tmp_path / "m.json",
                            "--strict"])
     assert rc == 1 and "verdict: BAD" in err
+
+
+def test_sound_end_readings_of_an_s_curve_are_kept():
+    """The two glitches of the rough S-curve, and only they: its end readings, where a
+    high-degree fit held out swings, are the curve's."""
+    from flann.golden.reading import read_usable
+
+    reading = read_usable(read_recordings(DATA / "rough_s_curve.csv", announce=False))
+    assert {int(line.split()[1]) for line in reading.lines_left_out} == CASES["rough_s_curve.csv"][0]

@@ -21,7 +21,7 @@ from ..hardware.datapath import check_design_model
 from ..hardware.design import open_directory
 from ..hardware.conditioner.verify import flann_design
 from ..hardware.fixed.twin import FlannTop
-from ..golden.reading import read_usable
+from ..golden.reading import usable_or_every
 from ..golden.verdict import Check, against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
 from .common import add_common, emit_json
@@ -188,19 +188,7 @@ def run(args) -> int:
     outside = None
     if not args.whole and not is_thermal(model):
         # the same reading train made: figures over the usable stroke, the rest counted
-        try:
-            reading = read_usable(rec, args.outliers)
-        except FlannError as exc:
-            if args.outliers == "refuse":
-                raise
-            # a recording train would refuse is still one a model can be judged on, whole
-            warnings.warn(f"{exc}; the figures are over every reading")
-            reading = None
-        if reading is not None:
-            for line in reading.said:
-                warnings.warn(line)
-            outside = len(rec) - len(reading.rec)
-            rec = reading.rec
+        rec, outside = usable_or_every(rec, args.outliers, "the figures are over every reading")
     # a design eval cannot judge is refused before any warning about the recording
     chain = conditioned_flann(args.model, args.design) if args.design and settings is not None else None
     spec = design_spec(args.model, args.design) if args.design and chain is None else None

@@ -7,6 +7,14 @@ there instead (the trigonometric terms are periodic: the result is rarely meanin
 row is flagged ``extrapolated`` = 1: every row says whether it is a figure of the trained range.
 A two-input model's displacement is also held at its calibrated limits (a voltage and a
 temperature each inside its range, but a pair the sensor never gave), flagged the same way.
+
+A recording with displacements is read as train reads it (:func:`flann.golden.reading.read_usable`,
+one warning line for each thing done): the readings at a rail, beyond a turning point and the
+gross outliers are left out, and the rows written are the usable stroke's (``--whole`` writes
+every row).  Plain voltages (no displacement) cannot show a fold-back or an outlier; a
+reading at a rail or past a turning point lies beyond the voltages the model was trained on
+(its rail and fold-back readings were left out of training), so it is clamped, flagged and
+counted like every voltage outside that range.
 """
 
 from __future__ import annotations
@@ -19,9 +27,11 @@ import numpy as np
 
 from ..fileio import atomic_write_text
 from ..errors import FlannError
+from ..golden.reading import usable_or_every
 from ..golden.thermal import is_thermal, load_any_model
 from ..recordings import read_recordings
-from .common import add_common
+from .common import add_common, info
+from .train import add_reading_flags
 
 HELP = "apply a model to recordings"
 
@@ -32,6 +42,10 @@ def add_arguments(p) -> None:
     p.add_argument("--extrapolate", action="store_true",
                    help="evaluate the model outside its trained voltage range instead of clamping "
                         "to it as the hardware does")
+    add_reading_flags(p)
+    p.add_argument("--whole", action="store_true",
+                   help="with displacements: write every row (rails, fold-back and outliers included); "
+                        "default: the rows of the usable stroke train keeps, the rest counted")
     add_common(p, output=dict(help="CSV to write", metavar="OUT.csv", required=True))
 
 
@@ -75,6 +89,31 @@ def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
                       f"model's trained range {where}{also}: {what}", stacklevel=2)
 
 
+def warn_plain_voltages(model, voltage_v, source: str) -> None:
+    """Plain voltages of a sensor whose training left out rails or a fold-back: what can still
+    be judged against the trained stroke, one line each (the readings at a rail are counted; a
+    reading past a turning point cannot be told from one inside the stroke)."""
+    tr = model.training if isinstance(model.training, dict) else {}
+    stroke = tr.get("usable_stroke_mm")
+    within = (f"the trained stroke {stroke[0]:g}..{stroke[1]:g} mm"
+              if isinstance(stroke, list) and len(stroke) == 2 and all(isinstance(e, (int, float)) for e in stroke)
+              else "the trained stroke")
+    v = np.asarray(voltage_v, dtype=float)
+    for rail in tr.get("rails") or ():
+        if not isinstance(rail, dict) or not isinstance(rail.get("level_v"), (int, float)):
+            continue
+        level, side = float(rail["level_v"]), rail.get("side")
+        at = v >= level if side == "high" else v <= level
+        if at.any():
+            warnings.warn(f"{source}: {int(at.sum())} of {v.size} voltages at or past the {side} rail {level:g} V "
+                          f"the model's training left out (clipped readings): beyond {within}, clamped and "
+                          "flagged (column clamped = 1)", stacklevel=2)
+    if tr.get("fold_back"):
+        warnings.warn(f"{source}: no displacements: a reading past the turning point the model's training left "
+                      f"out reads as one inside {within} and cannot be told apart here (flann eval with "
+                      "displacements can)", stacklevel=2)
+
+
 def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, np.ndarray]:
     """(displacement mm, clamped flags): the voltage (and a two-input model's temperature)
     clamped to the trained range first."""
@@ -93,11 +132,21 @@ def _predict_unclamped(model, voltage_v, temperature_c):
 
 def run(args) -> int:
     model = load_any_model(args.model)
-    rec = read_recordings(args.recordings, required=("voltage_v",), announce=not args.quiet)
-    temp = rec.temperature_c
-    if is_thermal(model) and temp is None:
+    rec = read_recordings(args.recordings, required=("voltage_v",), announce=not args.quiet,
+                          sensor=args.sensor_id, ab=args.ab)
+    if is_thermal(model) and rec.temperature_c is None:
         raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
                          "the recordings need a temperature_c column")
+    if rec.displacement_mm is not None and not args.whole and not is_thermal(model):
+        # the readings train would use; the rest counted, not predicted
+        n = len(rec)
+        rec, left = usable_or_every(rec, args.outliers, "every reading predicted")
+        if left:
+            info(args, f"{rec.source}: predicted {len(rec)} of {n} readings ({left} left out as train "
+                       "does, --whole keeps them)")
+    elif rec.displacement_mm is None and not is_thermal(model):
+        warn_plain_voltages(model, rec.voltage_v, rec.source)
+    temp = rec.temperature_c
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=args.extrapolate,
                        temperature_c=temp)
     cols = {"voltage_v": rec.voltage_v}

@@ -13,7 +13,9 @@ glitch, not data.  ``flann train --terms auto`` leaves such readings out
   sensor's formula; cross-validation picks the family member (the simplest as good as the
   best, by paired differences).
 * :func:`robust_forward` -- the fit with gross outliers (held-out residual > ``OUTLIER_K``
-  robust noise units) left out, and the noise: from repeated readings when there are
+  robust noise units, from the chosen fit and from the best fit of the other family: the end
+  of the stroke, where one family's held-out prediction swings, is not a glitch) left out,
+  and the noise: from repeated readings when there are
   enough (:func:`flann.recordings.checks.repeat_noise_v`), else from the residuals.
 """
 
@@ -198,6 +200,24 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     ``robust``: the smallest median held-out error instead (a gross outlier, not yet found,
     must not decide the fit it is judged against).
     Returns the smoother, its held-out predictions and its score."""
+    scored = _scored(pos, slope, folds, monotonic)
+    if robust:
+        sm, pred, e2 = min(scored, key=_robust_key(pos))
+        return sm, pred, float(np.median(e2))
+    best = min(scored, key=lambda t: float(np.mean(t[2])))
+    pool = []
+    for sm, pred, e2 in scored:
+        d = e2 - best[2]
+        se = float(np.std(d, ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0
+        if float(np.mean(d)) <= FORWARD_PAIRED_Z * se + 1e-300:
+            pool.append((sm.dof(pos), float(np.mean(e2)), sm, pred))
+    dof, score, sm, pred = min(pool, key=lambda t: (t[0], t[1]))
+    return sm, pred, score
+
+
+def _scored(pos: Positions, slope, folds, monotonic: bool) -> list:
+    """[(smoother, held-out predictions, held-out squared errors)] of every candidate
+    (:func:`choose`)."""
     folds = position_folds(pos.x.size) if folds is None else folds
     held = np.concatenate(folds)
     s = np.ones(pos.x.size) if slope is None else np.abs(slope)
@@ -214,18 +234,25 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     if not scored:
         raise RecordingsError("no smooth forward fit is monotonic over the stroke: no inverse "
                               "exists (flann train --trim keeps the monotonic span)")
-    if robust:
-        sm, pred, e2 = min(scored, key=lambda t: (float(np.median(t[2])), t[0].dof(pos)))
-        return sm, pred, float(np.median(e2))
-    best = min(scored, key=lambda t: float(np.mean(t[2])))
-    pool = []
-    for sm, pred, e2 in scored:
-        d = e2 - best[2]
-        se = float(np.std(d, ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0
-        if float(np.mean(d)) <= FORWARD_PAIRED_Z * se + 1e-300:
-            pool.append((sm.dof(pos), float(np.mean(e2)), sm, pred))
-    dof, score, sm, pred = min(pool, key=lambda t: (t[0], t[1]))
-    return sm, pred, score
+    return scored
+
+
+def _robust_key(pos: Positions):
+    return lambda t: (float(np.median(t[2])), t[0].dof(pos))
+
+
+def robust_pair(pos: Positions) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
+    """:func:`choose` ``robust`` (the smoother and its held-out predictions), and the held-out
+    predictions of the best candidate of the other family (polynomial or spline; None when
+    there is none), from one scoring.  Near the ends of the stroke a high-degree polynomial's
+    held-out prediction swings where a spline's does not (and the reverse can happen): a
+    reading both miss by far is a glitch, one only a single family misses is that family's."""
+    key = _robust_key(pos)
+    keyed = sorted(((key(t), i, t) for i, t in enumerate(_scored(pos, None, None, False))),
+                   key=lambda k: (k[0], k[1]))
+    sm, pred, _e2 = keyed[0][2]
+    other = next((t[1] for _k, _i, t in keyed if t[0].kind != sm.kind), None)
+    return sm, pred, other
 
 
 # -- noise -----------------------------------------------------------------------------------
@@ -293,10 +320,11 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
     outliers: dict[int, float] = {}
     for _ in range(MAX_OUTLIER_ROUNDS):
         pos = _positions(x, v, keep)
-        sm, pred, _score = choose(pos, monotonic=False, robust=True)
+        sm, pred, other = robust_pair(pos)
         coef = sm.solve(pos)
         fitted = sm.predict(coef, pos.x)
-        r = _reading_residuals(x, v, keep, _with_index(pos, x, keep), pred, fitted)
+        indexed = _with_index(pos, x, keep)
+        r = _reading_residuals(x, v, keep, indexed, pred, fitted)
         rk = r[keep]
         resid_sigma = float(1.4826 * np.median(np.abs(rk - np.median(rk))))
         if pairs >= MIN_REPEAT_PAIRS:
@@ -308,7 +336,14 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
             judge = sigma
         # the largest first: a gross outlier also pulls its neighbours' held-out predictions
         ar = np.abs(np.nan_to_num(r))
-        new = _largest_apart(x, keep & (ar > max(OUTLIER_K * judge, 0.5 * float(np.max(ar[keep])))), ar)
+        limit = max(OUTLIER_K * judge, 0.5 * float(np.max(ar[keep])))
+        if other is not None and np.any(keep & (ar > OUTLIER_K * judge)):
+            # a candidate is confirmed by the other family's held-out fit too (the noise
+            # stays the chosen fit's: the smaller of two residuals would understate it)
+            r2 = _reading_residuals(x, v, keep, indexed, other, fitted)
+            r = np.where(np.abs(np.nan_to_num(r2)) < ar, r2, r)
+            ar = np.abs(np.nan_to_num(r))
+        new = _largest_apart(x, keep & (ar > limit), ar)
         if not new.any():
             break
         for i in np.flatnonzero(new):

@@ -18,6 +18,7 @@ The usable stroke is the span of displacements kept.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -174,4 +175,21 @@ def read_usable(rec: Recordings, outliers: str | None = None, step_v: float | No
                    noise_v=record.get("noise_v"))
 
 
-__all__ = ["DROP_SHARE", "LeftOut", "OUTLIER_MODES", "REFUSE_SHARE", "Reading", "read_usable"]
+def usable_or_every(rec: Recordings, outliers: str | None, otherwise: str) -> tuple[Recordings, int | None]:
+    """(the readings a command reports on, how many the shared reading left out): each thing
+    :func:`read_usable` did said in one warning line, as train says it.  A recording it refuses
+    (except under ``--outliers refuse``) is still one a model can be applied to: every reading,
+    with one warning ending in ``otherwise`` (what the command does then); None left out."""
+    try:
+        reading = read_usable(rec, outliers)
+    except FlannError as exc:
+        if outliers == "refuse":
+            raise
+        warnings.warn(f"{exc}; {otherwise}", stacklevel=2)
+        return rec, None
+    for line in reading.said:
+        warnings.warn(line, stacklevel=2)
+    return reading.rec, len(rec) - len(reading.rec)
+
+
+__all__ = ["DROP_SHARE", "LeftOut", "OUTLIER_MODES", "REFUSE_SHARE", "Reading", "read_usable", "usable_or_every"]

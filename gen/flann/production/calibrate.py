@@ -63,7 +63,7 @@ from ..hardware.family.twin import FlannFamilyMem, FlannFamilyTop
 from ..physics.sensor import load_sensor
 from ..pool import run_batch
 from ..golden.screen import ready_for_fit
-from ..recordings import Recordings, read_recordings
+from ..recordings import Recordings, read_recordings, recording_sensors
 from ..hardware.family import images
 from .certificate import render_certificate, render_certificate_thermal, render_rejection
 from .spec import ProductionSpec
@@ -195,20 +195,21 @@ def own_design_for(rec, fam: FamilySpec, name: str) -> OwnDesign:
     return OwnDesign(int(choice.terms), str(choice.norm), float(choice.ridge), name)
 
 
-def first_own_design(paths, fam: FamilySpec) -> OwnDesign | None:
+def first_own_design(sources, fam: FamilySpec) -> OwnDesign | None:
     """:func:`own_design_for` on the first recording that reads and passes the screens (None:
-    none does; each sensor then chooses its own)."""
-    for path in paths:
-        if special_file(Path(path)):
+    none does; each sensor then chooses its own).  ``sources``: :class:`Source` or paths."""
+    for src in sources:
+        src = src if isinstance(src, Source) else Source(Path(src))
+        if special_file(src.path):
             continue
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                rec = read_recordings(path)
+                rec = read_recordings(src.path, announce=False, sensor=src.sensor_id)
                 if outside_input(fam, rec.voltage_v):
                     continue
                 rec, _said = ready_for_fit(rec)
-                return own_design_for(rec, fam, sensor_name(path))
+                return own_design_for(rec, fam, src.name)
         except (FlannError, ValueError, ArithmeticError, np.linalg.LinAlgError):
             continue
     return None
@@ -326,17 +327,54 @@ def _sensor(toml: str):
     return load_sensor(toml)
 
 
-def sensor_name(path) -> str:
-    """The sensor's name and folder under OUTDIR: the recording's stem, sanitised (never
-    ``..``, a hidden name or a path; see :func:`flann.fileio.safe_name`)."""
-    return safe_name(Path(path).stem)
+def sensor_name(path, sensor_id: str | None = None) -> str:
+    """The sensor's name and folder under OUTDIR: the recording's stem, and for one sensor of a
+    file of several its ID (``<stem>_<ID>``), sanitised (never ``..``, a hidden name or a path;
+    see :func:`flann.fileio.safe_name`)."""
+    stem = Path(path).stem
+    return safe_name(stem if sensor_id is None else f"{stem}_{sensor_id}")
+
+
+@dataclass(frozen=True)
+class Source:
+    """One sensor of a batch: its recordings file and, in a file of several sensors (a sensor
+    column), its ID."""
+
+    path: Path
+    sensor_id: str | None = None
+
+    @property
+    def name(self) -> str:
+        return sensor_name(self.path, self.sensor_id)
+
+    @property
+    def recording(self) -> str:
+        """The summary's recording cell: the file, and the ID read from it."""
+        return str(self.path) if self.sensor_id is None else f"{self.path} (sensor {self.sensor_id})"
+
+
+def batch_sources(paths) -> list[Source]:
+    """Each file one sensor, a file whose sensor column holds several IDs that many, in the
+    order the IDs first appear; a file that cannot be listed stays one source (its
+    calibration says why)."""
+    out = []
+    for p in map(Path, paths):
+        ids: list[str] = []
+        if not special_file(p):
+            try:
+                ids = recording_sensors(p)
+            except (FlannError, OSError):
+                ids = []
+        out += [Source(p, i) for i in ids] if len(ids) > 1 else [Source(p)]
+    return out
 
 
 def _start(path: Path, dhash: str, spec: ProductionSpec | None, max_error_mm: float | None,
-           station: Station | None) -> tuple[Result, ProductionSpec, Station]:
+           station: Station | None, sensor_id: str | None = None) -> tuple[Result, ProductionSpec, Station]:
     """A sensor's summary row, and the spec (``--max-error-mm`` alone when none is given) and
     station it is judged and recorded with."""
-    res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
+    src = Source(path, sensor_id)
+    res = Result(sensor=src.name, recording=src.recording, design_sha256=dhash)
     if spec is None:
         spec = ProductionSpec(max_error_mm=max_error_mm, source="--max-error-mm" if max_error_mm else "")
     return res, spec, station or Station()
@@ -344,16 +382,17 @@ def _start(path: Path, dhash: str, spec: ProductionSpec | None, max_error_mm: fl
 
 @contextmanager
 def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, spec: ProductionSpec,
-               station: Station):
+               station: Station, sensor_id: str | None = None):
     """Around one sensor's calibration: its verdict becomes the row's status; bad input or the
     numerics of a pathological file reject it (``seen["rec"]``: the recording, once read)."""
     try:
         yield
     except FlannError as exc:
-        _reject(res, str(exc), path, seen.get("rec"), out_dir, fam, dhash, spec, station)
+        _reject(res, str(exc), path, seen.get("rec"), out_dir, fam, dhash, spec, station, sensor_id)
         return
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        _reject(res, f"{exc.__class__.__name__}: {exc}", path, seen.get("rec"), out_dir, fam, dhash, spec, station)
+        _reject(res, f"{exc.__class__.__name__}: {exc}", path, seen.get("rec"), out_dir, fam, dhash, spec, station,
+                sensor_id)
         return
     if res.verdict.shipped:
         res.status, res.reason = "ok", ""
@@ -364,17 +403,18 @@ def _concluded(res: Result, seen: dict, path: Path, out_dir, fam, dhash: str, sp
 def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
                   max_error_mm: float | None = None, diagnosis_points: int | None = DIAGNOSIS_POINTS,
                   spec: ProductionSpec | None = None, station: Station | None = None,
-                  own: OwnDesign | None = None) -> Result:
+                  own: OwnDesign | None = None, sensor_id: str | None = None) -> Result:
     """One recording -> OUTDIR/<sensor>/ (all files or none) and its summary row; a sensor
     that fails its spec or is rejected gets a certificate saying why and no weights.  ``own``:
-    the batch's own-design structure for the reach judgement (None: chosen for this sensor)."""
+    the batch's own-design structure for the reach judgement (None: chosen for this sensor);
+    ``sensor_id``: the sensor of that ID in a file of several."""
     path = Path(path)
-    res, spec, station = _start(path, dhash, spec, max_error_mm, station)
+    res, spec, station = _start(path, dhash, spec, max_error_mm, station, sensor_id)
     seen: dict = {}
-    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station):
+    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station, sensor_id):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            rec = seen["rec"] = read_recordings(path)
+            rec = seen["rec"] = read_recordings(path, sensor=sensor_id)
             why = outside_input(fam, rec.voltage_v)
             if why:   # before the screen: readings beyond the converter are not glitches
                 raise FitError(why)
@@ -391,7 +431,7 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
         if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
-        res.trace = traceability(path, rec, station)
+        res.trace = traceability(path, rec, station, sensor_id)
         res.model_sha256 = text_sha256(chk["model"].to_json())
         res.own_reach_mm, res.costs_accuracy = reach_flag(rec, fam, res.max_error_mm, own)
         if res.costs_accuracy:
@@ -414,16 +454,17 @@ def calibrate_one(path, out_dir, fam: FamilySpec, dhash: str, sensor_toml=None,
 
 def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_error_mm: float | None = None,
                           diagnosis_points: int | None = DIAGNOSIS_POINTS, spec: ProductionSpec | None = None,
-                          station: Station | None = None) -> Result:
+                          station: Station | None = None, sensor_id: str | None = None) -> Result:
     """One multi-temperature recording for a family design with temperature (``fam`` its
-    FamilyThermalSpec): the image, verdicts at each temperature and overall, the drift."""
+    FamilyThermalSpec): the image, verdicts at each temperature and overall, the drift
+    (``sensor_id``: :func:`calibrate_one`)."""
     path = Path(path)
-    res, spec, station = _start(path, dhash, spec, max_error_mm, station)
+    res, spec, station = _start(path, dhash, spec, max_error_mm, station, sensor_id)
     seen: dict = {}
-    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station):
+    with _concluded(res, seen, path, out_dir, fam, dhash, spec, station, sensor_id):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            rec = seen["rec"] = read_recordings(path)
+            rec = seen["rec"] = read_recordings(path, sensor=sensor_id)
             if rec.temperature_c is None:
                 raise FlannError(f"{path}: no temperature_c column; the design compensates temperature "
                                  f"({fam.orders} orders): calibrate at {fam.orders} or more temperatures")
@@ -439,7 +480,7 @@ def calibrate_one_thermal(path, out_dir, fam, dhash: str, sensor_toml=None, max_
         if chk["twin_err_lsb"] > max(1.0, chk["bound_lsb"]):
             raise FlannError(f"twin differs from the float model by {chk['twin_err_lsb']:.3g} LSB, more than "
                              f"the bound {chk['bound_lsb']:.3g} LSB")
-        res.trace = traceability(path, rec, station)
+        res.trace = traceability(path, rec, station, sensor_id)
         res.model_sha256 = text_sha256(chk["model"].to_json())
         sensor = None if sensor_toml is None else _sensor(str(sensor_toml))
         findings, basis, named, groups = _diagnosis(rec, sensor, diagnosis_points)
@@ -478,7 +519,8 @@ def _write_sensor_thermal(dest: Path, res: Result, chk: dict, fam, dhash: str, f
     res.written = True
 
 
-def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec, station) -> None:
+def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec, station,
+            sensor_id: str | None = None) -> None:
     """A sensor that could not be calibrated: FAIL with the reason, and a certificate that
     says so (when even that cannot be written, the summary row still does)."""
     res.fail(reason)
@@ -487,9 +529,9 @@ def _reject(res: Result, reason: str, path: Path, rec, out_dir, fam, dhash, spec
     res.max_error_mm = res.limit_mm = res.ratio_to_limit = res.raw_max_error_mm = None
     res.twin_vs_float_lsb = res.drift_ppm_fs_per_c = None
     try:
-        res.trace = traceability(path, rec, station)
+        res.trace = traceability(path, rec, station, sensor_id)
     except FlannError:
-        res.trace = traceability(path, None, replace(station, serial_column=""))
+        res.trace = traceability(path, None, replace(station, serial_column=""), sensor_id)
     try:
         sha = rec.sha256 if rec is not None else hashlib.sha256(path.read_bytes()).hexdigest()
     except OSError:
@@ -549,14 +591,15 @@ def special_file(path: Path) -> str:
 
 
 def _calibrate_item(item, one=calibrate_one, **kw) -> Result:
-    return one(item[1], **kw)
+    return one(item[1].path, sensor_id=item[1].sensor_id, **kw)
 
 
 def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sensor_toml=None,
                     max_error_mm: float | None = None, progress: bool | None = None,
                     diagnosis_points: int | None = DIAGNOSIS_POINTS,
                     spec: ProductionSpec | None = None, station: Station | None = None) -> list[Result]:
-    """Every recording -> its folder and row; summary.csv last.  Never stops at a bad recording.
+    """Every sensor -> its folder and row; summary.csv last.  Never stops at a bad recording.
+    A file whose sensor column holds several IDs is that many sensors (:func:`batch_sources`).
 
     Ctrl-C stops the batch promptly (:func:`flann.pool.run_batch`): the sensors already
     running finish, the rest are ``interrupted`` rows, summary.csv is written, and then
@@ -597,28 +640,29 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
     results: dict[int, Result] = {}
     seen: dict[str, int] = {}
     todo = []
+    sources = batch_sources(paths)
 
-    def refused(path, why: str) -> Result:
+    def refused(src: Source, why: str) -> Result:
         """A rejected row with the reason and no certificate: the batch goes on."""
-        res = Result(sensor=sensor_name(path), recording=str(path), design_sha256=dhash)
+        res = Result(sensor=src.name, recording=src.recording, design_sha256=dhash)
         res.fail(why)
         res.verdict = rejected(spec, res.reason)
         return res
 
-    for i, p in enumerate(paths):
-        name = sensor_name(p)
+    for i, src in enumerate(sources):
+        name, p = src.name, src.path
         # these cannot have a folder of their own (it is the summary's name, or the folder of
         # an earlier recording, also on a file system that ignores case)
         clash = (f"sensor name {name!r} is the batch summary's file name; rename the recording"
                  if name.casefold() == SUMMARY else
-                 f"sensor name {name!r} already used by {paths[seen[name.casefold()]]} (one folder "
-                 "per name, letter case ignored); rename this recording"
+                 f"sensor name {name!r} already used by {sources[seen[name.casefold()]].recording} (one "
+                 "folder per name, letter case ignored); rename this recording"
                  if name.casefold() in seen else "")
         kind = special_file(p)
         if kind:   # opening a FIFO nobody writes would block its worker for good
-            results[i] = refused(p, f"{p}: is {kind}; flann reads recordings from regular files")
+            results[i] = refused(src, f"{p}: is {kind}; flann reads recordings from regular files")
         elif clash:
-            results[i] = refused(p, clash)
+            results[i] = refused(src, clash)
         else:
             seen[name.casefold()] = i
             todo.append(i)
@@ -633,26 +677,26 @@ def calibrate_batch(paths, out_dir, design_dir, *, jobs: int | None = None, sens
         if res.status != "ok":
             failed += 1
         if progress:
-            _progress(len(results), len(paths), failed, t0)
+            _progress(len(results), len(sources), failed, t0)
 
     if dp is FAMILY_THERMAL:
         one, extra = calibrate_one_thermal, {}
     else:   # the reach judgement's structure, chosen once for the batch
-        one, extra = calibrate_one, {"own": first_own_design([paths[i] for i in todo], fam)}
+        one, extra = calibrate_one, {"own": first_own_design([sources[i] for i in todo], fam)}
     fn = partial(_calibrate_item, one=one, out_dir=out_dir, fam=fam, dhash=dhash, sensor_toml=sensor_toml,
                  max_error_mm=max_error_mm, diagnosis_points=diagnosis_points, spec=spec, station=station, **extra)
-    stopped_by = run_batch(fn, [(i, paths[i]) for i in todo], jobs, record,
+    stopped_by = run_batch(fn, [(i, sources[i]) for i in todo], jobs, record,
                            lambda item, why: record(item, refused(item[1], why)))
     if progress:
         sys.stderr.write("\n")
     for i in todo:
         if i not in results:
             # not calibrated by this run: an earlier run's certificate must not stand beside it
-            remove_output_directory(child(out_dir, sensor_name(paths[i])), _is_sensor_output)
-            results[i] = Result(sensor=sensor_name(paths[i]), recording=str(paths[i]), status="interrupted",
+            remove_output_directory(child(out_dir, sources[i].name), _is_sensor_output)
+            results[i] = Result(sensor=sources[i].name, recording=sources[i].recording, status="interrupted",
                                 reason="not calibrated: the batch was interrupted "
                                        f"({'SIGTERM' if stopped_by == signal.SIGTERM else 'Ctrl-C'})")
-    ordered = [results[i] for i in range(len(paths))]
+    ordered = [results[i] for i in range(len(sources))]
     write_summary(summary_path(out_dir), ordered)
     if stopped_by == signal.SIGTERM:
         raise Terminated
@@ -675,6 +719,6 @@ def write_summary(path, results) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-__all__ = ["OwnDesign", "first_own_design", "own_design_for", "reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
+__all__ = ["OwnDesign", "Source", "batch_sources", "sensor_name", "first_own_design", "own_design_for", "reach_flag", "calibrate_batch", "calibrate_one", "calibrate_one_thermal", "check_sensor", "train_for_design",
            "diagnosis_sample", "write_summary", "summary_path", "Result", "SUMMARY", "SUMMARY_FIELDS",
            "DIAGNOSIS_POINTS"]

@@ -4,13 +4,15 @@ Each field comes from, in this order: the recording's own ``#`` comment lines
 (``# station: B2``, ``# operator = J. Smith``, ``# serial: SN-0042``, ``# fixture: F7``,
 ``# temperature_c: 23.1``), then the batch's flags (``--station``, ``--operator``,
 ``--fixture``, ``--temperature-c``).  The serial is the ``--serial-column`` value of the
-first data row when that flag is given, else the comment, else the file name's stem.  The
+first data row when that flag is given, else the sensor's ID in a file of several sensors,
+else the comment, else the file name's stem.  The
 calibration temperature falls back to the mean of the recording's ``temperature_c`` column.
 ``calibrated_at`` is the local time with its UTC offset (ISO 8601), taken per sensor.
 The displacement reference standard and its calibration due date come from the flags
 (``--reference-standard``, ``--reference-due``); the certificate number is
 ``PREFIX-YYYYMMDD-HHMMSS-xxxxxxxx`` (``--certificate-prefix``, the calibration time and the
-first 8 hex digits of the recording's sha256): a sensor calibrated again gets a new number.
+first 8 hex digits of the recording's sha256, with the sensor's ID in a file of several): a
+sensor calibrated again gets a new number.
 """
 
 from __future__ import annotations
@@ -131,15 +133,20 @@ def serial_from_column(path, column: str) -> str:
     return value
 
 
-def traceability(path, rec, station: Station) -> Traceability:
+def traceability(path, rec, station: Station, sensor_id: str | None = None) -> Traceability:
     """The identification and traceability of one recording (``rec`` None: unreadable file,
-    only flags and the file name are known)."""
+    only flags and the file name are known; ``sensor_id``: one sensor of a file of several)."""
     path = Path(path)
     found = comment_fields(rec.comments if rec is not None else ())
     serial, serial_from = path.stem, "file name"
+    key = getattr(rec, "sha256", "") or path.name
+    if sensor_id is not None:   # the file's sha256 is every sensor's in it: the ID tells them apart
+        key = hashlib.sha256(f"{key}\0{sensor_id}".encode()).hexdigest()
     if station.serial_column:
         serial, serial_from = serial_from_column(path, station.serial_column), \
             f"column {station.serial_column!r}"
+    elif sensor_id is not None:   # a comment line of a file of several names none of them
+        serial, serial_from = sensor_id, "sensor column"
     elif "serial" in found:
         serial, serial_from = found["serial"], "comment line"
     temp, temp_from = None, ""
@@ -164,8 +171,7 @@ def traceability(path, rec, station: Station) -> Traceability:
                         fixture=found.get("fixture", station.fixture),
                         temperature_c=temp, temperature_from=temp_from,
                         calibrated_at=(at := now_iso()),
-                        certificate_number=certificate_number(station.certificate_prefix, at,
-                                                              getattr(rec, "sha256", "") or path.name),
+                        certificate_number=certificate_number(station.certificate_prefix, at, key),
                         reference_standard=station.reference_standard, reference_due=station.reference_due)
 
 
