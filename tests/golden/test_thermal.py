@@ -74,7 +74,8 @@ def test_file_round_trip_and_both_kinds_load(tmp_path, default_model_json):
     back = load_any_model(p)
     assert back == m
     one = load_any_model(default_model_json)
-    assert one == load_model(default_model_json) and not hasattr(one, "inputs")
+    assert one == load_model(default_model_json) and one.inputs == ("voltage_v",)
+    assert back.inputs == ("voltage_v", "temperature_c")
     assert "inputs" not in json.loads(default_model_json.read_text())
     with pytest.raises(ModelFileError):   # the one-input loader refuses it in one line
         load_model(p)

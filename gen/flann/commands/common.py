@@ -99,6 +99,15 @@ def json_word_as_input(args, dest: str) -> None:
         args.json = JSON_STDOUT
 
 
+def check_model_inputs(model, rec, model_path) -> None:
+    """The recordings hold every input the model takes, or one line saying which column is missing."""
+    missing = [name for name in model.inputs if getattr(rec, name, None) is None]
+    if missing:
+        kind = {1: "one-input", 2: "two-input"}.get(len(model.inputs), f"{len(model.inputs)}-input")
+        raise FlannError(f"{rec.source}: {model_path} is a {kind} model ({', '.join(model.inputs)}): the recordings "
+                         f"need a {' and a '.join(missing)} column")
+
+
 def quiet(args) -> bool:
     return bool(getattr(args, "quiet", False))
 

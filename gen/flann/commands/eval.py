@@ -14,7 +14,7 @@ from ..argtypes import png_path
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
 from ..errors import FlannError
-from ..golden.thermal import is_thermal, load_any_model
+from ..golden.thermal import load_any_model
 from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import adc_codes, design_adc, design_spec, hardware_accuracy, plot_errors
 from ..hardware.datapath import check_design_model
@@ -24,7 +24,7 @@ from ..hardware.fixed.twin import FlannTop
 from ..golden.reading import usable_or_every
 from ..golden.verdict import Check, against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
-from .common import add_common, emit_json
+from .common import add_common, check_model_inputs, emit_json
 from .train import add_reading_flags
 from .train_waveforms import is_waveform, read_held_out
 from .predict import predict_clamped, warn_outside_range
@@ -182,11 +182,9 @@ def run(args) -> int:
                          "(its input is the conditioner's ratio): evaluate it on a waveform recording")
     else:
         rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
-    if is_thermal(model) and rec.temperature_c is None:
-        raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
-                         "the recordings need a temperature_c column")
+    check_model_inputs(model, rec, args.model)
     outside = None
-    if not args.whole and not is_thermal(model):
+    if not args.whole and model.single_curve:
         # the same reading train made: figures over the usable stroke, the rest counted
         rec, outside = usable_or_every(rec, args.outliers, "the figures are over every reading")
     # a design eval cannot judge is refused before any warning about the recording

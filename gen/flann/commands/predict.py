@@ -26,11 +26,10 @@ import warnings
 import numpy as np
 
 from ..fileio import atomic_write_text
-from ..errors import FlannError
 from ..golden.reading import usable_or_every
-from ..golden.thermal import is_thermal, load_any_model
+from ..golden.thermal import load_any_model
 from ..recordings import read_recordings
-from .common import add_common, info
+from .common import add_common, check_model_inputs, info
 from .train import add_reading_flags
 
 HELP = "apply a model to recordings"
@@ -76,12 +75,8 @@ def warn_outside_range(model, voltage_v, source: str, extrapolated: bool = True,
     outside = outside_range(model, voltage_v, temperature_c)
     far = _past_the_noise(model, voltage_v, temperature_c, outside)
     if far.any():
-        lo, hi = sorted(model.voltage_range_v)
         what = "extrapolated" if extrapolated else "clamped to the range as the hardware does (column clamped = 1)"
-        where, items = f"[{lo:g}, {hi:g}] V", "voltages"
-        if is_thermal(model):
-            tlo, thi = sorted(model.temperature_range_c)
-            where, items = where + f" or calibrated temperatures [{tlo:g}, {thi:g}] degC", "readings"
+        where, items = model.trained_range()
         near = int(outside.sum() - far.sum())
         also = (f" ({near} more past its ends by less than {NOISE_SIGMAS:g}x the training noise)"
                 if near else "")
@@ -118,44 +113,34 @@ def predict_clamped(model, voltage_v, temperature_c=None) -> tuple[np.ndarray, n
     """(displacement mm, clamped flags): the voltage (and a two-input model's temperature)
     clamped to the trained range first."""
     v, t, outside = model.clamp(voltage_v, temperature_c)
-    if not is_thermal(model):
-        return model.predict(v), outside
     # a (voltage, temperature) pair inside both ranges the sensor never gave: held at the
     # calibrated displacement limits, as the hardware's output is
-    x, beyond = model.saturate(model.predict(v, t))
+    x, beyond = model.saturate(model.predict_at(v, t))
     return x, outside | beyond
-
-
-def _predict_unclamped(model, voltage_v, temperature_c):
-    return model.predict(voltage_v, temperature_c) if is_thermal(model) else model.predict(voltage_v)
 
 
 def run(args) -> int:
     model = load_any_model(args.model)
     rec = read_recordings(args.recordings, required=("voltage_v",), announce=not args.quiet,
                           sensor=args.sensor_id, ab=args.ab)
-    if is_thermal(model) and rec.temperature_c is None:
-        raise FlannError(f"{rec.source}: {args.model} is a two-input model (voltage_v, temperature_c): "
-                         "the recordings need a temperature_c column")
-    if rec.displacement_mm is not None and not args.whole and not is_thermal(model):
+    check_model_inputs(model, rec, args.model)
+    if rec.displacement_mm is not None and not args.whole and model.single_curve:
         # the readings train would use; the rest counted, not predicted
         n = len(rec)
         rec, left = usable_or_every(rec, args.outliers, "every reading predicted")
         if left:
             info(args, f"{rec.source}: predicted {len(rec)} of {n} readings ({left} left out as train "
                        "does, --whole keeps them)")
-    elif rec.displacement_mm is None and not is_thermal(model):
+    elif rec.displacement_mm is None and model.single_curve:
         warn_plain_voltages(model, rec.voltage_v, rec.source)
     temp = rec.temperature_c
     warn_outside_range(model, rec.voltage_v, rec.source, extrapolated=args.extrapolate,
                        temperature_c=temp)
-    cols = {"voltage_v": rec.voltage_v}
-    if is_thermal(model):
-        cols["temperature_c"] = temp
+    cols = {name: getattr(rec, name) for name in model.inputs}
     if rec.displacement_mm is not None:
         cols["displacement_mm"] = rec.displacement_mm
     if args.extrapolate:
-        cols["predicted_mm"] = _predict_unclamped(model, rec.voltage_v, temp)
+        cols["predicted_mm"] = model.predict_at(rec.voltage_v, temp)
         flag, flags = "extrapolated", outside_range(model, rec.voltage_v, temp)
     else:
         cols["predicted_mm"], flags = predict_clamped(model, rec.voltage_v, temp)

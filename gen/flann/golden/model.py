@@ -125,9 +125,28 @@ class FlannModel(ModelFile):
     # written here: the golden model computes on the ratio and needs none of it)
     conditioner: dict | None = None
 
+    # the model protocol the commands use, whatever the model's inputs (ThermalModel has the same)
+    inputs = ("voltage_v",)
+    single_curve = True      # its readings are one curve v(x): the shared reading screens them
+
     @property
     def terms(self) -> int:
         return len(self.weights)
+
+    def predict_at(self, voltage_v, temperature_c=None) -> np.ndarray:
+        """:meth:`predict` with the readings' inputs (a one-input model takes no temperature)."""
+        return self.predict(voltage_v)
+
+    def saturate(self, displacement_mm) -> tuple[np.ndarray, np.ndarray]:
+        """(displacement, flags): a one-input model's output is never beyond its limits once its
+        voltage is clamped."""
+        x = np.asarray(displacement_mm, dtype=float)
+        return x, np.zeros(x.shape, dtype=bool)
+
+    def trained_range(self) -> tuple[str, str]:
+        """(the trained range in words, what its readings are called)."""
+        lo, hi = sorted(self.voltage_range_v)
+        return f"[{lo:g}, {hi:g}] V", "voltages"
 
     def normalise(self, voltage_v) -> np.ndarray:
         return (np.asarray(voltage_v, dtype=float) - self.input_offset_v) / self.input_scale_v

@@ -132,6 +132,17 @@ class ThermalModel(ModelFile):
             acc = acc * t_n + part
         return acc
 
+    inputs = INPUTS
+    single_curve = False     # a curve per temperature: the one-curve reading does not screen them
+
+    def predict_at(self, voltage_v, temperature_c=None) -> np.ndarray:
+        return self.predict(voltage_v, temperature_c)
+
+    def trained_range(self) -> tuple[str, str]:
+        vlo, vhi = sorted(self.voltage_range_v)
+        tlo, thi = sorted(self.temperature_range_c)
+        return f"[{vlo:g}, {vhi:g}] V or calibrated temperatures [{tlo:g}, {thi:g}] degC", "readings"
+
     def predict_direct(self, voltage_v, temperature_c) -> np.ndarray:
         """The same sum term by term from the design matrix: the reference for tests."""
         v_n, t_n = self.normalise(voltage_v, temperature_c)
