@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import RecordingsError, one_line
 from ..fileio import atomic_write_text
 from ..inputs import read_bytes
-from .csvio import _EXCEL_SEP, _WITH_UNIT, QUANTITIES, _cells, _sniff_separator, parse_recordings
+from .csvio import _EXCEL_SEP, _WITH_UNIT, MAX_LINE_CHARS, QUANTITIES, _cells, _sniff_separator, parse_recordings
 
 # the voltage channels: canonical column -> the names a header may give it (with a unit)
 CHANNELS: dict[str, tuple[str, ...]] = {
@@ -196,7 +196,8 @@ def is_waveform_csv(path) -> bool:
     """True when the file's header has a ``time_s`` column and both secondaries."""
     try:
         with open(path, encoding="utf-8", errors="replace") as fh:
-            head = [fh.readline() for _ in range(64)]
+            # bounded: a device that never ends (/dev/zero) has no line end to stop at
+            head = [fh.readline(MAX_LINE_CHARS + 1) for _ in range(64)]
         line = head[_header_at(head)]
     except (OSError, RecordingsError):
         return False
