@@ -22,8 +22,10 @@ from flann.errors import FlannError
 from flann.fileio import atomic_directory
 from flann.hardware.family.images import check_image, hex_text, read_image
 from flann.hardware.family.render import load_design
+from flann.hardware.design import from_directory
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.pool import run_batch
+from flann.verify.netlist import check_netlist
 
 REPO = Path(__file__).resolve().parents[2]
 WAIT_S = 60.0   # the longest any state here may take to arrive before the test gives up
@@ -250,13 +252,17 @@ def test_the_extreme_images_the_loader_accepts_agree_and_saturate(small_designs,
         assert out.max() == (1 << (fam.spec.out_fmt.width - 1)) - 1 or out.min() == -(1 << (fam.spec.out_fmt.width - 1))
         paths.append(tmp_path / f"{name}.hex")
         paths[-1].write_text(hex_text(words))
-    for p in paths:   # the netlist loads the last --image: one run per image
-        rc = main(["sim", str(d), "--image", str(p), "--netlist", "--build", str(tmp_path / p.stem),
-                   "--json", str(tmp_path / f"{p.stem}.json")])
-        summary = json.loads((tmp_path / f"{p.stem}.json").read_text())
-        assert rc == 0, capsys.readouterr().err
-        assert summary["mismatches"] == 0 and summary["all_passed"]
-        assert summary["netlist"]["mismatches"] == 0 and summary["netlist"]["codes_tested"] > 0
+    # the HDL over every code with both images, one loaded over the other; the netlist loads the last
+    rc = main(["sim", str(d), *(a for p in paths for a in ("--image", str(p))), "--netlist",
+               "--build", str(tmp_path / "b"), "--json", str(tmp_path / "sim.json")])
+    summary = json.loads((tmp_path / "sim.json").read_text())
+    assert rc == 0, capsys.readouterr().err
+    assert summary["mismatches"] == 0 and summary["all_passed"]
+    assert summary["netlist"]["mismatches"] == 0 and summary["netlist"]["codes_tested"] > 0
+    assert summary["images"] == ["max", "min"]     # both loaded, the HDL checked with each
+    # and the netlist with the first image loaded
+    nl = check_netlist(from_directory(d), tmp_path / "nl_max", image={"name": "max", "hex": str(paths[0])})
+    assert nl.passed and nl.codes_tested == summary["netlist"]["codes_tested"]
 
 
 IMAGE_CASES = [   # (datapath, the word every weight of the first memory holds, the error line)
