@@ -38,7 +38,7 @@ tools:
 TEST_WORKERS ?= auto
 
 test: venv tools
-	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal --durations=30
 
 # Main job: train (unless MODEL= is given), generate VHDL, verify every input code (RTL sweep,
 # reactive benches, post-synthesis netlist), summarise.  DESIGN=dir verifies that generated
