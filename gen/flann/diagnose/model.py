@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -818,9 +818,17 @@ class PhysicsFamily:
         return f
 
     def _fit(self, effects, idx, start, clip_sides, k_shape) -> Fit:
-        f = self._fit_now(effects, idx, start, clip_sides, self.basis(k_shape))
-        f.extra["k_shape"] = k_shape
-        return f
+        # the same fit is asked for again (a re-choice of the shape term walks the numbers of
+        # terms from the fit it was given): the cache goes with the family's data and shape
+        # range, the key holds the rest a fit depends on (a copy out: callers annotate extra)
+        key = ("fit", tuple(effects), idx.tobytes(), clip_sides, k_shape, self.terms, self.origin0,
+               self.gain0, self.scale, None if start is None else (tuple(start.names), start.theta.tobytes()))
+        f = self._shape_cache.get(key)
+        if f is None:
+            f = self._fit_now(effects, idx, start, clip_sides, self.basis(k_shape))
+            f.extra["k_shape"] = k_shape
+            self._shape_cache[key] = f
+        return replace(f, extra=dict(f.extra))
 
     def _fit_now(self, effects, idx, start, clip_sides, basis) -> Fit:
         specs = self.specs(effects, clip_sides)

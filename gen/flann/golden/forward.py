@@ -183,6 +183,60 @@ def heldout_predictions(sm: Smoother, pos: Positions, folds) -> np.ndarray:
     return pred
 
 
+def heldout_all(cands: list[Smoother], pos: Positions, folds) -> list[np.ndarray]:
+    """:func:`heldout_predictions` of every candidate, one factorisation per fold and kind:
+    a fold's weighted basis A (the widest candidate's: a polynomial's columns are the leading
+    ones of every higher degree's, the splines share one) is reduced once to A = QR, and each
+    candidate solves its small system on R (the leading block for a degree, with A's rcond;
+    one SVD of the penalty over R for every lambda).  Q keeps the residual's norm, so this is
+    the same least-squares solution as on A itself, to rounding."""
+    preds: list = [None] * len(cands)
+    by_kind: dict[str, list[int]] = {}
+    for i, sm in enumerate(cands):
+        by_kind.setdefault(sm.kind, []).append(i)
+    held_max = max((h.size for h in folds), default=0)
+    eps = np.finfo(float).eps
+    for kind, idx in by_kind.items():
+        widest = max((cands[i] for i in idx), key=lambda sm: sm.param if kind == "poly" else 0.0)
+        B = widest.basis(pos.x)
+        if pos.x.size - held_max < B.shape[1]:   # fewer rows than columns: no leading blocks
+            for i in idx:
+                preds[i] = heldout_predictions(cands[i], pos, folds)
+            continue
+        out = {i: np.full(pos.x.size, np.nan) for i in idx}
+        sw = np.sqrt(pos.w)
+        for held in folds:
+            keep = np.ones(pos.x.size, bool)
+            keep[held] = False
+            n_keep = int(keep.sum())
+            q, r = np.linalg.qr(B[keep] * sw[keep, None])
+            qy = q.T @ (pos.v[keep] * sw[keep])
+            Bh = B[held]
+            if kind == "spline":
+                # every lambda from one SVD (Demmler-Reinsch): with z = R c the penalised
+                # problem is |z - Q'y|^2 + mu |L R^-1 z|^2, so z = V (1 + mu S^2)^-1 V' Q'y
+                from scipy.linalg import solve_triangular
+                L = _penalty(widest.segments + 3)[1]
+                _u, sv, vt = np.linalg.svd(solve_triangular(r, L.T, trans="T").T, full_matrices=True)
+                s2 = np.zeros(vt.shape[0])
+                s2[:sv.size] = sv ** 2
+                H = solve_triangular(r, vt.T, check_finite=False)   # R^-1 V
+                H = Bh @ H
+                g = vt @ qy
+                scale = float(np.sum(pos.w[keep])) / max(1, n_keep)
+            for i in idx:
+                sm = cands[i]
+                if kind == "poly":
+                    m = int(sm.param) + 1
+                    coef, *_ = np.linalg.lstsq(r[:m, :m], qy[:m], rcond=eps * max(n_keep, m))
+                    out[i][held] = Bh[:, :m] @ coef
+                else:
+                    out[i][held] = H @ (g / (1.0 + sm.param * scale * s2))
+        for i in idx:
+            preds[i] = out[i]
+    return preds
+
+
 def strictly_monotone(y) -> bool:
     """Every step of ``y`` rises, or every step falls."""
     d = np.diff(y)
@@ -224,10 +278,10 @@ def _scored(pos: Positions, slope, folds, monotonic: bool) -> list:
     cw = pos.count[held] / np.sum(pos.count[held])
     grid = np.linspace(pos.x[0], pos.x[-1], 1025)
     scored = []
-    for sm in candidates(pos):
-        if monotonic and not strictly_monotone(sm.predict(sm.solve(pos), grid)):
-            continue   # no inverse: not a calibration curve
-        pred = heldout_predictions(sm, pos, folds)
+    cands = [sm for sm in candidates(pos)
+             # no inverse: not a calibration curve
+             if not monotonic or strictly_monotone(sm.predict(sm.solve(pos), grid))]
+    for sm, pred in zip(cands, heldout_all(cands, pos, folds)):
         e2 = cw * ((pos.v[held] - pred[held]) / s[held]) ** 2 * held.size
         if np.all(np.isfinite(e2)):
             scored.append((sm, pred, e2))
