@@ -183,6 +183,9 @@ def heldout_predictions(sm: Smoother, pos: Positions, folds) -> np.ndarray:
     return pred
 
 
+SPLINE_RANK_TOL = 1e-10    # R's smallest diagonal against its largest: below it, a fold is solved per candidate
+
+
 def heldout_all(cands: list[Smoother], pos: Positions, folds) -> list[np.ndarray]:
     """:func:`heldout_predictions` of every candidate, one factorisation per fold and kind:
     a fold's weighted basis A (the widest candidate's: a polynomial's columns are the leading
@@ -212,6 +215,13 @@ def heldout_all(cands: list[Smoother], pos: Positions, folds) -> list[np.ndarray
             q, r = np.linalg.qr(B[keep] * sw[keep, None])
             qy = q.T @ (pos.v[keep] * sw[keep])
             Bh = B[held]
+            diag = np.abs(np.diag(r))
+            if kind == "spline" and diag.min() <= SPLINE_RANK_TOL * diag.max():
+                # a B-spline with (nearly) no kept reading under it: R has no inverse, and the
+                # penalty alone decides those coefficients, which each candidate's own solve does
+                for i in idx:
+                    out[i][held] = cands[i].predict(cands[i].solve(pos, keep, B[keep]), pos.x[held])
+                continue
             if kind == "spline":
                 # every lambda from one SVD (Demmler-Reinsch): with z = R c the penalised
                 # problem is |z - Q'y|^2 + mu |L R^-1 z|^2, so z = V (1 + mu S^2)^-1 V' Q'y
