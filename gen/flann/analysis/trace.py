@@ -344,11 +344,6 @@ def _ulp(x: float, sig_bits: int) -> float:
 
 
 # -- plot ---------------------------------------------------------------------------------
-def plot_trace(result: TraceResult | ThermalTraceResult, path, title: str = "") -> None:
-    """Error per stage vs input voltage (PNG), as the result draws itself."""
-    result.plot(path, title)
-
-
 def plot_one_input_trace(result: TraceResult, path, title: str = "") -> None:
     """Error per stage vs input voltage (PNG)."""
     # matplotlib is heavy and only needed for plots: imported when one is drawn
@@ -386,7 +381,7 @@ def plot_compare(results: dict, path, points: dict | None = None, title: str = "
                  points_label: str = "the recordings' inputs") -> None:
     """Total error (hardware - golden) of several formats on the same axes, as the seed's
     Fig. 6(b); ``points``: {fmt: at_voltages() rows} drawn as markers, named ``points_label``."""
-    # matplotlib: imported when a plot is drawn (see plot_trace)
+    # matplotlib: imported when a plot is drawn (see plot_one_input_trace)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -465,5 +460,5 @@ def check_design_hdl(result: TraceResult, design: Design, build_dir) -> dict:
     return result.hdl
 
 
-__all__ = ["Stages", "Source", "twin_trace", "TraceResult", "STAGES", "attribute", "trace", "plot_trace", "plot_compare",
+__all__ = ["Stages", "Source", "twin_trace", "TraceResult", "STAGES", "attribute", "trace", "plot_compare",
            "run_trace", "check_hdl", "term_label", "trace_design", "check_design_hdl"]

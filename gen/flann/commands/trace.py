@@ -18,7 +18,7 @@ from ..errors import FlannError
 from ..golden.model import load_model
 from ..recordings import read_recordings
 from ..analysis.plugin import insight
-from ..analysis.trace import (check_design_hdl, check_hdl, plot_compare, plot_trace, run_trace,
+from ..analysis.trace import (check_design_hdl, check_hdl, plot_compare, run_trace,
                               trace_design)
 from ..hardware.registry import FORMATS as REGISTRY_FORMATS, datapath
 from ..hardware.design import from_directory
@@ -113,7 +113,7 @@ def run(args) -> int:
             plot_compare(results, args.plot, points, title=f"hardware − golden: {args.model}",
                          points_label=f"inputs of {Path(args.at).name}" if args.at else "")
         else:
-            plot_trace(results[args.format], args.plot, title=f"flann trace {args.model} ({label or args.format})")
+            results[args.format].plot(args.plot, title=f"flann trace {args.model} ({label or args.format})")
     if args.json:
         out = {f: r.to_dict() for f, r in results.items()} if args.compare else results[args.format].to_dict()
         if not args.compare:   # a model's trace is of the datapath of its number format

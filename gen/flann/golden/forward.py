@@ -179,8 +179,13 @@ def heldout_predictions(sm: Smoother, pos: Positions, folds) -> np.ndarray:
     for held in folds:
         keep = np.ones(pos.x.size, bool)
         keep[held] = False
-        pred[held] = sm.predict(sm.solve(pos, keep, B[keep]), pos.x[held])
+        pred[held] = _fold_prediction(sm, pos, keep, held, B)
     return pred
+
+
+def _fold_prediction(sm: Smoother, pos: Positions, keep, held, B) -> np.ndarray:
+    """``sm`` fitted to the kept positions (their rows of its basis ``B``), at the held ones."""
+    return sm.predict(sm.solve(pos, keep, B[keep]), pos.x[held])
 
 
 SPLINE_RANK_TOL = 1e-10    # R's smallest diagonal against its largest: below it, a fold is solved per candidate
@@ -220,7 +225,7 @@ def heldout_all(cands: list[Smoother], pos: Positions, folds) -> list[np.ndarray
                 # a B-spline with (nearly) no kept reading under it: R has no inverse, and the
                 # penalty alone decides those coefficients, which each candidate's own solve does
                 for i in idx:
-                    out[i][held] = cands[i].predict(cands[i].solve(pos, keep, B[keep]), pos.x[held])
+                    out[i][held] = _fold_prediction(cands[i], pos, keep, held, B)
                 continue
             if kind == "spline":
                 # every lambda from one SVD (Demmler-Reinsch): with z = R c the penalised
