@@ -10,6 +10,7 @@ import warnings
 
 import numpy as np
 
+from ..analysis.conditioner_figures import AD598_LINEARITY_PCT_FS, chain_figures, plot_chain
 from ..argtypes import png_path
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
@@ -30,7 +31,6 @@ from .train_waveforms import is_waveform, read_held_out
 from .predict import predict_clamped, warn_outside_range
 
 HELP = "accuracy of a model on recordings"
-AD598_LINEARITY_PCT_FS = 0.05   # the analog LVDT conditioner's data-sheet linearity, max
 # (figure name of drift_ppm_fs_per_c, the JSON section whose by_temperature it is)
 SECTIONS = (("raw", "raw"), ("float", "compensated"), ("hardware", "hardware"))
 
@@ -52,7 +52,8 @@ def add_arguments(p) -> None:
                         "FLANN's twin (linearity_pct_fs.hardware)")
     p.add_argument("--plot", metavar="OUT.png", default=None, type=png_path,
                    help="error vs displacement: raw sensor, float model, hardware (needs --design) "
-                        "and the physical limit")
+                        "and the physical limit; for a waveform recording: the waveforms, the demodulated "
+                        "ratio and the displacement error (the hardware's with --design)")
     add_reading_flags(p)
     p.add_argument("--whole", action="store_true",
                    help="figures over every reading (rails, fold-back and outliers included); default: "
@@ -63,10 +64,12 @@ def add_arguments(p) -> None:
     add_common(p, json="the figures")
 
 
-def eval_verdict(res: dict):
+def eval_verdict(res: dict, figures=()):
     """Against the straight line through the same readings; with a design, the hardware against
-    the float model (max error, and the drift of a two-input model)."""
+    the float model (max error, and the drift of a two-input model); a waveform recording's
+    data-sheet figures each against its reference."""
     checks = [against_line(res["compensated"]["max_error_mm"], res["raw"]["max_error_mm"])]
+    checks += [f.check() for f in figures]
     lin = res.get("linearity_pct_fs")
     for chain in ("float", "hardware") if lin else ():
         if lin[chain] is None:
@@ -167,15 +170,13 @@ def hardware_vs_float(hw: dict) -> str:
 
 
 def run(args) -> int:
-    if args.plot and not args.design:
+    waveform = is_waveform(args)
+    if args.plot and not args.design and not waveform:
         raise FlannError("--plot draws the hardware's error too: give --design DIR")
     model = load_any_model(args.model)
     settings = None
-    if is_waveform(args):
-        if args.plot:
-            raise FlannError("--plot: draws demodulated recordings; for a waveform recording the figures are "
-                             "linearity_pct_fs (flann diagnose --plot draws the waveforms)")
-        dwells, settings, conditioned = read_held_out(args, model)
+    if waveform:
+        dwells, settings, conditioned, wave = read_held_out(args, model)
         rec = dwells.recordings
     elif getattr(model, "conditioner", None) is not None:
         raise FlannError(f"{args.recordings}: demodulated readings, but {args.model} was trained from waveforms "
@@ -221,12 +222,20 @@ def run(args) -> int:
         res["drift_ppm_fs_per_c"] = report["drift_ppm_fs_per_c"]
     if outside is not None:
         res["readings_left_out"] = outside
+    figures = ()
     if settings is not None:
         res["linearity_pct_fs"] = linearity(res)
         if chain is not None:
             res["linearity_pct_fs"]["hardware"] = float(100 * np.max(np.abs(hardware_mm - rec.displacement_mm))
                                                         / res["full_scale_mm"])
-    verdict = eval_verdict(res)
+        figures = chain_figures(settings, wave, dwells, lambda r: predict_clamped(model, r)[0],
+                                res["full_scale_mm"])
+        for f in figures:
+            res[f.name] = f.to_json()
+        if args.plot:
+            plot_chain(args.plot, settings, wave, conditioned, dwells, lambda r: predict_clamped(model, r)[0],
+                       res["full_scale_mm"], hardware_mm if chain is not None else None)
+    verdict = eval_verdict(res, figures)
     res["verdict"] = verdict.to_json()
     if emit_json(args, res):
         return exit_code(verdict, args.strict)
@@ -280,6 +289,8 @@ def run(args) -> int:
         if lin["hardware"] is not None:
             print(f"linearity_pct_fs        {lin['hardware']:.4f} (hardware: the conditioner's twin, the FLANN's twin "
                   f"of {args.design})")
+    for f in figures:
+        print(f"{f.text()}\n    from {f.source}")
     if args.plot:
         print(f"plot: {args.plot}")
     print(verdict.line())

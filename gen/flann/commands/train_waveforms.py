@@ -76,7 +76,7 @@ def read_conditioned(args) -> tuple:
 
 
 def read_held_out(args, model) -> tuple:
-    """(dwell readings, settings, conditioned windows) of a waveform recording at the conditioner
+    """(dwell readings, settings, conditioned windows, the waveforms) of a waveform recording at the conditioner
     settings ``model`` keeps (``flann eval``): the record is not calibrated on, its reference
     turned by its excitation."""
     settings = of_model(model, args.model)
@@ -86,7 +86,7 @@ def read_held_out(args, model) -> tuple:
     _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None)))
     wave = read_waveforms(args.recordings, announce=not args.quiet)
     conditioned = condition_with(settings, wave)
-    return _readings(args, wave, settings, conditioned, " at the model's conditioner"), settings, conditioned
+    return _readings(args, wave, settings, conditioned, " at the model's conditioner"), settings, conditioned, wave
 
 
 def converter_of_ratio(settings: ConditionerSettings) -> dict:
