@@ -59,6 +59,10 @@ def calibrate_reference(spec: ConditionerSpec, chain_at_zero, displacement_mm=No
         null = at[np.argmin([np.mean(np.abs(diff[x == v])) for v in at])]
         near = np.isin(x, at[np.argsort(np.abs(at - null))[:3]])
         total = np.polyfit(x[near], diff[near], 1)[0]
+        # a difference falling with x turns the slope's phase by pi: keep A + B positive
+        if np.real(total * np.conj(np.sum(chain_at_zero.i_a + chain_at_zero.i_b)
+                                    + 1j * np.sum(chain_at_zero.q_a + chain_at_zero.q_b))) < 0:
+            total = -total
     else:
         total = (np.sum(chain_at_zero.i_a) + np.sum(chain_at_zero.i_b)
                  + 1j * (np.sum(chain_at_zero.q_a) + np.sum(chain_at_zero.q_b)))

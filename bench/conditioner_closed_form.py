@@ -1,0 +1,135 @@
+"""A sensor the project did not make through the whole conditioner chain: waveforms built from
+the closed-form family of ../shared/checks/e2e_sensors.py, then train -> gen -> eval.
+
+    PYTHONPATH=gen .venv/bin/python bench/conditioner_closed_form.py [--seed 1] [--family PATH]
+
+The family draws a demodulated curve s(x) (a saturating S-curve: span, sensitivity, roll-off,
+asymmetry, sign, origin, noise).  Its secondaries are built here, flann is not told the form:
+
+    A(x) = C + s(x)/2,  B(x) = C - s(x)/2,   C = 0.55 max|s| over the stroke
+
+(so A - B = s and (A - B)/(A + B) = s / 2C, within +-0.91), A at 0.7 rad against the excitation
+and B at 0.72 rad (a small phase imbalance), a 5 kHz carrier sampled at 32 x, the family's
+noise on each secondary, 12-bit converters ranged at the smallest of +-2.5, 5, 10 V above the
+peak.  Dwell 10 ms at 41 positions over the stroke for training; the held-out recording dwells
+at the 40 positions between them, with another noise seed; the ratio at 625 Hz (a 277 Hz
+bandwidth, the AD598's 250 Hz judged), the training screen told to keep every reading (each is
+the average of whole windows of a curve in closed form: no glitch to screen).  Each figure `flann eval --json`
+gives is printed with its verdict against its data-sheet reference.
+"""
+
+import argparse
+import contextlib
+import importlib.util
+import io
+import json
+import math
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from flann.cli import main as flann
+from flann.recordings.waveform import Waveforms, write_waveforms
+
+CARRIER_HZ = 5000.0
+SAMPLES_PER_PERIOD = 32
+ADC_BITS = 12
+RANGES_V = (2.5, 5.0, 10.0)
+PHASE_A, PHASE_B = 0.70, 0.72   # rad against the excitation
+EXCITATION_V = 5.0
+DWELL_S = 0.01
+POSITIONS = 41
+OUTPUT_RATE_HZ = 625.0   # 8 carrier periods a window: a bandwidth (0.443 x the rate) of 277 Hz, above 250
+FIGURES = ("linearity_pct_fs", "effective_bits", "noise_free_bits", "bandwidth_hz", "settling_time_s",
+           "excitation_rejection_ppm_fs_per_pct", "quadrature_rejection_ppm_fs", "phase_tolerance_deg")
+
+
+def load_family(path: Path):
+    spec = importlib.util.spec_from_file_location("e2e_sensors", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def waveforms(family, p, positions, seed: int, range_v: float, centre_v: float) -> Waveforms:
+    fs = CARRIER_HZ * SAMPLES_PER_PERIOD
+    per = int(round(DWELL_S * fs))
+    x = np.repeat(positions, per)
+    t = np.arange(x.size) / fs
+    s = family.s_curve(x, p)
+    w = 2 * math.pi * CARRIER_HZ * t
+    rng = np.random.default_rng(seed)
+    lsb = 2 * range_v / 2 ** ADC_BITS
+    a = (centre_v + s / 2) * np.cos(w + PHASE_A) + rng.normal(0, p["noise_v"], x.size)
+    b = (centre_v - s / 2) * np.cos(w + PHASE_B) + rng.normal(0, p["noise_v"], x.size)
+    top = range_v - lsb
+    a, b = (np.clip(np.round(v / lsb) * lsb, -range_v, top) for v in (a, b))
+    return Waveforms(time_s=t, sec_a_v=a, sec_b_v=b, displacement_mm=x, exc_v=EXCITATION_V * np.cos(w))
+
+
+def run(argv) -> tuple[int, str]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = flann([str(a) for a in argv])
+    return rc, out.getvalue() + err.getvalue()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seed", type=int, default=1, help="the family's draw (default 1: its first sensor)")
+    ap.add_argument("--family", type=Path, default=Path("..") / "shared" / "checks" / "e2e_sensors.py")
+    a = ap.parse_args()
+    if not a.family.is_file():
+        print(f"error: {a.family}: the closed-form family's script not found (give --family)", file=sys.stderr)
+        return 2
+    family = load_family(a.family)
+    p = family.draw(np.random.default_rng(a.seed))
+    lo, hi = (0.0, 2 * p["span_mm"]) if p["start_at_zero"] else (-p["span_mm"], p["span_mm"])
+    train_x = np.linspace(lo, hi, POSITIONS)
+    held_x = 0.5 * (train_x[1:] + train_x[:-1])
+    peak_s = float(np.max(np.abs(family.s_curve(np.linspace(lo, hi, 2001), p))))
+    centre = 0.55 * peak_s
+    range_v = next((r for r in RANGES_V if r >= 1.05 * (centre + peak_s / 2)), RANGES_V[-1])
+    print(f"sensor (seed {a.seed}): span {p['span_mm']:g} mm ({lo:g}..{hi:g}), amplitude {p['amp_v']:.3g} V, "
+          f"sharpness {p['sharp']:.3g}, asymmetry {p['asym']:+.3f}, sign {p['sign']:+g}, noise "
+          f"{1e3 * p['noise_v']:.3g} mV; secondaries {centre:.3g} V +- s/2 at {PHASE_A}/{PHASE_B} rad; "
+          f"{ADC_BITS}-bit +-{range_v:g} V converters, {CARRIER_HZ:g} Hz x {SAMPLES_PER_PERIOD}")
+    with tempfile.TemporaryDirectory(prefix="closed_form_") as tmp:
+        d = Path(tmp)
+        write_waveforms(d / "wave.csv", waveforms(family, p, train_x, a.seed + 100, range_v, centre))
+        write_waveforms(d / "held_out.csv", waveforms(family, p, held_x, a.seed + 200, range_v, centre))
+        steps = [("train", ["train", d / "wave.csv", "-o", d / "model.json", "--adc-bits", ADC_BITS,
+                            "--adc-range-v", range_v, "--outliers", "keep", "--output-rate-hz", OUTPUT_RATE_HZ]),
+                 ("gen", ["gen", d / "model.json", "-o", d / "design"]),
+                 ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
+                           "--quiet", "--outliers", "keep"])]
+        for name, argv in steps:
+            rc, text = run(argv)
+            if rc != 0:
+                print(f"{name}: exit {rc}: {text.strip().splitlines()[-1] if text.strip() else ''}")
+                return 1
+            if name == "train":
+                print("train: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
+        res = json.loads(text[: text.rindex("}") + 1])
+    lin = res["linearity_pct_fs"]
+    for chain in ("float", "hardware"):
+        ok = lin[chain] is not None and lin[chain] <= lin["reference_pct_fs"]
+        print(f"linearity_pct_fs ({chain}) {lin[chain]:.4f} % FS: {'within' if ok else 'beyond'} the "
+              f"{lin['reference']} of {lin['reference_pct_fs']:g}")
+    for name in FIGURES[1:]:
+        f = res[name]
+        if f["value"] is None:
+            print(f"{name}: not computable: {f['reason']}")
+            continue
+        word = {True: "meets", False: "misses", None: "not judged against"}[f["ok"]]
+        unmet = f" ({f['unmet']})" if f.get("unmet") else ""
+        print(f"{name} {f['value']:.4g} {f['unit']}: {word} the {f['reference']} "
+              f"({'<=' if f['at_most'] else '>='} {f['reference_value']:g}){unmet}; from {f['source']}")
+    print(res["verdict"]["line"])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
