@@ -185,3 +185,21 @@ def test_eval_with_the_design_gives_the_hardware_linearity(trained, generated, h
     assert lin["hardware"] == pytest.approx(want, rel=1e-9)
     # the hardware's output LSB and input bits cost little against the float chain
     assert abs(lin["hardware"] - lin["float"]) < 0.01 and lin["hardware"] < 0.05
+
+
+def test_eval_gives_each_data_sheet_figure_with_a_verdict_and_draws_the_chain(trained, held_out, in_process):
+    d, _err = trained
+    rc, out, err = in_process(["eval", d / "model.json", held_out, "--json", "--plot", d / "chain.png"])
+    assert rc == 0, err
+    res = json.loads(out)
+    names = ("effective_bits", "noise_free_bits", "bandwidth_hz", "settling_time_s",
+             "excitation_rejection_ppm_fs_per_pct", "quadrature_rejection_ppm_fs", "phase_tolerance_deg")
+    checks = {c["name"]: c for c in res["verdict"]["checks"]}
+    for name in names:
+        f = res[name]
+        assert (f["value"] is not None and math.isfinite(f["value"])) or f["reason"]
+        assert f["reference"] and f["source"] and name in checks
+        assert checks[name]["ok"] is f["ok"]
+    # the bandwidth is synthesised (the held-out recording dwells), the settling from its steps
+    assert "synthesised" in res["bandwidth_hz"]["source"] and "steps" in res["settling_time_s"]["source"]
+    assert (d / "chain.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
