@@ -370,8 +370,10 @@ def phase_tolerance_figure(chain: Chain, base_mm) -> Figure:
     while hi < 90 and holds(hi):
         lo, hi = hi, 2 * hi
     if hi >= 90:
-        return Figure("phase_tolerance_deg", 90.0, "deg", reference_name, resolution, False, src,
-                      detail={"linearity_limit_mm": limit_mm})
+        # secondaries in phase with each other: the error's cos is common and cancels in the ratio
+        return Figure("phase_tolerance_deg", 90.0, "deg", reference_name, resolution, False,
+                      src + " (holds to the search's 90 deg: the secondaries are in phase)",
+                      detail={"linearity_limit_mm": limit_mm, "capped": True})
     for _ in range(12):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if holds(mid) else (lo, mid)
