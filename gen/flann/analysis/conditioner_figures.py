@@ -21,15 +21,18 @@ Full scale (FS) is ``fs_mm``, half the stroke, as ``linearity_pct_fs``; the outp
   excitation's amplitude, which both follow) before the converters: the largest systematic
   output shift over the scale change, per %.
 * ``quadrature_rejection_ppm_fs``: a component of 10 % of the full-scale signal (the in-phase
-  difference at the stroke's end), in quadrature with the reference, added to the secondaries
-  in opposite signs (the null residual's form): the largest systematic output shift.
+  difference at the stroke's end), in quadrature with the secondaries' difference (its phase on
+  this recording, found as calibration finds it), added to the secondaries in opposite signs
+  (the null residual's form): the largest systematic output shift.  It passes through the
+  model's reference as far as that is off the recording's phase.
 
 Both change the secondaries before the converters (:meth:`Chain.analog`), so the changed
-samples are rounded afresh; that rounding is noise on each dwell's shift, which the systematic
-shift (a cubic in the position through the dwells' shifts) leaves out and ``scatter_ppm_fs``
-gives.
+samples are rounded afresh; that rounding is noise on each dwell's shift, averaged over eight
+dithers, and what remains the systematic shift (a quadratic in the ratio through the dwells'
+ratio shifts, carried through the FLANN) leaves out and ``scatter_ppm_fs`` gives.
 * ``phase_tolerance_deg``: the largest reference-phase error (either sign) for which the output
-  on the recording stays within the AD598's linearity of the true displacement.
+  on the recording stays within the AD598's linearity of the true displacement, against the
+  error calibration makes (the model's phase against this recording's, calibrated afresh).
 
 Public API: :class:`Figure`, :func:`chain_figures` -> ``list[Figure]``, :func:`plot_chain`.
 """
@@ -44,9 +47,10 @@ import numpy as np
 
 from ..fileio import atomic_save_figure
 from ..golden.verdict import Check
-from ..hardware.conditioner.condition import adc_codes
+from ..hardware.conditioner.condition import adc_codes, calibrate_reference
 from ..hardware.conditioner.settings import ConditionerSettings, DwellReadings
-from ..hardware.conditioner.spec import QUADRATURE_BUDGET, QUADRATURE_FRACTION, Reference, reference, reference_phase
+from ..hardware.conditioner.spec import (QUADRATURE_BUDGET, QUADRATURE_FRACTION, Reference, identity, reference,
+                                         reference_phase)
 from ..hardware.conditioner.twin import ConditionerChain
 from ..recordings.waveform import Waveforms
 
@@ -59,7 +63,7 @@ TARGET_BITS = 16.0                  # effective bits at a 250 Hz bandwidth with 
 AD2S93_BITS = 14.0                  # the LVDT-to-digital converter's resolution
 EXCITATION_STEP_PCT = 10.0          # the scale change, less when the converters lack the headroom
 SQRT12 = math.sqrt(12.0)
-DITHER_SEED = 1
+DITHER_SEEDS = range(1, 9)   # the changed samples' rounding, averaged over eight dithers
 
 
 @dataclass(frozen=True)
@@ -123,6 +127,21 @@ class Chain:
     def ref(self) -> Reference:
         return self.settings.reference_for(self.wave)
 
+    def signal_phase(self) -> float:
+        """The phase of the secondaries' difference on this recording (rad, the record's own
+        frame), as calibration finds it (the slope of A - B at the null), by the plain twin."""
+        s = self.spec
+        plain = ConditionerChain(s)
+        ca = adc_codes(self.wave.sec_a_v, s.adc_bits, self.settings.adc_range_v)
+        cb = adc_codes(self.wave.sec_b_v, s.adc_bits, self.settings.adc_range_v)
+        n = len(self.wave) // s.window * s.window
+        x = self.wave.displacement_mm[:n].reshape(-1, s.window).mean(axis=1)
+        return calibrate_reference(s, plain.process(ca, cb, identity(s)), x)[1]
+
+    def calibration_error_rad(self) -> float:
+        """The model's reference against this recording's own phase: the calibration's error."""
+        return math.remainder(reference_phase(self.spec, self.ref) - self.signal_phase(), 2 * math.pi)
+
     def ratio(self, a_v, b_v, ref: Reference | None = None):
         """(ratio per window, the twin's record) of the secondaries' volts ``a_v``, ``b_v``."""
         s = self.spec
@@ -131,20 +150,24 @@ class Chain:
         out = self.twin.process(ca, cb, self.ref if ref is None else ref)
         return out.out_ratio / float(1 << s.ratio_frac_bits), out
 
-    def analog(self) -> tuple[np.ndarray, np.ndarray]:
+    def analog(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """The secondaries as the converters saw them before rounding, as far as the recording
-        tells: each sample plus a uniform dither of one LSB (seeded).  Scaling or adding to the
+        tells: each sample plus a uniform dither of one LSB (``seed``).  Scaling or adding to the
         rounded samples themselves would round a grid again, whose error repeats with the code
         (a gain error of its own); these round back to the recording's samples."""
         lsb = 2.0 * self.settings.adc_range_v / (1 << self.spec.adc_bits)
-        rng = np.random.default_rng(DITHER_SEED)
+        rng = np.random.default_rng(seed)
         half = 0.5 * lsb * (1 - 1e-9)
         return (self.wave.sec_a_v + rng.uniform(-half, half, len(self.wave)),
                 self.wave.sec_b_v + rng.uniform(-half, half, len(self.wave)))
 
+    def per_dwell(self, ratio) -> np.ndarray:
+        """Each dwell's mean ratio, as eval's readings."""
+        return np.array([np.mean(ratio[g]) for g in self.dwells.groups])
+
     def per_dwell_mm(self, ratio) -> np.ndarray:
-        """The output per dwell: its windows' mean ratio through the FLANN, as eval's readings."""
-        return self.to_mm(np.array([np.mean(ratio[g]) for g in self.dwells.groups]))
+        """The output per dwell: its windows' mean ratio through the FLANN."""
+        return self.to_mm(self.per_dwell(ratio))
 
     def volts_per_code_sum(self) -> float:
         """A window's in-phase sum (codes) back to the amplitude in volts at a secondary."""
@@ -157,21 +180,31 @@ class Chain:
         s = self.spec
         return 2 * math.pi * np.arange(n) / s.samples_per_period + reference_phase(s, self.ref if ref is None else ref)
 
+    def signal_carrier(self, n: int, phase: float) -> np.ndarray:
+        """The carrier's phase at each of ``n`` samples, ``phase`` at the first."""
+        return 2 * math.pi * np.arange(n) / self.spec.samples_per_period + phase
+
 
 def _ppm(chain: Chain, shift_mm) -> float:
     return 1e6 * float(np.max(np.abs(shift_mm))) / chain.fs_mm
 
 
-def systematic_ppm(chain: Chain, shift_mm) -> tuple[float, float]:
-    """(the largest systematic shift, the dwells' scatter about it), ppm FS: a cubic in the
-    position through the dwells' shifts.  Each dwell's shift holds the converters' rounding of
-    the changed samples too, noise that a figure of the chain's gain should not count."""
-    x = chain.dwells.recordings.displacement_mm
-    shift = np.asarray(shift_mm, dtype=float)
-    if np.unique(x).size < 5:
-        return _ppm(chain, shift), 0.0
-    fit = np.polyval(np.polyfit(x, shift, 3), x)
-    return _ppm(chain, fit), 1e6 * float(np.std(shift - fit)) / chain.fs_mm
+def systematic_ppm(chain: Chain, base_ratio, moved_ratio) -> tuple[float, float, float]:
+    """(the largest systematic output shift, the worst dwell's, the dwells' scatter about the
+    systematic one), ppm FS.  Each dwell's ratio shift holds the converters' rounding of the
+    changed samples too, noise that a figure of the chain should not count: the systematic shift
+    is a quadratic in the ratio through the dwells' ratio shifts (a gain error moves the ratio in
+    proportion, a quadrature leak by a constant), carried to the output through the FLANN."""
+    r = np.asarray(base_ratio, dtype=float)
+    shift = np.asarray(moved_ratio, dtype=float) - r
+    base_mm = chain.to_mm(r)
+    worst = _ppm(chain, chain.to_mm(r + shift) - base_mm)
+    if np.unique(r).size < 4:
+        return worst, worst, 0.0
+    fit = np.polyval(np.polyfit(r, shift, 2), r)
+    out = chain.to_mm(r + fit) - base_mm
+    scatter = chain.to_mm(r + shift) - chain.to_mm(r + fit)
+    return _ppm(chain, out), worst, 1e6 * float(np.std(scatter)) / chain.fs_mm
 
 
 def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
@@ -305,17 +338,19 @@ def excitation_figure(chain: Chain) -> Figure:
     peak = max(float(np.max(np.abs(w.sec_a_v))), float(np.max(np.abs(w.sec_b_v))))
     headroom = 100 * (rng / peak - 1) if peak > 0 else EXCITATION_STEP_PCT
     step = max(1.0, min(EXCITATION_STEP_PCT, math.floor(headroom * 10) / 10))
-    a, b = chain.analog()
-    up = chain.per_dwell_mm(chain.ratio(a * (1 + step / 100), b * (1 + step / 100))[0])
-    down = chain.per_dwell_mm(chain.ratio(a * (1 - step / 100), b * (1 - step / 100))[0])
-    shift, scatter = systematic_ppm(chain, up - down)
+    ups, downs = [], []
+    for seed in DITHER_SEEDS:
+        a, b = chain.analog(seed)
+        ups.append(chain.per_dwell(chain.ratio(a * (1 + step / 100), b * (1 + step / 100))[0]))
+        downs.append(chain.per_dwell(chain.ratio(a * (1 - step / 100), b * (1 - step / 100))[0]))
+    shift, worst, scatter = systematic_ppm(chain, np.mean(downs, axis=0), np.mean(ups, axis=0))
     value = shift / (2 * step)
     note = "" if step == EXCITATION_STEP_PCT else f" (the converters' headroom: {headroom:.3g} %)"
     return Figure("excitation_rejection_ppm_fs_per_pct", value, "ppm FS/%",
                   "AD698-class limit (10 % of excitation moves the output <= 100 ppm FS)",
                   AD698_EXCITATION_PPM_FS_PER_PCT, True,
                   f"the held-out recording with its secondaries scaled by +-{step:g} %{note}, through the twin",
-                  detail={"scale_pct": step, "shift_ppm_fs": shift, "worst_dwell_ppm_fs": _ppm(chain, up - down),
+                  detail={"scale_pct": step, "shift_ppm_fs": shift, "worst_dwell_ppm_fs": worst,
                           "scatter_ppm_fs": scatter},
                   remedy="the ratio (A-B)/(A+B) cancels the excitation: check the divider and the converters' range")
 
@@ -329,19 +364,26 @@ def full_scale_signal_v(chain: Chain, out) -> float:
 def quadrature_figure(chain: Chain, out) -> Figure:
     w = chain.wave
     q = QUADRATURE_FRACTION * full_scale_signal_v(chain, out)
-    quad = 0.5 * q * np.cos(chain.carrier_phase(len(w)) + math.pi / 2)
-    a, b = chain.analog()
-    base_mm = chain.per_dwell_mm(chain.ratio(a, b)[0])
-    shifts = [chain.per_dwell_mm(chain.ratio(a + sign * quad, b - sign * quad)[0]) - base_mm
-              for sign in (1, -1)]
-    fits = [systematic_ppm(chain, d) for d in shifts]
+    error = chain.calibration_error_rad()
+    # in quadrature with the signal (what the sensor's null residual is), not with the reference:
+    # the reference's error against it is what lets the quadrature through
+    quad = 0.5 * q * np.cos(chain.signal_carrier(len(w), chain.signal_phase()) + math.pi / 2)
+    base, moved = [], {1: [], -1: []}
+    for seed in DITHER_SEEDS:
+        a, b = chain.analog(seed)
+        base.append(chain.per_dwell(chain.ratio(a, b)[0]))
+        for sign, runs in moved.items():
+            runs.append(chain.per_dwell(chain.ratio(a + sign * quad, b - sign * quad)[0]))
+    fits = [systematic_ppm(chain, np.mean(base, axis=0), np.mean(runs, axis=0)) for runs in moved.values()]
     value = max(f[0] for f in fits)
     return Figure("quadrature_rejection_ppm_fs", value, "ppm FS",
                   f"{QUADRATURE_FRACTION:.0%} FS quadrature budget", QUADRATURE_PPM_FS, True,
                   f"the held-out recording with {q * 1e3:.4g} mV peak ({QUADRATURE_FRACTION:.0%} of the full-scale "
-                  "difference) in quadrature with the reference, +- on the secondaries, through the twin",
-                  detail={"quadrature_v": q, "worst_dwell_ppm_fs": max(_ppm(chain, d) for d in shifts),
-                          "scatter_ppm_fs": max(f[1] for f in fits)},
+                  "difference) in quadrature with its difference A - B (its phase calibrated afresh; the model's "
+                  f"reference {math.degrees(error):+.3f} deg from it), +- on the secondaries, through the twin",
+                  detail={"quadrature_v": q, "calibration_error_deg": math.degrees(error),
+                          "worst_dwell_ppm_fs": max(f[1] for f in fits),
+                          "scatter_ppm_fs": max(f[2] for f in fits)},
                   remedy="recalibrate the reference phase (flann train on a recording of the sensor as wired)")
 
 
@@ -349,9 +391,12 @@ def phase_tolerance_figure(chain: Chain, base_mm) -> Figure:
     s = chain.spec
     x = chain.dwells.recordings.displacement_mm
     limit_mm = AD598_LINEARITY_PCT_FS / 100 * chain.fs_mm
-    resolution = math.degrees(2.0 ** -(s.rotation_bits + 1))
+    step = math.degrees(2.0 ** -(s.rotation_bits + 1))
+    error = abs(math.degrees(chain.calibration_error_rad()))
+    resolution = max(step, error)
     src = "the held-out recording through the twin with its reference phase turned, the FLANN unchanged"
-    reference_name = "reference registers' phase step (half the rotation's)"
+    reference_name = ("calibration's error on this recording (its phase calibrated afresh against the model's; "
+                      "at least the registers' step)")
     theta = reference_phase(s, chain.ref)
 
     def worst(err_deg: float) -> float:
@@ -373,12 +418,13 @@ def phase_tolerance_figure(chain: Chain, base_mm) -> Figure:
         # secondaries in phase with each other: the error's cos is common and cancels in the ratio
         return Figure("phase_tolerance_deg", 90.0, "deg", reference_name, resolution, False,
                       src + " (holds to the search's 90 deg: the secondaries are in phase)",
-                      detail={"linearity_limit_mm": limit_mm, "capped": True})
+                      detail={"linearity_limit_mm": limit_mm, "capped": True, "calibration_error_deg": error,
+                              "register_step_deg": step})
     for _ in range(12):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if holds(mid) else (lo, mid)
     return Figure("phase_tolerance_deg", lo, "deg", reference_name, resolution, False, src,
-                  detail={"linearity_limit_mm": limit_mm},
+                  detail={"linearity_limit_mm": limit_mm, "calibration_error_deg": error, "register_step_deg": step},
                   remedy="a finer rotation (more rotation bits) or a sensor with less quadrature")
 
 
