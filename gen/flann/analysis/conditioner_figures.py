@@ -99,10 +99,10 @@ class Figure:
     def text(self) -> str:
         if self.value is None:
             return f"{self.name} not computable: {self.reason}"
-        word = {True: "within" if self.at_most else "at least", False: "beyond" if self.at_most else "below",
-                None: "against"}[self.ok]
-        return (f"{self.name} {self.value:.4g} {self.unit} {word} the {self.reference} of {self.limit:g} {self.unit}"
-                + (f" ({self.unmet})" if self.unmet else ""))
+        met = self.value <= self.limit if self.at_most else self.value >= self.limit
+        word = ("within" if met else "beyond") if self.at_most else ("at least" if met else "below")
+        return (f"{self.name} {self.value:.4g} {self.unit}: {word} {self.limit:.4g} {self.unit}, the {self.reference}"
+                + (f"; {self.unmet}" if self.unmet else ""))
 
     def check(self) -> Check:
         return Check(self.name, self.ok, self.text(), "" if self.ok is not False else self.remedy)
@@ -211,7 +211,7 @@ def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
     span = 2 * chain.fs_mm
     groups = [g for g in chain.dwells.groups if g.size >= 2]
     src = "the held-out recording's dwells, one output a window"
-    ref16 = f"issue's target at a {AD598_BANDWIDTH_HZ:g} Hz bandwidth"
+    ref16 = f"issue's target at a {AD598_BANDWIDTH_HZ:g} Hz bandwidth with 12-bit converters"
     if not groups:
         reason = "no dwell holds two windows (dwell longer than two windows of the output rate)"
         return [Figure("effective_bits", None, "bits", ref16, TARGET_BITS, False, src, reason),
@@ -229,7 +229,7 @@ def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
                   "peak, or quieter converters (docs/conditioner.md, 'Effective bits')")
     if enob.value is not None and bw is not None and bw < AD598_BANDWIDTH_HZ:
         # integrating longer than the reference's bandwidth allows flatters the figure
-        enob = replace(enob, unmet=f"at a {bw:.4g} Hz bandwidth, narrower than {AD598_BANDWIDTH_HZ:g} Hz",
+        enob = replace(enob, unmet=f"measured at a {bw:.4g} Hz bandwidth, narrower than {AD598_BANDWIDTH_HZ:g} Hz",
                        remedy="train with a higher --output-rate-hz (the bandwidth is 0.443 x the output rate)")
     nfb = Figure("noise_free_bits", math.log2(span / ptp) if ptp > 0 else None, "bits", "AD2S93's resolution",
                  AD2S93_BITS, False, src, "" if ptp > 0 else quiet, {"peak_to_peak_mm": ptp},
@@ -294,7 +294,7 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
     band = AD598_LINEARITY_PCT_FS / 100 * chain.fs_mm
     span = 2 * chain.fs_mm
     one_pole = math.log(span / band) / (2 * math.pi * AD598_BANDWIDTH_HZ)
-    reference = f"AD598's {AD598_BANDWIDTH_HZ:g} Hz one-pole filter settling a full-scale step"
+    reference = f"AD598's {AD598_BANDWIDTH_HZ:g} Hz one-pole filter settling a full-scale step to 0.05 % FS"
     # the worst case: a full-scale step one sample into a window, synthesised
     k = 4 * s.window + 1
     r = np.where(np.arange(8 * s.window) < k, -r0, r0)

@@ -6,6 +6,7 @@ voltages quantised to the design's ADC codes, against the physical limit of that
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -228,13 +229,20 @@ def run(args) -> int:
         if chain is not None:
             res["linearity_pct_fs"]["hardware"] = float(100 * np.max(np.abs(hardware_mm - rec.displacement_mm))
                                                         / res["full_scale_mm"])
-        figures = chain_figures(settings, wave, dwells, lambda r: predict_clamped(model, r)[0],
-                                res["full_scale_mm"])
+        def to_mm(ratio):
+            return predict_clamped(model, ratio)[0]
+
+        figures = chain_figures(settings, wave, dwells, to_mm, res["full_scale_mm"])
         for f in figures:
             res[f.name] = f.to_json()
+        if chain is not None:
+            # the figures are the conditioner's (the FLANN in float); the design's output word
+            # holds log2(span / LSB) bits of them
+            res["effective_bits"]["hardware_output_bits"] = math.log2(2 * res["full_scale_mm"]
+                                                                      / chain.spec.output_lsb_mm)
         if args.plot:
-            plot_chain(args.plot, settings, wave, conditioned, dwells, lambda r: predict_clamped(model, r)[0],
-                       res["full_scale_mm"], hardware_mm if chain is not None else None)
+            plot_chain(args.plot, settings, wave, conditioned, dwells, to_mm, res["full_scale_mm"],
+                       hardware_mm if chain is not None else None)
     verdict = eval_verdict(res, figures)
     res["verdict"] = verdict.to_json()
     if emit_json(args, res):
@@ -284,13 +292,24 @@ def run(args) -> int:
             f"{k} {v:.3g}" for k, v in drift.items() if v is not None))
     lin = res.get("linearity_pct_fs")
     if lin:
+        def judged(value):
+            return f"{'within' if value <= lin['reference_pct_fs'] else 'beyond'} the {lin['reference']} " \
+                   f"of {lin['reference_pct_fs']:g}"
+
         print(f"linearity_pct_fs        {lin['float']:.4f} (float chain: the conditioner's twin, the FLANN in "
-              f"float; {lin['reference']}: {lin['reference_pct_fs']:g})")
+              f"float): {judged(lin['float'])}")
         if lin["hardware"] is not None:
             print(f"linearity_pct_fs        {lin['hardware']:.4f} (hardware: the conditioner's twin, the FLANN's twin "
-                  f"of {args.design})")
+                  f"of {args.design}): {judged(lin['hardware'])}")
     for f in figures:
         print(f"{f.text()}\n    from {f.source}")
+    enob = res.get("effective_bits") or {}
+    if enob.get("hardware_output_bits") is not None and enob.get("value") is not None:
+        held, lsb = enob["hardware_output_bits"], chain.spec.output_lsb_mm
+        enough = held >= enob["value"]
+        print(f"the design's output LSB {lsb:g} mm holds {held:.1f} bits of the {2 * fs:g} mm span: "
+              f"{'enough for' if enough else 'fewer than'} the {enob['value']:.1f} effective bits"
+              + ("" if enough else f" (flann gen --output-lsb-mm {2 * fs / 2 ** math.ceil(enob['value']):.2g} keeps them)"))
     if args.plot:
         print(f"plot: {args.plot}")
     print(verdict.line())
