@@ -129,3 +129,13 @@ def test_the_phase_tolerance_shrinks_with_a_phase_imbalance(measured):
                  / lsb) * lsb
     skewed = figures(Waveforms(time_s=t, sec_a_v=w.sec_a_v, sec_b_v=b, displacement_mm=x, exc_v=w.exc_v))
     assert 0 < skewed["phase_tolerance_deg"].value < measured["phase_tolerance_deg"].value
+
+
+def test_a_figure_the_recording_cannot_give_is_said_not_computable():
+    # one window a dwell: no window-to-window noise to measure
+    f = figures(wave(dwell_windows=1))
+    for name in ("effective_bits", "noise_free_bits"):
+        assert f[name].value is None and "two windows" in f[name].reason
+        assert f[name].ok is None and f[name].to_json()["value"] is None
+        assert "not computable" in f[name].text()
+    assert f["bandwidth_hz"].value is not None

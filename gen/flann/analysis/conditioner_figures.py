@@ -26,13 +26,14 @@ Full scale (FS) is ``fs_mm``, half the stroke, as ``linearity_pct_fs``; the outp
   (the null residual's form): the largest systematic output shift.  It passes through the
   model's reference as far as that is off the recording's phase.
 
-Both change the secondaries before the converters (:meth:`Chain.analog`), so the changed
-samples are rounded afresh; that rounding is noise on each dwell's shift, averaged over eight
-dithers, and what remains the systematic shift (a quadratic in the ratio through the dwells'
-ratio shifts, carried through the FLANN) leaves out and ``scatter_ppm_fs`` gives.
 * ``phase_tolerance_deg``: the largest reference-phase error (either sign) for which the output
   on the recording stays within the AD598's linearity of the true displacement, against the
   error calibration makes (the model's phase against this recording's, calibrated afresh).
+
+The rejection figures change the secondaries before the converters (:meth:`Chain.analog`), so
+the changed samples are rounded afresh; that rounding is noise on each dwell's shift, averaged
+over eight dithers, and what remains the systematic shift (a quadratic in the ratio through the
+dwells' ratio shifts, carried through the FLANN) leaves out and ``scatter_ppm_fs`` gives.
 
 Public API: :class:`Figure`, :func:`chain_figures` -> ``list[Figure]``, :func:`plot_chain`.
 """
@@ -41,6 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
@@ -123,10 +125,11 @@ class Chain:
     def spec(self):
         return self.settings.spec
 
-    @property
+    @cached_property
     def ref(self) -> Reference:
         return self.settings.reference_for(self.wave)
 
+    @cached_property
     def signal_phase(self) -> float:
         """The phase of the secondaries' difference on this recording (rad, the record's own
         frame), as calibration finds it (the slope of A - B at the null), by the plain twin."""
@@ -138,9 +141,10 @@ class Chain:
         x = self.wave.displacement_mm[:n].reshape(-1, s.window).mean(axis=1)
         return calibrate_reference(s, plain.process(ca, cb, identity(s)), x)[1]
 
+    @cached_property
     def calibration_error_rad(self) -> float:
         """The model's reference against this recording's own phase: the calibration's error."""
-        return math.remainder(reference_phase(self.spec, self.ref) - self.signal_phase(), 2 * math.pi)
+        return math.remainder(reference_phase(self.spec, self.ref) - self.signal_phase, 2 * math.pi)
 
     def ratio(self, a_v, b_v, ref: Reference | None = None):
         """(ratio per window, the twin's record) of the secondaries' volts ``a_v``, ``b_v``."""
@@ -175,14 +179,11 @@ class Chain:
         lsb = 2.0 * self.settings.adc_range_v / (1 << s.adc_bits)
         return lsb / (s.window / 2 * s.amplitude)
 
-    def carrier_phase(self, n: int, ref: Reference | None = None) -> np.ndarray:
-        """The reference's phase at each of ``n`` samples: the table's angle plus the rotation."""
-        s = self.spec
-        return 2 * math.pi * np.arange(n) / s.samples_per_period + reference_phase(s, self.ref if ref is None else ref)
-
-    def signal_carrier(self, n: int, phase: float) -> np.ndarray:
-        """The carrier's phase at each of ``n`` samples, ``phase`` at the first."""
-        return 2 * math.pi * np.arange(n) / self.spec.samples_per_period + phase
+    def carrier(self, n: int, phase: float | None = None) -> np.ndarray:
+        """The carrier's phase at each of ``n`` samples, ``phase`` at the first (default: the
+        reference's, the table's angle plus the rotation)."""
+        start = reference_phase(self.spec, self.ref) if phase is None else phase
+        return 2 * math.pi * np.arange(n) / self.spec.samples_per_period + start
 
 
 def _ppm(chain: Chain, shift_mm) -> float:
@@ -248,7 +249,7 @@ def _stimulus_level(chain: Chain, ratio, out) -> tuple[float, float]:
 def _synth(chain: Chain, total: float, r) -> tuple[np.ndarray, np.ndarray]:
     """Secondaries in phase with the reference whose balance ``(A - B)/(A + B)`` is ``r``
     (per sample), their sum ``total`` volts."""
-    c = np.cos(chain.carrier_phase(r.size))
+    c = np.cos(chain.carrier(r.size))
     return 0.5 * total * (1 + r) * c, 0.5 * total * (1 - r) * c
 
 
@@ -306,7 +307,7 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
     x = chain.wave.displacement_mm
     steps = np.flatnonzero(np.diff(x) != 0) + 1
     out_mm = chain.to_mm(ratio)
-    found = []
+    found, unsettled = [], 0
     for g in chain.dwells.groups:
         first = int(g[0]) * s.window
         before = steps[steps <= first]
@@ -316,7 +317,9 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
         start = step // s.window
         final = float(np.mean(out_mm[g]))
         at_w = _settled_after(out_mm, start, int(g[-1]) + 1, final, band)
-        if at_w is not None:
+        if at_w is None:
+            unsettled += 1
+        else:
             found.append((step, ((at_w + 1) * s.window - step) / fs))
     detail = {"band_mm": band, "worst_case_s": worst, "reference_s": one_pole}
     remedy = "train with a higher --output-rate-hz (a step settles within two windows)"
@@ -324,7 +327,12 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
         value = max(t for _, t in found)
         return Figure("settling_time_s", value, "s", reference, one_pole, True,
                       f"the held-out recording's {len(found)} steps, within {band:.3g} mm (0.05 % FS)",
-                      detail=detail, remedy=remedy)
+                      detail={**detail, "unsettled_steps": unsettled}, remedy=remedy,
+                      unmet=f"{unsettled} more step(s) did not settle within their dwell" if unsettled else "")
+    if unsettled:
+        return Figure("settling_time_s", None, "s", reference, one_pole, True, "the held-out recording's steps",
+                      f"none of its {unsettled} steps settles within its dwell (dwell longer, or a higher "
+                      "--output-rate-hz)", detail=detail)
     if worst is None:
         return Figure("settling_time_s", None, "s", reference, one_pole, True, "synthesised",
                       "the synthesised step does not settle within the band", detail=detail)
@@ -364,10 +372,10 @@ def full_scale_signal_v(chain: Chain, out) -> float:
 def quadrature_figure(chain: Chain, out) -> Figure:
     w = chain.wave
     q = QUADRATURE_FRACTION * full_scale_signal_v(chain, out)
-    error = chain.calibration_error_rad()
+    error = chain.calibration_error_rad
     # in quadrature with the signal (what the sensor's null residual is), not with the reference:
     # the reference's error against it is what lets the quadrature through
-    quad = 0.5 * q * np.cos(chain.signal_carrier(len(w), chain.signal_phase()) + math.pi / 2)
+    quad = 0.5 * q * np.cos(chain.carrier(len(w), chain.signal_phase) + math.pi / 2)
     base, moved = [], {1: [], -1: []}
     for seed in DITHER_SEEDS:
         a, b = chain.analog(seed)
@@ -392,7 +400,7 @@ def phase_tolerance_figure(chain: Chain, base_mm) -> Figure:
     x = chain.dwells.recordings.displacement_mm
     limit_mm = AD598_LINEARITY_PCT_FS / 100 * chain.fs_mm
     step = math.degrees(2.0 ** -(s.rotation_bits + 1))
-    error = abs(math.degrees(chain.calibration_error_rad()))
+    error = abs(math.degrees(chain.calibration_error_rad))
     resolution = max(step, error)
     src = "the held-out recording through the twin with its reference phase turned, the FLANN unchanged"
     reference_name = ("calibration's error on this recording (its phase calibrated afresh against the model's; "
