@@ -260,6 +260,11 @@ def bandwidth_figure(chain: Chain, total: float, r0: float) -> Figure:
            f"{fs:g} samples/s, window {s.window}), the recording's level: a sine of the balance, "
            f"amplitude {r0:.3g}")
 
+    if not (r0 > 0 and total > 0):
+        return Figure("bandwidth_hz", None, "Hz", "AD598's bandwidth (typical)", AD598_BANDWIDTH_HZ, False, src,
+                      "the recording's secondaries carry no balance to synthesise a stimulus at (no signal, or "
+                      "every dwell at the null)")
+
     def gain(f: float) -> float:
         windows = max(32, math.ceil(4 * rate / f))
         n = windows * s.window
@@ -297,12 +302,14 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
     one_pole = math.log(span / band) / (2 * math.pi * AD598_BANDWIDTH_HZ)
     reference = f"AD598's {AD598_BANDWIDTH_HZ:g} Hz one-pole filter settling a full-scale step to 0.05 % FS"
     # the worst case: a full-scale step one sample into a window, synthesised
-    k = 4 * s.window + 1
-    r = np.where(np.arange(8 * s.window) < k, -r0, r0)
-    syn_ratio, _ = chain.ratio(*_synth(chain, total, r))
-    syn_mm = chain.to_mm(syn_ratio)
-    at = _settled_after(syn_mm, 4, syn_ratio.size, float(syn_mm[-1]), band)
-    worst = None if at is None else ((at + 1) * s.window - k) / fs
+    worst = None
+    if r0 > 0 and total > 0:
+        k = 4 * s.window + 1
+        r = np.where(np.arange(8 * s.window) < k, -r0, r0)
+        syn_ratio, _ = chain.ratio(*_synth(chain, total, r))
+        syn_mm = chain.to_mm(syn_ratio)
+        at = _settled_after(syn_mm, 4, syn_ratio.size, float(syn_mm[-1]), band)
+        worst = None if at is None else ((at + 1) * s.window - k) / fs
     # the recording's steps
     x = chain.wave.displacement_mm
     steps = np.flatnonzero(np.diff(x) != 0) + 1
@@ -335,7 +342,8 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
                       "--output-rate-hz)", detail=detail)
     if worst is None:
         return Figure("settling_time_s", None, "s", reference, one_pole, True, "synthesised",
-                      "the synthesised step does not settle within the band", detail=detail)
+                      "the recording holds no step, and a synthesised step does not settle within the band "
+                      "(or the recording carries no signal to synthesise one at)", detail=detail)
     return Figure("settling_time_s", worst, "s", reference, one_pole, True,
                   "synthesised through the twin at the model's settings: a full-scale step one sample into a "
                   "window (the recording holds no step)", detail=detail, remedy=remedy)
@@ -372,6 +380,10 @@ def full_scale_signal_v(chain: Chain, out) -> float:
 def quadrature_figure(chain: Chain, out) -> Figure:
     w = chain.wave
     q = QUADRATURE_FRACTION * full_scale_signal_v(chain, out)
+    if not q > 0:
+        return Figure("quadrature_rejection_ppm_fs", None, "ppm FS", f"{QUADRATURE_FRACTION:.0%} FS quadrature budget",
+                      QUADRATURE_PPM_FS, True, "the held-out recording",
+                      "its secondaries' difference is zero at every dwell: no full-scale signal to take 10 % of")
     error = chain.calibration_error_rad
     # in quadrature with the signal (what the sensor's null residual is), not with the reference:
     # the reference's error against it is what lets the quadrature through
