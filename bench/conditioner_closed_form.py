@@ -15,7 +15,12 @@ peak.  Dwell 10 ms at 41 positions over the stroke for training; the held-out re
 at the 40 positions between them, with another noise seed; the ratio at 625 Hz (a 277 Hz
 bandwidth, the AD598's 250 Hz judged), the training screen told to keep every reading (each is
 the average of whole windows of a curve in closed form: no glitch to screen).  Each figure `flann eval --json`
-gives is printed with its verdict against its data-sheet reference.
+gives is printed with its verdict against its data-sheet reference.  The options change the
+carrier, the sample rate, the output rate, the noise, the positions and the dwell, e.g. the
+setting docs/conditioner.md's "Effective bits" measures on the LVDT:
+
+    ... bench/conditioner_closed_form.py --carrier-hz 10000 --samples-per-period 256 \
+        --output-rate-hz 588 --noise-v 0.0001 --positions 21 --dwell-s 0.01
 """
 
 import argparse
@@ -53,20 +58,21 @@ def load_family(path: Path):
     return module
 
 
-def waveforms(family, p, positions, seed: int, range_v: float, centre_v: float) -> Waveforms:
-    fs = CARRIER_HZ * SAMPLES_PER_PERIOD
-    per = int(round(DWELL_S * fs))
+def waveforms(family, p, positions, seed: int, range_v: float, centre_v: float, a) -> Waveforms:
+    fs = a.carrier_hz * a.samples_per_period
+    per = int(round(a.dwell_s * fs))
     x = np.repeat(positions, per)
     t = np.arange(x.size) / fs
     s = family.s_curve(x, p)
-    w = 2 * math.pi * CARRIER_HZ * t
+    w = 2 * math.pi * a.carrier_hz * t
     rng = np.random.default_rng(seed)
     lsb = 2 * range_v / 2 ** ADC_BITS
-    a = (centre_v + s / 2) * np.cos(w + PHASE_A) + rng.normal(0, p["noise_v"], x.size)
-    b = (centre_v - s / 2) * np.cos(w + PHASE_B) + rng.normal(0, p["noise_v"], x.size)
+    noise = p["noise_v"] if a.noise_v is None else a.noise_v
+    sa = (centre_v + s / 2) * np.cos(w + PHASE_A) + rng.normal(0, noise, x.size)
+    sb = (centre_v - s / 2) * np.cos(w + PHASE_B) + rng.normal(0, noise, x.size)
     top = range_v - lsb
-    a, b = (np.clip(np.round(v / lsb) * lsb, -range_v, top) for v in (a, b))
-    return Waveforms(time_s=t, sec_a_v=a, sec_b_v=b, displacement_mm=x, exc_v=EXCITATION_V * np.cos(w))
+    sa, sb = (np.clip(np.round(v / lsb) * lsb, -range_v, top) for v in (sa, sb))
+    return Waveforms(time_s=t, sec_a_v=sa, sec_b_v=sb, displacement_mm=x, exc_v=EXCITATION_V * np.cos(w))
 
 
 def run(argv) -> tuple[int, str]:
@@ -80,6 +86,12 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=1, help="the family's draw (default 1: its first sensor)")
     ap.add_argument("--family", type=Path, default=Path("..") / "shared" / "checks" / "e2e_sensors.py")
+    ap.add_argument("--carrier-hz", type=float, default=CARRIER_HZ)
+    ap.add_argument("--samples-per-period", type=int, default=SAMPLES_PER_PERIOD)
+    ap.add_argument("--output-rate-hz", type=float, default=OUTPUT_RATE_HZ)
+    ap.add_argument("--noise-v", type=float, default=None, help="rms on each secondary (default: the family's)")
+    ap.add_argument("--positions", type=int, default=POSITIONS)
+    ap.add_argument("--dwell-s", type=float, default=DWELL_S)
     a = ap.parse_args()
     if not a.family.is_file():
         print(f"error: {a.family}: the closed-form family's script not found (give --family)", file=sys.stderr)
@@ -87,21 +99,22 @@ def main() -> int:
     family = load_family(a.family)
     p = family.draw(np.random.default_rng(a.seed))
     lo, hi = (0.0, 2 * p["span_mm"]) if p["start_at_zero"] else (-p["span_mm"], p["span_mm"])
-    train_x = np.linspace(lo, hi, POSITIONS)
+    train_x = np.linspace(lo, hi, a.positions)
     held_x = 0.5 * (train_x[1:] + train_x[:-1])
     peak_s = float(np.max(np.abs(family.s_curve(np.linspace(lo, hi, 2001), p))))
     centre = 0.55 * peak_s
     range_v = next((r for r in RANGES_V if r >= 1.05 * (centre + peak_s / 2)), RANGES_V[-1])
     print(f"sensor (seed {a.seed}): span {p['span_mm']:g} mm ({lo:g}..{hi:g}), amplitude {p['amp_v']:.3g} V, "
           f"sharpness {p['sharp']:.3g}, asymmetry {p['asym']:+.3f}, sign {p['sign']:+g}, noise "
-          f"{1e3 * p['noise_v']:.3g} mV; secondaries {centre:.3g} V +- s/2 at {PHASE_A}/{PHASE_B} rad; "
-          f"{ADC_BITS}-bit +-{range_v:g} V converters, {CARRIER_HZ:g} Hz x {SAMPLES_PER_PERIOD}")
+          f"{1e3 * p['noise_v']:.3g} mV; secondaries {centre:.3g} V +- s/2 at {PHASE_A}/{PHASE_B} rad, "
+          f"{1e3 * (p['noise_v'] if a.noise_v is None else a.noise_v):.3g} mV rms; {ADC_BITS}-bit +-{range_v:g} V "
+          f"converters, {a.carrier_hz:g} Hz x {a.samples_per_period}, {a.positions} positions, dwell {a.dwell_s:g} s")
     with tempfile.TemporaryDirectory(prefix="closed_form_") as tmp:
         d = Path(tmp)
-        write_waveforms(d / "wave.csv", waveforms(family, p, train_x, a.seed + 100, range_v, centre))
-        write_waveforms(d / "held_out.csv", waveforms(family, p, held_x, a.seed + 200, range_v, centre))
+        write_waveforms(d / "wave.csv", waveforms(family, p, train_x, a.seed + 100, range_v, centre, a))
+        write_waveforms(d / "held_out.csv", waveforms(family, p, held_x, a.seed + 200, range_v, centre, a))
         steps = [("train", ["train", d / "wave.csv", "-o", d / "model.json", "--adc-bits", ADC_BITS,
-                            "--adc-range-v", range_v, "--outliers", "keep", "--output-rate-hz", OUTPUT_RATE_HZ]),
+                            "--adc-range-v", range_v, "--outliers", "keep", "--output-rate-hz", a.output_rate_hz]),
                  ("gen", ["gen", d / "model.json", "-o", d / "design"]),
                  ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
                            "--quiet", "--outliers", "keep"])]
