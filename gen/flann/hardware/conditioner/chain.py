@@ -34,7 +34,7 @@ from ..header import header
 from ..twin import Record
 from .render import TEMPLATES, cycles_per_sample
 from .spec import ConditionerSpec, Reference
-from .twin import ConditionerChain
+from .twin import ConditionerChain, FlannCondRatio
 
 CHAIN_TOP = "flann_chain_top"
 
@@ -69,8 +69,16 @@ class ChainSpec:
 
     @property
     def latency(self) -> int:
-        """Clocks from a window's last converter strobe to its displacement code."""
+        """Clocks from a window's last converter strobe to its displacement code (a window the
+        divider saturates on comes earlier: :meth:`latencies`)."""
         return ConditionerChain(self.conditioner).latency + self.flann.latency_cycles
+
+    def latencies(self, ratio_sat) -> np.ndarray:
+        """Each window's clocks from its last strobe to its code: the divider answers a saturated
+        ratio without dividing."""
+        ratio = FlannCondRatio(self.conditioner)
+        early = ratio.latency - ratio.saturated_latency
+        return np.where(np.asarray(ratio_sat) != 0, self.latency - early, self.latency)
 
     def to_dict(self) -> dict:
         return {"conditioner": self.conditioner.to_dict(), "flann_top": self.flann_top,

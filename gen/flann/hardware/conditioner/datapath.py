@@ -41,7 +41,8 @@ from ... import __version__
 NAME = "conditioner"
 FLANN = "flann"   # the manifest field holding the FLANN design's own manifest
 WAVEFORM = "waveform.csv"   # the training recording, kept for flann sim's whole-chain run
-LACKS = ("a conditioner (with its FLANN) has its benches (flann sim) and synthesis (flann synth) only")
+LACKS = ("written from a spec, or joined to its FLANN, it has the conditioner's benches and the FLANN's (flann sim) "
+         "and synthesis (flann synth) only")
 
 
 def latency_cycles(spec: ConditionerSpec) -> int:

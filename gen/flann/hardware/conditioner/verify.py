@@ -39,7 +39,7 @@ from .datapath import FLANN
 from .condition import adc_codes, calibrate_reference
 from .settings import of_model
 from .render import cycles_per_sample
-from .spec import ConditionerSpec, identity
+from .spec import ConditionerSpec, Reference, identity
 from .twin import ConditionerChain
 
 # the chain's stimulus: one position a window, the phase of the secondaries against the
@@ -128,19 +128,27 @@ def chain_stimulus(design: Design, spec: ConditionerSpec):
     return a, b, ref, "the closed-form LVDT"
 
 
+def run_chain_top(files, chain: ChainSpec, codes_a, codes_b, ref: Reference, build_dir, *, seed: int = 1) -> BenchResult:
+    """Converter codes through ``flann_chain_top`` (built from ``files``: every entity's) against
+    :class:`FlannChainTop`, whose values the bench is given."""
+    want = FlannChainTop(chain).process(codes_a, codes_b, ref)
+    spec = chain.conditioner
+    return run_cocotb(files, CHAIN_TOP, CHAIN_BENCH, build_dir,
+                      {"spec": spec.to_dict(), "codes_a": np.asarray(codes_a).tolist(),
+                       "codes_b": np.asarray(codes_b).tolist(), "ref": asdict(ref),
+                       "cycles_per_sample": cycles_per_sample(spec),
+                       "latencies": chain.latencies(want.ratio_sat).tolist(),
+                       "expected": [[int(d), int(s)] for d, s in zip(want.out_data, want.out_sat)]},
+                      name=CHAIN_TOP, seed=seed)
+
+
 def run_whole_chain(design: Design, flann: Design, build_dir, *, seed: int = 1) -> tuple[BenchResult, dict]:
     """A waveform through ``flann_chain_top`` against :class:`FlannChainTop`; (bench result, what
     was run)."""
-    spec = design.spec
-    chain = ChainSpec(spec, flann.spec, flann.manifest["top"])
-    a, b, ref, source = chain_stimulus(design, spec)
-    want = FlannChainTop(chain).process(a, b, ref)
-    res = run_cocotb(design.files, CHAIN_TOP, CHAIN_BENCH, build_dir,
-                     {"spec": spec.to_dict(), "codes_a": a.tolist(), "codes_b": b.tolist(), "ref": asdict(ref),
-                      "cycles_per_sample": cycles_per_sample(spec), "latency": chain.latency,
-                      "expected": [[int(d), int(s)] for d, s in zip(want.out_data, want.out_sat)]},
-                     name=CHAIN_TOP, seed=seed)
-    return res, {"samples": int(a.size), "source": source}
+    chain = ChainSpec(design.spec, flann.spec, flann.manifest["top"])
+    a, b, ref, source = chain_stimulus(design, design.spec)
+    return run_chain_top(design.files, chain, a, b, ref, build_dir, seed=seed), {"samples": int(a.size),
+                                                                                "source": source}
 
 
 def flann_design(design: Design) -> Design | None:
@@ -198,5 +206,5 @@ def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
 
 VERIFICATION = Verification(bench=bench)
 
-__all__ = ["VERIFICATION", "BLOCKS", "CHAIN_SAMPLES", "run_block", "run_chain", "run_whole_chain", "chain_stimulus",
+__all__ = ["VERIFICATION", "BLOCKS", "CHAIN_SAMPLES", "run_block", "run_chain", "run_whole_chain", "run_chain_top", "chain_stimulus",
            "lvdt_codes", "flann_design"]
