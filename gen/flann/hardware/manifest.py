@@ -73,7 +73,8 @@ def foreign_entries(directory: Path) -> list[str]:
     except FlannError:
         man = {}
     man = man if isinstance(man, dict) else {}
-    own = {MANIFEST, man.get("model"), man.get("init_model"), man.get("waveform")} | set(f for f in man.get("files", []) if isinstance(f, str))
+    own = {MANIFEST, man.get("model"), man.get("init_model"), man.get("waveform")}
+    own |= set(f for f in man.get("files", []) if isinstance(f, str))
     own |= {im.get(k) for im in man.get("images", []) if isinstance(im, dict) for k in ("hex", "model")}
     return sorted(p.name + ("/" if p.is_dir() else "") for p in directory.iterdir() if p.name not in own)
 
@@ -177,8 +178,9 @@ def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str,
 
 
 def _kept_files(path: Path, directory: Path, data: dict) -> None:
-    """The model, weight images and waveform recording a design keeps beside its VHDL, confined like its files (a
-    missing one is the reader's to report: a design may be checked in without its model)."""
+    """The model, weight images and waveform recording a design keeps beside its VHDL, confined
+    like its files (a missing one is the reader's to report: a design may be checked in without
+    its model)."""
     for key in ("model", "init_model"):
         model = data.get(key)
         if model is not None:

@@ -135,9 +135,10 @@ def summary(man: dict) -> list[str]:
              f"{ref.get('offset')}, in_tan {ref.get('tan')}"]
     flann, chain = man.get(FLANN), man.get("chain")
     if isinstance(flann, dict) and isinstance(chain, dict):
-        lines.append(f"  FLANN ({flann['top']}) behind it, joined in {man['top']}: out_ratio({man['spec']['ratio_frac_bits']} "
-                     f"downto {chain['dropped_ratio_bits']}) to its in_data; {man['output_bits']}-bit displacement code "
-                     f"{man['latency_cycles']} clocks after a window's last strobe")
+        lines.append(f"  FLANN ({flann['top']}) behind it, joined in {man['top']}: "
+                     f"out_ratio({man['spec']['ratio_frac_bits']} downto {chain['dropped_ratio_bits']}) to its "
+                     f"in_data; {man['output_bits']}-bit displacement code {man['latency_cycles']} clocks after a "
+                     "window's last strobe")
         lines += fixed_datapath.summary(flann)
         lines.append("  flann sim's whole-chain run: " + (f"the training recording, kept as {man['waveform']}"
                      if man.get("waveform") else "the closed-form LVDT (the training recording was not found "

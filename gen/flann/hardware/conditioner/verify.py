@@ -128,7 +128,8 @@ def chain_stimulus(design: Design, spec: ConditionerSpec):
     return a, b, ref, "the closed-form LVDT"
 
 
-def run_chain_top(files, chain: ChainSpec, codes_a, codes_b, ref: Reference, build_dir, *, seed: int = 1) -> BenchResult:
+def run_chain_top(files, chain: ChainSpec, codes_a, codes_b, ref: Reference, build_dir, *,
+                  seed: int = 1) -> BenchResult:
     """Converter codes through ``flann_chain_top`` (built from ``files``: every entity's) against
     :class:`FlannChainTop`, whose values the bench is given."""
     want = FlannChainTop(chain).process(codes_a, codes_b, ref)
@@ -206,5 +207,5 @@ def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
 
 VERIFICATION = Verification(bench=bench)
 
-__all__ = ["VERIFICATION", "BLOCKS", "CHAIN_SAMPLES", "run_block", "run_chain", "run_whole_chain", "run_chain_top", "chain_stimulus",
-           "lvdt_codes", "flann_design"]
+__all__ = ["VERIFICATION", "BLOCKS", "CHAIN_SAMPLES", "run_block", "run_chain", "run_whole_chain", "run_chain_top",
+           "chain_stimulus", "lvdt_codes", "flann_design"]

@@ -1,8 +1,9 @@
 """flann_chain_top against FlannChainTop: a waveform's converter codes through the conditioner and
 the FLANN behind it, one strobe every cycles_per_sample clocks (with random extra gaps); every
 window's displacement code and saturation flag in order, each at the twin's latency after the
-window's last strobe (shorter where the divider saturates).  The twin's values come in the configuration (the FLANN's twin is rebuilt
-from the model in the flann process, as the design's other benches are)."""
+window's last strobe (shorter where the divider saturates).  The twin's values come in the
+configuration, computed in the flann process (the FLANN's twin is rebuilt there from the model
+the design keeps)."""
 
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
