@@ -110,7 +110,7 @@ def kept_waveform(design: Design, spec: ConditionerSpec):
     wave = read_waveforms(path, announce=False)
     ref = settings.reference_for(wave)
     windows = len(wave) // spec.window
-    stride = max(1, -(-windows * spec.window // CHAIN_SAMPLES))
+    stride = -(-windows // max(1, CHAIN_SAMPLES // spec.window))   # at most CHAIN_SAMPLES, one window at least
     idx = (np.arange(windows)[::stride, None] * spec.window + np.arange(spec.window)).ravel()
     a = adc_codes(wave.sec_a_v, spec.adc_bits, settings.adc_range_v)[idx]
     b = adc_codes(wave.sec_b_v, spec.adc_bits, settings.adc_range_v)[idx]
