@@ -127,7 +127,12 @@ def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, gene
     d, _err = trained
     _design, out = generated
     design = from_directory(d / "design")
-    assert design.datapath.name == "conditioner" and design.top == "flann_cond_top"
+    # one top entity: the conditioner and its FLANN joined, compiled last
+    assert design.datapath.name == "conditioner" and design.top == "flann_chain_top"
+    assert design.files[-1].name == "flann_chain_top.vhd"
+    assert design.manifest["output_bits"] == flann_design(design).manifest["output_bits"]
+    # the recording the model was trained from, kept for flann sim's whole-chain run
+    assert (d / "design" / design.manifest["waveform"]).read_bytes() == (d / "wave.csv").read_bytes()
     settings = of_model(load_model(d / "model.json"))
     assert design.spec == settings.spec
     assert design.manifest["reference"] == {"offset": settings.reference.offset, "tan": settings.reference.tan}
@@ -136,7 +141,7 @@ def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, gene
     assert flann.manifest["adc_bits"] == settings.spec.ratio_bits and flann.manifest["input_bits"] == 16
     assert flann.manifest["input_lsb_v"] == settings.ratio_lsb * 2 ** (settings.spec.ratio_bits - 16)
     assert {p.name for p in flann.files} < {p.name for p in design.files}
-    assert "not joined" in out
+    assert "joined in flann_chain_top" in out and "kept as waveform.csv" in out
     # a converter of its own is refused: the input is the conditioner's ratio
     rc, _out, err = in_process(["gen", d / "model.json", "-o", d / "other", "--input-bits", 12])
     assert rc == 2 and "ratio" in err and not (d / "other").exists()
@@ -159,6 +164,12 @@ def test_a_tampered_flann_manifest_is_refused(trained, in_process, tmp_path):
     (tmp_path / "design" / "manifest.json").write_text(json.dumps(man))
     with pytest.raises(FlannError, match="does not list"):
         flann_design(open_directory(tmp_path / "design").with_twin())
+    # the chain's top named without the chain it joins
+    man = json.loads((tmp_path / "design" / "manifest.json").read_text())
+    del man["chain"]
+    (tmp_path / "design" / "manifest.json").write_text(json.dumps(man))
+    with pytest.raises(FlannError, match="without a 'chain' field"):
+        open_directory(tmp_path / "design").with_twin()
 
 
 def test_eval_with_the_design_gives_the_hardware_linearity(trained, generated, held_out, in_process):

@@ -83,7 +83,7 @@ def run(args) -> int:
         info(args, f"flann gen: replaced the flann design in {args.output}")
     if emit_json(args, man):
         return 0
-    kept = [f for f in (man.get("model"), *(im["hex"] for im in man.get("images", []))) if f]
+    kept = [f for f in (man.get("model"), *(im["hex"] for im in man.get("images", [])), man.get("waveform")) if f]
     print(f"wrote {len(man['files'])} VHDL files + manifest.json + {', '.join(dict.fromkeys(kept))} to {args.output} "
           f"({dp.name}, top {man['top']})")
     for line in dp.summary(man):

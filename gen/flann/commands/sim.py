@@ -160,6 +160,11 @@ def run(args) -> int:
         if sw.get("vhdl_sample"):
             print(f"  VHDL under GHDL       {sw['vhdl_sample']['codes']} codes (sample)")
         print(f"bit mismatches vs twin  {s['mismatches']}")
+        if isinstance(s.get("chain"), dict):
+            c = s["chain"]
+            print(f"  whole chain           {c['samples']} strobes of {c['source']}: {c['windows']} displacement "
+                  f"codes, {c['mismatches']} mismatches, {'/'.join(map(str, c['latency_cycles'] or []))} clocks "
+                  "after their window")
         if s["max_err_lsb"] is not None:
             print(f"max |HDL - float model| {s['max_err_lsb']:.4f} LSB = {s['max_err_mm']:.6f} mm "
                   f"(1 LSB = {s['output_lsb_mm']} mm)")

@@ -18,6 +18,7 @@ from ..errors import FlannError
 from ..fileio import atomic_save_figure
 from ..golden.metrics import error_report
 from ..numeric.fixed import nearest_codes, signed_range
+from .adc import wired_codes
 from .registry import read_design
 from .fixed.cost import fixed_point_cost
 from .fixed.spec import Spec
@@ -63,10 +64,7 @@ def adc_codes(spec: Spec, voltage_v, adc: tuple[int, float] | None = None) -> np
     range; from a converter wider than the design, its top ``spec.input_bits`` bits (the low
     bits are not wired: a floor, as an arithmetic shift right)."""
     bits, lsb = adc if adc is not None else (spec.input_bits, spec.input_lsb_v)
-    drop = bits - spec.input_bits
-    if drop < 0:
-        raise FlannError(f"ADC of {bits} bits is narrower than the design's {spec.input_bits}-bit input")
-    c = nearest_codes(voltage_v, lsb, *signed_range(bits)) >> drop
+    c = wired_codes(nearest_codes(voltage_v, lsb, *signed_range(bits)), bits, spec.input_bits)
     return np.clip(c, spec.code_min, spec.code_max)
 
 

@@ -93,6 +93,15 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
     return AdcPlan(bits, lsb, eff_bits, eff_lsb, dropped, tuple(notes))
 
 
+def wired_codes(codes, adc_bits: int, input_bits: int) -> np.ndarray:
+    """A converter's ``adc_bits``-bit codes as a design of ``input_bits`` receives them: its top
+    bits (the low ``adc_bits - input_bits`` are not wired: a floor, as an arithmetic shift right)."""
+    drop = int(adc_bits) - int(input_bits)
+    if drop < 0:
+        raise SpecError(f"ADC of {adc_bits} bits is narrower than the design's {input_bits}-bit input")
+    return np.asarray(codes, dtype=np.int64) >> drop
+
+
 def check_converter(voltage_range_v, input_bits, input_lsb_v=None,
                     clamp: bool = True) -> tuple[int, float, bool]:
     """(bits, volts per code, whether the LSB was given) of a converter that can carry the
@@ -208,5 +217,5 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
 
 __all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "check_converter", "check_output_step", "default_input_lsb",
            "default_lsb_for_range", "default_output_step_mm",
-           "max_mm_per_v", "model_accuracy_mm", "pathological_hint", "weight_range_text",
+           "max_mm_per_v", "model_accuracy_mm", "wired_codes", "pathological_hint", "weight_range_text",
            "MAX_DESIGN_INPUT_BITS", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]

@@ -149,6 +149,7 @@ class Datapath:
     derive: Callable | None = None     # (FlannModel, **derive options) -> spec of a model with no design directory
     number_format: str = ""            # the arithmetic of its products and sum (what flann gen --format names)
     common: tuple = COMMON_FIELDS      # the shared key set (a design flann did not write: fewer)
+    other_tops: tuple = ()             # further top entities its designs may have (a top joining it to another)
 
     def lacking(self, directory, what: str) -> FlannError:
         """The one-line refusal of a command its designs cannot take: ``what`` they have none of."""
@@ -157,9 +158,9 @@ class Datapath:
 
     def check(self, man: dict, where) -> None:
         check_fields(man, tuple(self.common) + tuple(self.fields), where)
-        if self.top and man["top"] != self.top:
+        if self.top and man["top"] not in (self.top, *self.other_tops):
             raise FlannError(f"{where}: field 'top' is {man['top']!r}, the {self.name} datapath's top is "
-                             f"{self.top!r}")
+                             + " or ".join(repr(t) for t in (self.top, *self.other_tops)))
 
     def model_path(self, directory: Path, man: dict) -> Path | None:
         name = man.get(self.model_field)

@@ -73,7 +73,8 @@ def foreign_entries(directory: Path) -> list[str]:
     except FlannError:
         man = {}
     man = man if isinstance(man, dict) else {}
-    own = {MANIFEST, man.get("model"), man.get("init_model")} | set(f for f in man.get("files", []) if isinstance(f, str))
+    own = {MANIFEST, man.get("model"), man.get("init_model"), man.get("waveform")}
+    own |= set(f for f in man.get("files", []) if isinstance(f, str))
     own |= {im.get(k) for im in man.get("images", []) if isinstance(im, dict) for k in ("hex", "model")}
     return sorted(p.name + ("/" if p.is_dir() else "") for p in directory.iterdir() if p.name not in own)
 
@@ -152,7 +153,8 @@ def _clamp_codes(path: Path, data: dict) -> None:
 # recording (any characters but a directory separator)
 _NAMES = {"vhd": re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+-]*\.vhd"),
           "json": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.json"),
-          "hex": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.hex")}
+          "hex": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.hex"),
+          "csv": re.compile(r"(?!\.\.?$)[^/\\\x00]+\.csv")}
 
 
 def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str, must_exist: bool = True) -> Path:
@@ -176,8 +178,9 @@ def _listed_file(path: Path, directory: Path, name: str, suffix: str, what: str,
 
 
 def _kept_files(path: Path, directory: Path, data: dict) -> None:
-    """The model and weight images a design keeps beside its VHDL, confined like its files (a
-    missing one is the reader's to report: a design may be checked in without its model)."""
+    """The model, weight images and waveform recording a design keeps beside its VHDL, confined
+    like its files (a missing one is the reader's to report: a design may be checked in without
+    its model)."""
     for key in ("model", "init_model"):
         model = data.get(key)
         if model is not None:
@@ -185,6 +188,11 @@ def _kept_files(path: Path, directory: Path, data: dict) -> None:
                 raise FlannError(f"{path}: field {key!r} must be a file name, got {model!r}")
             _listed_file(path, directory, model, "json", "kept model" if key == "model" else "initial model",
                          must_exist=False)
+    waveform = data.get("waveform")
+    if waveform is not None:
+        if not isinstance(waveform, str):
+            raise FlannError(f"{path}: field 'waveform' must be a file name, got {waveform!r}")
+        _listed_file(path, directory, waveform, "csv", "kept waveform recording", must_exist=False)
     images = data.get("images")
     if images is None:
         return

@@ -8,13 +8,19 @@ window's last strobe to its ratio) and the spec.
 ``flann gen MODEL`` of a model trained from waveforms (its ``conditioner`` settings) writes the
 same directory at the model's settings together with the FLANN's fixed-point design (its
 entities, the model, and its own manifest under the field ``flann``), which takes the ratio
-code as its converter: one directory that ``flann sim`` verifies whole.  The two are not joined
-into one top entity: ``flann_cond_top``'s ``out_ratio`` feeds ``flann_top``'s ``in_data``
-through the bits the FLANN's manifest names (``adc_bits`` -> ``input_bits``), and the
-calibrated reference (``reference``: ``in_offset``, ``in_tan``) is a constant of the board.
+code as its converter, and the two joined in one top entity, ``flann_chain_top``
+(:mod:`.chain`): converter codes in, displacement code out.  The top-level fields then describe
+the chain (``output_bits`` the FLANN's, ``latency_cycles`` from a window's last strobe to its
+displacement code), ``chain`` records how the two are joined, and the calibrated reference
+(``reference``: ``in_offset``, ``in_tan``) is a constant of the board.  The recording the model
+was trained from, when it lies beside the model (or in the working directory) with the sha256
+the model records, is kept as ``waveform`` for ``flann sim``'s whole-chain run.
 """
 
 from __future__ import annotations
+
+import hashlib
+from pathlib import Path
 
 from ...errors import FlannError
 from ...golden.model import load_model
@@ -25,6 +31,7 @@ from ..fixed import render as fixed_render
 from ..header import NO_MODEL
 from ..manifest import write_design
 from ..options import GenOptions
+from .chain import CHAIN_TOP, ChainSpec, render_chain
 from .render import ENTITIES, TOP, cycles_per_sample, render
 from .settings import flann_options, of_model
 from .spec import ConditionerSpec
@@ -33,8 +40,9 @@ from ... import __version__
 
 NAME = "conditioner"
 FLANN = "flann"   # the manifest field holding the FLANN design's own manifest
-LACKS = ("written from a spec, or beside a FLANN not joined to it, it has the conditioner's benches and the "
-         "FLANN's (flann sim) and synthesis (flann synth) only")
+WAVEFORM = "waveform.csv"   # the training recording, kept for flann sim's whole-chain run
+LACKS = ("written from a spec, or joined to its FLANN, it has the conditioner's benches and the FLANN's (flann sim) "
+         "and synthesis (flann synth) only")
 
 
 def latency_cycles(spec: ConditionerSpec) -> int:
@@ -59,14 +67,40 @@ def rebuild(model, man: dict, where="design"):
         spec = ConditionerSpec(**man["spec"])
     except TypeError as exc:
         raise FlannError(f"{where}: the manifest's spec is not a conditioner's ({exc})") from None
-    if man.get("output_bits") != spec.ratio_bits or man.get("input_bits") != spec.adc_bits:
+    chain = man.get("chain")
+    if (man.get("top") == CHAIN_TOP) != isinstance(chain, dict) or (chain is not None and FLANN not in man):
+        raise FlannError(f"{where}: top {man.get('top')!r} with{'' if chain is not None else 'out'} a 'chain' field "
+                         f"(the conditioner joined to its FLANN has top {CHAIN_TOP!r}, a chain and a {FLANN!r} "
+                         "field): regenerate the design")
+    out_bits = chain.get("flann_output_bits") if isinstance(chain, dict) else spec.ratio_bits
+    if man.get("output_bits") != out_bits or man.get("input_bits") != spec.adc_bits or \
+            (isinstance(chain, dict) and chain.get("conditioner") != spec.to_dict()):
         raise FlannError(f"{where}: input_bits/output_bits differ from its spec: regenerate the design")
     return spec, spec.to_dict()
 
 
+def training_waveform(model_path, m) -> str | None:
+    """The recording ``m`` was trained from, found beside the model file or in the working
+    directory under the name the model records, with the sha256 it records; None elsewhere."""
+    training = m.training if isinstance(m.training, dict) else {}
+    name, sha = training.get("data_file"), training.get("data_sha256")
+    if not isinstance(name, str) or not isinstance(sha, str) or Path(name).name != name:
+        return None
+    for place in (Path(model_path).resolve().parent, Path.cwd()):
+        path = place / name
+        if path.is_file():
+            data = path.read_bytes()
+            if hashlib.sha256(data).hexdigest() == sha:
+                try:
+                    return data.decode("utf-8")
+                except UnicodeDecodeError:
+                    return None   # kept as text, byte for byte: a recording in another encoding is not
+    return None
+
+
 def generate(model, out_dir, options: GenOptions | None = None, **_extra) -> dict:
-    """The conditioner at the settings of ``model`` (trained from waveforms) and its FLANN, one
-    directory; returns the manifest."""
+    """The conditioner at the settings of ``model`` (trained from waveforms), its FLANN and the
+    chain joining them, one directory; returns the manifest."""
     m = load_model(model)
     settings = of_model(m, str(model))
     if settings is None:
@@ -78,25 +112,37 @@ def generate(model, out_dir, options: GenOptions | None = None, **_extra) -> dic
     fman = fixed_render.manifest(fspec, list(ftexts), plan_adc(fspec.model, opts.input_bits, opts.input_lsb_v,
                                                                 opts.clamp))
     spec = settings.spec
-    ctexts = render(spec)
+    chain = ChainSpec(spec, fspec, fman["top"])   # refuses a FLANN slower than the ratio
+    ctexts, chtexts = render(spec), render_chain(chain, model_sha256=fspec.model_sha256)
     ref = settings.reference
+    texts = {**ctexts, **ftexts, **chtexts, fixed_render.MODEL_FILE: fixed_render.model_text(model)}
     man = {**manifest(spec, 2.0 * settings.adc_range_v / (1 << spec.adc_bits)),
-           "files": [*ctexts, *ftexts], "model": fixed_render.MODEL_FILE, "model_sha256": fspec.model_sha256,
-           "reference": {"offset": ref.offset, "tan": ref.tan}, FLANN: fman}
-    return write_design({**ctexts, **ftexts, fixed_render.MODEL_FILE: fixed_render.model_text(model)}, man, out_dir)
+           "top": CHAIN_TOP, "files": [*ctexts, *ftexts, *chtexts], "output_bits": fspec.out_fmt.width,
+           "output_lsb_mm": fspec.output_lsb_mm, "latency_cycles": chain.latency,
+           "model": fixed_render.MODEL_FILE, "model_sha256": fspec.model_sha256,
+           "reference": {"offset": ref.offset, "tan": ref.tan}, "chain": chain.to_dict(), FLANN: fman}
+    wave = training_waveform(model, m)
+    if wave is not None:
+        texts[WAVEFORM] = wave
+        man["waveform"] = WAVEFORM
+    return write_design(texts, man, out_dir)
 
 
 def summary(man: dict) -> list[str]:
     s, ref = man["spec"], man.get("reference", {})
     lines = [f"  conditioner: {s['adc_bits']}-bit converters, {s['samples_per_period']} samples a period, "
-             f"{s['periods_per_output']} periods a ratio of {man['output_bits']} bits; reference in_offset "
+             f"{s['periods_per_output']} periods a ratio of {s['ratio_frac_bits'] + 1} bits; reference in_offset "
              f"{ref.get('offset')}, in_tan {ref.get('tan')}"]
-    flann = man.get(FLANN)
-    if isinstance(flann, dict):
-        dropped = flann["adc_bits"] - flann["input_bits"]
-        lines.append(f"  FLANN ({flann['top']}) behind it, not joined: wire out_ratio({flann['adc_bits'] - 1} downto "
-                     f"{dropped}) to its in_data")
+    flann, chain = man.get(FLANN), man.get("chain")
+    if isinstance(flann, dict) and isinstance(chain, dict):
+        lines.append(f"  FLANN ({flann['top']}) behind it, joined in {man['top']}: "
+                     f"out_ratio({man['spec']['ratio_frac_bits']} downto {chain['dropped_ratio_bits']}) to its "
+                     f"in_data; {man['output_bits']}-bit displacement code {man['latency_cycles']} clocks after a "
+                     "window's last strobe")
         lines += fixed_datapath.summary(flann)
+        lines.append("  flann sim's whole-chain run: " + (f"the training recording, kept as {man['waveform']}"
+                     if man.get("waveform") else "the closed-form LVDT (the training recording was not found "
+                     "beside the model under the name and sha256 it records)"))
     return lines
 
 
@@ -105,7 +151,7 @@ DATAPATH = Datapath(
     generate=generate, rebuild=rebuild, twin=ConditionerChain, estimate=lambda man: None,
     fields=(_int("spec.adc_bits", 4), _int("spec.table_bits", 2), _int("spec.sine_bits", 4),
             _int("spec.samples_per_period", 8), _int("spec.periods_per_output"), _int("spec.ratio_frac_bits")),
-    model_field="", lacks=LACKS, ise=False, summary=summary,
+    model_field="", lacks=LACKS, ise=False, summary=summary, other_tops=(CHAIN_TOP,),
 )
 
-__all__ = ["DATAPATH", "write_conditioner", "manifest", "latency_cycles"]
+__all__ = ["DATAPATH", "write_conditioner", "manifest", "latency_cycles", "training_waveform", "WAVEFORM"]

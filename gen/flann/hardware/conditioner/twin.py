@@ -152,6 +152,8 @@ class FlannCondRatio:
         """Clocks from the strobe to the ratio: the operands, then one quotient bit a clock."""
         return self.spec.ratio_frac_bits + 3
 
+    saturated_latency = 2   # a saturated ratio: the operands, then the judgement (no division)
+
     def process(self, a, b) -> RatioOut:
         f = self.spec.ratio_frac_bits
         out, sat = [], []

@@ -3,8 +3,11 @@ its twin (the converter port on every code, the NCO over every phase it visits, 
 boundary cases for the demodulator, the rotation and the divider), then a waveform through the
 whole chain (``flann_cond_top`` against :class:`~.twin.ConditionerChain`), 0 mismatches.  A
 directory ``flann gen`` wrote from a model trained from waveforms also holds the FLANN behind the
-conditioner: its own benches (every input code against its twin) run after the conditioner's,
-one summary for both.
+conditioner and the chain joining them: the FLANN's own benches (every input code against its
+twin) run after the conditioner's, then a waveform through ``flann_chain_top`` against
+:class:`~.chain.FlannChainTop` (the recording the model was trained from when the directory
+keeps it, whole windows of it at a stride, at most ``CHAIN_SAMPLES`` strobes; else the
+closed-form LVDT below), one summary for all.
 
 The waveform is an LVDT's in closed form (the verify layer sits below the physics simulator):
 the secondaries ``(1 +- u) / 2`` of the carrier at a phase off the table's steps, a quadrature
@@ -14,6 +17,7 @@ stroke (the divider's saturation); the reference is calibrated on it as the hard
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import asdict
 from pathlib import Path
@@ -21,6 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import FlannError
+from ...golden.model import load_model
+from ...recordings.waveform import read_waveforms
 from ...verify.plugin import Verification
 from ...verify.results import SimResult, bench_entry, summary
 from ...verify.runner import BenchResult, run_cocotb
@@ -28,10 +34,12 @@ from ..design import Design
 from ..fixed.verify import VERIFICATION as FIXED_VERIFICATION
 from ..manifest import MANIFEST, Manifest
 from ..registry import FIXED, check_widths
+from .chain import CHAIN_TOP, ChainSpec, FlannChainTop
 from .datapath import FLANN
-from .condition import calibrate_reference
+from .condition import adc_codes, calibrate_reference
+from .settings import of_model
 from .render import cycles_per_sample
-from .spec import ConditionerSpec, identity
+from .spec import ConditionerSpec, Reference, identity
 from .twin import ConditionerChain
 
 # the chain's stimulus: one position a window, the phase of the secondaries against the
@@ -50,6 +58,8 @@ BLOCKS = {
     "ratio": ("flann_cond_ratio", "cond_ratio_bench", lambda s: dict(pairs=300)),
 }
 TOP_BENCH = "cond_top_bench"
+CHAIN_BENCH = "cond_chain_bench"
+CHAIN_SAMPLES = 4096   # the whole-chain run's strobes at most: a few seconds under GHDL and cocotb
 
 
 def run_block(files, spec: ConditionerSpec, entity: str, module: str, build_dir, *, seed: int = 1,
@@ -80,6 +90,66 @@ def run_chain(files, spec: ConditionerSpec, build_dir, *, seed: int = 1) -> tupl
     res = run_block(files, spec, ConditionerChain.entity, TOP_BENCH, build_dir, seed=seed, codes_a=a.tolist(),
                     codes_b=b.tolist(), ref=asdict(ref), cycles_per_sample=cycles_per_sample(spec))
     return res, int(a.size)
+
+
+def kept_waveform(design: Design, spec: ConditionerSpec):
+    """(codes A, codes B, reference, what they are) of the training recording the directory keeps:
+    whole windows at a stride (each starts on a whole carrier period, so the NCO's phase runs on
+    across the windows left out), at the model's reference turned by the record's excitation;
+    None when it keeps none."""
+    name = design.manifest.get("waveform")
+    if name is None:
+        return None
+    model = load_model(design.directory / design.manifest["model"])
+    settings = of_model(model, str(design.directory / design.manifest["model"]))
+    path = design.directory / name
+    sha = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else None
+    if settings is None or sha != (model.training or {}).get("data_sha256"):
+        raise FlannError(f"{path}: not the recording {design.manifest['model']} was trained from "
+                         "(missing or edited): regenerate the design with flann gen")
+    wave = read_waveforms(path, announce=False)
+    ref = settings.reference_for(wave)
+    windows = len(wave) // spec.window
+    stride = -(-windows // max(1, CHAIN_SAMPLES // spec.window))   # at most CHAIN_SAMPLES, one window at least
+    idx = (np.arange(windows)[::stride, None] * spec.window + np.arange(spec.window)).ravel()
+    a = adc_codes(wave.sec_a_v, spec.adc_bits, settings.adc_range_v)[idx]
+    b = adc_codes(wave.sec_b_v, spec.adc_bits, settings.adc_range_v)[idx]
+    return a, b, ref, f"{name} (the training recording), one window in {stride}"
+
+
+def chain_stimulus(design: Design, spec: ConditionerSpec):
+    """(codes A, codes B, reference, what they are) of the whole-chain run: the kept training
+    recording, else the closed-form LVDT calibrated as the hardware is."""
+    kept = kept_waveform(design, spec)
+    if kept is not None:
+        return kept
+    a, b, x = lvdt_codes(spec)
+    ref, _phase = calibrate_reference(spec, ConditionerChain(spec).process(a, b, identity(spec)), x)
+    return a, b, ref, "the closed-form LVDT"
+
+
+def run_chain_top(files, chain: ChainSpec, codes_a, codes_b, ref: Reference, build_dir, *,
+                  seed: int = 1) -> BenchResult:
+    """Converter codes through ``flann_chain_top`` (built from ``files``: every entity's) against
+    :class:`FlannChainTop`, whose values the bench is given."""
+    want = FlannChainTop(chain).process(codes_a, codes_b, ref)
+    spec = chain.conditioner
+    return run_cocotb(files, CHAIN_TOP, CHAIN_BENCH, build_dir,
+                      {"spec": spec.to_dict(), "codes_a": np.asarray(codes_a).tolist(),
+                       "codes_b": np.asarray(codes_b).tolist(), "ref": asdict(ref),
+                       "cycles_per_sample": cycles_per_sample(spec),
+                       "latencies": chain.latencies(want.ratio_sat).tolist(),
+                       "expected": [[int(d), int(s)] for d, s in zip(want.out_data, want.out_sat)]},
+                      name=CHAIN_TOP, seed=seed)
+
+
+def run_whole_chain(design: Design, flann: Design, build_dir, *, seed: int = 1) -> tuple[BenchResult, dict]:
+    """A waveform through ``flann_chain_top`` against :class:`FlannChainTop`; (bench result, what
+    was run)."""
+    chain = ChainSpec(design.spec, flann.spec, flann.manifest["top"])
+    a, b, ref, source = chain_stimulus(design, design.spec)
+    return run_chain_top(design.files, chain, a, b, ref, build_dir, seed=seed), {"samples": int(a.size),
+                                                                                "source": source}
 
 
 def flann_design(design: Design) -> Design | None:
@@ -118,17 +188,24 @@ def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
     f = fres.summary
     cond = {"samples": samples, "mismatches": s["mismatches"], "windows": s["windows"],
             "saturated_windows": s["saturated_windows"]}
-    bad = None if s["mismatches"] is None or f["mismatches"] is None else s["mismatches"] + f["mismatches"]
-    merged = {**f, "codes_tested": samples + f["codes_tested"], "mismatches": bad, "conditioner": cond,
+    cres, whole = run_whole_chain(design, flann, build_dir / "chain", seed=seed)
+    crec = cres.records.get("cond_chain", {})
+    whole.update({k: crec.get(k) for k in ("windows", "mismatches", "saturated", "latency_cycles")})
+    parts = (s["mismatches"], f["mismatches"], whole["mismatches"])
+    bad = None if None in parts else sum(parts)
+    merged = {**f, "codes_tested": samples + f["codes_tested"] + whole["samples"], "mismatches": bad,
+              "conditioner": cond, "chain": whole,
               "flann": {k: f[k] for k in ("codes_tested", "mismatches", "max_err_lsb", "max_err_mm",
                                           "cycles_per_sample", "latency_cycles")},
               "cycles_per_sample": s["cycles_per_sample"], "latency_cycles": s["latency_cycles"],
-              "benches": {**s["benches"], **{f"{FLANN}_{n}": b for n, b in f["benches"].items()}},
-              "all_passed": ok and fres.passed}
+              "benches": {**s["benches"], **{f"{FLANN}_{n}": b for n, b in f["benches"].items()},
+                          "chain": bench_entry(cres)},
+              "all_passed": ok and fres.passed and cres.ok and bool(crec)}
     merged.update({k: s[k] for k in s if k.startswith("samples_per_s") or k == "clock_hz"})
     return SimResult(merged, fres.curve, spec, merged["all_passed"], fres.bound_lsb)
 
 
 VERIFICATION = Verification(bench=bench)
 
-__all__ = ["VERIFICATION", "BLOCKS", "run_block", "run_chain", "lvdt_codes", "flann_design"]
+__all__ = ["VERIFICATION", "BLOCKS", "CHAIN_SAMPLES", "run_block", "run_chain", "run_whole_chain", "run_chain_top",
+           "chain_stimulus", "lvdt_codes", "flann_design"]
