@@ -49,6 +49,8 @@ CACHE_BYTES = 200e6
 # rise, and by RAIL_T standard errors, are not on a rail (see PhysicsFamily.implausible)
 RAIL_SLOPE = 0.1
 RAIL_T = 3.0
+# simulated outputs a family keeps (a fit's Jacobian asks for a handful at a time)
+SIM_CACHE = 64
 # Levenberg-Marquardt stops when the relative change of the sum of squares (and of the
 # step) is below this: 1e-5 of the RSS moves BIC (n ln RSS) by 0.02 on 2,000 points, far
 # inside the 10 it must move by; tighter only wandered on (up to 4x the evaluations)
@@ -210,6 +212,7 @@ class PhysicsFamily:
         self.untestable = self._untestable()
         self.candidates = tuple(c for c in CANDIDATES if c not in self.untestable)
         self._shape_cache: dict = {}
+        self._sim_cache: dict = {}
         self.nfev = 0
 
     # -- which effects these recordings can reveal ----------------------------------
@@ -358,21 +361,16 @@ class PhysicsFamily:
         d = self.data
         curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
-        s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
         core = (d.x[idx] - self.origin0) * self.scale
-        direction = None if d.direction is None else d.direction[idx]
-        temp = None if d.temperature_c is None else d.temperature_c[idx]
-        time = None if d.time_s is None else d.time_s[idx]
         # The core positions use the calibrated origin, so the simulator's magnetics cache
         # is hit whenever no position effect is on; a change of origin enters to first
         # order through the slope (it is ~1e-3 mm inside the effect fits).
-        y = simulate_output_v(s, core, direction=direction, temperature_c=temp, time_s=time)
+        y = self._simulate(gain, inner, idx, core)
         if curvature:
             # the imbalance's even part follows the sum of the secondaries, whose change
             # along the stroke the calibrated simulation knows only roughly: let it bend
             without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
-            y0 = simulate_output_v(s.replace(effects=without), core, direction=direction,
-                                   temperature_c=temp, time_s=time)
+            y0 = self._simulate(gain, without, idx, core)
             u = core / self._half_range()
             y = y + curvature * u ** 2 * (y - y0)
         if self.shape is not None:
@@ -408,6 +406,30 @@ class PhysicsFamily:
         if "adc_clipping" in eff:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
+
+    def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """The simulated output with the simulator's own effects ``inner`` at the points
+        ``idx``, cached on what it depends on: a finite-difference step of a parameter the
+        simulator does not see (origin, shape, offset, the sum's bend, rails; the gain
+        without a quadrature null) then costs no simulation.  Without a quadrature null the
+        demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
+        output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
+        linear = "quadrature_null" not in inner
+        s = self.sensor.replace(demodulator_gain_ratio=gain)   # the gain is checked as before
+        key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
+               idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        y = self._sim_cache.get(key)
+        if y is None:
+            d = self.data
+            if len(self._sim_cache) >= SIM_CACHE:
+                self._sim_cache.clear()
+            s = s.replace(demodulator_gain_ratio=1.0 if linear else gain, effects=inner)
+            y = simulate_output_v(
+                s, core, direction=None if d.direction is None else d.direction[idx],
+                temperature_c=None if d.temperature_c is None else d.temperature_c[idx],
+                time_s=None if d.time_s is None else d.time_s[idx])
+            self._sim_cache[key] = y
+        return gain * y if linear else y
 
     def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray, shift: float = 0.0):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
@@ -647,6 +669,7 @@ class PhysicsFamily:
             new.terms = 0
         if fresh_cache:
             new._shape_cache = {}
+            new._sim_cache = {}
         return new
 
     def basis(self, k: int):
