@@ -213,6 +213,8 @@ class PhysicsFamily:
         self.candidates = tuple(c for c in CANDIDATES if c not in self.untestable)
         self._shape_cache: dict = {}
         self._sim_cache: dict = {}
+        self._plans: dict = {}
+        self._gain_checked = math.nan
         self.nfev = 0
 
     # -- which effects these recordings can reveal ----------------------------------
@@ -297,27 +299,39 @@ class PhysicsFamily:
 
     # -- the model -------------------------------------------------------------------
     def _unpack(self, theta: np.ndarray, names: list[str]):
+        pos, plan = self._plan(names)
         gain = theta[0]
-        pos = 1
-        origin = self.origin0
-        if not self.origin_known:
-            origin = theta[pos]
-            pos += 1
-        shape = None
-        if self.shape is not None:
-            shape = theta[pos:pos + self.shape.k]
-            pos += self.shape.k
+        origin = self.origin0 if self.origin_known else theta[1]
+        shape = None if self.shape is None else theta[pos - self.shape.k:pos]
         eff: dict[str, dict[str, float]] = {}
-        for name, v in zip(names[pos:], theta[pos:]):
-            e, p = name.split(".", 1)
-            eff.setdefault(e, {})[p] = float(v)
-        for e, params in eff.items():
-            full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
-            if e == "thermal_drift":
-                full["reference_temperature_c"] = self.t_ref
-            full.update(params)
-            eff[e] = full
+        for e, full, params in plan:
+            eff[e] = dict(full)
+            eff[e].update((p, float(theta[i])) for p, i in params)
         return float(gain), float(origin), shape, eff
+
+    def _plan(self, names) -> tuple:
+        """How a parameter vector with ``names`` unpacks (every evaluation asks): where the
+        effects start, and per effect its neutral parameters and (name, index) of the fitted
+        ones; and the indices :meth:`_physical` bounds."""
+        key = tuple(names)
+        hit = self._plans.get(key)
+        if hit is None:
+            pos = 1 + (not self.origin_known) + (0 if self.shape is None else self.shape.k)
+            grouped: dict[str, list] = {}
+            for i, name in enumerate(names[pos:], pos):
+                e, p = name.split(".", 1)
+                grouped.setdefault(e, []).append((p, i))
+            plan = []
+            for e, params in grouped.items():
+                full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
+                if e == "thermal_drift":
+                    full["reference_temperature_c"] = self.t_ref
+                plan.append((e, full, tuple(params)))
+            one = np.array([i for i, n in enumerate(names) if n in self._ONE_SIDED], dtype=np.intp)
+            two = [i for i, n in enumerate(names) if n not in self._ONE_SIDED and n in self._CLIPPED]
+            bounds = np.array([self._CLIPPED[names[i]] for i in two], dtype=float).reshape(-1, 2)
+            hit = self._plans[key] = (pos, tuple(plan), one, np.array(two, dtype=np.intp), bounds)
+        return hit[:2]
 
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
@@ -329,11 +343,12 @@ class PhysicsFamily:
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
         """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
         th = np.array(theta, dtype=float)
-        for i, n in enumerate(names):
-            if n in self._ONE_SIDED:
-                th[i] = abs(th[i])
-            elif n in self._CLIPPED:
-                th[i] = float(np.clip(th[i], *self._CLIPPED[n]))
+        self._plan(names)
+        _, _, one, two, bounds = self._plans[tuple(names)]
+        if one.size:
+            th[one] = np.abs(th[one])
+        if two.size:
+            th[two] = np.clip(th[two], bounds[:, 0], bounds[:, 1])
         return th
 
     @staticmethod
@@ -415,7 +430,9 @@ class PhysicsFamily:
         demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
         output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
         linear = "quadrature_null" not in inner
-        s = self.sensor.replace(demodulator_gain_ratio=gain)   # the gain is checked as before
+        if not gain == self._gain_checked:   # checked as a simulation at this gain would be
+            self.sensor.replace(demodulator_gain_ratio=gain)
+            self._gain_checked = gain
         key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
                idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         y = self._sim_cache.get(key)
@@ -423,7 +440,7 @@ class PhysicsFamily:
             d = self.data
             if len(self._sim_cache) >= SIM_CACHE:
                 self._sim_cache.clear()
-            s = s.replace(demodulator_gain_ratio=1.0 if linear else gain, effects=inner)
+            s = self.sensor.replace(demodulator_gain_ratio=1.0 if linear else gain, effects=inner)
             y = simulate_output_v(
                 s, core, direction=None if d.direction is None else d.direction[idx],
                 temperature_c=None if d.temperature_c is None else d.temperature_c[idx],
@@ -441,10 +458,12 @@ class PhysicsFamily:
         if hit is None:
             # bounded in bytes too: an entry (basis and pseudo-inverse) is 2 n K floats, and
             # 400 of them on 10,000 points with 32 columns held 2 GB
-            held = sum(2 * v[0].nbytes for k, v in self._shape_cache.items() if k[0] == "disc")
-            if len(self._shape_cache) > 400 or held > CACHE_BYTES:
+            held = self._shape_cache.setdefault(("bytes",), [0.0])
+            if len(self._shape_cache) > 400 or held[0] > CACHE_BYTES:
                 self._shape_cache.clear()
+                held = self._shape_cache.setdefault(("bytes",), [0.0])
             B = basis.evaluate(core, shift)
+            held[0] += 2 * B.nbytes
             store: list = []
 
             def pinv():
@@ -667,6 +686,7 @@ class PhysicsFamily:
             setattr(new, k, v)
         if new.shape_ref is None:
             new.terms = 0
+        new._plans = {}
         if fresh_cache:
             new._shape_cache = {}
             new._sim_cache = {}
