@@ -330,7 +330,9 @@ class PhysicsFamily:
             one = np.array([i for i, n in enumerate(names) if n in self._ONE_SIDED], dtype=np.intp)
             two = [i for i, n in enumerate(names) if n not in self._ONE_SIDED and n in self._CLIPPED]
             bounds = np.array([self._CLIPPED[names[i]] for i in two], dtype=float).reshape(-1, 2)
-            hit = self._plans[key] = (pos, tuple(plan), one, np.array(two, dtype=np.intp), bounds)
+            turn = [i for i, n in enumerate(names) if n in self._TURNS]
+            hit = self._plans[key] = (pos, tuple(plan), one, np.array(two, dtype=np.intp), bounds,
+                                      tuple(turn))
         return hit[:2]
 
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
@@ -340,15 +342,24 @@ class PhysicsFamily:
                 "secondary_imbalance.sum_curvature": (-0.9, 3.0),
                 "thermal_drift.coefficient_per_c": (-0.2, 0.2)}
 
+    # angles, with the range the catalogue accepts
+    _TURNS = {"leadscrew_periodic.phase_rad": EFFECTS["leadscrew_periodic"].bounds()["phase_rad"]}
+
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
         """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
         th = np.array(theta, dtype=float)
         self._plan(names)
-        _, _, one, two, bounds = self._plans[tuple(names)]
+        _, _, one, two, bounds, turn = self._plans[tuple(names)]
         if one.size:
             th[one] = np.abs(th[one])
         if two.size:
             th[two] = np.clip(th[two], bounds[:, 0], bounds[:, 1])
+        for i in turn:
+            # a phase the fit wound past the catalogue's range (the simulator refuses it and
+            # the whole diagnosis failed) is the same phase within one turn
+            lo, hi = self._TURNS[names[i]]
+            if not lo <= th[i] <= hi:
+                th[i] = math.pi - (math.pi - th[i]) % (2 * math.pi)
         return th
 
     @staticmethod
