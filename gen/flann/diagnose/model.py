@@ -49,6 +49,8 @@ CACHE_BYTES = 200e6
 # rise, and by RAIL_T standard errors, are not on a rail (see PhysicsFamily.implausible)
 RAIL_SLOPE = 0.1
 RAIL_T = 3.0
+# simulated outputs a family keeps (a fit's Jacobian asks for a handful at a time)
+SIM_CACHE = 64
 # Levenberg-Marquardt stops when the relative change of the sum of squares (and of the
 # step) is below this: 1e-5 of the RSS moves BIC (n ln RSS) by 0.02 on 2,000 points, far
 # inside the 10 it must move by; tighter only wandered on (up to 4x the evaluations)
@@ -210,6 +212,9 @@ class PhysicsFamily:
         self.untestable = self._untestable()
         self.candidates = tuple(c for c in CANDIDATES if c not in self.untestable)
         self._shape_cache: dict = {}
+        self._sim_cache: dict = {}
+        self._plans: dict = {}
+        self._gain_checked = math.nan
         self.nfev = 0
 
     # -- which effects these recordings can reveal ----------------------------------
@@ -294,27 +299,41 @@ class PhysicsFamily:
 
     # -- the model -------------------------------------------------------------------
     def _unpack(self, theta: np.ndarray, names: list[str]):
+        pos, plan = self._plan(names)
         gain = theta[0]
-        pos = 1
-        origin = self.origin0
-        if not self.origin_known:
-            origin = theta[pos]
-            pos += 1
-        shape = None
-        if self.shape is not None:
-            shape = theta[pos:pos + self.shape.k]
-            pos += self.shape.k
+        origin = self.origin0 if self.origin_known else theta[1]
+        shape = None if self.shape is None else theta[pos - self.shape.k:pos]
         eff: dict[str, dict[str, float]] = {}
-        for name, v in zip(names[pos:], theta[pos:]):
-            e, p = name.split(".", 1)
-            eff.setdefault(e, {})[p] = float(v)
-        for e, params in eff.items():
-            full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
-            if e == "thermal_drift":
-                full["reference_temperature_c"] = self.t_ref
-            full.update(params)
-            eff[e] = full
+        for e, full, params in plan:
+            eff[e] = dict(full)
+            eff[e].update((p, float(theta[i])) for p, i in params)
         return float(gain), float(origin), shape, eff
+
+    def _plan(self, names) -> tuple:
+        """How a parameter vector with ``names`` unpacks (every evaluation asks): where the
+        effects start, and per effect its neutral parameters and (name, index) of the fitted
+        ones; and the indices :meth:`_physical` bounds."""
+        key = tuple(names)
+        hit = self._plans.get(key)
+        if hit is None:
+            pos = 1 + (not self.origin_known) + (0 if self.shape is None else self.shape.k)
+            grouped: dict[str, list] = {}
+            for i, name in enumerate(names[pos:], pos):
+                e, p = name.split(".", 1)
+                grouped.setdefault(e, []).append((p, i))
+            plan = []
+            for e, params in grouped.items():
+                full = {**EFFECTS[e].neutral(), **NEUTRAL_EXTRA.get(e, {})}
+                if e == "thermal_drift":
+                    full["reference_temperature_c"] = self.t_ref
+                plan.append((e, full, tuple(params)))
+            one = np.array([i for i, n in enumerate(names) if n in self._ONE_SIDED], dtype=np.intp)
+            two = [i for i, n in enumerate(names) if n not in self._ONE_SIDED and n in self._CLIPPED]
+            bounds = np.array([self._CLIPPED[names[i]] for i in two], dtype=float).reshape(-1, 2)
+            turn = [i for i, n in enumerate(names) if n in self._TURNS]
+            hit = self._plans[key] = (pos, tuple(plan), one, np.array(two, dtype=np.intp), bounds,
+                                      tuple(turn))
+        return hit[:2]
 
     _ONE_SIDED = ("quadrature_null.quadrature_v", "backlash.deadband_mm",
                   "leadscrew_periodic.period_mm")
@@ -323,14 +342,24 @@ class PhysicsFamily:
                 "secondary_imbalance.sum_curvature": (-0.9, 3.0),
                 "thermal_drift.coefficient_per_c": (-0.2, 0.2)}
 
+    # angles, with the range the catalogue accepts
+    _TURNS = {"leadscrew_periodic.phase_rad": EFFECTS["leadscrew_periodic"].bounds()["phase_rad"]}
+
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
         """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
         th = np.array(theta, dtype=float)
-        for i, n in enumerate(names):
-            if n in self._ONE_SIDED:
-                th[i] = abs(th[i])
-            elif n in self._CLIPPED:
-                th[i] = float(np.clip(th[i], *self._CLIPPED[n]))
+        self._plan(names)
+        _, _, one, two, bounds, turn = self._plans[tuple(names)]
+        if one.size:
+            th[one] = np.abs(th[one])
+        if two.size:
+            th[two] = np.clip(th[two], bounds[:, 0], bounds[:, 1])
+        for i in turn:
+            # a phase the fit wound past the catalogue's range (the simulator refuses it and
+            # the whole diagnosis failed) is the same phase within one turn
+            lo, hi = self._TURNS[names[i]]
+            if not lo <= th[i] <= hi:
+                th[i] = math.pi - (math.pi - th[i]) % (2 * math.pi)
         return th
 
     @staticmethod
@@ -358,21 +387,16 @@ class PhysicsFamily:
         d = self.data
         curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
-        s = self.sensor.replace(demodulator_gain_ratio=gain, effects=inner)
         core = (d.x[idx] - self.origin0) * self.scale
-        direction = None if d.direction is None else d.direction[idx]
-        temp = None if d.temperature_c is None else d.temperature_c[idx]
-        time = None if d.time_s is None else d.time_s[idx]
         # The core positions use the calibrated origin, so the simulator's magnetics cache
         # is hit whenever no position effect is on; a change of origin enters to first
         # order through the slope (it is ~1e-3 mm inside the effect fits).
-        y = simulate_output_v(s, core, direction=direction, temperature_c=temp, time_s=time)
+        y = self._simulate(gain, inner, idx, core)
         if curvature:
             # the imbalance's even part follows the sum of the secondaries, whose change
             # along the stroke the calibrated simulation knows only roughly: let it bend
             without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
-            y0 = simulate_output_v(s.replace(effects=without), core, direction=direction,
-                                   temperature_c=temp, time_s=time)
+            y0 = self._simulate(gain, without, idx, core)
             u = core / self._half_range()
             y = y + curvature * u ** 2 * (y - y0)
         if self.shape is not None:
@@ -409,6 +433,32 @@ class PhysicsFamily:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
+    def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+        """The simulated output with the simulator's own effects ``inner`` at the points
+        ``idx``, cached on what it depends on: a finite-difference step of a parameter the
+        simulator does not see (origin, shape, offset, the sum's bend, rails; the gain
+        without a quadrature null) then costs no simulation.  Without a quadrature null the
+        demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
+        output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
+        linear = "quadrature_null" not in inner
+        if not gain == self._gain_checked:   # checked as a simulation at this gain would be
+            self.sensor.replace(demodulator_gain_ratio=gain)
+            self._gain_checked = gain
+        key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
+               idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        y = self._sim_cache.get(key)
+        if y is None:
+            d = self.data
+            if len(self._sim_cache) >= SIM_CACHE:
+                self._sim_cache.clear()
+            s = self.sensor.replace(demodulator_gain_ratio=1.0 if linear else gain, effects=inner)
+            y = simulate_output_v(
+                s, core, direction=None if d.direction is None else d.direction[idx],
+                temperature_c=None if d.temperature_c is None else d.temperature_c[idx],
+                time_s=None if d.time_s is None else d.time_s[idx])
+            self._sim_cache[key] = y
+        return gain * y if linear else y
+
     def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray, shift: float = 0.0):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
         inside a fit the basis moves only with a zero shift, so the finite-difference
@@ -419,10 +469,12 @@ class PhysicsFamily:
         if hit is None:
             # bounded in bytes too: an entry (basis and pseudo-inverse) is 2 n K floats, and
             # 400 of them on 10,000 points with 32 columns held 2 GB
-            held = sum(2 * v[0].nbytes for k, v in self._shape_cache.items() if k[0] == "disc")
-            if len(self._shape_cache) > 400 or held > CACHE_BYTES:
+            held = self._shape_cache.setdefault(("bytes",), [0.0])
+            if len(self._shape_cache) > 400 or held[0] > CACHE_BYTES:
                 self._shape_cache.clear()
+                held = self._shape_cache.setdefault(("bytes",), [0.0])
             B = basis.evaluate(core, shift)
+            held[0] += 2 * B.nbytes
             store: list = []
 
             def pinv():
@@ -645,8 +697,10 @@ class PhysicsFamily:
             setattr(new, k, v)
         if new.shape_ref is None:
             new.terms = 0
+        new._plans = {}
         if fresh_cache:
             new._shape_cache = {}
+            new._sim_cache = {}
         return new
 
     def basis(self, k: int):
