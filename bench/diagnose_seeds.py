@@ -11,7 +11,8 @@ LVDT, no sensor file, 600 positions out and back, 5 mV noise, seeds 500+k), wher
 diagnosis' model is exact.  Per concealed case it prints:
 
 * the answers (the choice and every alternative, order aside, with the sign of each signed
-  parameter) and how many of the N sensors gave each; reference: the issue's target, the
+  parameter the report states: not of one "not determined by these recordings", whose
+  uncertainty exceeds it) and how many of the N sensors gave each; reference: the issue's target, the
   same answer in at least 19 of 20;
 * how many named the concealed set first, and how many offered it at all (the choice or an
   alternative); reference: every one of them; for a concealed pair, also the pair fitted as
@@ -110,7 +111,8 @@ def answer(dg) -> str:
     signs = sorted({f"{e.name}.{p}{'+' if v['value'] > 0 else '-'}"
                     for _, effects in explanations(dg) for e in effects
                     for p, v in e.params.items()
-                    if p in SIGNED and isinstance(v.get("value"), float)})
+                    if p in SIGNED and isinstance(v.get("value"), float)
+                    and v.get("determined", True)})
     return " | ".join(sets) + (f"   [{' '.join(signs)}]" if signs else "")
 
 

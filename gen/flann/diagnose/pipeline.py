@@ -23,7 +23,7 @@ from ..recordings import Recordings, converter_step, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
-from .confound import (Confounding, Separation, equivalent_sets, separations,
+from .confound import (Confounding, Separation, equivalent_sets, separations, with_mixtures,
                        with_shape_alternative)
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
@@ -357,7 +357,8 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     if progress:
         progress("testing for equally good explanations")
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
-    conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
+    conf = with_shape_alternative(family, sel, calib.fit_idx, conf, candidates)
+    conf = with_mixtures(family, calib.fit_idx, conf)
     final = sel.final
     if conf.confounded or set(conf.sets[0]) != set(order):
         # the choice is forward selection's set when it is among the equally good ones
