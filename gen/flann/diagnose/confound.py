@@ -285,11 +285,8 @@ def with_shape_alternative(family, sel: Selection, idx, conf: Confounding,
             if g is not None:
                 found.append(((d,), g, f"as good an explanation as {c}, which BIC prefers to "
                                "nothing: the curve bends alike for both"))
-        found.sort(key=lambda t: t[1].bic)
-        return Confounding(((),) + tuple(s for s, _, _ in found),
-                           (0.0,) + tuple(g.bic - sel.final.bic for _, g, _ in found), (),
-                           sel.final, margin, (sel.final,) + tuple(g for _, g, _ in found),
-                           ("",) + tuple(n for _, _, n in found))
+        return _with_more(Confounding(((),), (0.0,), (), sel.final, margin, (sel.final,), ("",)),
+                          found)
     if not hides(named[0]):
         return conf
     best, base = (conf.fits[0] if conf.fits else sel.final), sel.baseline
@@ -303,15 +300,7 @@ def with_shape_alternative(family, sel: Selection, idx, conf: Confounding,
     if not conf.confounded:
         return Confounding((named, ()), (0.0, base.bic - best.bic), (), best, conf.margin,
                            (best, base), ("", note))
-    # beside the other equally good sets, ranked by BIC (theirs are against the best's)
-    top = conf.best or best
-    notes = conf.notes or ("",) * len(conf.sets)
-    rest = sorted(list(zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes[1:]))
-                  + [((), base.bic - top.bic, base, note)], key=lambda t: t[1])
-    return Confounding((named,) + tuple(t[0] for t in rest),
-                       (conf.delta_bic[0],) + tuple(t[1] for t in rest), (), conf.best,
-                       conf.margin, (conf.fits[0],) + tuple(t[2] for t in rest),
-                       (notes[0],) + tuple(t[3] for t in rest))
+    return _with_more(conf, [((), base, note)])
 
 
 def with_mixtures(family, idx, conf: Confounding) -> Confounding:
@@ -329,31 +318,32 @@ def with_mixtures(family, idx, conf: Confounding) -> Confounding:
     quadrature null and an offset: 6.2-6.4 behind, margin 6).  The measurement that tells the
     two effects apart also tells whether both are there."""
     singles = [(s, f) for s, f in zip(conf.sets, conf.fits) if len(s) == 1]
-    if len(singles) < 2:
-        return conf
-    top = min(conf.fits, key=lambda f: f.bic)
-    ref = conf.fits[0].bic - conf.delta_bic[0]     # what conf's ΔBIC are measured against
+    top = min(conf.fits, key=lambda f: f.bic) if conf.fits else None
     have = {frozenset(s) for s in conf.sets}
-    notes = conf.notes or ("",) * len(conf.sets)
-    rest = list(zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes[1:]))
+    more = []
     for (a, fa), (b, fb) in itertools.combinations(singles, 2):
-        key = frozenset(a + b)
-        if key in have or key not in _PAIRS:
+        if frozenset(a + b) in have or frozenset(a + b) not in _PAIRS:
             continue
         common, own = _fitted(family, a + b, idx, min(fa, fb, key=lambda f: f.bic))
         fitted = [f for f in (own, common) if f.ok and f.bic - top.bic
                   - (f.k - top.k) * math.log(max(f.n, 1)) < conf.margin]
         if fitted:
-            f = min(fitted, key=lambda f: f.bic)
-            rest.append((a + b, f.bic - ref, f,
+            more.append((a + b, min(fitted, key=lambda f: f.bic),
                          f"{a[0]} and {b[0]} together: the curve cannot tell either from the "
                          "other, nor from both"))
-    if len(rest) == len(conf.sets) - 1:
-        return conf
-    rest.sort(key=lambda t: t[1])
-    return replace(conf, sets=(conf.sets[0],) + tuple(t[0] for t in rest),
-                   delta_bic=(conf.delta_bic[0],) + tuple(t[1] for t in rest),
-                   shared=tuple(e for e in conf.shared if all(e in t[0] for t in rest)),
+    return _with_more(conf, more) if more else conf
+
+
+def _with_more(conf: Confounding, more) -> Confounding:
+    """``conf`` (with its choice's fit) with the explanations ``more`` ((effects, fit, note)
+    each) among its alternatives, ranked by BIC; their ΔBIC measured as ``conf``'s are."""
+    ref = conf.fits[0].bic - conf.delta_bic[0]
+    notes = conf.notes or ("",) * len(conf.sets)
+    rest = sorted(list(zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes[1:]))
+                  + [(s, f.bic - ref, f, n) for s, f, n in more], key=lambda t: t[1])
+    sets = (conf.sets[0],) + tuple(t[0] for t in rest)
+    return replace(conf, sets=sets, delta_bic=(conf.delta_bic[0],) + tuple(t[1] for t in rest),
+                   shared=tuple(e for e in conf.sets[0] if all(e in s for s in sets)),
                    fits=(conf.fits[0],) + tuple(t[2] for t in rest),
                    notes=(notes[0],) + tuple(t[3] for t in rest))
 
