@@ -121,6 +121,7 @@ def answer(dg) -> tuple[str, dict]:
         for e in effects:
             for p, v in e.params.items():
                 if (p in SIGNED and isinstance(v.get("value"), float) and v.get("stderr")
+                        and v.get("determined", True)
                         and abs(v["value"]) >= SIGN_Z * v["stderr"]):
                     signs[("+".join(names) or "nothing", e.name, p)] = v["value"] > 0
     return " | ".join(sets), signs

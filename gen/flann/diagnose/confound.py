@@ -60,6 +60,9 @@ REPEAT_Z = 2.33
 SAME_READINGS = 20.0
 # at most this many sets are fitted (a budget: each is one nonlinear fit)
 MAX_SETS = 12
+# a mixture's fit names, under this key of its ``extra``, the two effects whose split the
+# recordings do not fix (see with_mixtures)
+UNSPLIT = "unsplit"
 
 
 @dataclass(frozen=True)
@@ -315,8 +318,10 @@ def with_mixtures(family, idx, conf: Confounding) -> Confounding:
     although its second effect does not earn its keep on this curve: that charge is the
     evidence against an effect the curve does not show, and the curve cannot show either of
     two effects it confounds.  Judged by BIC alone, the mixture sat on the margin's edge (a
-    quadrature null and an offset: 6.2-6.4 behind, margin 6).  The measurement that tells the
-    two effects apart also tells whether both are there."""
+    quadrature null and an offset: 6.2-6.4 behind, margin 6).  Its fit is one split of the two
+    effects' sum among many that fit alike: its parameters are not determined (the fit carries
+    the pair under ``UNSPLIT``).  The measurement that tells the two effects apart also tells
+    whether both are there."""
     singles = [(s, f) for s, f in zip(conf.sets, conf.fits) if len(s) == 1]
     top = min(conf.fits, key=lambda f: f.bic) if conf.fits else None
     have = {frozenset(s) for s in conf.sets}
@@ -324,13 +329,17 @@ def with_mixtures(family, idx, conf: Confounding) -> Confounding:
     for (a, fa), (b, fb) in itertools.combinations(singles, 2):
         if frozenset(a + b) in have or frozenset(a + b) not in _PAIRS:
             continue
+        # the better single with the other effect added, at its shape term first: along a
+        # valley the curve does not resolve, a fit that walks the shape terms from there ends
+        # anywhere along it (beside a 0.05 mm moved null, an offset of -14 mV or of -208 mV
+        # with an imbalance of either sign, alike within the noise)
         common, own = _fitted(family, a + b, idx, min(fa, fb, key=lambda f: f.bic))
-        fitted = [f for f in (own, common) if f.ok and f.bic - top.bic
+        fitted = [f for f in (common, own) if f.ok and f.bic - top.bic
                   - (f.k - top.k) * math.log(max(f.n, 1)) < conf.margin]
         if fitted:
-            more.append((a + b, min(fitted, key=lambda f: f.bic),
-                         f"{a[0]} and {b[0]} together: the curve cannot tell either from the "
-                         "other, nor from both"))
+            f = replace(fitted[0], extra={**fitted[0].extra, UNSPLIT: (a[0], b[0])})
+            more.append((a + b, f, f"{a[0]} and {b[0]} together: the curve cannot tell either "
+                         "from the other, nor from both"))
     return _with_more(conf, more) if more else conf
 
 
@@ -444,4 +453,4 @@ def separations(sets) -> tuple[Separation, ...]:
 
 
 __all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded",
-           "separations", "with_mixtures", "with_shape_alternative", "CONFOUND_BIC"]
+           "separations", "with_mixtures", "with_shape_alternative", "CONFOUND_BIC", "UNSPLIT"]
