@@ -91,6 +91,11 @@ def test_quadrature_null_at_a_v_tip_is_named():
     sets = sorted(sorted(a.named) for a in dg.alternatives)
     assert sets == [[], ["null_offset"], ["null_offset", "quadrature_null"]], format_text(dg)
     assert next(a for a in dg.alternatives if a.named == []).note
+    # the null and the offset together: one split of what either explains alone, not a value
+    both = next(a for a in dg.alternatives if len(a.named) == 2)
+    assert all(p.get("determined") is False and "share" in p["why"]
+               for e in both.effects for p in e.params.values())
+    assert "not determined" in format_text(dg)
     assert any("quadrature channel" in s.measurement for s in dg.separate_by)
     # another sensor of the same build, whose noise puts the offset 8 BIC behind the null
     # (the first: 11): the same explanations
