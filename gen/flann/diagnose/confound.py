@@ -21,7 +21,10 @@ the effects it must reproduce); so is a set that another recording of the same s
 put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names a choice
 (the set forward selection built, or the best by BIC when that set is not among them), ranks
 the others as alternatives, and names the measurement that would tell them apart
-(:func:`separations`).
+(:func:`separations`).  Beside an effect the shape term may hide, the effects the curve
+confounds it with are weighed whatever their first-round figure; each set is judged at its own
+shape term and at the choice's (:func:`_near`); two equally good single effects the curve
+confounds are listed together too (:func:`with_mixtures`).
 """
 
 from __future__ import annotations
