@@ -329,18 +329,23 @@ def with_mixtures(family, idx, conf: Confounding) -> Confounding:
     top = min(conf.fits, key=lambda f: f.bic) if conf.fits else None
     have = {frozenset(s) for s in conf.sets}
     more = []
+
+    def fits_as_well(f: Fit) -> bool:
+        return f.ok and f.bic - top.bic - (f.k - top.k) * math.log(max(f.n, 1)) < conf.margin
+
     for (a, fa), (b, fb) in itertools.combinations(singles, 2):
         if frozenset(a + b) in have or frozenset(a + b) not in _PAIRS:
             continue
-        # the better single with the other effect added, at its shape term first: along a
-        # valley the curve does not resolve, a fit that walks the shape terms from there ends
-        # anywhere along it (beside a 0.05 mm moved null, an offset of -14 mV or of -208 mV
-        # with an imbalance of either sign, alike within the noise)
-        common, own = _fitted(family, a + b, idx, min(fa, fb, key=lambda f: f.bic))
-        fitted = [f for f in (common, own) if f.ok and f.bic - top.bic
-                  - (f.k - top.k) * math.log(max(f.n, 1)) < conf.margin]
-        if fitted:
-            f = replace(fitted[0], extra={**fitted[0].extra, UNSPLIT: (a[0], b[0])})
+        # the better single with the other effect added, at its shape term (its own chosen
+        # again only when that does not fit): along a valley the curve does not resolve, a fit
+        # that walks the shape terms ends anywhere along it (beside a 0.05 mm moved null, an
+        # offset of -14 mV or of -208 mV with an imbalance of either sign, alike within the
+        # noise), and each walk is several nonlinear fits
+        f = family.fit(list(a + b), idx, start=min(fa, fb, key=lambda f: f.bic))
+        if f.ok and not fits_as_well(f):
+            f = family.rechoose(list(a + b), idx, f)
+        if fits_as_well(f):
+            f = replace(f, extra={**f.extra, UNSPLIT: (a[0], b[0])})
             more.append((a + b, f, f"{a[0]} and {b[0]} together: the curve cannot tell either "
                          "from the other, nor from both"))
     return _with_more(conf, more) if more else conf
