@@ -18,7 +18,8 @@ diagnosis' model is exact.  Per concealed case it prints:
   alternative); reference: every one of them; for a concealed pair, also the pair fitted as
   the diagnosis fits any set: its BIC against its best single effect and how well its least
   determined effect is told from none (whether the curve carries the pair at all);
-* per signed parameter of each explanation, the spread of its value across the seeds
+* per signed parameter of each explanation whose value the report states, the spread of
+  its value across the seeds
   against the median stated uncertainty (ratio); reference: 1 (0.7-1.3 is agreement on 20
   seeds, a chi distribution's 95 % range).
 
@@ -162,7 +163,8 @@ def run_case(label: str, n: int) -> int:
         for names, reports in sets:
             for e in reports:
                 for p, v in e.params.items():
-                    if p in SIGNED and v.get("stderr") and isinstance(v.get("value"), float):
+                    if (p in SIGNED and v.get("stderr") and isinstance(v.get("value"), float)
+                            and v.get("determined", True)):
                         values.setdefault(("+".join(names), e.name, p), []).append(
                             (v["value"], v["stderr"]))
     top = answers.most_common(1)[0][1]
