@@ -19,9 +19,8 @@ diagnosis' model is exact.  Per concealed case it prints:
   the diagnosis fits any set: its BIC against its best single effect and how well its least
   determined effect is told from none (whether the curve carries the pair at all);
 * per signed parameter of each explanation whose value the report states, the spread of
-  its value across the seeds
-  against the median stated uncertainty (ratio); reference: 1 (0.7-1.3 is agreement on 20
-  seeds, a chi distribution's 95 % range).
+  its value across the seeds against the median stated uncertainty (ratio); reference: 1
+  (0.7-1.3 is agreement on 20 seeds, a chi distribution's 95 % range).
 
 Exit 0 when every case meets the 19-of-20 target.
 """
