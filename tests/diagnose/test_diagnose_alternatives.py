@@ -86,11 +86,22 @@ def test_quadrature_null_at_a_v_tip_is_named():
     assert dg.named == ["quadrature_null"], format_text(dg)
     q = dg.effects[0].params["quadrature_v"]
     assert abs(q["value"] - 0.04) < max(3 * q["stderr"], 0.004)
-    # the shape term alone may draw the same tip: then it is the listed alternative, and the
-    # quadrature channel separates them
-    for a in dg.alternatives:
-        assert a.named == [] and a.note
-        assert "quadrature channel" in dg.separate_by[0].measurement
+    # the shape term alone, an offset, or the offset beside the null may draw the same tip;
+    # the quadrature channel tells the null from either of the first two
+    sets = sorted(sorted(a.named) for a in dg.alternatives)
+    assert sets == [[], ["null_offset"], ["null_offset", "quadrature_null"]], format_text(dg)
+    assert next(a for a in dg.alternatives if a.named == []).note
+    # the null and the offset together: one split of what either explains alone, not a value
+    both = next(a for a in dg.alternatives if len(a.named) == 2)
+    assert all(p.get("determined") is False and "share" in p["why"]
+               for e in both.effects for p in e.params.values())
+    assert "not determined" in format_text(dg)
+    assert any("quadrature channel" in s.measurement for s in dg.separate_by)
+    # another sensor of the same build, whose noise puts the offset 8 BIC behind the null
+    # (the first: 11): the same explanations
+    other = _diag(_filament_rectified(0.04, 3006))
+    assert sorted(sorted(e) for e in other.explanations) == sorted(
+        sorted(e) for e in dg.explanations), format_text(other)
     # and the same sensor without it: nothing named
     assert _diag(_filament_rectified(0.0, 3001)).named == []
 

@@ -81,19 +81,18 @@ def test_effect_signature_named_and_recovered(prefix, scale, words):
 def test_small_zero_shift_is_confounded_with_an_imbalance():
     """Both are even in the displacement; on 600 points a 10 um shift and an imbalance fit
     within 6 BIC of each other: the report ranks the truth first as the choice, gives the
-    imbalance as the first alternative with its figures, and says what would tell them
-    apart."""
+    imbalance as the first single-effect alternative with its figures (mixtures of the two
+    with an offset may rank beside it), and says what would tell them apart."""
     dg = _run(_case("zero_shift"), scale=2.0, seed=202)
     assert dg.named == ["zero_shift"]
-    alt = dg.alternatives[0]
+    alt = next(a for a in dg.alternatives if len(a.named) == 1)
     assert alt.named == ["secondary_imbalance"]
     assert 0 < alt.delta_bic < 6
     assert alt.rms_v > 0 and alt.effects[0].params["imbalance_fraction"]["stderr"] > 0
-    assert dg.explanations[:2] == [["zero_shift"], ["secondary_imbalance"]] and dg.shared == []
+    assert dg.explanations[0] == ["zero_shift"] and dg.shared == []
     # ranked: every later alternative is further behind
     assert all(a.delta_bic <= b.delta_bic for a, b in zip(dg.alternatives, dg.alternatives[1:]))
-    sep = dg.separate_by[0]
-    assert {sep.a, sep.b} == {"zero_shift", "secondary_imbalance"}
+    sep = next(s for s in dg.separate_by if {s.a, s.b} == {"zero_shift", "secondary_imbalance"})
     assert "both secondary amplitudes" in sep.measurement
 
 

@@ -21,14 +21,17 @@ the effects it must reproduce); so is a set that another recording of the same s
 put within that margin (``REPEAT_Z``).  When more than one is, the diagnosis names a choice
 (the set forward selection built, or the best by BIC when that set is not among them), ranks
 the others as alternatives, and names the measurement that would tell them apart
-(:func:`separations`).
+(:func:`separations`).  Beside an effect the shape term may hide, the effects the curve
+confounds it with are weighed whatever their first-round figure; each set is judged at its own
+shape term and at the choice's (:func:`_near`); two equally good single effects the curve
+confounds are listed together too (:func:`with_mixtures`).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,10 +56,16 @@ CONFOUND_FRACTION = 0.01
 # 0.05 mm zero shift an offset lay 3-35 BIC behind (margin 17): any fixed margin split them.
 REPEAT_Z = 2.33
 # ... judged so only where the differences are spread over at least this many readings
-# (their participation ratio): the spread of a few readings' differences is not known
-SAME_READINGS = 30.0
+# (their participation ratio): the spread of a few readings' differences is not known.  A
+# standard deviation from m values is uncertain by about 1/sqrt(2m): 16 % at 20, which moves
+# REPEAT_Z's one-sided 99 % to between 97.5 and 99.8 %.  (An offset against a 40 mV
+# quadrature null differs over the 28-58 readings at the tip of the V.)
+SAME_READINGS = 20.0
 # at most this many sets are fitted (a budget: each is one nonlinear fit)
 MAX_SETS = 12
+# a mixture's fit names, under this key of its ``extra``, the two effects whose split the
+# recordings do not fix (see with_mixtures)
+UNSPLIT = "unsplit"
 
 
 @dataclass(frozen=True)
@@ -92,7 +101,15 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     first = sel.trials[0] if sel.trials else []
     strong = [t.name for t in first if math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN
               and not t.vetoed]
-    pool = [c for c in candidates if c in named or c in strong]
+    # an effect the shape term may hide was judged with a shape complexity of its own, while
+    # the first round judged every other candidate at the complexity chosen without it, where
+    # the shape term already draws much of what they would: the effects the curve confounds
+    # it with are weighed whatever their first-round figure (a 40 mV quadrature null: an
+    # offset lay from 6 BIC ahead to 6 behind in that round, from 1 ahead to 25 behind fitted)
+    hides = getattr(family, "shape_may_hide", None)
+    hidden = [c for e in named if hides is not None and hides(e)
+              for c in _confounders(e, candidates)]
+    pool = [c for c in candidates if c in named or c in strong or c in hidden]
     # the pairs forward selection never built: it adds to the effect it holds, so a pair
     # without it is fitted only here (one with it, it has weighed already, with
     # cross-validation too).  Their effects need only have lowered BIC on their own: a 13 um
@@ -107,6 +124,8 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     if len(pool) <= len(named) and not pairs:
         return none_confounded(named)
     fits: dict[frozenset, Fit] = {frozenset(named): sel.final}
+    # each set also as fitted at the shape complexity of the set forward selection built
+    common: dict[frozenset, Fit] = {}
     for combo in list(itertools.combinations(pool, len(named))) + pairs:
         key = frozenset(combo)
         if key in fits:
@@ -116,9 +135,7 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
         # each set with its own shape term (chosen by cross-validation, as the selected set's
         # was): compared at one number of terms, the sets of an even residual swapped places
         # with it (2 terms: null_offset + zero_shift 360 behind; 6 terms: 12 ahead)
-        f = family.fit(list(combo), idx, start=sel.final)
-        if f.ok:
-            f = family.rechoose(list(combo), idx, f)
+        common[key], f = _fitted(family, combo, idx, sel.final)
         # a fit that does not show what one of its effects names (a "rail" through readings
         # that still move) is no explanation, as in forward selection
         implausible = getattr(family, "implausible", None)
@@ -132,8 +149,14 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     best_bic = min(f.bic for f in fits.values())
     margin = max(margin, fraction * (sel.baseline.bic - best_bic))
     best = min(fits.values(), key=lambda f: f.bic)
-    near = sorted(((f.bic - best_bic, key) for key, f in fits.items()
-                   if f.bic - best_bic < margin or _not_beaten(best, f, margin)),
+    # a set weighed only because the curve confounds it with a hidden effect has not shown
+    # its effect yet (the first round did so for the strong ones)
+    unshown = set(hidden) - set(strong)
+    shown = {key: _near(best, margin, f, common.get(key),
+                        _shows(family, idx) if key & unshown and not key <= set(named) else None)
+             for key, f in fits.items()}
+    fits.update({key: f for key, f in shown.items() if f is not None})
+    near = sorted(((fits[key].bic - best_bic, key) for key, f in shown.items() if f is not None),
                   key=lambda t: (t[0], sorted(t[1])))
     if len(near) <= 1:
         # one set left: forward selection's own, or a larger one far ahead of it
@@ -150,6 +173,44 @@ def equivalent_sets(family, sel: Selection, candidates, idx, order: tuple[str, .
     shared = tuple(c for c in named if all(c in s for s in sets))
     return Confounding(sets, tuple(d for d, _ in near), shared, fits[near[0][1]], margin,
                        tuple(fits[key] for _, key in near))
+
+
+def _confounders(effect: str, candidates) -> list[str]:
+    """The candidates whose DC curve bends as ``effect``'s does (those :data:`_PAIRS` names a
+    separating measurement for)."""
+    return [c for c in candidates if c != effect and frozenset({effect, c}) in _PAIRS]
+
+
+def _fitted(family, effects, idx, start: Fit) -> tuple[Fit, Fit]:
+    """``effects`` fitted at ``start``'s shape complexity, and with its own chosen again (by
+    cross-validation, as the selected set's was)."""
+    f = family.fit(list(effects), idx, start=start)
+    return f, (family.rechoose(list(effects), idx, f) if f.ok else f)
+
+
+def _near(best: Fit, margin: float, own: Fit, common: Fit | None = None,
+          shows=None) -> Fit | None:
+    """The fit by which a set is an equally good explanation (None if it is not): with its own
+    shape complexity, or with the choice's.  Cross-validation picks a set's complexity from
+    noisy readings (on 20 identical sensors, an offset in place of a quadrature null took 0
+    terms on 12 and 2 on 8, 25 BIC worse), so another recording may well fit it at the
+    choice's.  Of the two, the better by BIC.  ``shows``: whether a fit shows the effects it
+    names (see :func:`_shows`)."""
+    ok = [f for f in (own, common) if f is not None and f.ok
+          and (f.bic - best.bic < margin or _not_beaten(best, f, margin))
+          and (shows is None or shows(f))]
+    return min(ok, key=lambda f: f.bic) if ok else None
+
+
+def _shows(family, idx):
+    """Whether a fit of one effect shows it: it beats the calibrated simulation with the same
+    shape term by the acceptance margin, as the first round of forward selection asks of every
+    candidate.  Fitted beside a named effect for its curve alone, a moved null of 2e-5 mm
+    (none) came within the margin of a quadrature null whose complexity it shared."""
+    def shows(f: Fit) -> bool:
+        base = family.fit([], idx, start=f)
+        return base.ok and f.bic - base.bic < -BIC_MARGIN
+    return shows
 
 
 def _earns_its_size(key: frozenset, fit: Fit, fits: dict) -> bool:
@@ -195,18 +256,23 @@ SHAPE_NOTE = ("BIC prefers it, but cross-validation does not: the smooth shape t
               "the same readings without it")
 
 
-def with_shape_alternative(family, sel: Selection, idx, conf: Confounding) -> Confounding:
+def with_shape_alternative(family, sel: Selection, idx, conf: Confounding,
+                           candidates=()) -> Confounding:
     """Add "the sensor's shape" as an explanation beside an effect the shape term may draw
     (:meth:`PhysicsFamily.shape_may_hide`).  Nothing named, but such a candidate lowered BIC
     by the acceptance margin and failed only cross-validation: it is listed as an
-    alternative to nothing.  The effect named alone: nothing (its shape term) is listed when
-    it is within the margin or another recording may put it there.  Either way identical
-    sensors get the same pair, whichever side of the line their noise puts them."""
+    alternative to nothing, and so is each of ``candidates`` the curve confounds it with
+    that is as good as it (as :func:`equivalent_sets` weighs a named one's).  The effect named
+    alone, or beside equally good others: nothing (its shape term) is listed when it is within
+    the margin or another recording may put it there.  Either way identical sensors get the
+    same sets, whichever side of the line their noise puts them."""
     hides = getattr(family, "shape_may_hide", None)
-    if hides is None or conf.confounded or len(conf.sets[0]) > 1:
+    if hides is None or len(conf.sets[0]) > 1:
         return conf
     named = conf.sets[0]
     if not named:
+        if conf.confounded:
+            return conf
         first = sel.trials[0] if sel.trials else []
         strong = [t for t in first if hides(t.name) and not t.vetoed and not t.accepted
                   and math.isfinite(t.delta_bic) and t.delta_bic < -BIC_MARGIN
@@ -214,25 +280,89 @@ def with_shape_alternative(family, sel: Selection, idx, conf: Confounding) -> Co
         if not strong:
             return conf
         c = strong[0].name
-        f = family.fit([c], idx, start=sel.baseline)
-        if f.ok:
-            f = family.rechoose([c], idx, f)
+        _, f = _fitted(family, [c], idx, sel.baseline)
         if not f.ok:
             return conf
-        return Confounding(((), (c,)), (0.0, f.bic - sel.final.bic), (), sel.final,
-                           conf.margin, (sel.final, f), ("", SHAPE_NOTE))
+        margin = max(conf.margin, CONFOUND_FRACTION * (sel.baseline.bic - f.bic))
+        found = [((c,), f, SHAPE_NOTE)]
+        for d in _confounders(c, candidates):
+            common, own = _fitted(family, [d], idx, f)
+            g = _near(f, margin, own, common, _shows(family, idx))
+            if g is not None:
+                found.append(((d,), g, f"as good an explanation as {c}, which BIC prefers to "
+                               "nothing: the curve bends alike for both"))
+        return _with_more(Confounding(((),), (0.0,), (), sel.final, margin, (sel.final,), ("",)),
+                          found)
     if not hides(named[0]):
         return conf
-    best, base = sel.final, sel.baseline
+    best, base = (conf.fits[0] if conf.fits else sel.final), sel.baseline
     # cross-validation's t, too, moves by about 1 from one recording to the next
     cv_t = sel.steps[0].cv_t if sel.steps else math.inf
-    if (base.bic - best.bic < conf.margin or _not_beaten(best, base, conf.margin)
+    if not (base.bic - best.bic < conf.margin or _not_beaten(best, base, conf.margin)
             or cv_t - CV_T < REPEAT_Z * math.sqrt(2.0)):
+        return conf
+    note = ("the smooth shape term draws the same readings without it, nearly as well "
+            f"(cross-validation t {cv_t:.1f})")
+    if not conf.confounded:
         return Confounding((named, ()), (0.0, base.bic - best.bic), (), best, conf.margin,
-                           (best, base), ("", "the smooth shape term draws the same readings "
-                                          "without it, nearly as well (cross-validation t "
-                                          f"{cv_t:.1f})"))
-    return conf
+                           (best, base), ("", note))
+    return _with_more(conf, [((), base, note)])
+
+
+def with_mixtures(family, idx, conf: Confounding) -> Confounding:
+    """Add, beside equally good single effects that the curve confounds, the two together.
+
+    A curve that cannot tell one effect from the other cannot tell either from a mixture of
+    both (on 20 filament-model sensors with a 3 mV offset beside a 0.5 % imbalance, the pair
+    fitted is 11 BIC behind the offset alone, its weaker effect within one uncertainty of
+    zero, and the offset, the imbalance and a moved null are each named alone).  So the
+    mixture of two offered single effects is listed too when it fits as well as the best set
+    (its BIC, less the ln n BIC charges for each parameter it has more, within the margin),
+    although its second effect does not earn its keep on this curve: that charge is the
+    evidence against an effect the curve does not show, and the curve cannot show either of
+    two effects it confounds.  Judged by BIC alone, the mixture sat on the margin's edge (a
+    quadrature null and an offset: 6.2-6.4 behind, margin 6).  Its fit is one split of the two
+    effects' sum among many that fit alike: its parameters are not determined (the fit carries
+    the pair under ``UNSPLIT``).  The measurement that tells the two effects apart also tells
+    whether both are there."""
+    singles = [(s, f) for s, f in zip(conf.sets, conf.fits) if len(s) == 1]
+    top = min(conf.fits, key=lambda f: f.bic) if conf.fits else None
+    have = {frozenset(s) for s in conf.sets}
+    more = []
+
+    def fits_as_well(f: Fit) -> bool:
+        return f.ok and f.bic - top.bic - (f.k - top.k) * math.log(max(f.n, 1)) < conf.margin
+
+    for (a, fa), (b, fb) in itertools.combinations(singles, 2):
+        if frozenset(a + b) in have or frozenset(a + b) not in _PAIRS:
+            continue
+        # the better single with the other effect added, at its shape term (its own chosen
+        # again only when that does not fit): along a valley the curve does not resolve, a fit
+        # that walks the shape terms ends anywhere along it (beside a 0.05 mm moved null, an
+        # offset of -14 mV or of -208 mV with an imbalance of either sign, alike within the
+        # noise), and each walk is several nonlinear fits
+        f = family.fit(list(a + b), idx, start=min(fa, fb, key=lambda f: f.bic))
+        if f.ok and not fits_as_well(f):
+            f = family.rechoose(list(a + b), idx, f)
+        if fits_as_well(f):
+            f = replace(f, extra={**f.extra, UNSPLIT: (a[0], b[0])})
+            more.append((a + b, f, f"{a[0]} and {b[0]} together: the curve cannot tell either "
+                         "from the other, nor from both"))
+    return _with_more(conf, more) if more else conf
+
+
+def _with_more(conf: Confounding, more) -> Confounding:
+    """``conf`` (with its choice's fit) with the explanations ``more`` ((effects, fit, note)
+    each) among its alternatives, ranked by BIC; their ΔBIC measured as ``conf``'s are."""
+    ref = conf.fits[0].bic - conf.delta_bic[0]
+    notes = conf.notes or ("",) * len(conf.sets)
+    rest = sorted(list(zip(conf.sets[1:], conf.delta_bic[1:], conf.fits[1:], notes[1:]))
+                  + [(s, f.bic - ref, f, n) for s, f, n in more], key=lambda t: t[1])
+    sets = (conf.sets[0],) + tuple(t[0] for t in rest)
+    return replace(conf, sets=sets, delta_bic=(conf.delta_bic[0],) + tuple(t[1] for t in rest),
+                   shared=tuple(e for e in conf.sets[0] if all(e in s for s in sets)),
+                   fits=(conf.fits[0],) + tuple(t[2] for t in rest),
+                   notes=(notes[0],) + tuple(t[3] for t in rest))
 
 
 @dataclass(frozen=True)
@@ -331,4 +461,4 @@ def separations(sets) -> tuple[Separation, ...]:
 
 
 __all__ = ["Confounding", "Separation", "bic_spread", "equivalent_sets", "none_confounded",
-           "separations", "with_shape_alternative", "CONFOUND_BIC"]
+           "separations", "with_mixtures", "with_shape_alternative", "CONFOUND_BIC", "UNSPLIT"]

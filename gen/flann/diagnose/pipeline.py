@@ -23,8 +23,8 @@ from ..recordings import Recordings, converter_step, monotonic_span
 from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
-from .confound import (Confounding, Separation, equivalent_sets, separations,
-                       with_shape_alternative)
+from .confound import (UNSPLIT, Confounding, Separation, equivalent_sets, separations,
+                       with_mixtures, with_shape_alternative)
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
 from .select import Fit, Selection, Trial, evidence_chain, forward_select
@@ -192,13 +192,17 @@ class SelectionResult:
     final: Fit
 
 
-def _param(value, stderr, unit, magnitude: bool = True) -> dict:
+def _param(value, stderr, unit, magnitude: bool = True, unsplit: str = "") -> dict:
     """A fitted parameter.  A magnitude (a length, a gain, an effect's size; not a position
     or a phase, which may sit near zero) whose uncertainty exceeds its value is not
-    determined by the recordings: marked ``determined: False``."""
+    determined by the recordings: marked ``determined: False``.  So is any parameter of an
+    effect whose share of the misfit the recordings do not fix (``unsplit`` says why)."""
     se = float(stderr)
     out = {"value": float(value), "stderr": se if math.isfinite(se) else None, "unit": unit}
-    if magnitude and math.isfinite(se) and se > abs(float(value)):
+    if unsplit:
+        out["determined"] = False
+        out["why"] = unsplit
+    elif magnitude and math.isfinite(se) and se > abs(float(value)):
         out["determined"] = False
     return out
 
@@ -357,7 +361,8 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
     if progress:
         progress("testing for equally good explanations")
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
-    conf = with_shape_alternative(family, sel, calib.fit_idx, conf)
+    conf = with_shape_alternative(family, sel, calib.fit_idx, conf, candidates)
+    conf = with_mixtures(family, calib.fit_idx, conf)
     final = sel.final
     if conf.confounded or set(conf.sets[0]) != set(order):
         # the choice is forward selection's set when it is among the equally good ones
@@ -553,12 +558,19 @@ RAILS_EVIDENCE = ("not computable: the rails are read off flat runs of readings 
 def _effect_params(family: PhysicsFamily, fit: Fit, name: str, units: dict) -> dict:
     """``name``'s fitted parameters in ``fit``, in recorded units."""
     params = {}
+    # a mixture of two effects the curve confounds: one split of their sum among many that
+    # fit alike (its fit ends anywhere along that valley: beside a 0.05 mm moved null, an
+    # offset of -14 mV or of -208 mV with an imbalance of either sign)
+    pair = fit.extra.get(UNSPLIT, ())
+    unsplit = (f"the curve does not tell how {pair[0]} and {pair[1]} share the misfit"
+               if name in pair else "")
     for n, v, se in zip(fit.names, fit.theta, fit.stderr):
         if n.startswith(name + "."):
             # position effects act in the simulated sensor's mm: back to recorded units
             k_unit = 1.0 / family.scale if units.get(n) == "mm" else 1.0
             params[n.split(".", 1)[1]] = _param(v * k_unit, se * k_unit, units.get(n, ""),
-                                                magnitude=not n.endswith("phase_rad"))
+                                                magnitude=not n.endswith("phase_rad"),
+                                                unsplit=unsplit)
     if name == "thermal_drift":
         params["reference_temperature_c"] = _param(family.t_ref, math.nan, "degC")
     return params

@@ -67,6 +67,8 @@ def _params(params: dict) -> dict:
         else:
             out[k] = {"value": None, "fitted_value": _num(p["value"]), "stderr": _num(p["stderr"]),
                       "unit": p["unit"], "determined": False}
+            if p.get("why"):
+                out[k]["why"] = p["why"]
     return out
 
 
@@ -86,6 +88,9 @@ def _fmt_param(name: str, p: dict) -> str:
     se = p.get("stderr")
     if isinstance(p.get("value"), str):
         return f"{name} = {p['value']}"
+    if p.get("why"):
+        return (f"{name} not determined by these recordings ({p['why']}; fitted "
+                f"{p['value']:.3g}{unit})")
     if not p.get("determined", True):
         return (f"{name} not determined by these recordings (its uncertainty ±{se:.2g}{unit} "
                 f"exceeds the fitted {p['value']:.3g}{unit})")
