@@ -367,6 +367,14 @@ def _reading_residuals(x, v, keep, pos: Positions, pred_pos, fitted_pos) -> np.n
             vv = v[rows]
             for j, i in enumerate(rows):
                 r[i] = v[i] - np.median(np.delete(vv, j))
+        elif len(rows) == 2:
+            # two readings that agree are the curve, however far a held-out fit misses them
+            # (a sharp knee in quiet dwell means); a glitch stays far from its partner too
+            a, b = rows
+            d = v[a] - v[b]
+            for i, di in ((a, d), (b, -d)):
+                if abs(di) < abs(r[i]):
+                    r[i] = di
     return r
 
 
