@@ -65,6 +65,13 @@ RANDOM_STARTS = 6
 REFINED = 6                 # starting points refined per K (the best by their first residual)
 NEAR_BEST = 0.05            # local optima within 5 % of the best residual are members too
 SPREAD_DERIVATIVES = 4      # an odd member with one width carries up to this many derivatives
+# A fit stops once its residual has fallen by less than STALL_RTOL over the last STALL_EVALS
+# evaluations.  The fits that crawl on are units narrower than the spacing of the positions, a
+# step between two of them sharpening toward the narrowest width: the residual's slope in the
+# width vanishes exponentially, the solver gains 1e-3 of it in a further 100-300 evaluations,
+# half of all it does; a hundredth of NEAR_BEST, far below any weight's sensitivity.
+STALL_EVALS = 10
+STALL_RTOL = 1e-4
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 _CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
@@ -305,10 +312,16 @@ class Units:
         return self.shape.basis(self.nl, xn, self.linear) @ self.beta
 
 
+class _Stalled(Exception):
+    """The residual has stopped falling (:data:`STALL_EVALS`, :data:`STALL_RTOL`)."""
+
+
 def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
     lo, hi = shape.bounds(shape.units(nl0))
     nl0 = np.clip(nl0, lo + 1e-9, hi - 1e-9)
     last: dict = {}
+    best = [np.inf, nl0]        # the lowest residual so far and where: the solver's iterate
+    trail: list = []            # the lowest residual after each evaluation
 
     def solved(nl):     # the solver asks for the Jacobian where it just took the residuals
         key = nl.tobytes()
@@ -317,12 +330,25 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
             last[key] = _linear(nl, x, y, sw, linear, shape)
         return last[key]
 
+    def residuals(nl):
+        res = solved(nl)[2]
+        sse = float(res @ res)
+        if sse < best[0]:
+            best[:] = sse, nl.copy()
+        trail.append(best[0])
+        if len(trail) > STALL_EVALS and trail[-STALL_EVALS - 1] - best[0] <= STALL_RTOL * best[0]:
+            raise _Stalled
+        return res
+
     from scipy.optimize import least_squares  # slow to import: only where fitted
-    r = least_squares(lambda nl: solved(nl)[2], nl0, bounds=(lo, hi),
-                      jac=lambda nl: _jacobian(shape, nl, x, sw, linear, *solved(nl)[:2]),
-                      method="trf", max_nfev=300)
-    _B, beta, res = solved(r.x)
-    return Units(r.x, beta, linear, float(res @ res), shape)
+    try:
+        nl = least_squares(residuals, nl0, bounds=(lo, hi),
+                           jac=lambda nl: _jacobian(shape, nl, x, sw, linear, *solved(nl)[:2]),
+                           method="trf", max_nfev=300).x
+    except _Stalled:
+        nl = best[1]
+    _B, beta, res = solved(nl)
+    return Units(nl, beta, linear, float(res @ res), shape)
 
 
 def _near_best(fits: list[Units]) -> list[Units]:
