@@ -196,10 +196,10 @@ class _TanhUnit:
             self._p.append(np.polynomial.Polynomial([1.0, 0.0, -1.0]) * self._p[-1].deriv())
         self._fast = _polynomials(self._p)
 
-    def __call__(self, u: np.ndarray) -> list[np.ndarray]:
-        """The unit and its first n derivatives at u."""
+    def __call__(self, u: np.ndarray, n: int | None = None) -> list[np.ndarray]:
+        """The unit and its first n derivatives at u (all it was made with by default)."""
         t = np.tanh(u)
-        return [_at(t, f) for f in self._fast]
+        return [_at(t, f) for f in self._fast[:None if n is None else n + 1]]
 
 
 class _AlgebraicUnit:
@@ -216,9 +216,9 @@ class _AlgebraicUnit:
             self._p.append(self._p[-1].deriv() * (1 + u * u) - (2 * j + 1) * u * self._p[-1])
         self._fast = _polynomials(self._p)
 
-    def __call__(self, u: np.ndarray) -> list[np.ndarray]:
+    def __call__(self, u: np.ndarray, n: int | None = None) -> list[np.ndarray]:
         r = 1.0 / np.sqrt(1.0 + u * u)
-        return [_at(u, f) * r ** (2 * j + 1) for j, f in enumerate(self._fast)]
+        return [_at(u, f) * r ** (2 * j + 1) for j, f in enumerate(self._fast[:None if n is None else n + 1])]
 
 
 class _OddSpread:
@@ -243,7 +243,8 @@ class _OddSpread:
         z = x - nl[0]
         gain = 1.0 + nl[1] * np.sign(z)
         u = z * np.exp(-nl[2])
-        p = self._unit(u)
+        # the columns' derivatives take one derivative of the unit more than the columns
+        p = self._unit(u, self.derivatives + (1 if derivatives else 0))
         powers = [u ** j for j in range(self.derivatives + 1)]    # each power once
         cols = [powers[j] * p[j] for j in range(self.derivatives + 1)]
         d_cols = None if not derivatives else [
