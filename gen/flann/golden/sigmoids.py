@@ -72,16 +72,17 @@ SPREAD_DERIVATIVES = 4      # an odd member with one width carries up to this ma
 # half of all it does; a hundredth of NEAR_BEST, far below any weight's sensitivity.
 STALL_EVALS = 10
 STALL_RTOL = 1e-4
+RANK_RTOL = 1e-10           # a basis whose QR diagonal spans more than this is near rank deficient
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
 MAX_GROUPS = 1000           # a logger's continuous positions are averaged in this many bins of x
 _CHECK = np.linspace(-1.0, 1.0, CHECK_POINTS)
 
 
-def _jacobian(shape, nl, x, sw, linear, B, beta) -> np.ndarray:
+def _jacobian(shape, nl, x, sw, linear, q, beta) -> np.ndarray:
     """d(weighted residual)/d(nonlinear parameters) by Kaufman's variable-projection
     approximation: each column of the shape's ``derivative`` (the curve's, at the linear
-    parameters ``beta``), weighted, projected orthogonally to the weighted basis ``B``."""
-    q, _r = np.linalg.qr(B)
+    parameters ``beta``), weighted, projected orthogonally to the weighted basis, whose
+    orthonormal columns are ``q``."""
     d = shape.derivative(nl, x, linear, beta) * sw[:, None]
     return d - q @ (q.T @ d)
 
@@ -289,6 +290,21 @@ def _linear(nl, x, y, sw, linear, shape=_Free):
     return B, beta, B @ beta - y * sw
 
 
+def _projected(nl, x, y, sw, linear, shape):
+    """(orthonormal columns of the weighted basis, linear parameters, residuals): one QR
+    serves the linear parameters and the Jacobian's projection.  A basis near rank
+    deficiency (units that coincide, or saturate to the offset) takes the least squares of
+    :func:`_linear`, which drops the directions it cannot resolve."""
+    B = shape.basis(nl, x, linear) * sw[:, None]
+    q, r = np.linalg.qr(B)
+    diag = np.abs(np.diag(r))
+    if diag.min() <= RANK_RTOL * diag.max():
+        beta = np.linalg.lstsq(B, y * sw, rcond=None)[0]
+        return q, beta, B @ beta - y * sw
+    qy = q.T @ (y * sw)
+    return q, np.linalg.solve(r, qy), q @ qy - y * sw
+
+
 @dataclass(frozen=True)
 class Units:
     """One fitted member: K units of one shape (:class:`_Free`, :class:`_Odd` or an
@@ -328,7 +344,7 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
         key = nl.tobytes()
         if key not in last:
             last.clear()
-            last[key] = _linear(nl, x, y, sw, linear, shape)
+            last[key] = _projected(nl, x, y, sw, linear, shape)
         return last[key]
 
     def residuals(nl):
@@ -348,7 +364,7 @@ def _refine(nl0, x, y, sw, linear, shape=_Free) -> Units:
                            method="trf", max_nfev=300).x
     except _Stalled:
         nl = best[1]
-    _B, beta, res = solved(nl)
+    _q, beta, res = solved(nl)
     return Units(nl, beta, linear, float(res @ res), shape)
 
 
