@@ -68,9 +68,9 @@ SPREAD_DERIVATIVES = 4      # an odd member with one width carries up to this ma
 # A fit stops once its residual has fallen by less than STALL_RTOL over the last STALL_EVALS
 # evaluations.  The fits that crawl on are units narrower than the spacing of the positions, a
 # step between two of them sharpening toward the narrowest width: the residual's slope in the
-# width vanishes exponentially, the solver gains 1e-3 of it in a further 100-300 evaluations,
-# half of all it does; a hundredth of NEAR_BEST, far below any weight's sensitivity.
-STALL_EVALS = 10
+# width vanishes exponentially, and the solver gained 1e-3 of the residual in a further 100-300
+# evaluations, half of all it did; a fiftieth of NEAR_BEST.
+STALL_EVALS = 5
 STALL_RTOL = 1e-4
 RANK_RTOL = 1e-10           # a basis whose QR diagonal spans more than this is near rank deficient
 CHECK_POINTS = 20001        # monotonicity checked on this many points over the stroke
