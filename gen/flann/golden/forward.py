@@ -350,6 +350,14 @@ class ForwardFit:
         return _slope(self.smoother, self.coef, np.asarray(x, float))
 
 
+def _rows_by_position(keep, index) -> list[list[int]]:
+    """The kept readings' rows, grouped by the position each was read at."""
+    by_pos: dict[int, list[int]] = {}
+    for i in np.flatnonzero(keep):
+        by_pos.setdefault(int(index[i]), []).append(int(i))
+    return list(by_pos.values())
+
+
 def _reading_residuals(x, v, keep, pos: Positions, pred_pos, fitted_pos) -> np.ndarray:
     """Each reading's residual against what the other data say: the held-out prediction of
     its position, or (a position read several times) the median of its other readings."""
@@ -358,18 +366,23 @@ def _reading_residuals(x, v, keep, pos: Positions, pred_pos, fitted_pos) -> np.n
     ref = np.where(np.isfinite(pred_pos), pred_pos, fitted_pos)
     r[keep] = v[keep] - ref[idx[keep]]
     # several readings at one position: the others' median is the local reference
-    kept = np.flatnonzero(keep)
-    by_pos: dict[int, list[int]] = {}
-    for i in kept:
-        by_pos.setdefault(int(idx[i]), []).append(int(i))
-    for rows in by_pos.values():
+    for rows in _rows_by_position(keep, idx):
         if len(rows) >= 3:
             vv = v[rows]
             for j, i in enumerate(rows):
                 r[i] = v[i] - np.median(np.delete(vv, j))
-        elif len(rows) == 2:
-            # two readings that agree are the curve, however far a held-out fit misses them
-            # (a sharp knee in quiet dwell means); a glitch stays far from its partner too
+    return r
+
+
+def _partners_agree(v, keep, pos: Positions, r) -> np.ndarray:
+    """``r`` with each reading of a position read exactly twice judged against its partner
+    where that is the smaller residual: two readings that agree are the curve, however far a
+    held-out fit misses them (a sharp knee in quiet dwell means), while a glitch stays far from
+    its partner too.  For judging only: the noise is the held-out residuals' (pairs of equal
+    quantised readings would set it at zero)."""
+    r = r.copy()
+    for rows in _rows_by_position(keep, pos.index):
+        if len(rows) == 2:
             a, b = rows
             d = v[a] - v[b]
             for i, di in ((a, d), (b, -d)):
@@ -412,12 +425,13 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
             sigma, source = max(resid_sigma, floor), "held-out residuals (no repeats)"
             judge = sigma
         # the largest first: a gross outlier also pulls its neighbours' held-out predictions
+        r = _partners_agree(v, keep, indexed, r)
         ar = np.abs(np.nan_to_num(r))
         limit = max(OUTLIER_K * judge, 0.5 * float(np.max(ar[keep])))
         if other is not None and np.any(keep & (ar > OUTLIER_K * judge)):
             # a candidate is confirmed by the other family's held-out fit too (the noise
             # stays the chosen fit's: the smaller of two residuals would understate it)
-            r2 = _reading_residuals(x, v, keep, indexed, other, fitted)
+            r2 = _partners_agree(v, keep, indexed, _reading_residuals(x, v, keep, indexed, other, fitted))
             r = np.where(np.abs(np.nan_to_num(r2)) < ar, r2, r)
             ar = np.abs(np.nan_to_num(r))
         new = _largest_apart(x, keep & (ar > limit), ar)
