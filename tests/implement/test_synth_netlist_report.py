@@ -9,10 +9,7 @@ from pathlib import Path
 import pytest
 
 from flann.cli import main
-from flann.commands import synth as synth_command
-from flann.implement import synth
 
-REPO = Path(__file__).resolve().parents[2]
 GOOD = Path(__file__).parent / "fixtures" / "synth" / "good"
 
 needs_tools = pytest.mark.skipif(
@@ -26,38 +23,15 @@ def _run(capsys, *argv):
     return rc, out, err
 
 
-def _once(fn):
-    """``fn`` run once, its result handed out again (a second report of the same design)."""
-    done = []
-
-    def again(*args, **kwargs):
-        if not done:
-            done.append(fn(*args, **kwargs))
-        return done[0]
-    return again
-
-
 @pytest.mark.synth
 @needs_tools
-def test_passing_check_is_reported_in_json_and_text(tmp_path, capsys, monkeypatch):
-    # an 8-bit input: 2^8 = 256 codes; no --model, the manifest's model is the twin's
-    model = tmp_path / "m.json"
-    assert main(["train", str(REPO / "data" / "paper_table1.csv"), "--terms", "11", "--method", "lstsq",
-                 "-o", str(model)]) == 0
-    assert main(["gen", str(model), "-o", str(tmp_path / "d"), "--input-bits", "8"]) == 0
-    capsys.readouterr()
-    # the text run reuses the JSON run's synthesis and simulation (minutes on two cores)
-    monkeypatch.setattr(synth, "synthesize", _once(synth.synthesize))
-    simulated = _once(synth_command.check_synthesized)
-    monkeypatch.setattr(synth_command, "check_synthesized", simulated)
-
-    rc, out, err = _run(capsys, tmp_path / "d", "--no-lint", "--abc", "fast", "--json")
+def test_passing_check_is_reported_in_json_and_text(small_synths):
+    """The run's one synthesis of the small fixed design (8-bit input: 2^8 = 256 codes; no
+    --model, the manifest's model is the twin's): the JSON report and the text table."""
+    rc, out, err, report = small_synths("fixed")
     assert rc == 0, err
-    check = json.loads(out)["netlist_check"]
+    check = report["netlist_check"]
     assert check["codes"] == 256 and check["mismatches"] == 0 and check["passed"] is True
-
-    rc, out, err = _run(capsys, tmp_path / "d", "--no-lint", "--abc", "fast")
-    assert rc == 0, err
     line = next(ln for ln in out.splitlines() if "netlist check" in ln)
     assert "256 input codes" in line and "0 mismatches" in line and line.endswith("passed")
 
