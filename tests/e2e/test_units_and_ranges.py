@@ -27,10 +27,13 @@ def sensor_csv(path, scale=1.0, header="displacement_mm,voltage_v", noise_v=0.0,
     return path
 
 
-@pytest.fixture
-def model(tmp_path, capsys):
-    m = tmp_path / "m.json"
-    assert run(["train", sensor_csv(tmp_path / "r.csv"), "-o", m], capsys)[0] == 0
+@pytest.fixture(scope="module")
+def model(tmp_path_factory, in_process):
+    """One training for the module's gen and eval checks (none of them writes the model)."""
+    d = tmp_path_factory.mktemp("units")
+    m = d / "m.json"
+    rc, _out, err = in_process(["train", sensor_csv(d / "r.csv"), "-o", m])
+    assert rc == 0, err
     return m
 
 
