@@ -20,7 +20,7 @@ from flann.errors import FlannError
 from flann.hardware.family.images import read_image
 from flann.hardware.family.twin import FlannFamilyTop
 from flann.hardware.manifest import read_manifest
-from flann.hardware.design import from_directory, from_model
+from flann.hardware.design import from_directory
 from flann.verify.netlist import check_netlist, compare, compile_netlist, mapped_netlist, run_netlist, sweep_of
 
 pytestmark = [pytest.mark.sim, pytest.mark.synth,
@@ -28,8 +28,9 @@ pytestmark = [pytest.mark.sim, pytest.mark.synth,
                                  reason="needs ghdl, yosys, verilator (scripts/ensure_tools.sh)")]
 
 
-def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_model):
-    design = from_model(small_model(11), tmp_path / "d", {"input_bits": 8})
+def test_mapped_netlist_every_code_and_a_wrong_netlist(tmp_path, small_designs, small_synths):
+    small_synths("fixed")   # the run's one synthesis of this design: the check below takes it from the cache
+    design = from_directory(small_designs["dir"] / "fixed")
     r = check_netlist(design, tmp_path / "nl")
     assert r.codes_tested == 256 and r.mismatches == 0, r
     assert Path(r.netlist).read_text().count("LUT") > 10  # the mapped cells, not RTL
