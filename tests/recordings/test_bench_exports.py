@@ -35,9 +35,12 @@ def _lines_named(text: str) -> set[int]:
 
 @pytest.fixture(scope="session")
 def trained(once, in_process):
-    """Each export trained once per run (every worker shares it): {name: (model, (rc, out, err))}."""
+    """Each export trained once per run (every worker shares it): {name: (model, (rc, out, err))}.
+    Nine terms, not the default search: the reading and its screens come before the fit and
+    do not depend on it (tests/golden covers `--terms auto`)."""
     def make(d):
-        return {name: (d / (name + ".json"), in_process(["train", DATA / name, "-o", d / (name + ".json")]))
+        return {name: (d / (name + ".json"),
+                       in_process(["train", DATA / name, "-o", d / (name + ".json"), "--terms", "9"]))
                 for name in CASES}
     return once("bench-exports-trained", make)
 
