@@ -49,7 +49,7 @@ import numpy as np
 
 from ..fileio import atomic_save_figure
 from ..golden.verdict import Check
-from ..hardware.conditioner.condition import adc_codes, calibrate_reference
+from ..hardware.conditioner.condition import adc_codes, adc_lsb_v, calibrate_reference, converted, window_sum_v
 from ..hardware.conditioner.settings import ConditionerSettings, DwellReadings
 from ..hardware.conditioner.spec import (QUADRATURE_BUDGET, QUADRATURE_FRACTION, Reference, identity, reference,
                                          reference_phase)
@@ -134,12 +134,8 @@ class Chain:
         """The phase of the secondaries' difference on this recording (rad, the record's own
         frame), as calibration finds it (the slope of A - B at the null), by the plain twin."""
         s = self.spec
-        plain = ConditionerChain(s)
-        ca = adc_codes(self.wave.sec_a_v, s.adc_bits, self.settings.adc_range_v)
-        cb = adc_codes(self.wave.sec_b_v, s.adc_bits, self.settings.adc_range_v)
-        n = len(self.wave) // s.window * s.window
-        x = self.wave.displacement_mm[:n].reshape(-1, s.window).mean(axis=1)
-        return calibrate_reference(s, plain.process(ca, cb, identity(s)), x)[1]
+        ca, cb, x = converted(self.wave, s, self.settings.adc_range_v)
+        return calibrate_reference(s, ConditionerChain(s).process(ca, cb, identity(s)), x.mean(axis=1))[1]
 
     @cached_property
     def calibration_error_rad(self) -> float:
@@ -159,7 +155,7 @@ class Chain:
         tells: each sample plus a uniform dither of one LSB (``seed``).  Scaling or adding to the
         rounded samples themselves would round a grid again, whose error repeats with the code
         (a gain error of its own); these round back to the recording's samples."""
-        lsb = 2.0 * self.settings.adc_range_v / (1 << self.spec.adc_bits)
+        lsb = adc_lsb_v(self.spec.adc_bits, self.settings.adc_range_v)
         rng = np.random.default_rng(seed)
         half = 0.5 * lsb * (1 - 1e-9)
         return (self.wave.sec_a_v + rng.uniform(-half, half, len(self.wave)),
@@ -175,9 +171,7 @@ class Chain:
 
     def volts_per_code_sum(self) -> float:
         """A window's in-phase sum (codes) back to the amplitude in volts at a secondary."""
-        s = self.spec
-        lsb = 2.0 * self.settings.adc_range_v / (1 << s.adc_bits)
-        return lsb / (s.window / 2 * s.amplitude)
+        return window_sum_v(self.spec, self.settings.adc_range_v)
 
     def carrier(self, n: int, phase: float | None = None) -> np.ndarray:
         """The carrier's phase at each of ``n`` samples, ``phase`` at the first (default: the

@@ -38,11 +38,29 @@ class Conditioned:
     phase_rad: float
 
 
+def adc_lsb_v(bits: int, range_v: float) -> float:
+    """Volts per code of a ``bits``-bit converter of +-``range_v``."""
+    return 2.0 * range_v / (1 << bits)
+
+
+def window_sum_v(spec: ConditionerSpec, adc_range_v: float) -> float:
+    """Volts at a secondary per code of a window's in-phase sum (M/2 A |V| cos(...) in codes)."""
+    return adc_lsb_v(spec.adc_bits, adc_range_v) / (spec.window / 2 * spec.amplitude)
+
+
 def adc_codes(volts, bits: int, range_v: float) -> np.ndarray:
     """Straight-binary codes of a ``bits``-bit converter of +-``range_v`` (saturating)."""
     lo, hi = signed_range(bits)
-    lsb = 2.0 * range_v / (1 << bits)
-    return nearest_codes(np.asarray(volts, dtype=float), lsb, lo, hi).astype(np.int64) - lo
+    return nearest_codes(np.asarray(volts, dtype=float), adc_lsb_v(bits, range_v), lo, hi).astype(np.int64) - lo
+
+
+def converted(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(codes of A, codes of B, the displacement of each sample in whole windows, one row a
+    window): what the conditioner and its calibration read from a recording."""
+    ca = adc_codes(wave.sec_a_v, spec.adc_bits, adc_range_v)
+    cb = adc_codes(wave.sec_b_v, spec.adc_bits, adc_range_v)
+    n = len(wave) // spec.window * spec.window
+    return ca, cb, wave.displacement_mm[:n].reshape(-1, spec.window)
 
 
 def calibrate_reference(spec: ConditionerSpec, chain_at_zero, displacement_mm=None) -> tuple[Reference, float]:
@@ -79,18 +97,13 @@ def condition(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float, ref: R
         raise FlannError("the recording's sample rate does not match the conditioner's")
     if len(wave) < spec.window:
         raise FlannError(f"{wave.source}: {len(wave)} samples, fewer than one window of {spec.window}")
-    ca = adc_codes(wave.sec_a_v, spec.adc_bits, adc_range_v)
-    cb = adc_codes(wave.sec_b_v, spec.adc_bits, adc_range_v)
+    ca, cb, x = converted(wave, spec, adc_range_v)
     chain = ConditionerChain(spec)
-    n = len(wave) // spec.window * spec.window
-    x = wave.displacement_mm[:n].reshape(-1, spec.window)
     phase = float("nan")
     if ref is None:
         ref, phase = calibrate_reference(spec, chain.process(ca, cb, identity(spec)), x.mean(axis=1))
     out = chain.process(ca, cb, ref)
-    lsb = 2.0 * adc_range_v / (1 << spec.adc_bits)
-    # a window's sum is M/2 A |V| cos(...) in codes: back to volts at the secondaries
-    scale = lsb / (spec.window / 2 * spec.amplitude)
+    scale = window_sum_v(spec, adc_range_v)
     return Conditioned(ratio=out.out_ratio / float(1 << spec.ratio_frac_bits), sat=out.out_sat,
                        difference_v=(out.rot_a - out.rot_b) * scale, displacement_mm=x.mean(axis=1),
                        steady=np.ptp(x, axis=1) == 0, ref=ref, phase_rad=phase)

@@ -32,6 +32,7 @@ from ..header import NO_MODEL
 from ..manifest import write_design
 from ..options import GenOptions
 from .chain import CHAIN_TOP, ChainSpec, render_chain
+from .condition import adc_lsb_v
 from .render import ENTITIES, TOP, cycles_per_sample, render
 from .settings import flann_options, of_model
 from .spec import ConditionerSpec
@@ -58,7 +59,7 @@ def manifest(spec: ConditionerSpec, input_lsb_v: float) -> dict:
 
 def write_conditioner(spec: ConditionerSpec, out_dir, adc_range_v: float) -> dict:
     """Write the conditioner's design directory; returns its manifest."""
-    return write_design(render(spec), manifest(spec, 2.0 * adc_range_v / (1 << spec.adc_bits)), out_dir)
+    return write_design(render(spec), manifest(spec, adc_lsb_v(spec.adc_bits, adc_range_v)), out_dir)
 
 
 def rebuild(model, man: dict, where="design"):
@@ -116,7 +117,7 @@ def generate(model, out_dir, options: GenOptions | None = None, **_extra) -> dic
     ctexts, chtexts = render(spec), render_chain(chain, model_sha256=fspec.model_sha256)
     ref = settings.reference
     texts = {**ctexts, **ftexts, **chtexts, fixed_render.MODEL_FILE: fixed_render.model_text(model)}
-    man = {**manifest(spec, 2.0 * settings.adc_range_v / (1 << spec.adc_bits)),
+    man = {**manifest(spec, adc_lsb_v(spec.adc_bits, settings.adc_range_v)),
            "top": CHAIN_TOP, "files": [*ctexts, *ftexts, *chtexts], "output_bits": fspec.out_fmt.width,
            "output_lsb_mm": fspec.output_lsb_mm, "latency_cycles": chain.latency,
            "model": fixed_render.MODEL_FILE, "model_sha256": fspec.model_sha256,
