@@ -3,6 +3,7 @@ carrier; the design directory it writes and the manifest its datapath record rea
 
 import json
 
+import numpy as np
 import pytest
 
 from flann.errors import FlannError, SpecError
@@ -23,11 +24,25 @@ def test_output_rate_is_whole_periods_and_bandwidth_follows():
     assert bandwidth_hz(s, 10000.0) == pytest.approx(110.7, abs=0.1)
 
 
+def test_a_period_of_more_samples_than_table_entries_reads_each_entry_in_turn():
+    """N = 1024 samples a period on a 256-entry table: the phase accumulator has 10 bits and
+    each entry serves four consecutive samples, k * 256 / 1024 rounded down."""
+    s = derive_conditioner(carrier_hz=2500.0, sample_rate_hz=2.56e6, output_rate_hz=625.0, table_bits=8)
+    assert (s.phase_bits, s.step) == (10, 1)
+    k = np.arange(3 * 1024)
+    np.testing.assert_array_equal(s.phases(k.size), (k % 1024) * 256 // 1024)
+    # a table at least N long: the accumulator is the table's address, as before
+    t = derive_conditioner(carrier_hz=2500.0, sample_rate_hz=80000.0, table_bits=8)
+    assert (t.phase_bits, t.step) == (8, 8)
+    np.testing.assert_array_equal(t.phases(64), (np.arange(64) * 8) % 256)
+
+
 @pytest.mark.parametrize("kw, words", [
     (dict(carrier_hz=5000.0, sample_rate_hz=200000.0), "power of two"),
     (dict(carrier_hz=5000.0, output_rate_hz=6000.0), "at most the carrier"),
     (dict(carrier_hz=5000.0, sample_rate_hz=20000.0), "at least 8"),
-    (dict(table_bits=4), "at least 32 entries"),
+    (dict(table_bits=1), "2..16"),
+    (dict(carrier_hz=10.0, sample_rate_hz=10.0 * 2 ** 17, output_rate_hz=10.0), "at most 65536 samples a period"),
     (dict(carrier_hz=20000.0, output_rate_hz=0.5, adc_bits=24, sine_bits=18), "accumulator"),
 ])
 def test_bad_choices_are_refused_naming_the_option(kw, words):

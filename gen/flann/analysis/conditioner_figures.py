@@ -174,10 +174,10 @@ class Chain:
         return window_sum_v(self.spec, self.settings.adc_range_v)
 
     def carrier(self, n: int, phase: float | None = None) -> np.ndarray:
-        """The carrier's phase at each of ``n`` samples, ``phase`` at the first (default: the
-        reference's, the table's angle plus the rotation)."""
+        """The carrier's phase at each of ``n`` samples for a signal that demodulates at ``phase``
+        (default: the reference's, the table's angle plus the rotation): the table's lag taken off."""
         start = reference_phase(self.spec, self.ref) if phase is None else phase
-        return 2 * math.pi * np.arange(n) / self.spec.samples_per_period + start
+        return 2 * math.pi * np.arange(n) / self.spec.samples_per_period + start - self.spec.table_lag_rad
 
 
 def _ppm(chain: Chain, shift_mm) -> float:

@@ -66,8 +66,13 @@ class Waveforms:
 
     @property
     def sample_rate_hz(self) -> float:
-        """Samples per second (from the median step of ``time_s``)."""
-        return 1.0 / float(np.median(np.diff(self.time_s)))
+        """Samples per second: the sample steps between the first and the last time over their
+        duration (each step counted in whole median steps, so that a gap counts its samples);
+        the median step alone is only as fine as the times' last digit (a 390.625 ns step written
+        to the nanosecond reads as 390 or 391)."""
+        step = np.diff(self.time_s)
+        steps = float(np.sum(np.maximum(1.0, np.round(step / float(np.median(step))))))
+        return steps / float(self.time_s[-1] - self.time_s[0])
 
     def columns(self) -> dict[str, np.ndarray]:
         out = {c: getattr(self, c) for c in COLUMNS}

@@ -23,6 +23,7 @@ def test_dac_word_is_the_rounded_cosine_and_the_bit_density_follows_it():
     (dict(carrier_hz=100.0, sample_rate_hz=25600.0, output_rate_hz=100.0), 1200, 256),     # step 1: every entry
     (dict(carrier_hz=100.0, sample_rate_hz=102400.0, output_rate_hz=100.0, table_bits=10), 4200, 1024),
     (dict(carrier_hz=5000.0), 1500, 32),                                                   # the default carrier
+    (dict(carrier_hz=100.0, sample_rate_hz=102400.0, output_rate_hz=100.0), 2600, 256),    # 4 samples an entry
 ])
 def test_nco_matches_twin_under_ghdl(block, tmp_path, options, cycles, entries):
     spec = derive_conditioner(**options)

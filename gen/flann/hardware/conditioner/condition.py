@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import fdtrc
 
 from ...errors import FlannError
 from ...numeric.fixed import nearest_codes, signed_range
@@ -63,20 +64,53 @@ def converted(wave: Waveforms, spec: ConditionerSpec, adc_range_v: float) -> tup
     return ca, cb, wave.displacement_mm[:n].reshape(-1, spec.window)
 
 
+# the positions the reference phase is calibrated on: |A - B| within this fraction of its largest
+LINEAR_PART = 0.7
+# a cubic in the quadrature part of A - B is kept when a line leaves this little chance to its gain
+CUBIC_P = 1e-3
+
+
+def _slope_at_null(x: np.ndarray, diff: np.ndarray) -> complex:
+    """The complex slope of A - B against the displacement at the null, from the positions'
+    mean differences over the stroke's linear part (the run around the null where |A - B| is
+    within LINEAR_PART of its largest, and at least the three positions nearest it).  A line
+    through them gives the phase where the secondaries' phase holds still; where it moves with
+    the core (the primary current's phase), the quadrature part of A - B against that line
+    bends as a cubic in x, and a cubic, kept only when it is significant (an F test), gives
+    the slope at the null itself.  A constant quadrature residual turns neither."""
+    at, inv = np.unique(x, return_inverse=True)
+    count = np.bincount(inv)
+    mean = (np.bincount(inv, diff.real) + 1j * np.bincount(inv, diff.imag)) / count
+    size = np.abs(mean)
+    centre = int(np.argmin(size))
+    lo = hi = centre
+    while lo > 0 and size[lo - 1] <= LINEAR_PART * size.max():
+        lo -= 1
+    while hi < at.size - 1 and size[hi + 1] <= LINEAR_PART * size.max():
+        hi += 1
+    used = np.union1d(np.arange(lo, hi + 1), np.argsort(np.abs(at - at[centre]))[:3])
+    u, d = at[used] - at[centre], mean[used]
+    line = np.polyfit(u, d, 1)[0]
+    if used.size < 6 or line == 0:
+        return complex(line)
+    turn = line / abs(line)
+    quad = (d / turn).imag     # the quadrature part against the line's phase: flat when the phase holds
+    rss = [float(np.sum((quad - np.polyval(np.polyfit(u, quad, k), u)) ** 2)) for k in (1, 3)]
+    free = used.size - 4
+    if rss[1] > 0 and fdtrc(2, free, (rss[0] - rss[1]) / 2 / (rss[1] / free)) >= CUBIC_P:
+        return complex(line)
+    return complex(turn * (abs(line) + 1j * np.polyfit(u, quad, 3)[-2]))
+
+
 def calibrate_reference(spec: ConditionerSpec, chain_at_zero, displacement_mm=None) -> tuple[Reference, float]:
     """(reference registers, phase) from the chain's windows at offset 0.  With the windows'
-    displacements: the phase of the difference A - B's slope at the null (a line through the
-    complex differences at the three positions nearest it: a constant quadrature residual
-    does not turn it, and the primary current's phase, which moves with the core, is taken
-    where the detector's reference is trimmed); without them: the phase of A + B."""
+    displacements: the phase of the difference A - B's slope at the null (:func:`_slope_at_null`:
+    the converters' rounding, a fixed error of each position when the noise is too small to
+    dither it, averages over the positions of the linear part); without them: the phase of A + B."""
     diff = (chain_at_zero.i_a - chain_at_zero.i_b) + 1j * (chain_at_zero.q_a - chain_at_zero.q_b)
     x = None if displacement_mm is None else np.asarray(displacement_mm, dtype=float)[: diff.size]
     if x is not None and np.unique(x).size >= 3:
-        # a line through the three positions nearest the null (the smallest |A - B|)
-        at = np.unique(x)
-        null = at[np.argmin([np.mean(np.abs(diff[x == v])) for v in at])]
-        near = np.isin(x, at[np.argsort(np.abs(at - null))[:3]])
-        total = np.polyfit(x[near], diff[near], 1)[0]
+        total = _slope_at_null(x, diff)
         # a difference falling with x turns the slope's phase by pi: keep A + B positive
         if np.real(total * np.conj(np.sum(chain_at_zero.i_a + chain_at_zero.i_b)
                                     + 1j * np.sum(chain_at_zero.q_a + chain_at_zero.q_b))) < 0:

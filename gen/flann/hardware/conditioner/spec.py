@@ -48,6 +48,7 @@ GUARD_BITS = 2
 QUADRATURE_FRACTION = 0.1   # the quadrature residual the rotation is sized for, of full scale
 QUADRATURE_BUDGET = 50e-6   # its largest move of the ratio, of full scale
 ROTATION_GUARD = 2          # the rotation's step a quarter of the phase that budget tolerates
+MAX_SAMPLES_PER_PERIOD = 1 << 16
 MAX_ACC_BITS = 62   # the twin's int64, with a bit to spare for I_A + I_B
 
 
@@ -62,8 +63,28 @@ class ConditionerSpec:
     rotation_bits: int        # R: fraction bits of the fine rotation's tan
 
     @property
+    def phase_bits(self) -> int:
+        """P: the NCO's phase accumulator; the table reads its top T bits (P > T when a period
+        holds more samples than the table has entries: each entry then serves 2^(P-T) samples)."""
+        return max(self.table_bits, self.samples_per_period.bit_length() - 1)
+
+    @property
     def step(self) -> int:
-        return (1 << self.table_bits) // self.samples_per_period
+        return (1 << self.phase_bits) // self.samples_per_period
+
+    @property
+    def table_lag_rad(self) -> float:
+        """The phase by which the demodulator's reference lags the carrier: an entry serving
+        2^(P-T) samples in turn is a staircase whose fundamental is (2^(P-T) - 1)/2 samples late
+        (0 when P = T).  A secondary at phase p against the NCO's phase zero demodulates at
+        p + lag; the calibration measures it there, so the hardware needs no correction, but a
+        signal synthesised at a measured phase starts at the phase less the lag."""
+        return math.pi * ((1 << (self.phase_bits - self.table_bits)) - 1) / self.samples_per_period
+
+    def phases(self, count: int) -> np.ndarray:
+        """The table index the NCO gives each of ``count`` samples from its phase 0."""
+        acc = (np.arange(count, dtype=np.int64) * self.step) & ((1 << self.phase_bits) - 1)
+        return acc >> (self.phase_bits - self.table_bits)
 
     @property
     def window(self) -> int:
@@ -130,8 +151,11 @@ def derive_conditioner(adc_bits: int = 12, carrier_hz: float = 5000.0, sample_ra
         raise SpecError(f"output rate {output_rate_hz:g} Hz: must be > 0 and at most the carrier "
                         f"{carrier_hz:g} Hz (a ratio integrates whole carrier periods)")
     k = max(1, int(round(carrier_hz / output_rate_hz)))
-    if not (table_bits >= 2 and (1 << table_bits) >= n and table_bits <= 16):
-        raise SpecError(f"table bits {table_bits}: the table needs at least {n} entries (N) and at most 2^16")
+    if not 2 <= table_bits <= 16:
+        raise SpecError(f"table bits {table_bits}: must be 2..16")
+    if n > MAX_SAMPLES_PER_PERIOD:
+        raise SpecError(f"sample rate {fs:g} Hz over carrier {carrier_hz:g} Hz = {n}: at most "
+                        f"{MAX_SAMPLES_PER_PERIOD} samples a period (the NCO's accumulator)")
     frac = adc_bits + math.ceil(math.log2(n * k) / 2) + GUARD_BITS
     spec = ConditionerSpec(adc_bits=adc_bits, table_bits=table_bits, sine_bits=sine_bits,
                            samples_per_period=n, periods_per_output=k, ratio_frac_bits=frac,

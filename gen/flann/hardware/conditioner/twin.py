@@ -37,14 +37,15 @@ class FlannCondNco:
         """Registered outputs after each clock, for the ``in_en`` value of each clock (from reset)."""
         s = self.spec
         en = np.asarray(en, dtype=np.int64)
-        mask, full = (1 << s.table_bits) - 1, 1 << s.sine_bits
+        mask, full, drop = (1 << s.phase_bits) - 1, 1 << s.sine_bits, s.phase_bits - s.table_bits
         acc = phase = dac = err = 0
         out = np.zeros((3, en.size), dtype=np.int64)
         for i, e in enumerate(en):
             total = err + dac + (full >> 1)   # the DAC word, offset to unsigned, into the modulator
             bit, err = total >> s.sine_bits, total & (full - 1)
             if e:
-                phase, dac = acc, int(self.table[acc])
+                phase = acc >> drop
+                dac = int(self.table[phase])
                 acc = (acc + s.step) & mask
             out[:, i] = phase, dac, bit
         return NcoOut(*out)
@@ -207,7 +208,7 @@ class ConditionerChain:
         ``i_*``, ``q_*`` are the demodulators' sums (at the offset, before the rotation)."""
         s = self.spec
         xa, xb = self.adc.process(codes_a).out_sample, self.adc.process(codes_b).out_sample
-        phases = (np.arange(xa.size, dtype=np.int64) * s.step) & ((1 << s.table_bits) - 1)
+        phases = s.phases(xa.size)
         da, db = self.demod.process(xa, phases, ref.offset), self.demod.process(xb, phases, ref.offset)
         rot = self.rotate.process(da.out_i, da.out_q, db.out_i, db.out_q, ref.tan)
         r = self.ratio.process(rot.out_a, rot.out_b)

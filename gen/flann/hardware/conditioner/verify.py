@@ -51,7 +51,7 @@ NOISE = 2e-4
 # block bench -> (entity, cocotb module in flann.verify.benches, its configuration from the spec)
 BLOCKS = {
     "nco": ("flann_cond_nco", "cond_nco_bench",
-            lambda s: dict(cycles=4 * s.samples_per_period + 200, p_en=0.6, entries=s.samples_per_period)),
+            lambda s: dict(cycles=4 * s.samples_per_period + 200, p_en=0.6, entries=min(s.samples_per_period, 1 << s.table_bits))),
     "adc": ("flann_cond_adc", "cond_adc_bench", lambda s: {}),
     "demod": ("flann_cond_demod", "cond_demod_bench", lambda s: dict(windows=3)),
     "rotate": ("flann_cond_rotate", "cond_rotate_bench", lambda s: dict(cases=200)),
