@@ -197,7 +197,8 @@ class CaseResult:
 
     @property
     def right(self) -> bool:
-        return IND.judged_right(self.truth, self.named, self.regions)
+        return IND.judged_right(self.truth, self.named, self.regions, self.alternatives,
+                                self.separate_by)
 
     def to_json(self) -> dict:
         return {"case": self.case.name, "hidden": self.case.hidden,

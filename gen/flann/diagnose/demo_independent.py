@@ -131,12 +131,20 @@ def recording(case: IndependentCase, seed: int | None = None, scale: float = 1.0
     return rec, d, eff
 
 
-def judged_right(truth: list[str], named: list[str], regions: int) -> bool:
-    """A demo case is right when exactly the hidden effects are named; a control (nothing
-    hidden) must also locate no mismatch.  Both forward models' demos judge by this."""
+def judged_right(truth: list[str], named: list[str], regions: int,
+                 alternatives: list[list[str]] | None = None,
+                 separate_by: list[str] | None = None) -> bool:
+    """A demo case is right when exactly the hidden effects are named, or when the evidence
+    does not decide between two explanations, the hidden set is the one alternative beside
+    the choice and a measurement to tell them apart is named ("either A or B, and this tells
+    which").  A control (nothing hidden) must name nothing, offer nothing beside it and locate
+    no mismatch.  Both forward models' demos judge by this."""
     if not truth:
-        return not named and regions == 0
-    return sorted(named) == truth
+        return not named and regions == 0 and not alternatives
+    if sorted(named) == truth:
+        return True
+    return (alternatives is not None and len(alternatives) == 1
+            and sorted(alternatives[0]) == truth and bool(separate_by))
 
 
 def measurements(dg) -> list[str]:
@@ -174,7 +182,8 @@ class IndependentResult:
 
     @property
     def right(self) -> bool:
-        return judged_right(self.truth, self.named, self.regions)
+        return judged_right(self.truth, self.named, self.regions, self.alternatives,
+                            self.separate_by)
 
     def to_json(self) -> dict:
         return {"model": "independent (filament)", "case": self.case.name,
