@@ -26,6 +26,7 @@ def test_offset_with_the_null_free_is_offered_beside_nothing():
     assert res.named == [] and res.alternatives == [["null_offset"]]
     assert any("both secondary amplitudes" in m for m in res.separate_by)
     assert res.right
+    assert not res.named_right      # a detection limit counts only the set named
 
 
 def test_offset_beside_backlash_is_offered_with_it():

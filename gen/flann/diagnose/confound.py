@@ -314,7 +314,7 @@ def with_shape_alternative(family, sel: Selection, idx, conf: Confounding,
 # forward selection stops: "positive" evidence on the Kass-Raftery scale (2-6), short of the
 # "very strong" (BIC_MARGIN) that names it.  One parameter on n points lowers BIC by z^2 - ln n
 # (z its value over its uncertainty), so on 500-2,000 points this asks z > 2.9-3.1: a pure
-# noise draw does so for about 1 candidate in 250.  Another recording of the same sensor moves
+# noise draw does so for 1 candidate in 250-500.  Another recording of the same sensor moves
 # z by about 1, so one at z = 3 is named on some recordings and not on others.
 UNDECIDED_BIC = TIE_BIC
 UNDECIDED_NOTE = ("BIC prefers it by {gain:.1f}, short of the {margin:g} that names an effect "

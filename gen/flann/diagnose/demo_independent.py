@@ -181,6 +181,11 @@ class IndependentResult:
         return self.case.truth
 
     @property
+    def named_right(self) -> bool:
+        """Exactly the hidden set named (what a detection limit counts)."""
+        return judged_right(self.truth, self.named, self.regions)
+
+    @property
     def right(self) -> bool:
         return judged_right(self.truth, self.named, self.regions, self.alternatives,
                             self.separate_by)
@@ -334,7 +339,7 @@ def detection_limit(case: IndependentCase, reps: int = LIMIT_REPS, scales=None,
     scales = LIMIT_CASES[case.name] if scales is None else scales
     base = recording(case, 7000)[2][case.main][key]
     rows, limit = rate_search(lambda size, r: run_case(case, seed=7000 + r,
-                                                       scale=size / base).right,
+                                                       scale=size / base).named_right,
                               [base * sc for sc in scales], reps, progress=progress,
                               label=case.name)
     return {"case": case.name, "effect": NAMES[case.main], "parameter": key,
