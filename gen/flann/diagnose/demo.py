@@ -196,8 +196,14 @@ class CaseResult:
         return sorted(self.case.effects)
 
     @property
-    def right(self) -> bool:
+    def named_right(self) -> bool:
+        """Exactly the hidden set named (what a detection limit counts)."""
         return IND.judged_right(self.truth, self.named, self.regions)
+
+    @property
+    def right(self) -> bool:
+        return IND.judged_right(self.truth, self.named, self.regions, self.alternatives,
+                                self.separate_by)
 
     def to_json(self) -> dict:
         return {"case": self.case.name, "hidden": self.case.hidden,
@@ -302,7 +308,8 @@ def detection_limit(case: Case, scales=(2.0, 1.0, 0.5, 0.25), reps: int = IND.LI
     e, p = case.main
     base = resolved_effects(case)[e][p]
     rows, limit = IND.rate_search(
-        lambda size, r: run_case(case, scale=size / base, seed=1000 + r, points=points).right,
+        lambda size, r: run_case(case, scale=size / base, seed=1000 + r,
+                                 points=points).named_right,
         [base * sc for sc in scales], reps, progress=progress, label=case.name)
     n_points = len(simulate_case(case, points=points))
     return {"case": case.name, "effect": e, "parameter": p, "noise_v": case.noise_v,

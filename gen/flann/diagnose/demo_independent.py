@@ -131,12 +131,20 @@ def recording(case: IndependentCase, seed: int | None = None, scale: float = 1.0
     return rec, d, eff
 
 
-def judged_right(truth: list[str], named: list[str], regions: int) -> bool:
-    """A demo case is right when exactly the hidden effects are named; a control (nothing
-    hidden) must also locate no mismatch.  Both forward models' demos judge by this."""
+def judged_right(truth: list[str], named: list[str], regions: int,
+                 alternatives: list[list[str]] | None = None,
+                 separate_by: list[str] | None = None) -> bool:
+    """A demo case is right when exactly the hidden effects are named, or when the evidence
+    does not decide between two explanations, the hidden set is the one alternative beside
+    the choice and a measurement to tell them apart is named ("either A or B, and this tells
+    which").  A control (nothing hidden) must name nothing, offer nothing beside it and locate
+    no mismatch.  Both forward models' demos judge by this."""
     if not truth:
-        return not named and regions == 0
-    return sorted(named) == truth
+        return not named and regions == 0 and not alternatives
+    if sorted(named) == truth:
+        return True
+    return (alternatives is not None and len(alternatives) == 1
+            and sorted(alternatives[0]) == truth and bool(separate_by))
 
 
 def measurements(dg) -> list[str]:
@@ -173,8 +181,14 @@ class IndependentResult:
         return self.case.truth
 
     @property
-    def right(self) -> bool:
+    def named_right(self) -> bool:
+        """Exactly the hidden set named (what a detection limit counts)."""
         return judged_right(self.truth, self.named, self.regions)
+
+    @property
+    def right(self) -> bool:
+        return judged_right(self.truth, self.named, self.regions, self.alternatives,
+                            self.separate_by)
 
     def to_json(self) -> dict:
         return {"model": "independent (filament)", "case": self.case.name,
@@ -325,7 +339,7 @@ def detection_limit(case: IndependentCase, reps: int = LIMIT_REPS, scales=None,
     scales = LIMIT_CASES[case.name] if scales is None else scales
     base = recording(case, 7000)[2][case.main][key]
     rows, limit = rate_search(lambda size, r: run_case(case, seed=7000 + r,
-                                                       scale=size / base).right,
+                                                       scale=size / base).named_right,
                               [base * sc for sc in scales], reps, progress=progress,
                               label=case.name)
     return {"case": case.name, "effect": NAMES[case.main], "parameter": key,

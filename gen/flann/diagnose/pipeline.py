@@ -24,7 +24,7 @@ from . import data as D
 from .calibrate import Calibration as IdealCalibration
 from .calibrate import calibrate, initial_origin
 from .confound import (UNSPLIT, Confounding, Separation, equivalent_sets, separations,
-                       with_mixtures, with_shape_alternative)
+                       with_mixtures, with_shape_alternative, with_undecided)
 from .explain import explain
 from .model import NEUTRAL_EXTRA, Data, PhysicsFamily
 from .select import Fit, Selection, Trial, evidence_chain, forward_select
@@ -362,6 +362,7 @@ def selection_pass(shape: ShapeResult, rails: RailsResult, calib: CalibrationRes
         progress("testing for equally good explanations")
     conf = equivalent_sets(family, sel, candidates, calib.fit_idx, tuple(order))
     conf = with_shape_alternative(family, sel, calib.fit_idx, conf, candidates)
+    conf = with_undecided(family, sel, calib.fit_idx, conf, candidates)
     conf = with_mixtures(family, calib.fit_idx, conf)
     final = sel.final
     if conf.confounded or set(conf.sets[0]) != set(order):
