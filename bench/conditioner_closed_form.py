@@ -126,9 +126,16 @@ def main() -> int:
             if name == "train":
                 print("train: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
         res = json.loads(text[: text.rindex("}") + 1])
-    lin = res["linearity_pct_fs"]
+    return print_figures(res)
+
+
+def print_figures(res: dict) -> int:
+    """Each figure of ``flann eval --json`` with its verdict against its data-sheet reference;
+    0 when every judged figure meets it."""
+    lin, missed = res["linearity_pct_fs"], 0
     for chain in ("float", "hardware"):
         ok = lin[chain] is not None and lin[chain] <= lin["reference_pct_fs"]
+        missed += lin[chain] is not None and not ok
         print(f"linearity_pct_fs ({chain}) {lin[chain]:.4f} % FS: {'within' if ok else 'beyond'} the "
               f"{lin['reference']} of {lin['reference_pct_fs']:g}")
     for name in FIGURES[1:]:
@@ -136,12 +143,13 @@ def main() -> int:
         if f["value"] is None:
             print(f"{name}: not computable: {f['reason']}")
             continue
+        missed += f["ok"] is False
         word = {True: "meets", False: "misses", None: "not judged against"}[f["ok"]]
         unmet = f" ({f['unmet']})" if f.get("unmet") else ""
         print(f"{name} {f['value']:.4g} {f['unit']}: {word} the {f['reference']} "
               f"({'<=' if f['at_most'] else '>='} {f['reference_value']:g}){unmet}; from {f['source']}")
     print(res["verdict"]["line"])
-    return 0
+    return 1 if missed else 0
 
 
 if __name__ == "__main__":

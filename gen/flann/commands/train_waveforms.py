@@ -37,7 +37,7 @@ def is_waveform(args) -> bool:
     if is_waveform_csv(args.recordings):
         return True
     given = [f"--{f.replace('_', '-')}" for f in FLAGS if getattr(args, f, None) is not None]
-    if given:
+    if given and Path(args.recordings).is_file():
         raise FlannError(f"{', '.join(given)}: set the conditioner of a waveform recording; "
                          f"{args.recordings} holds demodulated readings")
     return False
