@@ -77,7 +77,8 @@ def eval_verdict(res: dict, figures=()):
             continue
         ok = lin[chain] <= lin["reference_pct_fs"]
         what = ("the conditioner's twin and the float FLANN" if chain == "float" else
-                "the conditioner's twin and the FLANN's, as the design computes")
+                "the conditioner's twin and the FLANN's, as the design computes; its output LSB "
+                f"{lin['hardware_lsb_pct_fs']:.4f} % FS")
         checks.append(Check(f"linearity_vs_ad598_{chain}", ok,
                             f"linearity {lin[chain]:.4f} % FS ({what}, per dwell) "
                             f"{'within' if ok else 'beyond'} the {lin['reference']} of {lin['reference_pct_fs']:g} % FS",
@@ -229,6 +230,8 @@ def run(args) -> int:
         if chain is not None:
             res["linearity_pct_fs"]["hardware"] = float(100 * np.max(np.abs(hardware_mm - rec.displacement_mm))
                                                         / res["full_scale_mm"])
+            # a dwell whose codes do not toggle is exact to within half of it: the figure's resolution
+            res["linearity_pct_fs"]["hardware_lsb_pct_fs"] = 100 * chain.spec.output_lsb_mm / res["full_scale_mm"]
         def to_mm(ratio):
             return predict_clamped(model, ratio)[0]
 
