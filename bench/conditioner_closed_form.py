@@ -47,6 +47,7 @@ EXCITATION_V = 5.0
 DWELL_S = 0.01
 POSITIONS = 41
 OUTPUT_RATE_HZ = 625.0   # 8 carrier periods a window: a bandwidth (0.443 x the rate) of 277 Hz, above 250
+TARGET_BITS = 16   # the effective bits at 250 Hz with 12-bit converters
 FIGURES = ("linearity_pct_fs", "effective_bits", "noise_free_bits", "bandwidth_hz", "settling_time_s",
            "excitation_rejection_ppm_fs_per_pct", "quadrature_rejection_ppm_fs", "phase_tolerance_deg")
 
@@ -115,7 +116,8 @@ def main() -> int:
         write_waveforms(d / "held_out.csv", waveforms(family, p, held_x, a.seed + 200, range_v, centre, a))
         steps = [("train", ["train", d / "wave.csv", "-o", d / "model.json", "--adc-bits", ADC_BITS,
                             "--adc-range-v", range_v, "--outliers", "keep", "--output-rate-hz", a.output_rate_hz]),
-                 ("gen", ["gen", d / "model.json", "-o", d / "design"]),
+                 # an output LSB finer than the ratio's noise: the words keep the conditioner's bits
+                 ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", 2 * p["span_mm"] / 2 ** 18]),
                  ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
                            "--quiet", "--outliers", "keep"])]
         for name, argv in steps:
@@ -148,6 +150,11 @@ def print_figures(res: dict) -> int:
         unmet = f" ({f['unmet']})" if f.get("unmet") else ""
         print(f"{name} {f['value']:.4g} {f['unit']}: {word} the {f['reference']} "
               f"({'<=' if f['at_most'] else '>='} {f['reference_value']:g}){unmet}; from {f['source']}")
+    hw = res["effective_bits"].get("hardware_bits")
+    if hw is not None:
+        missed += hw < TARGET_BITS
+        print(f"effective_bits of the design's output words {hw:.4g} bits: {'meets' if hw >= TARGET_BITS else 'misses'} "
+              f"the {TARGET_BITS} asked (their noise and their LSB's rounding, through the bit-true chain)")
     print(res["verdict"]["line"])
     return 1 if missed else 0
 

@@ -137,9 +137,11 @@ def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, gene
     assert design.spec == settings.spec
     assert design.manifest["reference"] == {"offset": settings.reference.offset, "tan": settings.reference.tan}
     flann = flann_design(design)
-    # the FLANN's converter is the ratio code, its top 16 bits
-    assert flann.manifest["adc_bits"] == settings.spec.ratio_bits and flann.manifest["input_bits"] == 16
-    assert flann.manifest["input_lsb_v"] == settings.ratio_lsb * 2 ** (settings.spec.ratio_bits - 16)
+    # the FLANN's converter is the ratio code, its top 20 bits (behind a conditioner a FLANN
+    # takes 20, not a demodulated converter's 16)
+    wired = min(20, settings.spec.ratio_bits)
+    assert flann.manifest["adc_bits"] == settings.spec.ratio_bits and flann.manifest["input_bits"] == wired
+    assert flann.manifest["input_lsb_v"] == settings.ratio_lsb * 2 ** (settings.spec.ratio_bits - wired)
     assert {p.name for p in flann.files} < {p.name for p in design.files}
     assert "joined in flann_chain_top" in out and "kept as waveform.csv" in out
     # a converter of its own is refused: the input is the conditioner's ratio
@@ -183,13 +185,15 @@ def test_eval_with_the_design_gives_the_hardware_linearity(trained, generated, h
     rc, out, err = in_process(["eval", d / "model.json", held_out, "--design", design, "--json", "--outliers", "keep"])
     assert rc == 0, err
     lin = json.loads(out)["linearity_pct_fs"]
-    # the same chain built here: each window's ratio code, its top 16 bits wired to the FLANN's twin
+    # the same chain built here: each window's ratio code, its top bits wired to the FLANN's twin
     settings = of_model(load_model(d / "model.json"))
     wave = read_waveforms(held_out, announce=False)
     c = condition_with(settings, wave)
     dw = dwell_readings(c, wave, settings.spec.window)
     flann = flann_design(open_directory(design).with_twin())
-    codes = np.round(c.ratio * 2 ** settings.spec.ratio_frac_bits).astype(np.int64) >> (settings.spec.ratio_bits - 16)
+    drop = settings.spec.ratio_bits - flann.spec.input_bits
+    assert drop == max(0, settings.spec.ratio_bits - 20)
+    codes = np.round(c.ratio * 2 ** settings.spec.ratio_frac_bits).astype(np.int64) >> drop
     mm = flann.twin().process(codes).out_data * flann.spec.output_lsb_mm
     per = np.array([mm[g].mean() for g in dw.groups])
     want = 100 * np.max(np.abs(per - dw.recordings.displacement_mm)) / 25.0

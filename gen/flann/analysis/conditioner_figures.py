@@ -202,6 +202,23 @@ def systematic_ppm(chain: Chain, base_ratio, moved_ratio) -> tuple[float, float,
     return _ppm(chain, out), worst, 1e6 * float(np.std(scatter)) / chain.fs_mm
 
 
+def pooled_rms(outs) -> float:
+    """The rms of each dwell's outputs about the dwell's own mean, pooled over the dwells."""
+    resid = np.concatenate([o - o.mean() for o in outs])
+    return math.sqrt(float(np.sum(resid ** 2)) / sum(o.size - 1 for o in outs))
+
+
+def hardware_bits(window_mm, groups, span_mm: float, lsb_mm: float) -> float | None:
+    """Effective bits of a design's output words (one a window, in mm): their noise about each
+    dwell's mean with the output word's own rounding (an ideal quantiser's LSB / sqrt 12) beside
+    it, so that a word too coarse to move within a dwell counts its LSB, not zero."""
+    outs = [np.asarray(window_mm, dtype=float)[g] for g in groups if g.size >= 2]
+    if not outs:
+        return None
+    sigma = math.sqrt(pooled_rms(outs) ** 2 + lsb_mm ** 2 / 12)
+    return math.log2(span_mm / (sigma * SQRT12))
+
+
 def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
     span = 2 * chain.fs_mm
     groups = [g for g in chain.dwells.groups if g.size >= 2]
@@ -212,8 +229,7 @@ def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
         return [Figure("effective_bits", None, "bits", ref16, TARGET_BITS, False, src, reason),
                 Figure("noise_free_bits", None, "bits", "AD2S93's resolution", AD2S93_BITS, False, src, reason)]
     outs = [chain.to_mm(ratio[g]) for g in groups]
-    resid = np.concatenate([o - o.mean() for o in outs])
-    sigma = math.sqrt(float(np.sum(resid ** 2)) / sum(o.size - 1 for o in outs))
+    sigma = pooled_rms(outs)
     ptp = max(float(np.ptp(o)) for o in outs)
     bw = bandwidth.value
     detail = {"rms_mm": sigma, "span_mm": span, "bandwidth_hz": bw, "dwells": len(groups)}

@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from ..analysis.conditioner_figures import AD598_LINEARITY_PCT_FS, chain_figures, plot_chain
+from ..analysis.conditioner_figures import AD598_LINEARITY_PCT_FS, chain_figures, hardware_bits, plot_chain
 from ..argtypes import png_path
 from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_report, full_scale_mm,
                        raw_output_mm)
@@ -107,12 +107,17 @@ def conditioned_flann(model, design_dir):
     return flann
 
 
-def chain_outputs_mm(flann, settings, conditioned, dwells, rec) -> np.ndarray:
-    """The design's output per reading of ``rec``: each window's ratio code into the FLANN's twin
-    (its top input bits, as wired), averaged over the dwell as the float chain's ratio is."""
+def chain_window_mm(flann, settings, conditioned) -> np.ndarray:
+    """The design's output of each window: its ratio code into the FLANN's twin (its top input
+    bits, as wired), in mm."""
     spec = flann.spec
     codes = adc_codes(spec, conditioned.ratio, settings.ratio_converter)
-    out = FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
+    return FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
+
+
+def chain_outputs_mm(out, dwells, rec) -> np.ndarray:
+    """The design's output per reading of ``rec``: its windows' outputs ``out`` averaged over
+    the dwell as the float chain's ratio is."""
     full = dwells.recordings
     per = {(float(x), float(v)): float(np.mean(out[g]))
            for x, v, g in zip(full.displacement_mm, full.voltage_v, dwells.groups)}
@@ -199,7 +204,8 @@ def run(args) -> int:
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     errors = res.pop("_errors", None)
     if chain is not None:
-        hardware_mm = chain_outputs_mm(chain, settings, conditioned, dwells, rec)
+        window_mm = chain_window_mm(chain, settings, conditioned)
+        hardware_mm = chain_outputs_mm(window_mm, dwells, rec)
     elif args.design:
         hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
                                adc=design_adc(args.design))
@@ -243,6 +249,8 @@ def run(args) -> int:
             # holds log2(span / LSB) bits of them
             res["effective_bits"]["hardware_output_bits"] = math.log2(2 * res["full_scale_mm"]
                                                                       / chain.spec.output_lsb_mm)
+            res["effective_bits"]["hardware_bits"] = hardware_bits(window_mm, dwells.groups, 2 * res["full_scale_mm"],
+                                                                   chain.spec.output_lsb_mm)
         if args.plot:
             plot_chain(args.plot, settings, wave, conditioned, dwells, to_mm, res["full_scale_mm"],
                        hardware_mm if chain is not None else None)
@@ -312,7 +320,9 @@ def run(args) -> int:
         enough = held >= enob["value"]
         print(f"the design's output LSB {lsb:g} mm holds {held:.1f} bits of the {2 * fs:g} mm span: "
               f"{'enough for' if enough else 'fewer than'} the {enob['value']:.1f} effective bits"
-              + ("" if enough else f" (flann gen --output-lsb-mm {2 * fs / 2 ** math.ceil(enob['value']):.2g} keeps them)"))
+              + ("" if enough else f" (flann gen --output-lsb-mm {2 * fs / 2 ** math.ceil(enob['value']):.2g} keeps them)")
+              + (f"; its words measure {enob['hardware_bits']:.1f} effective bits (their noise and rounding)"
+                 if enob.get("hardware_bits") is not None else ""))
     if args.plot:
         print(f"plot: {args.plot}")
     print(verdict.line())

@@ -19,6 +19,15 @@ from ..golden.model import FlannModel
 
 ADC_BITS = (4, 32)           # ADC widths accepted (wider ones give their top MAX_DESIGN_INPUT_BITS)
 MAX_DESIGN_INPUT_BITS = 16   # widest ADC code the datapath takes (serial normaliser, guard bits)
+# behind the conditioner: the ratio's resolution, which a 16-bit input would cut below the
+# conditioner's own (its top 16 of 21 bits: 15.7 bits over the LVDT's stroke against 16.7 of
+# noise); every code is verified through the compiled netlist, the VHDL on a sample
+CHAIN_INPUT_BITS = 20
+
+
+def max_input_bits(model) -> int:
+    """The widest input code a design of ``model`` takes: the ratio's behind a conditioner."""
+    return CHAIN_INPUT_BITS if getattr(model, "conditioner", None) is not None else MAX_DESIGN_INPUT_BITS
 MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
 MIN_OUTPUT_CODES = 16        # the same floor on the output: codes over the trained stroke
 SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)
@@ -80,7 +89,7 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             f"the trained range {vlo:.6g}..{vhi:.6g} V uses {100 * used:.2g} % of the ADC's "
             f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): about {math.log2(1 / used):.1f} of its bits "
             "carry no signal; check the voltage unit or the conditioner's gain")
-    dropped = max(0, bits - MAX_DESIGN_INPUT_BITS)
+    dropped = max(0, bits - max_input_bits(model))
     eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
     if dropped:
         slope = max_mm_per_v(model)
@@ -218,4 +227,4 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
 __all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "check_converter", "check_output_step", "default_input_lsb",
            "default_lsb_for_range", "default_output_step_mm",
            "max_mm_per_v", "model_accuracy_mm", "wired_codes", "pathological_hint", "weight_range_text",
-           "MAX_DESIGN_INPUT_BITS", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]
+           "CHAIN_INPUT_BITS", "MAX_DESIGN_INPUT_BITS", "max_input_bits", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]

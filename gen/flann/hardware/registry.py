@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import FlannError
 from ..golden.thermal import is_thermal, load_any_model
 from ..numeric.fixed import FixedFormat
-from .adc import ADC_BITS, MAX_DESIGN_INPUT_BITS
+from .adc import ADC_BITS, CHAIN_INPUT_BITS, MAX_DESIGN_INPUT_BITS
 from .conditioner.datapath import DATAPATH as CONDITIONER
 from .datapath import Datapath, Field, _int
 from .family_thermal.build import is_thermal_family
@@ -113,7 +113,7 @@ def read_design(directory) -> tuple[Manifest, Datapath]:
 
 # input widths flann gen builds: the one-input datapaths take 16 bits at most, the two-input
 # one more (its grid coarser than the code); the rebuild holds each datapath to its own
-INPUT_BITS = (ADC_BITS[0], max(MAX_DESIGN_INPUT_BITS, THERMAL_INPUT_BITS))
+INPUT_BITS = (ADC_BITS[0], max(MAX_DESIGN_INPUT_BITS, THERMAL_INPUT_BITS, CHAIN_INPUT_BITS))
 # what a manifest repeats at its top level of what its spec records: the benches, the netlist
 # sweeps and the ISE pin map read the top level, the rebuilt twin the spec
 REPEATED = ("input_bits", "input_lsb_v", "output_bits", "output_lsb_mm", "temp_bits", "temp_lsb_c")

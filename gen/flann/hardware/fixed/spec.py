@@ -401,7 +401,7 @@ def derive_input(model: FlannModel, input_bits, input_lsb_v, clamp) -> InputStag
     plan = adc.plan_adc(model, input_bits, input_lsb_v, clamp)  # ranges, units, wide ADCs
     for note in plan.notes:
         warnings.warn(note)
-    B = _check_int("input_bits", plan.input_bits, adc.ADC_BITS[0], adc.MAX_DESIGN_INPUT_BITS)
+    B = _check_int("input_bits", plan.input_bits, adc.ADC_BITS[0], adc.max_input_bits(model))
     vlo, vhi = sorted(model.voltage_range_v)
     cmin, cmax = signed_range(B)
     input_lsb_v = adc.default_input_lsb(model, B) if plan.input_lsb_v is None else plan.input_lsb_v
