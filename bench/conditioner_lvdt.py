@@ -37,6 +37,19 @@ def output_rate_hz(carrier_hz: float) -> float:
     return carrier_hz / periods
 
 
+def synth_line(r: dict) -> tuple[str, bool]:
+    """The whole chain's resources and clock, judged against the part and the 50 MHz asked."""
+    if "logic_cells" in r:
+        return (f"{r['device']}: {r['logic_cells']} logic cells ({r['lc_pct']:g} %), {r['brams']} block RAMs, "
+                f"{r['fmax_mhz']:g} MHz placed and routed: {'meets' if r['timing_met'] else 'misses'} "
+                f"{r['clock_mhz']:g} MHz; bitstream {r['bitstream']}"), bool(r["timing_met"])
+    t = r["timing"]
+    return (f"{r['device']}: {r['luts']} LUT4 ({r['lut_pct']:g} %), {r['ffs']} flip-flops, {r['brams']} of "
+            f"{r['device_brams']} block RAMs: {'fits' if r['fits'] else 'does not fit'} (smallest "
+            f"{r['smallest_device']}); Fmax estimate {t['fmax_mhz_estimate']:g} MHz: "
+            f"{'meets' if t['meets_clock'] else 'misses'} {t['clock_mhz']:g} MHz"), bool(r["fits"] and t["meets_clock"])
+
+
 def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: float) -> int:
     rate = output_rate_hz(hz)
     print(f"\n== carrier {hz:g} Hz, {SAMPLE_RATE_HZ / hz:g} samples a period, ratio at {rate:.4g} Hz, "
@@ -52,9 +65,9 @@ def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: f
              ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json", "--quiet"])]
     if hardware:
         steps += [("sim", ["sim", d / "design"]),
-                  ("synth", ["synth", d / "design"]),
-                  ("synth", ["synth", d / "design", "--device", "ice40-hx8k-ct256"])]
-    res = None
+                  ("synth", ["synth", d / "design", "--json"]),
+                  ("synth", ["synth", d / "design", "--device", "ice40-hx8k-ct256", "--json"])]
+    res, missed = None, 0
     for name, argv in steps:
         rc, text = run(argv)
         if rc != 0:
@@ -62,9 +75,13 @@ def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: f
             return 1
         if name == "eval":
             res = json.loads(text[: text.rindex("}") + 1])
-        elif name in ("train", "sim", "synth"):
+        elif name == "synth":
+            line, ok = synth_line(json.loads(text[text.index("{"): text.rindex("}") + 1]))
+            missed += not ok
+            print("synth: " + line)
+        elif name in ("train", "sim"):
             print(f"{name}: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
-    return print_figures(res)
+    return 1 if print_figures(res) or missed else 0
 
 
 def main() -> int:
