@@ -209,3 +209,101 @@ def simulate_recording(m: FilamentLVDT, travel_mm: tuple[float, float], step_mm:
         y = np.clip(y, r["low_v"], r["high_v"])
     return Recordings(displacement_mm=x + origin_mm, voltage_v=y, direction=d, time_s=t,
                       temperature_c=temp, source=source)
+
+
+# -- waveform recordings ------------------------------------------------------------------
+#
+# The same magnetics sampled as a DAQ records them: the excitation and the two secondaries'
+# e.m.f.s at the carrier, each a complex amplitude from the couplings and the primary current
+# Ip = V / (R + j w L(x)) with its phase kept.  What a waveform sees of the effects, in this
+# model's own terms: ``imbalance`` scales the couplings (m1 by 1 + f/2, m2 by 1 - f/2);
+# ``zero_shift`` moves the core; ``quadrature`` (output-referred, as for the rectified output)
+# is q / |gain| in quadrature with the primary-induced e.m.f., added to the secondaries'
+# difference, half on each secondary; ``excitation_drift`` (``drift_pct`` over the run)
+# scales the drive.  ``offset`` and ``rails`` are made by a demodulator after the secondaries
+# and are not in a waveform; ``backlash``, ``leadscrew`` and ``thermal`` are not modelled here.
+
+# a DAQ's input ranges (V), the smallest at least 10 % above a channel's peak is used
+DAQ_RANGES_V = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)
+WAVE_EFFECTS = ("zero_shift", "imbalance", "quadrature", "excitation_drift", "offset", "rails")
+
+
+def secondary_emfs(m: FilamentLVDT, displacement_mm) -> tuple[np.ndarray, np.ndarray]:
+    """Complex peak e.m.f.s of secondary 1 and secondary 2 (phase against the excitation
+    ``drive_v cos(w t)``) for commanded displacements, with the effects a waveform shows
+    (not the excitation drift, which is a function of time)."""
+    bad = sorted(set(m.effects) - set(WAVE_EFFECTS))
+    if bad:
+        raise ValueError(f"not modelled in the filament waveforms: {', '.join(bad)}")
+    e = m.effects
+    core = np.asarray(displacement_mm, float).copy()
+    if "zero_shift" in e:
+        core = core - e["zero_shift"]["shift_mm"]
+    m1, m2, l_p = _couplings(m, core)
+    w = 2 * math.pi * m.frequency_hz
+    ip = m.drive_v / (m.primary_resistance_ohm + 1j * w * l_p)          # complex, phase kept
+    if "imbalance" in e:
+        f = e["imbalance"]["fraction"]
+        m1, m2 = m1 * (1 + f / 2), m2 * (1 - f / 2)
+    v1, v2 = -1j * w * m1 * ip, -1j * w * m2 * ip                       # Faraday: -j w M Ip
+    if "quadrature" in e:
+        q = e["quadrature"]["quadrature_v"] / abs(m.gain)
+        along = -1j * ip / np.abs(ip)                                    # the e.m.f.s' phase
+        v1, v2 = v1 + 0.5j * q * along, v2 - 0.5j * q * along
+    return v1, v2
+
+
+def daq_range_v(peak_v: float) -> float:
+    for r in DAQ_RANGES_V:
+        if r >= 1.1 * peak_v:
+            return r
+    raise ValueError(f"peak {peak_v:.3g} V beyond the largest DAQ range {DAQ_RANGES_V[-1]:g} V")
+
+
+def _daq(v: np.ndarray, range_v: float, bits: int) -> np.ndarray:
+    """Bipolar converter: saturate at +-range, round to its LSB."""
+    lsb = 2 * range_v / 2 ** bits
+    codes = np.clip(np.round(v / lsb), -2 ** (bits - 1), 2 ** (bits - 1) - 1)
+    return codes * lsb
+
+
+def dwell_positions(half_range_mm: float, step_mm: float) -> tuple[np.ndarray, np.ndarray]:
+    """Stepped positions -h..h forward and back (each turning point once) and directions."""
+    n = int(math.floor(half_range_mm / step_mm + 1e-9))
+    fwd = step_mm * np.arange(-n, n + 1)
+    back = fwd[-2::-1]
+    return np.concatenate([fwd, back]), np.concatenate([np.ones(fwd.size), -np.ones(back.size)])
+
+
+def simulate_waveforms(m: FilamentLVDT, half_range_mm: float, step_mm: float, noise_v: float,
+                       seed: int, dwell_s: float = 0.003, samples_per_carrier: int = 32,
+                       adc_bits: int = 12, source: str = "filament model waveforms"):
+    """A waveform recording (:class:`flann.recordings.waveform.Waveforms`): dwells of
+    ``dwell_s`` at positions stepped by ``step_mm`` over +-``half_range_mm`` forward and back;
+    ``exc_v = drive a(t) cos(w t)``, ``sec_a_v, sec_b_v = Re(V a(t) e^{j w t})`` (secondary 1,
+    secondary 2), ``a(t)`` the excitation drift (linear over the run); white noise of
+    ``noise_v`` rms on every channel per sample; ``adc_bits`` converters, the excitation on its
+    own range, both secondaries on one, each the smallest DAQ range 10 % above the peak."""
+    from ..recordings.waveform import Waveforms
+
+    pos, _dirs = dwell_positions(half_range_mm, step_mm)
+    fc = m.frequency_hz
+    fs = samples_per_carrier * fc
+    per = int(round(dwell_s * fs))
+    t = np.arange(pos.size * per) / fs
+    x = np.repeat(pos, per)
+    v1, v2 = secondary_emfs(m, pos)
+    drift = m.effects.get("excitation_drift", {}).get("drift_pct", 0.0) / 100.0
+    a = 1.0 + drift * t / t[-1]
+    ph = np.exp(1j * 2 * math.pi * fc * t)
+    sec_a = np.real(np.repeat(v1, per) * a * ph)
+    sec_b = np.real(np.repeat(v2, per) * a * ph)
+    exc = m.drive_v * a * np.real(ph)
+    rng = np.random.default_rng(seed)
+    sec_a, sec_b, exc = (v + rng.normal(0.0, noise_v, t.size) for v in (sec_a, sec_b, exc))
+    r_sec = daq_range_v(max(np.max(np.abs(v1)), np.max(np.abs(v2))) * max(1.0, np.max(a)))
+    r_exc = daq_range_v(m.drive_v * max(1.0, np.max(a)))
+    return Waveforms(time_s=t, sec_a_v=_daq(sec_a, r_sec, adc_bits), sec_b_v=_daq(sec_b, r_sec, adc_bits),
+                     displacement_mm=x, exc_v=_daq(exc, r_exc, adc_bits), source=source,
+                     comments=(f"filament model, carrier {fc:.9g} Hz, sample rate {fs:.9g} Hz, ADC "
+                               f"{adc_bits} bits, secondaries +-{r_sec:g} V, excitation +-{r_exc:g} V",))
