@@ -307,3 +307,18 @@ def simulate_waveforms(m: FilamentLVDT, half_range_mm: float, step_mm: float, no
                      displacement_mm=x, exc_v=_daq(exc, r_exc, adc_bits), source=source,
                      comments=(f"filament model, carrier {fc:.9g} Hz, sample rate {fs:.9g} Hz, ADC "
                                f"{adc_bits} bits, secondaries +-{r_sec:g} V, excitation +-{r_exc:g} V",))
+
+
+def waveform_draw(seed: int, positions: int = 33) -> tuple[FilamentLVDT, float, float]:
+    """A random sensor for a waveform recording (:func:`random_geometry`, output scaled to
+    2-8 V at the travel's end, either sign), its half travel (60-100 % of the monotonic
+    range, centred on 0 mm as the waveform diagnosis' mirrored pairs need) and a stage step
+    in whole micrometres giving ``positions`` dwell positions per pass."""
+    rng = np.random.default_rng(20_000 + seed)
+    m = random_geometry(rng)
+    h = monotonic_half_range(m) * rng.uniform(0.6, 1.0)
+    m = scaled_to(m, rng.uniform(2.0, 8.0), h)
+    if rng.random() < 0.5:
+        m = replace(m, gain=-m.gain)
+    step = round(2 * h / (positions - 1), 3)
+    return m, step * ((positions - 1) // 2), step
