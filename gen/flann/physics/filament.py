@@ -24,6 +24,10 @@ Formulation (magnetostatic, reciprocity):
 Non-ideal effects are written out here again (on purpose not the catalogue's code):
 offset, zero shift, secondary imbalance, backlash, thermal drift of the drive, rails
 (asymmetric allowed), lead-screw error, quadrature at the null.
+
+Waveform recordings (:func:`simulate_waveforms`): the same couplings and primary current
+with its phase give each secondary's complex e.m.f.; the excitation and both secondaries are
+sampled through 12-bit converters with noise, dwelling at stepped positions.
 """
 
 from __future__ import annotations
