@@ -54,7 +54,7 @@ def contexts(s: ConditionerSpec) -> dict[str, dict]:
     ratio_busy = FlannCondRatio(s).latency
     return {
         "flann_cond_nco": dict(**_table(s), step=s.step, samples_per_period=s.samples_per_period,
-                               phase_bits=s.phase_bits,
+                               phase_bits=s.phase_bits, table_lsb=s.phase_bits - s.table_bits,
                                step_literal=bits_literal(s.step, s.phase_bits, signed=False)),
         "flann_cond_adc": dict(adc_bits=s.adc_bits),
         "flann_cond_demod": dict(**_table(s), adc_bits=s.adc_bits, acc_bits=s.acc_bits, window=s.window,
