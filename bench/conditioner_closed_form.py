@@ -120,15 +120,26 @@ def main() -> int:
                  ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", 2 * p["span_mm"] / 2 ** 18]),
                  ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
                            "--quiet", "--outliers", "keep"])]
-        for name, argv in steps:
-            rc, text = run(argv)
-            if rc != 0:
-                print(f"{name}: exit {rc}: {text.strip().splitlines()[-1] if text.strip() else ''}")
-                return 1
-            if name == "train":
-                print("train: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
-        res = json.loads(text[: text.rindex("}") + 1])
+        outs = run_steps(steps)
+        if outs is None:
+            return 1
+        res = json.loads(outs[-1][1][: outs[-1][1].rindex("}") + 1])
     return print_figures(res)
+
+
+def run_steps(steps) -> list[tuple[str, str]] | None:
+    """Each (name, argv) through flann in turn, train's and sim's verdict printed: (name, output)
+    of each, or None at the first that fails (its last line printed)."""
+    outs = []
+    for name, argv in steps:
+        rc, text = run(argv)
+        if rc != 0:
+            print(f"{name}: exit {rc}: {text.strip().splitlines()[-1] if text.strip() else ''}")
+            return None
+        if name in ("train", "sim"):
+            print(f"{name}: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
+        outs.append((name, text))
+    return outs
 
 
 def print_figures(res: dict) -> int:

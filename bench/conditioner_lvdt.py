@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from conditioner_closed_form import print_figures, run
+from conditioner_closed_form import print_figures, run_steps
 
 SENSOR = Path("data/sensors/paper_lvdt.toml")
 SAMPLE_RATE_HZ = 2.56e6
@@ -67,20 +67,17 @@ def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: f
         steps += [("sim", ["sim", d / "design"]),
                   ("synth", ["synth", d / "design", "--json"]),
                   ("synth", ["synth", d / "design", "--device", "ice40-hx8k-ct256", "--json"])]
+    outs = run_steps(steps)
+    if outs is None:
+        return 1
     res, missed = None, 0
-    for name, argv in steps:
-        rc, text = run(argv)
-        if rc != 0:
-            print(f"{name}: exit {rc}: {text.strip().splitlines()[-1] if text.strip() else ''}")
-            return 1
+    for name, text in outs:
         if name == "eval":
             res = json.loads(text[: text.rindex("}") + 1])
         elif name == "synth":
             line, ok = synth_line(json.loads(text[text.index("{"): text.rindex("}") + 1]))
             missed += not ok
             print("synth: " + line)
-        elif name in ("train", "sim"):
-            print(f"{name}: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
     return 1 if print_figures(res) or missed else 0
 
 
