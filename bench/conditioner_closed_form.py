@@ -93,6 +93,7 @@ def main() -> int:
     ap.add_argument("--noise-v", type=float, default=None, help="rms on each secondary (default: the family's)")
     ap.add_argument("--positions", type=int, default=POSITIONS)
     ap.add_argument("--dwell-s", type=float, default=DWELL_S)
+    ap.add_argument("--hardware", action="store_true", help="also flann sim and flann synth the design")
     a = ap.parse_args()
     if not a.family.is_file():
         print(f"error: {a.family}: the closed-form family's script not found (give --family)", file=sys.stderr)
@@ -120,11 +121,31 @@ def main() -> int:
                  ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", 2 * p["span_mm"] / 2 ** 18]),
                  ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
                            "--quiet", "--outliers", "keep"])]
+        if a.hardware:
+            steps += hardware_steps(d / "design")
         outs = run_steps(steps)
         if outs is None:
             return 1
-        res = json.loads(outs[-1][1][: outs[-1][1].rindex("}") + 1])
-    return print_figures(res)
+        return judge(outs)
+
+
+def synth_line(r: dict) -> tuple[str, bool]:
+    """The whole chain's resources and clock, judged against the part and the 50 MHz asked."""
+    if "logic_cells" in r:
+        return (f"{r['device']}: {r['logic_cells']} logic cells ({r['lc_pct']:g} %), {r['brams']} block RAMs, "
+                f"{r['fmax_mhz']:g} MHz placed and routed: {'meets' if r['timing_met'] else 'misses'} "
+                f"{r['clock_mhz']:g} MHz; bitstream {r['bitstream']}"), bool(r["timing_met"])
+    t = r["timing"]
+    return (f"{r['device']}: {r['luts']} LUT4 ({r['lut_pct']:g} %), {r['ffs']} flip-flops, {r['brams']} of "
+            f"{r['device_brams']} block RAMs: {'fits' if r['fits'] else 'does not fit'} (smallest "
+            f"{r['smallest_device']}); Fmax estimate {t['fmax_mhz_estimate']:g} MHz: "
+            f"{'meets' if t['meets_clock'] else 'misses'} {t['clock_mhz']:g} MHz"), bool(r["fits"] and t["meets_clock"])
+
+
+def hardware_steps(design: Path) -> list:
+    """flann sim and flann synth (Spartan-II, then placed and routed on an iCE40-HX8K) of a design."""
+    return [("sim", ["sim", design]), ("synth", ["synth", design, "--json"]),
+            ("synth", ["synth", design, "--device", "ice40-hx8k-ct256", "--json"])]
 
 
 def run_steps(steps) -> list[tuple[str, str]] | None:
@@ -140,6 +161,20 @@ def run_steps(steps) -> list[tuple[str, str]] | None:
             print(f"{name}: " + next((s for s in text.splitlines() if s.startswith("verdict")), "?"))
         outs.append((name, text))
     return outs
+
+
+def judge(outs) -> int:
+    """The eval's figures and the synth's lines of a run of :func:`run_steps`, each judged:
+    0 when every one meets its reference."""
+    res, missed = None, 0
+    for name, text in outs:
+        if name == "eval":
+            res = json.loads(text[: text.rindex("}") + 1])
+        elif name == "synth":
+            line, ok = synth_line(json.loads(text[text.index("{"): text.rindex("}") + 1]))
+            missed += not ok
+            print("synth: " + line)
+    return 1 if print_figures(res) or missed else 0
 
 
 def print_figures(res: dict) -> int:

@@ -16,13 +16,12 @@ design.  Exit 0 when every judged figure meets its reference at every carrier.
 """
 
 import argparse
-import json
 import math
 import sys
 import tempfile
 from pathlib import Path
 
-from conditioner_closed_form import print_figures, run_steps
+from conditioner_closed_form import hardware_steps, judge, run_steps
 
 SENSOR = Path("data/sensors/paper_lvdt.toml")
 SAMPLE_RATE_HZ = 2.56e6
@@ -35,19 +34,6 @@ def output_rate_hz(carrier_hz: float) -> float:
     """The fastest whole-period rate whose boxcar bandwidth is at least 250 Hz."""
     periods = math.floor(carrier_hz * 0.4429 / BANDWIDTH_HZ)
     return carrier_hz / periods
-
-
-def synth_line(r: dict) -> tuple[str, bool]:
-    """The whole chain's resources and clock, judged against the part and the 50 MHz asked."""
-    if "logic_cells" in r:
-        return (f"{r['device']}: {r['logic_cells']} logic cells ({r['lc_pct']:g} %), {r['brams']} block RAMs, "
-                f"{r['fmax_mhz']:g} MHz placed and routed: {'meets' if r['timing_met'] else 'misses'} "
-                f"{r['clock_mhz']:g} MHz; bitstream {r['bitstream']}"), bool(r["timing_met"])
-    t = r["timing"]
-    return (f"{r['device']}: {r['luts']} LUT4 ({r['lut_pct']:g} %), {r['ffs']} flip-flops, {r['brams']} of "
-            f"{r['device_brams']} block RAMs: {'fits' if r['fits'] else 'does not fit'} (smallest "
-            f"{r['smallest_device']}); Fmax estimate {t['fmax_mhz_estimate']:g} MHz: "
-            f"{'meets' if t['meets_clock'] else 'misses'} {t['clock_mhz']:g} MHz"), bool(r["fits"] and t["meets_clock"])
 
 
 def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: float) -> int:
@@ -64,21 +50,11 @@ def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: f
              ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", output_lsb_mm]),
              ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json", "--quiet"])]
     if hardware:
-        steps += [("sim", ["sim", d / "design"]),
-                  ("synth", ["synth", d / "design", "--json"]),
-                  ("synth", ["synth", d / "design", "--device", "ice40-hx8k-ct256", "--json"])]
+        steps += hardware_steps(d / "design")
     outs = run_steps(steps)
     if outs is None:
         return 1
-    res, missed = None, 0
-    for name, text in outs:
-        if name == "eval":
-            res = json.loads(text[: text.rindex("}") + 1])
-        elif name == "synth":
-            line, ok = synth_line(json.loads(text[text.index("{"): text.rindex("}") + 1]))
-            missed += not ok
-            print("synth: " + line)
-    return 1 if print_figures(res) or missed else 0
+    return judge(outs)
 
 
 def main() -> int:
