@@ -193,9 +193,11 @@ def _pair_fit(u, ai, bi, sig, pos, shift):
 
 def _imbalance_shift(u, ai, bi, sig) -> tuple[Evidence, Evidence, dict]:
     """``A_I(u) - B_I(-u) = e f(u) - 2 s f'(u)`` over the mirrored positions, to first order
-    in ``s``; then refitted about the shift found, the measured curves translated by it,
-    until the shift left is a small part of its standard error: the first order's error
-    vanishes with the shift left, so the shift and the imbalance are the exact ones."""
+    in ``s``.  A shift beyond its standard error is then refitted about, the measured curves
+    translated by it, until the shift left is a small part of its standard error: the first
+    order's error vanishes with the shift left, so the shift and the imbalance are the exact
+    ones (a first-order misfit, on secondaries whose amplitude is nearly exponential, is
+    otherwise taken for an imbalance: there a scale is nearly a translation)."""
     idx = {round(float(p), 6): i for i, p in enumerate(u)}
     mirrored = np.array([p for p in u if round(-float(p), 6) in idx])
     if mirrored.size < MIN_POSITIONS:
@@ -205,7 +207,9 @@ def _imbalance_shift(u, ai, bi, sig) -> tuple[Evidence, Evidence, dict]:
                 Evidence("zero_shift", "null shift s (core centred at)", None, None, "mm", None, False, why), {})
     (e, ds), (se, ss) = _pair_fit(u, ai, bi, sig, mirrored, 0.0)
     s = float(ds)
-    for _ in range(SHIFT_ITERATIONS):
+    # a shift within its standard error leaves a first-order error below the noise: the
+    # mirrored pairs, which keep the travel's ends, stand
+    for _ in range(SHIFT_ITERATIONS if abs(s) > ss else 0):
         hit = _pair_fit(u, ai, bi, sig, mirrored, s)
         if hit is None:        # the shift leaves too few pairs in the travel: keep the last fit
             break
