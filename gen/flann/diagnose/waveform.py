@@ -7,7 +7,8 @@ From them, each against a noise-based threshold (``Z_FOUND`` standard errors):
 
 * imbalance against zero shift: with ``A(x) = (1 + e/2) f(x - s)`` and ``B(x) = (1 - e/2)
   f(-(x - s))``, the mirrored pair ``A_I(u) - B_I(-u) = e f(u) - 2 s f'(u)`` (to first order)
-  is linear in ``e`` and ``s``: one least-squares fit separates them;
+  is linear in ``e`` and ``s``: one least-squares fit separates them; a shift it finds is
+  refitted about (both curves translated by it) until none is left, so it is exact;
 * quadrature null: the quadrature of A - B at the null (a demodulator offset cannot be in
   the secondaries: it is made after them);
 * phase shift: the reference phase against the excitation, against the sensor model's;
