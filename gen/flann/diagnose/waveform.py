@@ -7,7 +7,8 @@ From them, each against a noise-based threshold (``Z_FOUND`` standard errors):
 
 * imbalance against zero shift: with ``A(x) = (1 + e/2) f(x - s)`` and ``B(x) = (1 - e/2)
   f(-(x - s))``, the mirrored pair ``A_I(u) - B_I(-u) = e f(u) - 2 s f'(u)`` (to first order)
-  is linear in ``e`` and ``s``: one least-squares fit separates them;
+  is linear in ``e`` and ``s``: one least-squares fit separates them; a shift it finds is
+  refitted about (both curves translated by it) until none is left, so it is exact;
 * quadrature null: the quadrature of A - B at the null (a demodulator offset cannot be in
   the secondaries: it is made after them);
 * phase shift: the reference phase against the excitation, against the sensor model's;
@@ -24,6 +25,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from ..errors import FlannError
 from ..fileio import atomic_save_figure
@@ -40,6 +42,8 @@ DRIFT_FLOOR_PCT = 0.01
 SETTLE_FRACTION = 0.1          # the start of each dwell skipped: the core and filters settle
 MIN_PERIODS = 2                # carrier periods a dwell needs after settling
 MIN_POSITIONS = 5              # distinct positions the evidence needs
+SHIFT_ITERATIONS = 20          # refits about the shift found (each leaves a fraction of the last)
+SHIFT_CONVERGED = 0.01         # a shift left below this part of its standard error is none
 
 _EXPLAIN = {
     "secondary_imbalance": "the secondaries' sensitivities differ (turns or coupling mismatch)",
@@ -166,24 +170,54 @@ def _fit(X: np.ndarray, y: np.ndarray, sigma_y: np.ndarray):
     return coef, np.sqrt(np.diag(cov) * max(1.0, chi2))
 
 
+def _pair_fit(u, ai, bi, sig, pos, shift):
+    """One first-order fit about ``shift``: both measured curves translated by ``shift``
+    (cubic interpolation), paired about the translated origin, ``A(v + shift) - B(shift - v)
+    = e f(v) - 2 ds f'(v)``; the pairs whose points fall outside the travel are left out."""
+    lo, hi = float(u[0]), float(u[-1])
+    v = pos[(pos + shift >= lo - 1e-9) & (pos + shift <= hi + 1e-9)
+            & (shift - pos >= lo - 1e-9) & (shift - pos <= hi + 1e-9)]
+    if v.size < MIN_POSITIONS:
+        return None
+    v = np.sort(v)
+    if shift == 0.0:           # the mirrored pairs themselves: no interpolation
+        at = {round(float(p), 6): i for i, p in enumerate(u)}
+        ia, ib = np.array([at[round(float(p), 6)] for p in v]), np.array([at[round(-float(p), 6)] for p in v])
+        a, b, sa, sb = ai[ia], bi[ib], sig[ia], sig[ib]
+    else:
+        a, b = CubicSpline(u, ai)(v + shift), CubicSpline(u, bi)(shift - v)
+        sa, sb = np.interp(v + shift, u, sig), np.interp(shift - v, u, sig)
+    f = 0.5 * (a + b)
+    fp = np.gradient(f, v)
+    return _fit(np.column_stack([f, -2 * fp]), a - b, np.sqrt(sa ** 2 + sb ** 2))
+
+
 def _imbalance_shift(u, ai, bi, sig) -> tuple[Evidence, Evidence, dict]:
-    """``A_I(u) - B_I(-u) = e f(u) - 2 s f'(u)`` over the mirrored positions."""
+    """``A_I(u) - B_I(-u) = e f(u) - 2 s f'(u)`` over the mirrored positions, to first order
+    in ``s``.  A shift beyond its standard error is then refitted about, the measured curves
+    translated by it, until the shift left is a small part of its standard error: the first
+    order's error vanishes with the shift left, so the shift and the imbalance are the exact
+    ones (a first-order misfit, on secondaries whose amplitude is nearly exponential, is
+    otherwise taken for an imbalance: there a scale is nearly a translation)."""
     idx = {round(float(p), 6): i for i, p in enumerate(u)}
-    pairs = [(i, idx[round(-float(p), 6)]) for i, p in enumerate(u) if round(-float(p), 6) in idx]
-    if len(pairs) < MIN_POSITIONS:
-        why = (f"{len(pairs)} position(s) mirrored about 0 mm; the fit needs {MIN_POSITIONS} "
+    mirrored = np.array([p for p in u if round(-float(p), 6) in idx])
+    if mirrored.size < MIN_POSITIONS:
+        why = (f"{mirrored.size} position(s) mirrored about 0 mm; the fit needs {MIN_POSITIONS} "
                "(record a travel symmetric about 0)")
         return (Evidence("secondary_imbalance", "sensitivity imbalance e", None, None, "1", None, False, why),
-                Evidence("zero_shift", "null shift s", None, None, "mm", None, False, why), {})
-    i, j = np.array(pairs).T
-    uu = u[i]
-    f = 0.5 * (ai[i] + bi[j])
-    order = np.argsort(uu)
-    fp = np.empty_like(f)
-    fp[order] = np.gradient(f[order], uu[order])
-    d = ai[i] - bi[j]
-    s_d = np.sqrt(sig[i] ** 2 + sig[j] ** 2)
-    (e, s), (se, ss) = _fit(np.column_stack([f, -2 * fp]), d, s_d)
+                Evidence("zero_shift", "null shift s (core centred at)", None, None, "mm", None, False, why), {})
+    (e, ds), (se, ss) = _pair_fit(u, ai, bi, sig, mirrored, 0.0)
+    s = float(ds)
+    # a shift within its standard error leaves a first-order error below the noise: the
+    # mirrored pairs, which keep the travel's ends, stand
+    for _ in range(SHIFT_ITERATIONS if abs(s) > ss else 0):
+        hit = _pair_fit(u, ai, bi, sig, mirrored, s)
+        if hit is None:        # the shift leaves too few pairs in the travel: keep the last fit
+            break
+        (e, ds), (se, ss) = hit
+        s += float(ds)
+        if abs(ds) < SHIFT_CONVERGED * ss:
+            break
     ev_e = Evidence("secondary_imbalance", "sensitivity imbalance e (A over B)", float(e), float(se),
                     "1", Z_FOUND * float(se), abs(e) > Z_FOUND * se)
     ev_s = Evidence("zero_shift", "null shift s (core centred at)", float(s), float(ss), "mm",
