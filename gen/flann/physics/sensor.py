@@ -186,6 +186,8 @@ class Sensor:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new.__dict__.update(changes)
+        if "_magnetics_key" in new.__dict__ and not _KEY_FIELDS.isdisjoint(changes):
+            del new.__dict__["_magnetics_key"]
         _validate(new, changed=changes.keys())
         if "effects" in changes:
             object.__setattr__(new, "effects", _frozen_effects(new.effects))
@@ -217,8 +219,13 @@ class Sensor:
     def magnetics_key(self) -> tuple:
         """The fields the inductances depend on (cache key); the frequency only matters
         when the core conducts (eddy currents)."""
-        key = tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
-        return key + (self.excitation_frequency_hz,) if self.core_conductivity_s_per_m > 0 else key
+        key = self.__dict__.get("_magnetics_key")
+        if key is None:   # kept on the instance (every simulated output asks, twice)
+            key = tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
+            if self.core_conductivity_s_per_m > 0:
+                key += (self.excitation_frequency_hz,)
+            self.__dict__["_magnetics_key"] = key
+        return key
 
 
 _FIELD_NAMES = {f.name for f in dataclasses.fields(Sensor)}
@@ -229,6 +236,8 @@ _MAGNETIC_FIELDS = (
     "housing_inner_diameter_mm", "primary_turns", "primary_length_mm",
     "secondary_turns", "secondary_length_mm", "secondary_gap_mm",
 )
+# a change of any of these makes a copy's magnetics key anew (Sensor.replace)
+_KEY_FIELDS = frozenset(_MAGNETIC_FIELDS + ("excitation_frequency_hz",))
 
 
 def _bad(src: str, msg: str) -> SensorError:
