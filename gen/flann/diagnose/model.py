@@ -433,6 +433,90 @@ class PhysicsFamily:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
+    def evaluate_many(self, thetas, names: list[str], idx: np.ndarray,
+                      coef: np.ndarray | None = None, target: np.ndarray | None = None,
+                      basis: OddBasis | None = None) -> np.ndarray:
+        """:meth:`evaluate` at each of ``thetas`` as rows of one array, the same numbers bit
+        for bit: every step is :meth:`evaluate`'s own, in its order, the elementwise ones
+        done on all rows at once (a scalar per row times an array is the same product either
+        way) and the rest (simulations, products with a matrix, the shape term's solve) row
+        by row as there.  A finite-difference Jacobian evaluates one point per parameter, and
+        their Python overhead was most of a diagnosis' time."""
+        m = len(thetas)
+        d = self.data
+        core = (d.x[idx] - self.origin0) * self.scale
+        rows = [self._unpack(self._physical(th, names), names) for th in thetas]
+        self.nfev += m
+        sims, curv, y0 = [], np.zeros(m), {}
+        for r, (gain, _origin, _shape, eff) in enumerate(rows):
+            curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
+            inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
+            sims.append(self._simulate(gain, inner, idx, core))
+            if curvature:
+                curv[r] = curvature
+                without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
+                y0[r] = self._simulate(gain, without, idx, core)
+        y = np.array(sims)
+        if y0:
+            bent = np.array(sorted(y0))
+            u = core / self._half_range()
+            y[bent] = y[bent] + curv[bent, None] * u ** 2 * (y[bent] - np.array([y0[r] for r in bent]))
+        gains = [row[0] for row in rows]
+        moved = [r for r, row in enumerate(rows) if row[1] != self.origin0]
+        if self.shape is not None:
+            modes = self._modes_at(idx, core)
+            if moved:
+                step = np.array([gains[r] * (rows[r][1] - self.origin0) * self.scale for r in moved])
+                y[moved] = y[moved] - step[:, None] * modes[0]
+            if rows[0][2] is not None:
+                y = y + np.array(gains)[:, None] * np.array([row[2] @ modes[1:] for row in rows])
+        elif moved:
+            step = np.array([gains[r] * (rows[r][1] - self.origin0) * self.scale for r in moved])
+            y[moved] = y[moved] - step[:, None] * self._slope_at(idx, core)
+        effs = [row[3] for row in rows]
+        if "null_offset" in effs[0]:
+            y = y + np.array([e["null_offset"]["offset_v"] for e in effs])[:, None]
+        clip = "adc_clipping" in effs[0]
+        hi = [e.get("adc_clipping", {}).get("rail_high_v", math.inf) for e in effs]
+        lo = [e.get("adc_clipping", {}).get("rail_low_v", -math.inf) for e in effs]
+        if basis is not None:
+            for r, e in enumerate(effs):
+                shift = e.get("zero_shift", {}).get("shift_mm", 0.0)
+                B, pinv = self._basis_at(basis, idx, core, shift)
+                c = coef
+                yr = y[r]
+                if c is None:
+                    if target is None:
+                        c = np.zeros(basis.ncols)
+                    else:
+                        free = (yr < hi[r]) & (yr > lo[r])
+                        if free.all():
+                            c = pinv() @ (target - yr)
+                        elif free.sum() > basis.ncols:
+                            c = np.linalg.lstsq(B[free], (target - yr)[free], rcond=RCOND)[0]
+                        else:
+                            c = np.zeros(basis.ncols)
+                y[r] = yr + B @ c
+        if clip:
+            y = np.clip(y, np.array(lo)[:, None], np.array(hi)[:, None])
+        return y
+
+    def _evaluator(self, names, idx: np.ndarray, target: np.ndarray, basis):
+        """A ``workers`` map for least_squares: its finite-difference points, evaluated
+        together (:meth:`evaluate_many`) and returned as ``fun`` would return each (the model
+        minus ``target``).  Whatever :meth:`evaluate_many` cannot do quietly (an exception,
+        a floating-point warning) is done by ``fun`` point by point instead, which then
+        raises or warns as it always did."""
+        def columns(fun, points):
+            points = list(points)
+            try:
+                with np.errstate(over="raise", divide="raise", invalid="raise"):
+                    y = self.evaluate_many(points, names, idx, target=target, basis=basis)
+            except Exception:   # noqa: BLE001 -- one by one, as map would
+                return [fun(p) for p in points]
+            return [row - target for row in y]
+        return columns
+
     def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
         """The simulated output with the simulator's own effects ``inner`` at the points
         ``idx``, cached on what it depends on: a finite-difference step of a parameter the
@@ -910,7 +994,8 @@ class PhysicsFamily:
         for t0 in starts:
             try:
                 r = least_squares(fun, t0, method="lm", x_scale="jac",
-                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL)
+                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL,
+                                  workers=self._evaluator(names, idx, y, basis))
             except (ValueError, FloatingPointError, np.linalg.LinAlgError):
                 continue
             if res is None or r.cost < res.cost:
