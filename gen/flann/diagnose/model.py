@@ -927,12 +927,19 @@ class PhysicsFamily:
             coef = np.zeros(0 if basis is None else basis.ncols)
         coef = np.asarray(coef, float)
         y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef, basis=basis)
-        cols = []
+        steps, points = [], []
         for j, th in enumerate(fit.theta):
             h = 1e-6 * max(abs(th), 1e-3)
             t1 = fit.theta.copy()
             t1[j] += h
-            cols.append((self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) - y0) / h)
+            steps.append(h)
+            points.append(t1)
+        try:   # the points together (evaluate_many); one by one when that cannot be quiet
+            with np.errstate(over="raise", divide="raise", invalid="raise"):
+                ys = list(self.evaluate_many(points, fit.names, idx, coef=coef, basis=basis))
+        except Exception:   # noqa: BLE001
+            ys = [self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) for t1 in points]
+        cols = [(y1 - y0) / h for y1, h in zip(ys, steps)]
         for j in range(coef.size):
             c1 = coef.copy()
             c1[j] += 1.0
