@@ -214,7 +214,7 @@ class PhysicsFamily:
         self._shape_cache: dict = {}
         self._sim_cache: dict = {}
         self._plans: dict = {}
-        self._gain_checked = math.nan
+        self._gains_ok: set = set()   # gains a sensor accepts (every copy's: the same sensor)
         self.nfev = 0
 
     # -- which effects these recordings can reveal ----------------------------------
@@ -525,9 +525,11 @@ class PhysicsFamily:
         demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
         output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
         linear = "quadrature_null" not in inner
-        if not gain == self._gain_checked:   # checked as a simulation at this gain would be
+        if gain not in self._gains_ok:   # checked as a simulation at this gain would be
             self.sensor.replace(demodulator_gain_ratio=gain)
-            self._gain_checked = gain
+            if len(self._gains_ok) >= 256:
+                self._gains_ok.clear()
+            self._gains_ok.add(gain)
         key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
                idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         y = self._sim_cache.get(key)

@@ -129,6 +129,10 @@ _SCHEMA: dict[str, dict[str, tuple[str, float, bool, float]]] = {
 }
 _STRING_KEYS = {("", "format"), ("", "name"), ("", "description"), ("demodulator", "kind")}
 _OPTIONAL_SECTIONS = ("adc",)
+# the range checks in schema order, and each field's (a copy checks only what changed)
+_CHECKS = [(i, section, key, spec) for i, (section, key, spec) in enumerate(
+    (section, key, spec) for section, keys in _SCHEMA.items() for key, spec in keys.items())]
+_CHECK_OF = {c[3][0]: c for c in _CHECKS}
 # Keys that may be omitted, with the value they then take.
 _OPTIONAL_KEYS = {("core", "conductivity_s_per_m"): 0.0}
 
@@ -278,22 +282,20 @@ def _validate(s: Sensor, changed=None) -> None:
     skipped, the rest run in the same order, so the first failure is the same."""
     src = s.source
     every = changed is None
-    for section, keys in _SCHEMA.items():
-        for key, (fname, lo, lo_incl, hi) in keys.items():
-            if not every and fname not in changed:
-                continue
-            value = getattr(s, fname)
-            if value is None and section in _OPTIONAL_SECTIONS:
-                continue
-            label = f"{section}.{key}" if section else key
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise _bad(src, f"{label} must be a number, got {value!r}")
-            if not math.isfinite(value):
-                raise _bad(src, f"{label} must be finite, got {value!r}")
-            ok_lo = value >= lo if lo_incl else value > lo
-            if not ok_lo or value > hi:
-                lo_txt = f"{'>=' if lo_incl else '>'} {lo:g}"
-                raise _bad(src, f"{label} = {value:g} out of range (must be {lo_txt} and <= {hi:g})")
+    checks = _CHECKS if every else sorted(_CHECK_OF[f] for f in changed if f in _CHECK_OF)
+    for _order, section, key, (fname, lo, lo_incl, hi) in checks:
+        value = getattr(s, fname)
+        if value is None and section in _OPTIONAL_SECTIONS:
+            continue
+        label = f"{section}.{key}" if section else key
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise _bad(src, f"{label} must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise _bad(src, f"{label} must be finite, got {value!r}")
+        ok_lo = value >= lo if lo_incl else value > lo
+        if not ok_lo or value > hi:
+            lo_txt = f"{'>=' if lo_incl else '>'} {lo:g}"
+            raise _bad(src, f"{label} = {value:g} out of range (must be {lo_txt} and <= {hi:g})")
     if (every or "demodulator_kind" in changed) and s.demodulator_kind not in DEMODULATORS:
         raise _bad(src, f"demodulator.kind = {s.demodulator_kind!r}: allowed {', '.join(DEMODULATORS)}")
     if (every or "demodulator_gain_ratio" in changed) and s.demodulator_gain_ratio == 0:
