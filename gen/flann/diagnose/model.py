@@ -214,6 +214,7 @@ class PhysicsFamily:
         self._shape_cache: dict = {}
         self._sim_cache: dict = {}
         self._plans: dict = {}
+        self._bases: dict = {}
         self._gains_ok: set = set()   # gains a sensor accepts (every copy's: the same sensor)
         self.nfev = 0
 
@@ -784,6 +785,7 @@ class PhysicsFamily:
         if new.shape_ref is None:
             new.terms = 0
         new._plans = {}
+        new._bases = {}
         if fresh_cache:
             new._shape_cache = {}
             new._sim_cache = {}
@@ -792,7 +794,14 @@ class PhysicsFamily:
     def basis(self, k: int):
         """The shape term with ``k`` terms (None for none)."""
         ref = self.shape_ref
-        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified, ref.warp, ref.known)
+        if k == 0 or ref is None:
+            return None
+        # built once per family and number of terms (a copy with another shape range builds
+        # its own, see _copy): every prediction and fit asks, and each build is a least squares
+        hit = self._bases.get(k)
+        if hit is None:
+            hit = self._bases[k] = OddBasis(ref.half, k, ref.rectified, ref.warp, ref.known)
+        return hit
 
     @staticmethod
     def _sides(fit: Fit | None) -> str:
