@@ -214,7 +214,8 @@ class PhysicsFamily:
         self._shape_cache: dict = {}
         self._sim_cache: dict = {}
         self._plans: dict = {}
-        self._gain_checked = math.nan
+        self._bases: dict = {}
+        self._gains_ok: set = set()   # gains a sensor accepts (every copy's: the same sensor)
         self.nfev = 0
 
     # -- which effects these recordings can reveal ----------------------------------
@@ -433,6 +434,90 @@ class PhysicsFamily:
             y = np.clip(y, lo, hi)
         return (y, coef) if want_coef else y
 
+    def evaluate_many(self, thetas, names: list[str], idx: np.ndarray,
+                      coef: np.ndarray | None = None, target: np.ndarray | None = None,
+                      basis: OddBasis | None = None) -> np.ndarray:
+        """:meth:`evaluate` at each of ``thetas`` as rows of one array, the same numbers bit
+        for bit: every step is :meth:`evaluate`'s own, in its order, the elementwise ones
+        done on all rows at once (a scalar per row times an array is the same product either
+        way) and the rest (simulations, products with a matrix, the shape term's solve) row
+        by row as there.  A finite-difference Jacobian evaluates one point per parameter, and
+        their Python overhead was most of a diagnosis' time."""
+        m = len(thetas)
+        d = self.data
+        core = (d.x[idx] - self.origin0) * self.scale
+        rows = [self._unpack(self._physical(th, names), names) for th in thetas]
+        self.nfev += m
+        sims, curv, y0 = [], np.zeros(m), {}
+        for r, (gain, _origin, _shape, eff) in enumerate(rows):
+            curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
+            inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
+            sims.append(self._simulate(gain, inner, idx, core))
+            if curvature:
+                curv[r] = curvature
+                without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
+                y0[r] = self._simulate(gain, without, idx, core)
+        y = np.array(sims)
+        if y0:
+            bent = np.array(sorted(y0))
+            u = core / self._half_range()
+            y[bent] = y[bent] + curv[bent, None] * u ** 2 * (y[bent] - np.array([y0[r] for r in bent]))
+        gains = [row[0] for row in rows]
+        moved = [r for r, row in enumerate(rows) if row[1] != self.origin0]
+        if self.shape is not None:
+            modes = self._modes_at(idx, core)
+            if moved:
+                step = np.array([gains[r] * (rows[r][1] - self.origin0) * self.scale for r in moved])
+                y[moved] = y[moved] - step[:, None] * modes[0]
+            if rows[0][2] is not None:
+                y = y + np.array(gains)[:, None] * np.array([row[2] @ modes[1:] for row in rows])
+        elif moved:
+            step = np.array([gains[r] * (rows[r][1] - self.origin0) * self.scale for r in moved])
+            y[moved] = y[moved] - step[:, None] * self._slope_at(idx, core)
+        effs = [row[3] for row in rows]
+        if "null_offset" in effs[0]:
+            y = y + np.array([e["null_offset"]["offset_v"] for e in effs])[:, None]
+        clip = "adc_clipping" in effs[0]
+        hi = [e.get("adc_clipping", {}).get("rail_high_v", math.inf) for e in effs]
+        lo = [e.get("adc_clipping", {}).get("rail_low_v", -math.inf) for e in effs]
+        if basis is not None:
+            for r, e in enumerate(effs):
+                shift = e.get("zero_shift", {}).get("shift_mm", 0.0)
+                B, pinv = self._basis_at(basis, idx, core, shift)
+                c = coef
+                yr = y[r]
+                if c is None:
+                    if target is None:
+                        c = np.zeros(basis.ncols)
+                    else:
+                        free = (yr < hi[r]) & (yr > lo[r])
+                        if free.all():
+                            c = pinv() @ (target - yr)
+                        elif free.sum() > basis.ncols:
+                            c = np.linalg.lstsq(B[free], (target - yr)[free], rcond=RCOND)[0]
+                        else:
+                            c = np.zeros(basis.ncols)
+                y[r] = yr + B @ c
+        if clip:
+            y = np.clip(y, np.array(lo)[:, None], np.array(hi)[:, None])
+        return y
+
+    def _evaluator(self, names, idx: np.ndarray, target: np.ndarray, basis):
+        """A ``workers`` map for least_squares: its finite-difference points, evaluated
+        together (:meth:`evaluate_many`) and returned as ``fun`` would return each (the model
+        minus ``target``).  Whatever :meth:`evaluate_many` cannot do quietly (an exception,
+        a floating-point warning) is done by ``fun`` point by point instead, which then
+        raises or warns as it always did."""
+        def columns(fun, points):
+            points = list(points)
+            try:
+                with np.errstate(over="raise", divide="raise", invalid="raise"):
+                    y = self.evaluate_many(points, names, idx, target=target, basis=basis)
+            except Exception:   # noqa: BLE001 -- one by one, as map would
+                return [fun(p) for p in points]
+            return [row - target for row in y]
+        return columns
+
     def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
         """The simulated output with the simulator's own effects ``inner`` at the points
         ``idx``, cached on what it depends on: a finite-difference step of a parameter the
@@ -441,9 +526,11 @@ class PhysicsFamily:
         demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
         output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
         linear = "quadrature_null" not in inner
-        if not gain == self._gain_checked:   # checked as a simulation at this gain would be
+        if gain not in self._gains_ok:   # checked as a simulation at this gain would be
             self.sensor.replace(demodulator_gain_ratio=gain)
-            self._gain_checked = gain
+            if len(self._gains_ok) >= 256:
+                self._gains_ok.clear()
+            self._gains_ok.add(gain)
         key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
                idx.size, hash(idx.tobytes()), hash(core.tobytes()))
         y = self._sim_cache.get(key)
@@ -698,6 +785,7 @@ class PhysicsFamily:
         if new.shape_ref is None:
             new.terms = 0
         new._plans = {}
+        new._bases = {}
         if fresh_cache:
             new._shape_cache = {}
             new._sim_cache = {}
@@ -706,7 +794,14 @@ class PhysicsFamily:
     def basis(self, k: int):
         """The shape term with ``k`` terms (None for none)."""
         ref = self.shape_ref
-        return None if k == 0 or ref is None else OddBasis(ref.half, k, ref.rectified, ref.warp, ref.known)
+        if k == 0 or ref is None:
+            return None
+        # built once per family and number of terms (a copy with another shape range builds
+        # its own, see _copy): every prediction and fit asks, and each build is a least squares
+        hit = self._bases.get(k)
+        if hit is None:
+            hit = self._bases[k] = OddBasis(ref.half, k, ref.rectified, ref.warp, ref.known)
+        return hit
 
     @staticmethod
     def _sides(fit: Fit | None) -> str:
@@ -843,12 +938,19 @@ class PhysicsFamily:
             coef = np.zeros(0 if basis is None else basis.ncols)
         coef = np.asarray(coef, float)
         y0 = self.evaluate(fit.theta, fit.names, idx, coef=coef, basis=basis)
-        cols = []
+        steps, points = [], []
         for j, th in enumerate(fit.theta):
             h = 1e-6 * max(abs(th), 1e-3)
             t1 = fit.theta.copy()
             t1[j] += h
-            cols.append((self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) - y0) / h)
+            steps.append(h)
+            points.append(t1)
+        try:   # the points together (evaluate_many); one by one when that cannot be quiet
+            with np.errstate(over="raise", divide="raise", invalid="raise"):
+                ys = list(self.evaluate_many(points, fit.names, idx, coef=coef, basis=basis))
+        except Exception:   # noqa: BLE001
+            ys = [self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) for t1 in points]
+        cols = [(y1 - y0) / h for y1, h in zip(ys, steps)]
         for j in range(coef.size):
             c1 = coef.copy()
             c1[j] += 1.0
@@ -910,7 +1012,8 @@ class PhysicsFamily:
         for t0 in starts:
             try:
                 r = least_squares(fun, t0, method="lm", x_scale="jac",
-                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL)
+                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL,
+                                  workers=self._evaluator(names, idx, y, basis))
             except (ValueError, FloatingPointError, np.linalg.LinAlgError):
                 continue
             if res is None or r.cost < res.cost:

@@ -310,10 +310,31 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
     out = tuple(r[inverse].reshape(x.shape) for r in res)
     for arr in out:
         arr.setflags(write=False)
-    _INDUCTANCES[key] = out
-    if len(_INDUCTANCES) > _CACHE_SIZE:
-        _INDUCTANCES.popitem(last=False)
+    _keep(key, out, x.nbytes + sum(a.nbytes for a in out))
     return out
+
+
+# Inductances kept: the most recent results up to this many and this many bytes (positions
+# and values).  A diagnosis revisits positions (a fit's trial points, the starts of the
+# next fits, the same point under another number of shape terms, the geometry grid of the
+# previous sensor recorded at the same positions): about a quarter of its line solutions
+# were repeats that 32 entries had already dropped.
+_INDUCTANCE_ENTRIES = 8192
+_INDUCTANCE_BYTES = 64e6
+_INDUCTANCE_SIZES: dict = {}
+_inductance_bytes = [0]
+
+
+def _keep(key, out, size: int) -> None:
+    if key in _INDUCTANCE_SIZES:
+        _inductance_bytes[0] -= _INDUCTANCE_SIZES.pop(key)
+    _INDUCTANCES[key] = out
+    _INDUCTANCE_SIZES[key] = size
+    _inductance_bytes[0] += size
+    while len(_INDUCTANCES) > 1 and (len(_INDUCTANCES) > _INDUCTANCE_ENTRIES
+                                     or _inductance_bytes[0] > _INDUCTANCE_BYTES):
+        old, _ = _INDUCTANCES.popitem(last=False)
+        _inductance_bytes[0] -= _INDUCTANCE_SIZES.pop(old)
 
 
 def coupling_table(s: Sensor, half_range_mm: float | None = None, n: int = 401) -> CouplingTable:
@@ -348,7 +369,7 @@ def reference_phase_rad(s: Sensor) -> float:
     slope = (m1[2] - m2[2]) - (m1[0] - m2[0])
     slope_phase = float(np.angle(slope)) if np.iscomplexobj(slope) and slope != 0 else 0.0
     phase = float(np.angle(1j * s.omega_rad_s * primary_current_a(s, lp[1]))) + slope_phase
-    if len(_REFERENCE_PHASES) >= 4 * _CACHE_SIZE:
+    if len(_REFERENCE_PHASES) >= 4096:   # a float each; a diagnosis tries ~1,000 geometries
         _REFERENCE_PHASES.clear()
     _REFERENCE_PHASES[key] = phase
     return phase

@@ -129,6 +129,10 @@ _SCHEMA: dict[str, dict[str, tuple[str, float, bool, float]]] = {
 }
 _STRING_KEYS = {("", "format"), ("", "name"), ("", "description"), ("demodulator", "kind")}
 _OPTIONAL_SECTIONS = ("adc",)
+# the range checks in schema order, and each field's (a copy checks only what changed)
+_CHECKS = [(i, section, key, spec) for i, (section, key, spec) in enumerate(
+    (section, key, spec) for section, keys in _SCHEMA.items() for key, spec in keys.items())]
+_CHECK_OF = {c[3][0]: c for c in _CHECKS}
 # Keys that may be omitted, with the value they then take.
 _OPTIONAL_KEYS = {("core", "conductivity_s_per_m"): 0.0}
 
@@ -186,6 +190,8 @@ class Sensor:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new.__dict__.update(changes)
+        if "_magnetics_key" in new.__dict__ and not _KEY_FIELDS.isdisjoint(changes):
+            del new.__dict__["_magnetics_key"]
         _validate(new, changed=changes.keys())
         if "effects" in changes:
             object.__setattr__(new, "effects", _frozen_effects(new.effects))
@@ -217,8 +223,13 @@ class Sensor:
     def magnetics_key(self) -> tuple:
         """The fields the inductances depend on (cache key); the frequency only matters
         when the core conducts (eddy currents)."""
-        key = tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
-        return key + (self.excitation_frequency_hz,) if self.core_conductivity_s_per_m > 0 else key
+        key = self.__dict__.get("_magnetics_key")
+        if key is None:   # kept on the instance (every simulated output asks, twice)
+            key = tuple(getattr(self, f) for f in _MAGNETIC_FIELDS)
+            if self.core_conductivity_s_per_m > 0:
+                key += (self.excitation_frequency_hz,)
+            self.__dict__["_magnetics_key"] = key
+        return key
 
 
 _FIELD_NAMES = {f.name for f in dataclasses.fields(Sensor)}
@@ -229,6 +240,8 @@ _MAGNETIC_FIELDS = (
     "housing_inner_diameter_mm", "primary_turns", "primary_length_mm",
     "secondary_turns", "secondary_length_mm", "secondary_gap_mm",
 )
+# a change of any of these makes a copy's magnetics key anew (Sensor.replace)
+_KEY_FIELDS = frozenset(_MAGNETIC_FIELDS + ("excitation_frequency_hz",))
 
 
 def _bad(src: str, msg: str) -> SensorError:
@@ -269,22 +282,20 @@ def _validate(s: Sensor, changed=None) -> None:
     skipped, the rest run in the same order, so the first failure is the same."""
     src = s.source
     every = changed is None
-    for section, keys in _SCHEMA.items():
-        for key, (fname, lo, lo_incl, hi) in keys.items():
-            if not every and fname not in changed:
-                continue
-            value = getattr(s, fname)
-            if value is None and section in _OPTIONAL_SECTIONS:
-                continue
-            label = f"{section}.{key}" if section else key
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise _bad(src, f"{label} must be a number, got {value!r}")
-            if not math.isfinite(value):
-                raise _bad(src, f"{label} must be finite, got {value!r}")
-            ok_lo = value >= lo if lo_incl else value > lo
-            if not ok_lo or value > hi:
-                lo_txt = f"{'>=' if lo_incl else '>'} {lo:g}"
-                raise _bad(src, f"{label} = {value:g} out of range (must be {lo_txt} and <= {hi:g})")
+    checks = _CHECKS if every else sorted(_CHECK_OF[f] for f in changed if f in _CHECK_OF)
+    for _order, section, key, (fname, lo, lo_incl, hi) in checks:
+        value = getattr(s, fname)
+        if value is None and section in _OPTIONAL_SECTIONS:
+            continue
+        label = f"{section}.{key}" if section else key
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise _bad(src, f"{label} must be a number, got {value!r}")
+        if not math.isfinite(value):
+            raise _bad(src, f"{label} must be finite, got {value!r}")
+        ok_lo = value >= lo if lo_incl else value > lo
+        if not ok_lo or value > hi:
+            lo_txt = f"{'>=' if lo_incl else '>'} {lo:g}"
+            raise _bad(src, f"{label} = {value:g} out of range (must be {lo_txt} and <= {hi:g})")
     if (every or "demodulator_kind" in changed) and s.demodulator_kind not in DEMODULATORS:
         raise _bad(src, f"demodulator.kind = {s.demodulator_kind!r}: allowed {', '.join(DEMODULATORS)}")
     if (every or "demodulator_gain_ratio" in changed) and s.demodulator_gain_ratio == 0:
