@@ -145,7 +145,7 @@ def synth_line(r: dict) -> tuple[str, bool]:
 def hardware_steps(design: Path) -> list:
     """flann sim and flann synth (Spartan-II, then placed and routed on an iCE40-HX8K) of a design."""
     return [("sim", ["sim", design]), ("synth", ["synth", design, "--json"]),
-            ("synth", ["synth", design, "--device", "ice40-hx8k-ct256", "--json"])]
+            ("synth", ["synth", design, "--device", "ice40-hx8k-ct256", "--json", "-o", design.parent / "ice40"])]
 
 
 def run_steps(steps) -> list[tuple[str, str]] | None:
