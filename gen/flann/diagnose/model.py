@@ -185,6 +185,19 @@ class OddBasis:
                 "in place")
 
 
+def _shape_coef(ncols: int, B, pinv, y, target, lo, hi) -> np.ndarray:
+    """The shape terms' coefficients that take ``y`` to ``target`` where it is within the rails
+    (none without a target, or when too few points are)."""
+    if target is None:
+        return np.zeros(ncols)
+    free = (y < hi) & (y > lo)
+    if free.all():
+        return pinv() @ (target - y)
+    if free.sum() > ncols:
+        return np.linalg.lstsq(B[free], (target - y)[free], rcond=RCOND)[0]
+    return np.zeros(ncols)
+
+
 class PhysicsFamily:
     """Least-squares fits of the calibrated ideal simulation + any set of catalogue effects."""
 
@@ -419,16 +432,7 @@ class PhysicsFamily:
             shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
             B, pinv = self._basis_at(basis, idx, core, shift)
             if coef is None:
-                if target is None:
-                    coef = np.zeros(basis.ncols)
-                else:
-                    free = (y < hi) & (y > lo)
-                    if free.all():
-                        coef = pinv() @ (target - y)
-                    elif free.sum() > basis.ncols:
-                        coef = np.linalg.lstsq(B[free], (target - y)[free], rcond=RCOND)[0]
-                    else:
-                        coef = np.zeros(basis.ncols)
+                coef = _shape_coef(basis.ncols, B, pinv, y, target, lo, hi)
             y = y + B @ coef
         if "adc_clipping" in eff:
             y = np.clip(y, lo, hi)
@@ -487,16 +491,7 @@ class PhysicsFamily:
                 c = coef
                 yr = y[r]
                 if c is None:
-                    if target is None:
-                        c = np.zeros(basis.ncols)
-                    else:
-                        free = (yr < hi[r]) & (yr > lo[r])
-                        if free.all():
-                            c = pinv() @ (target - yr)
-                        elif free.sum() > basis.ncols:
-                            c = np.linalg.lstsq(B[free], (target - yr)[free], rcond=RCOND)[0]
-                        else:
-                            c = np.zeros(basis.ncols)
+                    c = _shape_coef(basis.ncols, B, pinv, yr, target, lo[r], hi[r])
                 y[r] = yr + B @ c
         if clip:
             y = np.clip(y, np.array(lo)[:, None], np.array(hi)[:, None])
