@@ -497,20 +497,21 @@ class PhysicsFamily:
             y = np.clip(y, np.array(lo)[:, None], np.array(hi)[:, None])
         return y
 
+    def _points(self, points, names, idx: np.ndarray, coef=None, target=None, basis=None) -> list:
+        """:meth:`evaluate` at each of ``points``: together (:meth:`evaluate_many`), or one by
+        one where that cannot be quiet (an exception, a floating-point warning), which then
+        raises or warns as :meth:`evaluate` always did."""
+        try:
+            with np.errstate(over="raise", divide="raise", invalid="raise"):
+                return list(self.evaluate_many(points, names, idx, coef=coef, target=target, basis=basis))
+        except Exception:   # noqa: BLE001 -- one by one, as a map would
+            return [self.evaluate(p, names, idx, coef=coef, target=target, basis=basis) for p in points]
+
     def _evaluator(self, names, idx: np.ndarray, target: np.ndarray, basis):
-        """A ``workers`` map for least_squares: its finite-difference points, evaluated
-        together (:meth:`evaluate_many`) and returned as ``fun`` would return each (the model
-        minus ``target``).  Whatever :meth:`evaluate_many` cannot do quietly (an exception,
-        a floating-point warning) is done by ``fun`` point by point instead, which then
-        raises or warns as it always did."""
-        def columns(fun, points):
-            points = list(points)
-            try:
-                with np.errstate(over="raise", divide="raise", invalid="raise"):
-                    y = self.evaluate_many(points, names, idx, target=target, basis=basis)
-            except Exception:   # noqa: BLE001 -- one by one, as map would
-                return [fun(p) for p in points]
-            return [row - target for row in y]
+        """A ``workers`` map for least_squares: its finite-difference points through
+        :meth:`_points`, each returned as ``fun`` returns one (the model minus ``target``)."""
+        def columns(_fun, points):
+            return [y - target for y in self._points(list(points), names, idx, target=target, basis=basis)]
         return columns
 
     def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
@@ -940,11 +941,7 @@ class PhysicsFamily:
             t1[j] += h
             steps.append(h)
             points.append(t1)
-        try:   # the points together (evaluate_many); one by one when that cannot be quiet
-            with np.errstate(over="raise", divide="raise", invalid="raise"):
-                ys = list(self.evaluate_many(points, fit.names, idx, coef=coef, basis=basis))
-        except Exception:   # noqa: BLE001
-            ys = [self.evaluate(t1, fit.names, idx, coef=coef, basis=basis) for t1 in points]
+        ys = self._points(points, fit.names, idx, coef=coef, basis=basis)
         cols = [(y1 - y0) / h for y1, h in zip(ys, steps)]
         for j in range(coef.size):
             c1 = coef.copy()
