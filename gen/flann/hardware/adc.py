@@ -91,7 +91,13 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             "carry no signal; check the voltage unit or the conditioner's gain")
     dropped = max(0, bits - max_input_bits(model))
     eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
-    if dropped:
+    if dropped and getattr(model, "conditioner", None) is not None:
+        # the chain top wires the ratio's top bits itself: nothing for the user to wire
+        notes.append(
+            f"the FLANN takes the ratio's top {eff_bits} of {bits} bits (its input LSB {eff_lsb:.4g}): up "
+            f"to {eff_lsb * max_mm_per_v(model):.3g} mm of quantisation error at the steepest point (a "
+            f"FLANN input is at most {eff_bits} bits)")
+    elif dropped:
         slope = max_mm_per_v(model)
         notes.append(
             f"{bits}-bit ADC: the design takes its top {eff_bits} bits (drops {dropped} low bits; "

@@ -20,12 +20,11 @@ the model records, is kept as ``waveform`` for ``flann sim``'s whole-chain run.
 from __future__ import annotations
 
 import hashlib
-import warnings
 from pathlib import Path
 
 from ...errors import FlannError
 from ...golden.model import load_model
-from ..adc import max_mm_per_v, plan_adc
+from ..adc import plan_adc
 from ..datapath import Datapath, _int
 from ..fixed import datapath as fixed_datapath
 from ..fixed import render as fixed_render
@@ -109,17 +108,10 @@ def generate(model, out_dir, options: GenOptions | None = None, **_extra) -> dic
         raise FlannError(f"{model}: trained from demodulated readings, it has no conditioner: generate it "
                          "with flann gen --format fixed (train from a waveform recording for the conditioner)")
     opts = flann_options(m, options or GenOptions(), source=str(model))
-    with warnings.catch_warnings():
-        # the chain top wires the ratio's top bits itself: no converter for the user to wire
-        warnings.filterwarnings("ignore", message=r"\d+-bit ADC: the design takes its top")
-        fspec = fixed_render.load(model, opts)
+    fspec = fixed_render.load(model, opts)
     ftexts = fixed_render.render(fspec)
-    plan = plan_adc(fspec.model, opts.input_bits, opts.input_lsb_v, opts.clamp)
-    if plan.dropped:
-        warnings.warn(f"the FLANN takes the ratio's top {plan.input_bits} of {plan.adc_bits} bits (its input "
-                      f"LSB {plan.input_lsb_v:.4g}): up to {plan.input_lsb_v * max_mm_per_v(fspec.model):.3g} mm "
-                      f"of quantisation error at the steepest point (a FLANN input is at most {plan.input_bits} bits)")
-    fman = fixed_render.manifest(fspec, list(ftexts), plan)
+    fman = fixed_render.manifest(fspec, list(ftexts), plan_adc(fspec.model, opts.input_bits, opts.input_lsb_v,
+                                                                opts.clamp))
     spec = settings.spec
     chain = ChainSpec(spec, fspec, fman["top"])   # refuses a FLANN slower than the ratio
     ctexts, chtexts = render(spec), render_chain(chain, model_sha256=fspec.model_sha256)
