@@ -112,6 +112,31 @@ def test_trajectories():
     assert len(sine) == 4000
 
 
+def test_a_calibration_at_several_temperatures_runs_the_trajectory_at_each_in_turn():
+    s = _sensor(thermal_construction={"reference_temperature_c": 25.0, "copper_tempco_per_c": 0.00393,
+                                      "source_resistance_ohm": 50.0, "permeability_tempco_per_c": 2e-4,
+                                      "balance_drift_per_c": 2e-6})
+    traj, args = parse_trajectory("steps:0.002"), dict(travel_mm=(-20.0, 20.0), step_mm=10.0)
+    soaks = (0.0, 50.0)
+    wave = simulate_waveforms(s, WaveformSettings(**EXACT), traj, temperatures=soaks, **args)
+    each = [simulate_waveforms(s, WaveformSettings(**EXACT), traj, temperature_profile=f"const:{t:g}", **args)
+            for t in soaks]
+    n = len(each[0])
+    assert len(wave) == 2 * n and np.all(np.diff(wave.time_s) > 0)
+    for k, one in enumerate(each):
+        part = slice(k * n, (k + 1) * n)
+        assert np.all(wave.temperature_c[part] == soaks[k])
+        np.testing.assert_array_equal(wave.displacement_mm[part], one.displacement_mm)
+        # the pass takes whole carrier periods: each soak's secondaries are its own run's
+        np.testing.assert_allclose(wave.sec_a_v[part], one.sec_a_v, atol=1e-7)
+        np.testing.assert_allclose(wave.sec_b_v[part], one.sec_b_v, atol=1e-7)
+    # the excitation runs on across the soaks: no jump in its phase where the temperature steps
+    np.testing.assert_allclose(wave.exc_v, s.excitation_peak_v * np.cos(2 * math.pi * 5000.0 * wave.time_s), atol=1e-9)
+    # and the sensor's temperature is in the secondaries: the hot soak's differ from the cold one's
+    ia = [_lockin(w, 5000.0, reference_phase_rad(s), 400)[0] for w in each]
+    assert np.max(np.abs(ia[0] - ia[1])) > 1e-3 * np.max(np.abs(ia[0]))
+
+
 def test_cli_writes_a_waveform_file_the_reader_reads(cli, tmp_path):
     out = tmp_path / "wave.csv"
     rc, _out, err = cli(["simulate", "--waveforms", "-o", out, "--step-mm", "10", "--trajectory", "steps:0.002",
@@ -129,6 +154,8 @@ def test_cli_writes_a_waveform_file_the_reader_reads(cli, tmp_path):
     (["--waveforms", "--sample-rate-hz", "6000"], "--sample-rate-hz"),
     (["--waveforms", "--trajectory", "ramp:100"], "more than a recording holds"),
     (["--carrier-hz", "2500"], "need --waveforms"),
+    (["--waveforms", "--temperatures", "0,50", "--temperature-profile", "ramp:0:50"], "either"),
+    (["--waveforms", "--temperatures", "0,0"], "repeated"),
 ])
 def test_cli_refuses_in_one_line(cli, tmp_path, argv, words):
     out = tmp_path / "wave.csv"

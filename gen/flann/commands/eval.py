@@ -18,11 +18,12 @@ from ..golden.metrics import (DEFAULT_BAND_PCT_FS, DEFAULT_TOL_PCT_FS, error_rep
 from ..errors import FlannError
 from ..golden.thermal import load_any_model
 from ..golden.thermal_metrics import temperature_report
-from ..hardware.accuracy import adc_codes, design_adc, design_spec, hardware_accuracy, plot_errors
+from ..hardware.accuracy import adc_codes, design_adc, design_spec, hardware_accuracy, plot_errors, temperature_codes
 from ..hardware.datapath import check_design_model
 from ..hardware.design import open_directory
 from ..hardware.conditioner.verify import flann_design
 from ..hardware.fixed.twin import FlannTop
+from ..hardware.thermal.twin import FlannThermalTop
 from ..golden.reading import usable_or_every
 from ..golden.verdict import Check, against_line, combine, exit_code, hardware_against_float
 from ..recordings import read_recordings
@@ -107,12 +108,17 @@ def conditioned_flann(model, design_dir):
     return flann
 
 
-def chain_window_mm(flann, settings, conditioned) -> np.ndarray:
+def chain_window_mm(flann, settings, conditioned, wave) -> np.ndarray:
     """The design's output of each window: its ratio code into the FLANN's twin (its top input
-    bits, as wired), in mm."""
+    bits, as wired; a two-input FLANN's with the temperature code at the window's last sample,
+    as the chain holds it), in mm."""
     spec = flann.spec
     codes = adc_codes(spec, conditioned.ratio, settings.ratio_converter)
-    return FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
+    if not getattr(spec, "temp_bits", None):
+        return FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
+    m = settings.spec.window
+    temps = temperature_codes(spec, wave.temperature_c[m - 1::m][:codes.size])
+    return FlannThermalTop(spec).process(codes, temps).out_data * spec.output_lsb_mm
 
 
 def chain_outputs_mm(out, dwells, rec) -> np.ndarray:
@@ -204,8 +210,10 @@ def run(args) -> int:
     res = evaluate(model, rec, args.tol, args.band, args.full_scale_mm)
     errors = res.pop("_errors", None)
     if chain is not None:
-        window_mm = chain_window_mm(chain, settings, conditioned)
+        window_mm = chain_window_mm(chain, settings, conditioned, wave)
         hardware_mm = chain_outputs_mm(window_mm, dwells, rec)
+        if errors is not None:
+            errors["hardware"] = hardware_mm - rec.displacement_mm
     elif args.design:
         hw = hardware_accuracy(spec, rec, tol=args.tol, band=args.band, fs_mm=res["full_scale_mm"],
                                adc=design_adc(args.design))
@@ -238,8 +246,12 @@ def run(args) -> int:
                                                         / res["full_scale_mm"])
             # a dwell whose codes do not toggle is exact to within half of it: the figure's resolution
             res["linearity_pct_fs"]["hardware_lsb_pct_fs"] = 100 * chain.spec.output_lsb_mm / res["full_scale_mm"]
+        # a two-input model's figures at the recording's (median) temperature: each compares
+        # outputs of one temperature
+        at = None if rec.temperature_c is None or len(model.inputs) < 2 else float(np.median(rec.temperature_c))
+
         def to_mm(ratio):
-            return predict_clamped(model, ratio)[0]
+            return predict_clamped(model, ratio, at)[0]
 
         figures = chain_figures(settings, wave, dwells, to_mm, res["full_scale_mm"])
         for f in figures:

@@ -162,6 +162,8 @@ def run(args) -> int:
         drawn = ", ".join(f"{k} x{v:.4f}" for k, v in factors.items())
     lo = -s.stroke_mm if args.from_mm is None else args.from_mm
     hi = s.stroke_mm if args.to_mm is None else args.to_mm
+    if args.temperatures is not None and args.temperature_profile != "const:20":
+        raise FlannError("simulate: give either --temperatures or --temperature-profile")
     if args.waveforms:
         return run_waveforms(args, s, (lo, hi))
     if waveform_options_used(args):
@@ -177,8 +179,6 @@ def run(args) -> int:
                          f"{per_sweep * max(args.sweeps, 1) * n_temps:,.0f} rows, more than flann reads "
                          f"({MAX_ROWS:,}): use a larger --step-mm")
     if args.temperatures is not None:
-        if args.temperature_profile != "const:20":
-            raise FlannError("simulate: give either --temperatures or --temperature-profile")
         temps = parse_temperatures(args.temperatures)
         rec = simulate_calibration(s, temps, sweeps=args.sweeps, step_mm=args.step_mm,
                                    noise_v=args.noise_v, seed=seed, travel_mm=(lo, hi),

@@ -1,13 +1,15 @@
 """``flann simulate SENSOR.toml --waveforms -o wave.csv``: sampled excitation and secondaries.
 
-The options of this mode; the travel, step, sweeps, noise, seed and temperature profile are
-the simulation's own (``flann simulate``).
+The options of this mode; the travel, step, sweeps, noise, seed, temperature profile and
+temperatures (a calibration at several: the trajectory at each in turn) are the simulation's
+own (``flann simulate``).
 """
 
 from __future__ import annotations
 
 from ..argtypes import bounded
 from ..errors import FlannError
+from ..physics.simulate import parse_temperatures
 from ..physics.waveforms import SAMPLES_PER_CARRIER, WaveformSettings, parse_trajectory, simulate_waveforms
 from ..recordings.waveform import write_waveforms
 from .common import info
@@ -45,16 +47,16 @@ def waveform_options_used(args) -> bool:
 
 def run_waveforms(args, s, travel_mm: tuple[float, float]) -> int:
     """Write the waveforms of sensor ``s`` (effects already chosen) to ``args.output``."""
-    for opt in ("temperatures", "plot"):
-        if getattr(args, opt):
-            raise FlannError(f"simulate --waveforms: --{opt} is for demodulated recordings")
+    if args.plot:
+        raise FlannError("simulate --waveforms: --plot is for demodulated recordings")
+    temps = parse_temperatures(args.temperatures) if args.temperatures is not None else None
     settings = WaveformSettings(carrier_hz=args.carrier_hz, sample_rate_hz=args.sample_rate_hz,
                                 adc_bits=args.adc_bits, adc_range_v=args.adc_range_v,
                                 noise_v=args.noise_v, excitation_drift_pct=args.excitation_drift_pct,
                                 harmonic_pct=args.harmonic_pct, seed=args.seed)
     wave = simulate_waveforms(s, settings, parse_trajectory(args.trajectory), travel_mm=travel_mm,
                               step_mm=args.step_mm, sweeps=args.sweeps,
-                              temperature_profile=args.temperature_profile)
+                              temperature_profile=args.temperature_profile, temperatures=temps)
     carrier = args.carrier_hz or s.excitation_frequency_hz
     effects = "; ".join(f"{n}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
                         for n, p in s.effects.items()) or "none"
@@ -63,7 +65,9 @@ def run_waveforms(args, s, travel_mm: tuple[float, float]) -> int:
         f"carrier {carrier:g} Hz, trajectory {args.trajectory}, travel {travel_mm[0]:g}..{travel_mm[1]:g} mm",
         *wave.comments,
         f"noise {args.noise_v:g} V rms, seed {args.seed}, excitation drift {args.excitation_drift_pct:g} %, "
-        f"third harmonic {args.harmonic_pct:g} %, temperature {args.temperature_profile}",
+        f"third harmonic {args.harmonic_pct:g} %, temperature "
+        + (f"a calibration at {', '.join(f'{t:g}' for t in temps)} degC, the trajectory at each" if temps
+           else args.temperature_profile),
         f"effects: {effects}",
     )
     write_waveforms(args.output, wave, comments=comments)

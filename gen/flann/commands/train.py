@@ -224,7 +224,7 @@ def run(args) -> int:
     else:
         rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if args.temperature:
-        return run_thermal(args, rec)
+        return run_thermal(args, rec, settings)
     hint = compensation_hint(rec)
     if hint:   # before the checks: a multi-temperature recording may not pass them as one
         info(args, hint)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +43,9 @@ def _prepare(rec, trim: bool):
             cat([p.displacement_mm for p in parts]))
 
 
-def run_thermal(args, rec) -> int:
+def run_thermal(args, rec, settings=None) -> int:
+    """The two-input model of ``rec``; ``settings``: the conditioner whose ratio ``rec`` holds
+    (a waveform recording's dwells), kept in the model."""
     if args.terms != "auto" or args.method != "lstsq" or args.ridge or args.normalise \
             or args.input_scale_v is not None or args.input_offset_v is not None:
         raise FlannError("--temperature chooses terms, normalisation and ridge by cross-validation: "
@@ -57,6 +60,8 @@ def run_thermal(args, rec) -> int:
     if rec.comments:
         provenance["data_provenance"] = rec.comments[0]
     model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
+    if settings is not None:
+        model = replace(model, conditioner=settings.to_dict())
     model.save(args.output)
     tr = model.training
     info(args, f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "

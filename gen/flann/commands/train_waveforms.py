@@ -66,9 +66,6 @@ def read_conditioned(args) -> tuple:
     dwell; the line saying what was found is printed (unless --quiet)."""
     _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None),
                          ("--input-bits", args.input_bits, None), ("--input-lsb-v", args.input_lsb_v, None)))
-    if args.temperature:
-        raise FlannError("--temperature: a two-input model is trained from demodulated recordings at "
-                         "several temperatures, not yet from waveforms")
     wave = read_waveforms(args.recordings, announce=not args.quiet)
     rate = args.output_rate_hz if args.output_rate_hz is not None else DEFAULT_OUTPUT_RATE_HZ
     settings, conditioned = calibrate(wave, rate, args.adc_bits, args.adc_range_v)

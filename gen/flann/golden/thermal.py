@@ -93,6 +93,8 @@ class ThermalModel(ModelFile):
     temperature_range_c: tuple[float, float] = (0.0, 1.0)
     displacement_range_mm: tuple[float, float] = (-1.0, 1.0)
     training: dict = field(default_factory=dict)
+    # trained from waveforms: the conditioner whose ratio is its voltage input, as FlannModel keeps it
+    conditioner: dict | None = None
 
     inputs = INPUTS
 
@@ -176,7 +178,7 @@ class ThermalModel(ModelFile):
 
     # -- file -----------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {
+        out = {
             "format": FORMAT,
             "inputs": list(INPUTS),
             "terms": list(self.terms),
@@ -193,6 +195,9 @@ class ThermalModel(ModelFile):
             "displacement_range_mm": list(self.displacement_range_mm),
             "training": self.training,
         }
+        if self.conditioner is not None:
+            out["conditioner"] = self.conditioner
+        return out
 
     @classmethod
     def from_dict(cls, d: dict, source: str = "<dict>") -> "ThermalModel":
@@ -217,6 +222,9 @@ class ThermalModel(ModelFile):
                             for k, ws in enumerate(d["weights"]))
             bias = nums("bias")
             terms = nums("terms", integer=True, lo=0, hi=MAX_TERMS)
+            conditioner = d.get("conditioner")
+            if conditioner is not None and not isinstance(conditioner, dict):
+                raise ModelFileError(f"{source}: 'conditioner' must be an object")
             model = cls(
                 weights=weights, bias=bias,
                 input_offset_v=num(d["input_offset_v"], "input_offset_v"),
@@ -229,6 +237,7 @@ class ThermalModel(ModelFile):
                 temperature_range_c=nums("temperature_range_c"),
                 displacement_range_mm=nums("displacement_range_mm"),
                 training=dict(d.get("training", {})) if isinstance(d.get("training", {}), dict) else {},
+                conditioner=conditioner,
             )
         except KeyError as exc:
             raise ModelFileError(f"{source}: missing field {exc.args[0]!r}") from None

@@ -26,8 +26,12 @@ CHAIN_INPUT_BITS = 20
 
 
 def max_input_bits(model) -> int:
-    """The widest input code a design of ``model`` takes: the ratio's behind a conditioner."""
-    return CHAIN_INPUT_BITS if getattr(model, "conditioner", None) is not None else MAX_DESIGN_INPUT_BITS
+    """The widest input code a design of ``model`` takes: the ratio's behind a conditioner.  A
+    two-input model's keeps 16 (its orders interpolate below them): its sweep runs every code at
+    each of some temperature codes, which 20 bits would make sixteen times as long."""
+    if getattr(model, "conditioner", None) is None or len(model.inputs) > 1:
+        return MAX_DESIGN_INPUT_BITS
+    return CHAIN_INPUT_BITS
 MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
 MIN_OUTPUT_CODES = 16        # the same floor on the output: codes over the trained stroke
 SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)

@@ -125,6 +125,11 @@ def _inductances(s: Sensor, core_mm, permeability_scale, loop: bool) -> tuple[np
     nodes = levels if levels.size <= _MU_NODES else np.linspace(levels[0], levels[-1], _MU_NODES)
     at = [inductances_h(s.replace(core_permeability_ratio=max(1.0, s.core_permeability_ratio * float(k))),
                         core, loop=loop) for k in nodes]
+    if nodes is levels:
+        # every level a node (a calibration's few soaks): each sample takes its own, exactly
+        at_level = np.searchsorted(levels, scale)[None]
+        return tuple(np.take_along_axis(np.stack([np.broadcast_to(a[k], core.shape) for a in at]), at_level, 0)[0]
+                     for k in range(len(at[0])))
     # quadratic (Lagrange) through the three nearest nodes: the inductances curve with mu
     lo = np.clip(np.searchsorted(nodes, scale) - 2, 0, nodes.size - 3)
     n0, n1, n2 = nodes[lo], nodes[lo + 1], nodes[lo + 2]

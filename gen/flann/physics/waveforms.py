@@ -138,9 +138,11 @@ def _phasors(s: Sensor, sig) -> tuple[np.ndarray, np.ndarray]:
 
 def simulate_waveforms(s: Sensor, settings: WaveformSettings, trajectory: Trajectory,
                        travel_mm: tuple[float, float] | None = None, step_mm: float = 1.0,
-                       sweeps: int = 1, temperature_profile=None) -> Waveforms:
+                       sweeps: int = 1, temperature_profile=None, temperatures=None) -> Waveforms:
     """Waveforms of ``s`` along ``trajectory`` (see the module docstring), reproducible from
-    ``settings.seed``."""
+    ``settings.seed``.  ``temperatures``: a calibration at several temperatures, the trajectory
+    once at each in turn (the sensor soaked at it), one record whose excitation runs on across
+    them; it replaces ``temperature_profile``."""
     settings.check()
     if settings.carrier_hz is not None:
         s = s.replace(excitation_frequency_hz=float(settings.carrier_hz))
@@ -151,18 +153,26 @@ def simulate_waveforms(s: Sensor, settings: WaveformSettings, trajectory: Trajec
         raise FlannError(f"--sample-rate-hz {fs:g}: must be above twice the highest frequency in the "
                          f"waveforms ({highest:g} Hz)")
     travel = travel_mm if travel_mm is not None else (-s.stroke_mm, s.stroke_mm)
+    soaks = tuple(float(t) for t in temperatures) if temperatures else ()
     total = duration_s(trajectory, travel, step_mm, sweeps)
-    n = int(math.floor(total * fs + 1e-9))
+    per = int(math.floor(total * fs + 1e-9))   # the samples of one pass of the trajectory
+    n = per * max(1, len(soaks))
     if n > MAX_ROWS:
-        raise FlannError(f"{total:g} s at {fs:g} samples/s is {n:,} samples, more than a recording holds "
+        raise FlannError(f"{n / fs:g} s at {fs:g} samples/s is {n:,} samples, more than a recording holds "
                          f"({MAX_ROWS:,}): shorten the trajectory or lower --sample-rate-hz")
     if n < 2:
         raise FlannError(f"{total:g} s at {fs:g} samples/s is fewer than 2 samples")
     t = np.arange(n, dtype=float) / fs
-    x, direction = trajectory_positions(trajectory, t, travel, step_mm, sweeps)
-    profile = (temperature_profile if callable(temperature_profile)
-               else parse_temperature_profile(temperature_profile))
-    temp = np.asarray(profile(t, float(t[-1])), dtype=float)
+    if soaks:
+        # each pass at the times of the first, so that each soak dwells where the others do
+        i = np.arange(n)
+        x, direction = trajectory_positions(trajectory, (i % per) / fs, travel, step_mm, sweeps)
+        temp = np.asarray(soaks)[i // per]
+    else:
+        x, direction = trajectory_positions(trajectory, t, travel, step_mm, sweeps)
+        profile = (temperature_profile if callable(temperature_profile)
+                   else parse_temperature_profile(temperature_profile))
+        temp = np.asarray(profile(t, float(t[-1])), dtype=float)
     drive = 1.0 + settings.excitation_drift_pct / 100.0 * t / t[-1]
     sig = transformer_signal(s, x, direction=direction, temperature_c=temp, time_s=t)
     va, vb = _phasors(s, sig)

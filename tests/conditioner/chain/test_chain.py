@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from flann.errors import SpecError
-from flann.golden.train import fit_lstsq
 from flann.hardware.conditioner.chain import CHAIN_TOP, ChainSpec, FlannChainTop, render_chain
 from flann.hardware.conditioner.condition import calibrate_reference
 from flann.hardware.conditioner.render import render
@@ -16,7 +15,6 @@ from flann.hardware.conditioner.spec import derive_conditioner, identity
 from flann.hardware.conditioner.twin import ConditionerChain
 from flann.hardware.conditioner.verify import lvdt_codes, run_chain_top
 from flann.hardware.fixed import render as fixed_render
-from flann.hardware.options import GenOptions
 
 # the FLANN behind the conditioner takes the ratio's top 16 bits: flann gen says so, as here
 pytestmark = pytest.mark.filterwarnings("ignore:.*-bit ADC. the design takes its top")
@@ -24,16 +22,8 @@ pytestmark = pytest.mark.filterwarnings("ignore:.*-bit ADC. the design takes its
 COND = dict(carrier_hz=5000.0, output_rate_hz=5000.0)
 
 
-def flann_behind(cond, terms: int = 5):
-    """A FLANN of a monotonic LVDT curve over the ratio +-0.8, generated as flann gen does behind
-    the conditioner: the ratio code its converter."""
-    x = np.linspace(-25.0, 25.0, 101)
-    model = fit_lstsq(0.8 * np.tanh(x / 20.0) / np.tanh(25.0 / 20.0), x, terms, norm="half")
-    return fixed_render.load(model, GenOptions(input_bits=cond.ratio_bits, input_lsb_v=2.0 ** -cond.ratio_frac_bits))
-
-
 @pytest.fixture(scope="module")
-def chain():
+def chain(flann_behind):
     cond = derive_conditioner(**COND)
     return ChainSpec(cond, flann_behind(cond))
 
@@ -59,7 +49,7 @@ def test_the_flann_takes_the_ratios_top_bits_and_nothing_wraps(chain, stimulus):
     assert not out.out_sat[np.abs(x) < 0.5].any()
 
 
-def test_a_flann_slower_than_the_ratio_is_refused():
+def test_a_flann_slower_than_the_ratio_is_refused(flann_behind):
     # 8 strobes of 9 clocks a ratio
     cond = derive_conditioner(adc_bits=4, carrier_hz=5000.0, sample_rate_hz=40000.0, output_rate_hz=5000.0)
     with pytest.raises(SpecError, match="--output-rate-hz"):

@@ -16,6 +16,11 @@ converter strobes, each at least ``cycles_per_sample`` clocks apart, so the FLAN
 ratio comes when its own cycles per sample fit in that window (:class:`ChainSpec` refuses a
 chain where they do not).
 
+A two-input FLANN (:mod:`flann.hardware.thermal`, a model trained from waveforms at several
+temperatures) adds the port ``in_temp``: the temperature code at a window's last converter
+strobe is held for that window's ratio (a register the strobes' own count loads), so a window's
+displacement is computed at its own temperature whenever the temperature code changes.
+
 Public API: :class:`ChainSpec`, :class:`FlannChainTop`, :func:`render_chain`, ``CHAIN_TOP``.
 """
 
@@ -26,10 +31,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import SpecError
+from ...numeric.fixed import bits_literal
 from ...textgen import template
 from ..adc import wired_codes
 from ..fixed.spec import Spec
 from ..fixed.twin import FlannTop
+from ..thermal.spec import ThermalSpec
+from ..thermal.twin import FlannThermalTop
 from ..header import header
 from ..twin import Record
 from .render import TEMPLATES, cycles_per_sample
@@ -41,10 +49,11 @@ CHAIN_TOP = "flann_chain_top"
 
 @dataclass(frozen=True)
 class ChainSpec:
-    """The conditioner's spec and the FLANN's behind it; ``flann_top`` its entity's name."""
+    """The conditioner's spec and the FLANN's behind it (one input, or two with the
+    temperature); ``flann_top`` its entity's name."""
 
     conditioner: ConditionerSpec
-    flann: Spec
+    flann: Spec | ThermalSpec
     flann_top: str = "flann_top"
 
     def __post_init__(self):
@@ -56,6 +65,15 @@ class ChainSpec:
             raise SpecError(f"a ratio every {self.ratio_clocks} clocks ({c.window} strobes of {cycles_per_sample(c)}), "
                             f"but the FLANN takes {f.cycles_per_sample} clocks a sample: lower the output rate "
                             "(flann train --output-rate-hz) or train fewer terms")
+        if self.temp_bits and ConditionerChain(c).latency >= self.ratio_clocks:
+            raise SpecError(f"a window's ratio comes {ConditionerChain(c).latency} clocks after its last strobe, "
+                            f"not within the next window's {self.ratio_clocks}: its temperature would not be held "
+                            "for it; lower the output rate (flann train --output-rate-hz)")
+
+    @property
+    def temp_bits(self) -> int | None:
+        """The temperature code's width of a two-input FLANN; None for one input."""
+        return getattr(self.flann, "temp_bits", None)
 
     @property
     def ratio_clocks(self) -> int:
@@ -81,9 +99,12 @@ class ChainSpec:
         return np.where(np.asarray(ratio_sat) != 0, self.latency - early, self.latency)
 
     def to_dict(self) -> dict:
-        return {"conditioner": self.conditioner.to_dict(), "flann_top": self.flann_top,
-                "flann_input_bits": self.flann.input_bits, "flann_output_bits": self.flann.out_fmt.width,
-                "dropped_ratio_bits": self.dropped}
+        out = {"conditioner": self.conditioner.to_dict(), "flann_top": self.flann_top,
+               "flann_input_bits": self.flann.input_bits, "flann_output_bits": self.flann.out_fmt.width,
+               "dropped_ratio_bits": self.dropped}
+        if self.temp_bits:
+            out["flann_temp_bits"] = self.temp_bits
+        return out
 
 
 @dataclass(frozen=True)
@@ -93,29 +114,41 @@ class ChainTopOut(Record):
     ratio: np.ndarray       # the conditioner's ratio code
     ratio_sat: np.ndarray   # the divider's saturation
     flann_code: np.ndarray  # the FLANN's input code (the ratio's top bits)
+    temp_code: np.ndarray | None = None   # a two-input FLANN's: the code at the window's last strobe
 
 
 class FlannChainTop:
-    """Converter codes to displacement codes: the conditioner's twin, the ratio wired to the
-    FLANN's input, the FLANN's twin."""
+    """Converter codes (and a two-input FLANN's temperature codes, one a strobe) to
+    displacement codes: the conditioner's twin, the ratio wired to the FLANN's input, the
+    FLANN's twin."""
 
     entity = CHAIN_TOP
 
     def __init__(self, spec: ChainSpec):
         self.spec = spec
-        self.conditioner, self.flann = ConditionerChain(spec.conditioner), FlannTop(spec.flann)
+        self.conditioner = ConditionerChain(spec.conditioner)
+        self.flann = FlannThermalTop(spec.flann) if spec.temp_bits else FlannTop(spec.flann)
 
     @property
     def latency(self) -> int:
         return self.spec.latency
 
-    def process(self, codes_a, codes_b, ref: Reference) -> ChainTopOut:
-        """Every whole window of the codes at the reference ``ref``: its displacement code."""
+    def process(self, codes_a, codes_b, ref: Reference, temp_codes=None) -> ChainTopOut:
+        """Every whole window of the codes at the reference ``ref``: its displacement code;
+        ``temp_codes`` (one a strobe) for a two-input FLANN, which takes each window's last."""
+        if (temp_codes is None) != (self.spec.temp_bits is None):
+            raise SpecError("temperature codes are for a FLANN with a temperature input, and it needs them")
         c = self.conditioner.process(codes_a, codes_b, ref)
         code = wired_codes(c.out_ratio, self.spec.conditioner.ratio_bits, self.spec.flann.input_bits)
-        f = self.flann.process(code)
+        temp = None
+        if temp_codes is None:
+            f = self.flann.process(code)
+        else:
+            m = self.spec.conditioner.window
+            temp = np.asarray(temp_codes, dtype=np.int64)[m - 1::m][:code.size]
+            f = self.flann.process(code, temp)
         sat = (np.asarray(f.out_sat, dtype=bool) | (c.out_sat != 0)).astype(np.int64)
-        return ChainTopOut(f.out_data, sat, c.out_ratio, c.out_sat, code)
+        return ChainTopOut(f.out_data, sat, c.out_ratio, c.out_sat, code, temp)
 
 
 def render_chain(spec: ChainSpec, command: str = "flann gen", model_sha256: str = "") -> dict[str, str]:
@@ -123,12 +156,14 @@ def render_chain(spec: ChainSpec, command: str = "flann gen", model_sha256: str 
     rendered by their own datapaths)."""
     c, f = spec.conditioner, spec.flann
     name = f"{CHAIN_TOP}.vhd"
+    count_bits = max(1, (c.window - 1).bit_length())   # the strobes of a window, counted for its temperature
     h = header(name, "LVDT conditioner and FLANN, top level", command, spec.to_dict(), model_sha256)
     return {name: template(f"{TEMPLATES}/{CHAIN_TOP}.vhd.j2").render(
         h=h, entity=CHAIN_TOP, flann_top=spec.flann_top, adc_bits=c.adc_bits, table_bits=c.table_bits,
         sine_bits=c.sine_bits, tan_bits=c.tan_bits, ratio_bits=c.ratio_bits, dropped=spec.dropped,
         in_bits=f.input_bits, out_bits=f.out_fmt.width, cycles_per_sample=cycles_per_sample(c),
-        window=c.window, flann_cycles=f.cycles_per_sample, latency=spec.latency)}
+        window=c.window, flann_cycles=f.cycles_per_sample, latency=spec.latency, temp_bits=spec.temp_bits,
+        count_bits=count_bits, last_count=bits_literal(c.window - 1, count_bits, signed=False))}
 
 
 __all__ = ["CHAIN_TOP", "ChainSpec", "ChainTopOut", "FlannChainTop", "render_chain"]

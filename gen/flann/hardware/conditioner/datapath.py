@@ -23,7 +23,8 @@ import hashlib
 from pathlib import Path
 
 from ...errors import FlannError
-from ...golden.model import load_model
+from ...golden.model import model_sha256
+from ...golden.thermal import ThermalModel, load_any_model
 from ..adc import plan_adc
 from ..datapath import Datapath, _int
 from ..fixed import datapath as fixed_datapath
@@ -31,6 +32,8 @@ from ..fixed import render as fixed_render
 from ..header import NO_MODEL
 from ..manifest import write_design
 from ..options import GenOptions
+from ..thermal import datapath as thermal_datapath
+from ..thermal import render as thermal_render
 from .chain import CHAIN_TOP, ChainSpec, render_chain
 from .condition import adc_lsb_v
 from .render import ENTITIES, TOP, cycles_per_sample, render
@@ -99,29 +102,43 @@ def training_waveform(model_path, m) -> str | None:
     return None
 
 
+def _flann(model, m, opts: GenOptions):
+    """(spec, {file: VHDL}, manifest, model sha256) of the FLANN behind the conditioner: the
+    fixed datapath for a one-input model, the two-input one (its temperature port) for a model
+    trained at several temperatures."""
+    if isinstance(m, ThermalModel):
+        tspec = thermal_render.derive(m, opts)
+        sha = model_sha256(model)
+        texts = thermal_render.render(tspec, sha)
+        return tspec, texts, thermal_render.manifest(tspec, list(texts), sha), sha
+    fspec = fixed_render.load(model, opts)
+    texts = fixed_render.render(fspec)
+    plan = plan_adc(fspec.model, opts.input_bits, opts.input_lsb_v, opts.clamp)
+    return fspec, texts, fixed_render.manifest(fspec, list(texts), plan), fspec.model_sha256
+
+
 def generate(model, out_dir, options: GenOptions | None = None, **_extra) -> dict:
     """The conditioner at the settings of ``model`` (trained from waveforms), its FLANN and the
     chain joining them, one directory; returns the manifest."""
-    m = load_model(model)
+    m = load_any_model(model)
     settings = of_model(m, str(model))
     if settings is None:
         raise FlannError(f"{model}: trained from demodulated readings, it has no conditioner: generate it "
                          "with flann gen --format fixed (train from a waveform recording for the conditioner)")
     opts = flann_options(m, options or GenOptions(), source=str(model))
-    fspec = fixed_render.load(model, opts)
-    ftexts = fixed_render.render(fspec)
-    fman = fixed_render.manifest(fspec, list(ftexts), plan_adc(fspec.model, opts.input_bits, opts.input_lsb_v,
-                                                                opts.clamp))
+    fspec, ftexts, fman, sha = _flann(model, m, opts)
     spec = settings.spec
     chain = ChainSpec(spec, fspec, fman["top"])   # refuses a FLANN slower than the ratio
-    ctexts, chtexts = render(spec), render_chain(chain, model_sha256=fspec.model_sha256)
+    ctexts, chtexts = render(spec), render_chain(chain, model_sha256=sha)
     ref = settings.reference
     texts = {**ctexts, **ftexts, **chtexts, fixed_render.MODEL_FILE: fixed_render.model_text(model)}
     man = {**manifest(spec, adc_lsb_v(spec.adc_bits, settings.adc_range_v)),
            "top": CHAIN_TOP, "files": [*ctexts, *ftexts, *chtexts], "output_bits": fspec.out_fmt.width,
            "output_lsb_mm": fspec.output_lsb_mm, "latency_cycles": chain.latency,
-           "model": fixed_render.MODEL_FILE, "model_sha256": fspec.model_sha256,
+           "model": fixed_render.MODEL_FILE, "model_sha256": sha,
            "reference": {"offset": ref.offset, "tan": ref.tan}, "chain": chain.to_dict(), FLANN: fman}
+    if chain.temp_bits:
+        man["cfg_port"] = fman["cfg_port"]   # in_temp, beyond the common interface
     wave = training_waveform(model, m)
     if wave is not None:
         texts[WAVEFORM] = wave
@@ -140,7 +157,8 @@ def summary(man: dict) -> list[str]:
                      f"out_ratio({man['spec']['ratio_frac_bits']} downto {chain['dropped_ratio_bits']}) to its "
                      f"in_data; {man['output_bits']}-bit displacement code {man['latency_cycles']} clocks after a "
                      "window's last strobe")
-        lines += fixed_datapath.summary(flann)
+        lines += (thermal_datapath.summary(flann) if flann.get("datapath") == thermal_datapath.DATAPATH.name
+                  else fixed_datapath.summary(flann))
         lines.append("  flann sim's whole-chain run: " + (f"the training recording, kept as {man['waveform']}"
                      if man.get("waveform") else "the closed-form LVDT (the training recording was not found "
                      "beside the model under the name and sha256 it records)"))

@@ -26,8 +26,10 @@ import numpy as np
 
 from ...errors import FlannError, ModelFileError
 from ...recordings import converter_of
+from ...recordings.checks import TEMPERATURE_RESOLUTION_C
 from ...recordings.csvio import Recordings
 from ...recordings.waveform import Waveforms, carrier_hz
+from ..adc import max_input_bits
 from ..options import GenOptions
 from .condition import Conditioned, condition
 from .spec import ConditionerSpec, Reference, derive_conditioner, reference
@@ -172,6 +174,10 @@ def flann_options(model, options: GenOptions, given=(), source: str = "model.jso
                          "waveforms; its input is the conditioner's ratio, "
                          f"{settings.spec.ratio_bits} bits x 2^-{settings.spec.ratio_frac_bits}")
     bits, lsb = settings.ratio_converter
+    if len(model.inputs) > 1:
+        # a two-input design takes the ratio's top bits here, as a one-input one's converter plan does
+        drop = max(0, bits - max_input_bits(model))
+        bits, lsb = bits - drop, lsb * 2 ** drop
     return replace(options, input_bits=bits, input_lsb_v=lsb)
 
 
@@ -243,20 +249,26 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
     """The conditioned windows averaged per dwell (a run of steady windows at one position,
     unsaturated), as the DC path's readings: displacement_mm and voltage_v (the ratio)."""
     keep = c.steady & (c.sat == 0)
+    per = None
+    if wave.temperature_c is not None:
+        # a soak's step within a window leaves it out, and starts a new dwell (a slow drift does neither)
+        temps = wave.temperature_c[: c.ratio.size * window].reshape(-1, window)
+        per = temps.mean(axis=1)
+        keep &= np.ptp(temps, axis=1) <= TEMPERATURE_RESOLUTION_C
     if not np.any(keep):
         raise FlannError(f"{wave.source}: no window of whole carrier periods dwells at one position unsaturated: "
                          "training needs dwell at stepped positions (flann simulate --waveforms --trajectory "
                          "steps:DWELL)")
     idx = np.flatnonzero(keep)
     # a new dwell where a kept window does not follow the last, or the position changes
-    starts = np.flatnonzero(np.r_[True, (np.diff(idx) != 1) | (np.diff(c.displacement_mm[idx]) != 0)])
+    new = (np.diff(idx) != 1) | (np.diff(c.displacement_mm[idx]) != 0)
+    if per is not None:
+        new |= np.abs(np.diff(per[idx])) > TEMPERATURE_RESOLUTION_C
+    starts = np.flatnonzero(np.r_[True, new])
     groups = np.split(idx, starts[1:])
     x = np.array([c.displacement_mm[g[0]] for g in groups])
     v = np.array([np.mean(c.ratio[g]) for g in groups])
-    temp = None
-    if wave.temperature_c is not None:
-        per = wave.temperature_c[: c.ratio.size * window].reshape(-1, window).mean(axis=1)
-        temp = np.array([np.mean(per[g]) for g in groups])
+    temp = None if per is None else np.array([np.mean(per[g]) for g in groups])
     rec = Recordings(displacement_mm=x, voltage_v=v, temperature_c=temp, source=wave.source, sha256=sha256,
                      comments=wave.comments)
     return DwellReadings(rec, int(idx.size), int(c.ratio.size - idx.size), tuple(groups))

@@ -4,7 +4,8 @@ boundary cases for the demodulator, the rotation and the divider), then a wavefo
 whole chain (``flann_cond_top`` against :class:`~.twin.ConditionerChain`), 0 mismatches.  A
 directory ``flann gen`` wrote from a model trained from waveforms also holds the FLANN behind the
 conditioner and the chain joining them: the FLANN's own benches (every input code against its
-twin) run after the conditioner's, then a waveform through ``flann_chain_top`` against
+twin; a two-input FLANN's at its temperature codes) run after the conditioner's, then a waveform
+(and its temperature codes, one a strobe) through ``flann_chain_top`` against
 :class:`~.chain.FlannChainTop` (the recording the model was trained from when the directory
 keeps it, whole windows of it at a stride, at most ``CHAIN_SAMPLES`` strobes; else the
 closed-form LVDT below), one summary for all.
@@ -25,15 +26,15 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import FlannError
-from ...golden.model import load_model
+from ...golden.thermal import load_any_model
 from ...recordings.waveform import read_waveforms
-from ...verify.plugin import Verification
+from ...verify.plugin import Verification, verification
 from ...verify.results import SimResult, bench_entry, summary
 from ...verify.runner import BenchResult, run_cocotb
+from ..accuracy import temperature_codes
 from ..design import Design
-from ..fixed.verify import VERIFICATION as FIXED_VERIFICATION
 from ..manifest import MANIFEST, Manifest
-from ..registry import FIXED, check_widths
+from ..registry import FIXED, THERMAL, check_widths
 from .chain import CHAIN_TOP, ChainSpec, FlannChainTop
 from .datapath import FLANN
 from .condition import adc_codes, calibrate_reference
@@ -92,15 +93,16 @@ def run_chain(files, spec: ConditionerSpec, build_dir, *, seed: int = 1) -> tupl
     return res, int(a.size)
 
 
-def kept_waveform(design: Design, spec: ConditionerSpec):
-    """(codes A, codes B, reference, what they are) of the training recording the directory keeps:
+def kept_waveform(design: Design, spec: ConditionerSpec, flann_spec=None):
+    """(codes A, codes B, reference, what they are, temperature codes or None) of the training
+    recording the directory keeps (its temperature column as a two-input ``flann_spec`` receives it):
     whole windows at a stride (each starts on a whole carrier period, so the NCO's phase runs on
     across the windows left out), at the model's reference turned by the record's excitation;
     None when it keeps none."""
     name = design.manifest.get("waveform")
     if name is None:
         return None
-    model = load_model(design.directory / design.manifest["model"])
+    model = load_any_model(design.directory / design.manifest["model"])
     settings = of_model(model, str(design.directory / design.manifest["model"]))
     path = design.directory / name
     sha = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else None
@@ -114,60 +116,81 @@ def kept_waveform(design: Design, spec: ConditionerSpec):
     idx = (np.arange(windows)[::stride, None] * spec.window + np.arange(spec.window)).ravel()
     a = adc_codes(wave.sec_a_v, spec.adc_bits, settings.adc_range_v)[idx]
     b = adc_codes(wave.sec_b_v, spec.adc_bits, settings.adc_range_v)[idx]
-    return a, b, ref, f"{name} (the training recording), one window in {stride}"
+    temps = None
+    if getattr(flann_spec, "temp_bits", None):
+        if wave.temperature_c is None:
+            raise FlannError(f"{path}: no temperature_c column, but the FLANN behind the conditioner takes the "
+                             "temperature: regenerate the design with flann gen")
+        temps = temperature_codes(flann_spec, wave.temperature_c[idx])
+    return a, b, ref, f"{name} (the training recording), one window in {stride}", temps
 
 
-def chain_stimulus(design: Design, spec: ConditionerSpec):
-    """(codes A, codes B, reference, what they are) of the whole-chain run: the kept training
-    recording, else the closed-form LVDT calibrated as the hardware is."""
-    kept = kept_waveform(design, spec)
+def swept_temperatures(flann_spec, n: int) -> np.ndarray:
+    """A two-input FLANN's temperature codes for ``n`` strobes of the closed-form LVDT: a ramp
+    one code apart from a few codes below its calibrated range to a few above (its clamp), so
+    that the code at each window's last strobe differs from the window's others."""
+    lo, hi = flann_spec.temp_lo - 4, flann_spec.temp_hi + 4
+    ramp = lo + np.arange(n) % (hi - lo + 1)
+    return np.clip(ramp, flann_spec.temp_code_min, flann_spec.temp_code_max)
+
+
+def chain_stimulus(design: Design, spec: ConditionerSpec, flann_spec=None):
+    """(codes A, codes B, reference, what they are, temperature codes or None) of the
+    whole-chain run: the kept training recording, else the closed-form LVDT calibrated as the
+    hardware is (a two-input FLANN's temperature swept over its codes)."""
+    kept = kept_waveform(design, spec, flann_spec)
     if kept is not None:
         return kept
     a, b, x = lvdt_codes(spec)
     ref, _phase = calibrate_reference(spec, ConditionerChain(spec).process(a, b, identity(spec)), x)
-    return a, b, ref, "the closed-form LVDT"
+    temps = swept_temperatures(flann_spec, a.size) if getattr(flann_spec, "temp_bits", None) else None
+    return a, b, ref, "the closed-form LVDT", temps
 
 
 def run_chain_top(files, chain: ChainSpec, codes_a, codes_b, ref: Reference, build_dir, *,
-                  seed: int = 1) -> BenchResult:
-    """Converter codes through ``flann_chain_top`` (built from ``files``: every entity's) against
-    :class:`FlannChainTop`, whose values the bench is given."""
-    want = FlannChainTop(chain).process(codes_a, codes_b, ref)
+                  seed: int = 1, temp_codes=None) -> BenchResult:
+    """Converter codes (and a two-input FLANN's temperature codes, one a strobe) through
+    ``flann_chain_top`` (built from ``files``: every entity's) against :class:`FlannChainTop`,
+    whose values the bench is given."""
+    want = FlannChainTop(chain).process(codes_a, codes_b, ref, temp_codes)
     spec = chain.conditioner
-    return run_cocotb(files, CHAIN_TOP, CHAIN_BENCH, build_dir,
-                      {"spec": spec.to_dict(), "codes_a": np.asarray(codes_a).tolist(),
-                       "codes_b": np.asarray(codes_b).tolist(), "ref": asdict(ref),
-                       "cycles_per_sample": cycles_per_sample(spec),
-                       "latencies": chain.latencies(want.ratio_sat).tolist(),
-                       "expected": [[int(d), int(s)] for d, s in zip(want.out_data, want.out_sat)]},
-                      name=CHAIN_TOP, seed=seed)
+    cfg = {"spec": spec.to_dict(), "codes_a": np.asarray(codes_a).tolist(),
+           "codes_b": np.asarray(codes_b).tolist(), "ref": asdict(ref),
+           "cycles_per_sample": cycles_per_sample(spec),
+           "latencies": chain.latencies(want.ratio_sat).tolist(),
+           "expected": [[int(d), int(s)] for d, s in zip(want.out_data, want.out_sat)]}
+    if temp_codes is not None:
+        cfg["temp_codes"] = np.asarray(temp_codes).tolist()
+    return run_cocotb(files, CHAIN_TOP, CHAIN_BENCH, build_dir, cfg, name=CHAIN_TOP, seed=seed)
 
 
 def run_whole_chain(design: Design, flann: Design, build_dir, *, seed: int = 1) -> tuple[BenchResult, dict]:
     """A waveform through ``flann_chain_top`` against :class:`FlannChainTop`; (bench result, what
     was run)."""
     chain = ChainSpec(design.spec, flann.spec, flann.manifest["top"])
-    a, b, ref, source = chain_stimulus(design, design.spec)
-    return run_chain_top(design.files, chain, a, b, ref, build_dir, seed=seed), {"samples": int(a.size),
-                                                                                "source": source}
+    a, b, ref, source, temps = chain_stimulus(design, design.spec, flann.spec)
+    res = run_chain_top(design.files, chain, a, b, ref, build_dir, seed=seed, temp_codes=temps)
+    return res, {"samples": int(a.size), "source": source}
 
 
 def flann_design(design: Design) -> Design | None:
     """The FLANN design a conditioner's directory holds behind it (``flann gen`` of a model
-    trained from waveforms), with its twin; None for a conditioner written from a spec."""
+    trained from waveforms: the fixed datapath, or the two-input one of a model trained at several
+    temperatures), with its twin; None for a conditioner written from a spec."""
     fman = design.manifest.get(FLANN)
     if fman is None:
         return None
     where = design.directory / MANIFEST
     if not isinstance(fman, dict):
         raise FlannError(f"{where}: field {FLANN!r} must be an object (the FLANN design's manifest)")
-    FIXED.check(fman, f"{where}: field {FLANN!r}")
+    dp = THERMAL if fman.get("datapath") == THERMAL.name else FIXED
+    dp.check(fman, f"{where}: field {FLANN!r}")
     check_widths(fman, f"{where}: field {FLANN!r}")
     if not set(fman["files"]) <= set(design.manifest["files"]) or fman.get("model") != design.manifest.get("model"):
         raise FlannError(f"{where}: field {FLANN!r} names files or a model the design does not list: "
                          "regenerate the design with flann gen")
     files = tuple(design.directory / f for f in fman["files"])
-    return Design(design.directory, Manifest(design.directory, fman["top"], files, fman), datapath=FIXED).with_twin()
+    return Design(design.directory, Manifest(design.directory, fman["top"], files, fman), datapath=dp).with_twin()
 
 
 def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
@@ -184,7 +207,7 @@ def bench(design: Design, build_dir, *, seed=1, **options) -> SimResult:
     s["windows"], s["saturated_windows"] = rec.get("windows"), rec.get("saturated")
     if flann is None:
         return SimResult(s, None, spec, ok)
-    fres = FIXED_VERIFICATION.bench(flann, build_dir / FLANN, seed=seed, **options)
+    fres = verification(flann.datapath).bench(flann, build_dir / FLANN, seed=seed, **options)
     f = fres.summary
     cond = {"samples": samples, "mismatches": s["mismatches"], "windows": s["windows"],
             "saturated_windows": s["saturated_windows"]}

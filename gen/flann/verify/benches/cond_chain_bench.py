@@ -1,14 +1,15 @@
 """flann_chain_top against FlannChainTop: a waveform's converter codes through the conditioner and
 the FLANN behind it, one strobe every cycles_per_sample clocks (with random extra gaps); every
 window's displacement code and saturation flag in order, each at the twin's latency after the
-window's last strobe (shorter where the divider saturates).  The twin's values come in the
+window's last strobe (shorter where the divider saturates).  A two-input FLANN's temperature
+code is driven with each strobe (``temp_codes``).  The twin's values come in the
 configuration, computed in the flann process (the FLANN's twin is rebuilt there from the model
 the design keeps)."""
 
 import cocotb
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-from flann.verify.benches import CLK_NS
+from flann.verify.benches import CLK_NS, config
 from flann.verify.benches.cond_bench import setup, signed
 from flann.verify.benches.flann_bench import cycle_now, write_record
 
@@ -23,7 +24,9 @@ async def monitor(dut, got: list) -> None:
 
 @cocotb.test()
 async def waveform_through_the_whole_chain(dut):
-    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset", "in_tan"])
+    temps = config().get("temp_codes")
+    cfg, spec, r = await setup(dut, ["in_valid", "in_code_a", "in_code_b", "in_offset", "in_tan"]
+                               + (["in_temp"] if temps is not None else []))
     a, b = cfg["codes_a"], cfg["codes_b"]
     exp = [tuple(e) for e in cfg["expected"]]
     cps, latencies = int(cfg["cycles_per_sample"]), [int(n) for n in cfg["latencies"]]
@@ -35,6 +38,8 @@ async def waveform_through_the_whole_chain(dut):
         dut.in_valid.value = 1
         dut.in_code_a.value = a[k]
         dut.in_code_b.value = b[k]
+        if temps is not None:
+            dut.in_temp.value = temps[k]
         await RisingEdge(dut.clk)
         if (k + 1) % spec.window == 0:
             last_strobe.append(cycle_now())
