@@ -163,14 +163,18 @@ def run_steps(steps) -> list[tuple[str, str]] | None:
     return outs
 
 
+def eval_result(outs) -> dict:
+    """``flann eval --json``'s result in a run of :func:`run_steps` (its JSON, then its lines)."""
+    text = dict(outs)["eval"]
+    return json.loads(text[: text.rindex("}") + 1])
+
+
 def judge(outs) -> int:
     """The eval's figures and the synth's lines of a run of :func:`run_steps`, each judged:
     0 when every one meets its reference."""
-    res, missed = None, 0
+    res, missed = eval_result(outs), 0
     for name, text in outs:
-        if name == "eval":
-            res = json.loads(text[: text.rindex("}") + 1])
-        elif name == "synth":
+        if name == "synth":
             line, ok = synth_line(json.loads(text[text.index("{"): text.rindex("}") + 1]))
             missed += not ok
             print("synth: " + line)

@@ -33,7 +33,7 @@ def wave(noise_v: float = 0.5e-3, seed: int = 1, dwell_windows: int = 5) -> Wave
     return Waveforms(time_s=t, sec_a_v=a, sec_b_v=b, displacement_mm=x, exc_v=np.cos(w))
 
 
-def to_mm(ratio):
+def to_mm(ratio, _temperature_c=None):
     return 2 * CENTRE_V * np.asarray(ratio) / GAIN_V_PER_MM
 
 

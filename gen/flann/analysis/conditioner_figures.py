@@ -3,7 +3,9 @@
 twin at the model's settings and the FLANN (docs/conditioner.md, "Figures").
 
 The output is the chain's displacement: each window's ratio (the twin's, bit-true) through
-``to_mm`` (the FLANN, in float, so that shifts below the hardware's output LSB still show).
+``to_mm(ratio, temperature_c)`` (the FLANN, in float, so that shifts below the hardware's output
+LSB still show; a two-input FLANN's at each dwell's or window's own temperature, or at the
+recording's when None).
 Full scale (FS) is ``fs_mm``, half the stroke, as ``linearity_pct_fs``; the output's span is
 ``2 fs_mm``.
 
@@ -110,6 +112,12 @@ class Figure:
         return Check(self.name, self.ok, self.text(), "" if self.ok is not False else self.remedy)
 
 
+def window_temperature_c(wave: Waveforms, window: int) -> np.ndarray | None:
+    """Each whole window's mean temperature (None for a recording without one)."""
+    t = wave.temperature_c
+    return None if t is None else t[: len(t) // window * window].reshape(-1, window).mean(axis=1)
+
+
 @dataclass(frozen=True)
 class Chain:
     """The recording through a conditioner twin and the FLANN: what each figure re-runs."""
@@ -117,7 +125,7 @@ class Chain:
     settings: ConditionerSettings
     wave: Waveforms
     dwells: DwellReadings
-    to_mm: Callable[[np.ndarray], np.ndarray]
+    to_mm: Callable[..., np.ndarray]
     fs_mm: float
     twin: ConditionerChain
 
@@ -167,7 +175,15 @@ class Chain:
 
     def per_dwell_mm(self, ratio) -> np.ndarray:
         """The output per dwell: its windows' mean ratio through the FLANN."""
-        return self.to_mm(self.per_dwell(ratio))
+        return self.dwell_mm(self.per_dwell(ratio))
+
+    def dwell_mm(self, dwell_ratio) -> np.ndarray:
+        """A ratio per dwell through the FLANN, at each dwell's temperature."""
+        return self.to_mm(dwell_ratio, self.dwells.recordings.temperature_c)
+
+    @cached_property
+    def window_temperature_c(self) -> np.ndarray | None:
+        return window_temperature_c(self.wave, self.spec.window)
 
     def volts_per_code_sum(self) -> float:
         """A window's in-phase sum (codes) back to the amplitude in volts at a secondary."""
@@ -192,13 +208,13 @@ def systematic_ppm(chain: Chain, base_ratio, moved_ratio) -> tuple[float, float,
     proportion, a quadrature leak by a constant), carried to the output through the FLANN."""
     r = np.asarray(base_ratio, dtype=float)
     shift = np.asarray(moved_ratio, dtype=float) - r
-    base_mm = chain.to_mm(r)
-    worst = _ppm(chain, chain.to_mm(r + shift) - base_mm)
+    base_mm = chain.dwell_mm(r)
+    worst = _ppm(chain, chain.dwell_mm(r + shift) - base_mm)
     if np.unique(r).size < 4:
         return worst, worst, 0.0
     fit = np.polyval(np.polyfit(r, shift, 2), r)
-    out = chain.to_mm(r + fit) - base_mm
-    scatter = chain.to_mm(r + shift) - chain.to_mm(r + fit)
+    out = chain.dwell_mm(r + fit) - base_mm
+    scatter = chain.dwell_mm(r + shift) - chain.dwell_mm(r + fit)
     return _ppm(chain, out), worst, 1e6 * float(np.std(scatter)) / chain.fs_mm
 
 
@@ -228,7 +244,8 @@ def noise_figures(chain: Chain, ratio, bandwidth: Figure) -> list[Figure]:
         reason = "no dwell holds two windows (dwell longer than two windows of the output rate)"
         return [Figure("effective_bits", None, "bits", ref16, TARGET_BITS, False, src, reason),
                 Figure("noise_free_bits", None, "bits", "AD2S93's resolution", AD2S93_BITS, False, src, reason)]
-    outs = [chain.to_mm(ratio[g]) for g in groups]
+    temps = chain.window_temperature_c
+    outs = [chain.to_mm(ratio[g], None if temps is None else temps[g]) for g in groups]
     sigma = pooled_rms(outs)
     ptp = max(float(np.ptp(o)) for o in outs)
     bw = bandwidth.value
@@ -323,7 +340,7 @@ def settling_figure(chain: Chain, ratio, total: float, r0: float) -> Figure:
     # the recording's steps
     x = chain.wave.displacement_mm
     steps = np.flatnonzero(np.diff(x) != 0) + 1
-    out_mm = chain.to_mm(ratio)
+    out_mm = chain.to_mm(ratio, chain.window_temperature_c)
     found, unsettled = [], 0
     for g in chain.dwells.groups:
         first = int(g[0]) * s.window
@@ -459,7 +476,7 @@ def phase_tolerance_figure(chain: Chain, base_mm) -> Figure:
 
 
 def chain_figures(settings: ConditionerSettings, wave: Waveforms, dwells: DwellReadings,
-                  to_mm: Callable[[np.ndarray], np.ndarray], fs_mm: float,
+                  to_mm: Callable[..., np.ndarray], fs_mm: float,
                   twin: ConditionerChain | None = None) -> list[Figure]:
     """Every figure of the module docstring, in its order after linearity."""
     chain = Chain(settings, wave, dwells, to_mm, float(fs_mm), twin or ConditionerChain(settings.spec))
@@ -503,12 +520,13 @@ def plot_chain(path, settings: ConditionerSettings, wave: Waveforms, conditioned
     ax[2].plot(t_w, conditioned.ratio, ".", ms=2, color="C0", label="(A-B)/(A+B), one a window (the twin)")
     ax[2].set_ylabel("ratio")
     ax[2].legend(loc="upper left", fontsize=7)
-    err = 100 * (to_mm(conditioned.ratio) - conditioned.displacement_mm) / fs_mm
+    err = 100 * (to_mm(conditioned.ratio, window_temperature_c(wave, window)) - conditioned.displacement_mm) / fs_mm
     steady = conditioned.steady & (conditioned.sat == 0)
     ax[3].plot(t_w[steady], err[steady], ".", ms=2, color="0.6", label="float chain, each window")
     t_d = np.array([t_w[g].mean() for g in dwells.groups])
     x = dwells.recordings.displacement_mm
-    ax[3].plot(t_d, 100 * (to_mm(dwells.recordings.voltage_v) - x) / fs_mm, "o", ms=4, color="C0",
+    ax[3].plot(t_d, 100 * (to_mm(dwells.recordings.voltage_v, dwells.recordings.temperature_c) - x) / fs_mm, "o",
+               ms=4, color="C0",
                label="float chain, dwell mean")
     if hardware_mm is not None and len(hardware_mm) == t_d.size:
         ax[3].plot(t_d, 100 * (np.asarray(hardware_mm) - x) / fs_mm, "x", ms=5, color="C3",

@@ -14,10 +14,9 @@ from ..argtypes import bounded, checked, terms_or_auto
 from ..errors import FlannError
 from ..recordings import converter_of, converter_step, read_recordings
 from ..recordings.csvio import AB_FORMS
-from ..golden.metrics import raw_output_mm
 from ..golden.model import MAX_TERMS
 from ..golden.reading import OUTLIER_MODES, read_usable
-from ..golden.verdict import against_line, combine, exit_code
+from ..golden.verdict import exit_code
 from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_validate,
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
@@ -26,7 +25,7 @@ from ..hardware.adc import ADC_BITS, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .common import add_common, info, on_terminal, quiet
-from .train_thermal import compensation_hint, run_thermal
+from .train_thermal import compensation_hint, run_thermal, train_verdict
 from .train_waveforms import add_waveform_arguments, converter_of_ratio, is_waveform, read_conditioned
 
 HELP = "train a FLANN inverse model on recordings"
@@ -204,17 +203,6 @@ def _train_auto(args, rec, provenance: dict, settings=None) -> tuple:
     elif "hardware_why" in t:
         said.append(_Verdict(f"auto: no candidate builds in fixed point ({t['hardware_why']})"))
     return model, said, choice.max_mm
-
-
-def train_verdict(model, rec, heldout_max_mm: float | None):
-    """The model's error against the straight line through the same readings: held out when
-    cross-validated (a model that only follows its training points is judged as it generalises),
-    else at the training readings."""
-    line = float(np.max(np.abs(raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm)))
-    if heldout_max_mm is not None:
-        return combine(against_line(heldout_max_mm, line, "held-out max error"))
-    own = float(np.max(np.abs(model.predict(rec.voltage_v) - rec.displacement_mm)))
-    return combine(against_line(own, line, "max error"))
 
 
 def run(args) -> int:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -9,7 +10,9 @@ import numpy as np
 
 from ..errors import FlannError
 from ..golden.thermal_train import MIN_TEMPERATURES, compensable, fit_thermal_auto
+from ..golden.metrics import raw_output_mm
 from ..golden.thermal import temperature_groups
+from ..golden.verdict import against_line, combine, exit_code
 from ..recordings import MIN_FIT_POINTS, prepare_for_fit
 from ..recordings.checks import TEMPERATURE_RESOLUTION_C
 from .common import info
@@ -43,6 +46,18 @@ def _prepare(rec, trim: bool):
             cat([p.displacement_mm for p in parts]))
 
 
+def train_verdict(model, rec, heldout_max_mm: float | None):
+    """The model's error against the straight line through the same readings (a two-input
+    model's: through every temperature's, as an uncompensated sensor reads them): held out when
+    cross-validated (a model that only follows its training points is judged as it generalises),
+    else at the training readings."""
+    line = float(np.max(np.abs(raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm)))
+    if heldout_max_mm is not None:
+        return combine(against_line(heldout_max_mm, line, "held-out max error"))
+    own = float(np.max(np.abs(model.predict(rec.voltage_v) - rec.displacement_mm)))
+    return combine(against_line(own, line, "max error"))
+
+
 def run_thermal(args, rec, settings=None) -> int:
     """The two-input model of ``rec``; ``settings``: the conditioner whose ratio ``rec`` holds
     (a waveform recording's dwells), kept in the model."""
@@ -62,6 +77,8 @@ def run_thermal(args, rec, settings=None) -> int:
     model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
     if settings is not None:
         model = replace(model, conditioner=settings.to_dict())
+    verdict = train_verdict(model, rec, choice.max_mm)
+    model.training["verdict"] = verdict.to_json()
     model.save(args.output)
     tr = model.training
     info(args, f"temperature: terms per temperature order {list(model.terms)} ({model.coefficients} "
@@ -70,4 +87,5 @@ def run_thermal(args, rec, settings=None) -> int:
                f"ridge {choice.ridge:g}; held-out error (cross-validation over "
                f"{tr['cv_position_folds']} position folds and {tr['cv_temperature_folds']} held-out "
                f"temperatures): RMS {choice.rms_mm:.4g} mm, max {choice.max_mm:.4g} mm")
-    return 0
+    print(verdict.line(), file=sys.stderr)
+    return exit_code(verdict, args.strict)
