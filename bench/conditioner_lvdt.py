@@ -10,8 +10,8 @@ peak at 2.35 V), the ratio at the whole number of carrier periods whose boxcar b
 over +-25 mm (noise seed 1); the held-out recording is the same trajectory with noise seed 2.
 The noise is white on each secondary's samples, before the converters (default 0.1 mV rms:
 0.08 LSB, a quiet front end and a converter whose own transition noise is below 0.1 LSB).
-The design's output LSB is 0.0002 mm (``--output-lsb-mm``), so that its words carry the
-conditioner's resolution (`flann gen`'s default follows the model's accuracy).  ``--hardware`` also runs ``flann sim`` and ``flann synth`` (Spartan-II and iCE40-HX8K) on each
+The design's output LSB is `flann gen`'s default (at the output's noise as training measured
+it, so that its words carry the conditioner's resolution), or ``--output-lsb-mm``.  ``--hardware`` also runs ``flann sim`` and ``flann synth`` (Spartan-II and iCE40-HX8K) on each
 design.  Exit 0 when every judged figure meets its reference at every carrier.
 """
 
@@ -27,7 +27,6 @@ SENSOR = Path("data/sensors/paper_lvdt.toml")
 SAMPLE_RATE_HZ = 2.56e6
 RANGE_V = 2.5
 BANDWIDTH_HZ = 250.0
-OUTPUT_LSB_MM = 0.0002   # finer than the ratio's noise (0.00014 mm rms at 0.1 mV): the words keep its bits
 
 
 def output_rate_hz(carrier_hz: float) -> float:
@@ -36,7 +35,7 @@ def output_rate_hz(carrier_hz: float) -> float:
     return carrier_hz / periods
 
 
-def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: float) -> int:
+def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: float | None) -> int:
     rate = output_rate_hz(hz)
     print(f"\n== carrier {hz:g} Hz, {SAMPLE_RATE_HZ / hz:g} samples a period, ratio at {rate:.4g} Hz, "
           f"{1e3 * noise_v:g} mV rms", flush=True)
@@ -47,7 +46,8 @@ def carrier(d: Path, hz: float, noise_v: float, hardware: bool, output_lsb_mm: f
              ("simulate", ["simulate", SENSOR, "-o", d / "held_out.csv", *common, "--seed", 2]),
              ("train", ["train", d / "wave.csv", "-o", d / "model.json", "--adc-bits", 12,
                         "--adc-range-v", RANGE_V, "--output-rate-hz", rate]),
-             ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", output_lsb_mm]),
+             ("gen", ["gen", d / "model.json", "-o", d / "design",
+                      *(["--output-lsb-mm", output_lsb_mm] if output_lsb_mm is not None else [])]),
              ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json", "--quiet"])]
     if hardware:
         steps += hardware_steps(d / "design")
@@ -62,8 +62,8 @@ def main() -> int:
     ap.add_argument("--noise-v", type=float, default=1e-4, help="rms on each secondary (default 0.1 mV)")
     ap.add_argument("--carriers", type=float, nargs="+", default=[2500.0, 10000.0])
     ap.add_argument("--hardware", action="store_true", help="also flann sim and flann synth each design")
-    ap.add_argument("--output-lsb-mm", type=float, default=OUTPUT_LSB_MM,
-                    help=f"the design's output LSB (default {OUTPUT_LSB_MM:g}: 17.9 bits over the 50 mm span)")
+    ap.add_argument("--output-lsb-mm", type=float, default=None,
+                    help="the design's output LSB (default flann gen's: at the output's noise as training measured it)")
     a = ap.parse_args()
     if not SENSOR.is_file():
         print(f"error: {SENSOR}: not found (run from the repository's root)", file=sys.stderr)

@@ -151,6 +151,21 @@ def test_gen_writes_the_conditioner_and_its_flann_in_one_directory(trained, gene
     assert rc == 2 and "flann gen" in err
 
 
+def test_the_default_output_lsb_carries_the_noise_training_measured(trained, generated, held_out, in_process):
+    d, _err = trained
+    design, _out = generated
+    noise = load_model(d / "model.json").training["window_noise_rms_mm"]
+    lsb = json.loads((design / "manifest.json").read_text())["output_lsb_mm"]
+    # at the noise, on the 1-2-5 series: finer than the model's accuracy asks (that LSB would
+    # round off bits the conditioner resolves), no finer than the noise needs
+    assert noise / 2.5 <= lsb <= noise
+    rc, out, err = in_process(["eval", d / "model.json", held_out, "--design", design, "--json", "--outliers", "keep"])
+    assert rc == 0, err
+    enob = json.loads(out)["effective_bits"]
+    # the words lose at most a tenth of a bit of the chain's resolution to their rounding
+    assert enob["hardware_bits"] >= enob["value"] - 0.1
+
+
 def test_a_tampered_flann_manifest_is_refused(trained, in_process, tmp_path):
     import shutil
 

@@ -21,12 +21,13 @@ from ..golden.train import (MAX_EPOCHS, PAPER_TERMS, check_fit_input, cross_vali
                             fit_lms, fit_lstsq, normalisation_kind)
 from ..errors import SpecError
 from ..golden.inverse import MIN_POSITIONS, fit_default
-from ..hardware.adc import ADC_BITS, check_converter
+from ..hardware.adc import ADC_BITS, WINDOW_NOISE, check_converter
 from ..hardware.fixed.cost import fixed_point_cost
 from ..hardware.fixed.spec import derive_spec
 from .common import add_common, info, on_terminal, quiet
 from .train_thermal import compensation_hint, run_thermal, train_verdict
-from .train_waveforms import add_waveform_arguments, converter_of_ratio, is_waveform, read_conditioned
+from .train_waveforms import (add_waveform_arguments, converter_of_ratio, is_waveform, read_conditioned,
+                              window_noise_mm)
 
 HELP = "train a FLANN inverse model on recordings"
 
@@ -206,9 +207,10 @@ def _train_auto(args, rec, provenance: dict, settings=None) -> tuple:
 
 
 def run(args) -> int:
-    settings = None
+    settings = dwells = None
     if is_waveform(args):
-        rec, settings = read_conditioned(args)
+        dwells, settings, conditioned = read_conditioned(args)
+        rec = dwells.recordings
     else:
         rec = read_recordings(args.recordings, announce=not args.quiet, sensor=args.sensor_id, ab=args.ab)
     if args.temperature:
@@ -263,6 +265,10 @@ def run(args) -> int:
                         f"{model.training['train_rms_error_mm']:.4g} mm (not a held-out figure)" + heldout)
     if settings is not None:
         model = replace(model, conditioner=settings.to_dict())
+        # the words flann gen sizes by default carry the resolution, not only the accuracy
+        noise = window_noise_mm(model, dwells, conditioned)
+        if noise is not None:
+            model.training[WINDOW_NOISE] = noise
     _check_generatable(model)
     verdict = train_verdict(model, rec, heldout_max)
     model.training["verdict"] = verdict.to_json()

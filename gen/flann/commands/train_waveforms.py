@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
+from ..analysis.conditioner_figures import pooled_rms
 from ..argtypes import bounded
 from ..errors import FlannError
 from ..hardware.conditioner.settings import (DEFAULT_OUTPUT_RATE_HZ, ConditionerSettings, calibrate, condition_with,
@@ -62,14 +63,22 @@ def _readings(args, wave, settings, conditioned, found: str):
 
 
 def read_conditioned(args) -> tuple:
-    """(readings, settings): the record through the conditioner calibrated on it, one reading per
-    dwell; the line saying what was found is printed (unless --quiet)."""
+    """(dwell readings, settings, conditioned windows): the record through the conditioner
+    calibrated on it, one reading per dwell; the line saying what was found is printed (unless
+    --quiet)."""
     _refuse_flags(args, (("--ab", args.ab, "ratio"), ("--sensor-id", args.sensor_id, None),
                          ("--input-bits", args.input_bits, None), ("--input-lsb-v", args.input_lsb_v, None)))
     wave = read_waveforms(args.recordings, announce=not args.quiet)
     rate = args.output_rate_hz if args.output_rate_hz is not None else DEFAULT_OUTPUT_RATE_HZ
     settings, conditioned = calibrate(wave, rate, args.adc_bits, args.adc_range_v)
-    return _readings(args, wave, settings, conditioned, "").recordings, settings
+    return _readings(args, wave, settings, conditioned, ""), settings, conditioned
+
+
+def window_noise_mm(model, dwells, conditioned) -> float | None:
+    """The output's noise at the ratio's rate (mm rms): each dwell's windows through the model,
+    about their dwell's mean, pooled; None when no dwell holds two windows."""
+    outs = [model.predict(conditioned.ratio[g]) for g in dwells.groups if g.size >= 2]
+    return pooled_rms(outs) if outs else None
 
 
 def read_held_out(args, model) -> tuple:
@@ -92,4 +101,5 @@ def converter_of_ratio(settings: ConditionerSettings) -> dict:
     return {"input_bits": bits, "input_lsb_v": lsb, "from": "the conditioner's ratio"}
 
 
-__all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "read_held_out", "converter_of_ratio"]
+__all__ = ["add_waveform_arguments", "is_waveform", "read_conditioned", "read_held_out", "converter_of_ratio",
+           "window_noise_mm"]

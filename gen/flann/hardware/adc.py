@@ -23,6 +23,8 @@ MAX_DESIGN_INPUT_BITS = 16   # widest ADC code the datapath takes (serial normal
 # conditioner's own (its top 16 of 21 bits: 15.7 bits over the LVDT's stroke against 16.7 of
 # noise); every code is verified through the compiled netlist, the VHDL on a sample
 CHAIN_INPUT_BITS = 20
+# model.json's training record: the output's rms noise (mm) at the conditioner's ratio rate
+WINDOW_NOISE = "window_noise_rms_mm"
 
 
 def max_input_bits(model) -> int:
@@ -215,7 +217,15 @@ def model_accuracy_mm(model: FlannModel) -> float | None:
 def default_output_step_mm(model: FlannModel, code_step_mm: float) -> float:
     """What the default output LSB must resolve: a quarter of the output change per input
     code, but no finer than a quarter of the model's own held-out RMS error (bits below the
-    model's accuracy only widen the datapath)."""
+    model's accuracy only widen the datapath).  Behind a conditioner, whose ratio comes
+    averaged over a window, the floor is the output's noise at that rate as training measured
+    it instead (``WINDOW_NOISE``): an LSB at the noise rounds off 0.06 bits of its resolution,
+    where one at the accuracy would round off bits the conditioner resolves."""
+    training = model.training if isinstance(model.training, dict) else {}
+    noise = training.get(WINDOW_NOISE)
+    if getattr(model, "conditioner", None) is not None and isinstance(noise, (int, float)) \
+            and math.isfinite(noise) and noise > 0:
+        return max(code_step_mm / 4, float(noise))
     acc = model_accuracy_mm(model)
     return max(code_step_mm, acc if acc is not None else 0.0) / 4
 
@@ -237,4 +247,4 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
 __all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "check_converter", "check_output_step", "default_input_lsb",
            "default_lsb_for_range", "default_output_step_mm",
            "max_mm_per_v", "model_accuracy_mm", "wired_codes", "pathological_hint", "weight_range_text",
-           "CHAIN_INPUT_BITS", "MAX_DESIGN_INPUT_BITS", "max_input_bits", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]
+           "CHAIN_INPUT_BITS", "WINDOW_NOISE", "MAX_DESIGN_INPUT_BITS", "max_input_bits", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]
