@@ -190,8 +190,12 @@ def test_train_temperature_refusals(tmp_path, capsys):
     assert rc == 2 and "2 or more temperatures" in err and not (tmp_path / "m.json").exists()
     x, v, t = calibration()
     cal = write_csv(tmp_path / "cal.csv", x, v, t)
+    rc, _, err = run(["train", cal, "--temperature", "--method", "lms", "-o", tmp_path / "m.json"], capsys)
+    assert rc == 2 and "--method" in err and not (tmp_path / "m.json").exists()
+    # --terms N sets the expansion per temperature order (a hardware that must fit a part)
     rc, _, err = run(["train", cal, "--temperature", "--terms", "5", "-o", tmp_path / "m.json"], capsys)
-    assert rc == 2 and "--terms" in err
+    assert rc == 0, err
+    assert set(json.loads((tmp_path / "m.json").read_text())["terms"]) == {5}
 
 
 def test_one_line_says_a_multi_temperature_recording_could_be_compensated(tmp_path, capsys):

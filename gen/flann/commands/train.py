@@ -65,7 +65,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="exit 1 when the verdict is bad (compensated worse than the straight line)")
     p.add_argument("--temperature", action="store_true",
                    help="a two-input model x(voltage, temperature) from a calibration at several "
-                        "temperatures (the temperature_c column; docs/temperature.md)")
+                        "temperatures (the temperature_c column; docs/temperature.md); --terms N sets "
+                        "each temperature order's expansion (the hardware's size)")
     p.add_argument("--input-bits", type=bounded(int, *ADC_BITS), default=None,
                    help="--terms auto: the converter the model will be generated for (signed code "
                         "width); default: read from the recording's converter grid")

@@ -61,10 +61,11 @@ def train_verdict(model, rec, heldout_max_mm: float | None):
 def run_thermal(args, rec, settings=None) -> int:
     """The two-input model of ``rec``; ``settings``: the conditioner whose ratio ``rec`` holds
     (a waveform recording's dwells), kept in the model."""
-    if args.terms != "auto" or args.method != "lstsq" or args.ridge or args.normalise \
+    if args.method != "lstsq" or args.ridge or args.normalise \
             or args.input_scale_v is not None or args.input_offset_v is not None:
-        raise FlannError("--temperature chooses terms, normalisation and ridge by cross-validation: "
-                         "give none of --terms/--method/--ridge/--normalise/--input-*")
+        raise FlannError("--temperature chooses normalisation and ridge by cross-validation (and the terms, "
+                         "unless --terms N sets them per temperature order): give none of "
+                         "--method/--ridge/--normalise/--input-*")
     if rec.temperature_c is None:
         raise FlannError(f"{rec.source}: --temperature needs a temperature_c column")
     if len(compensable(rec.temperature_c)) < MIN_TEMPERATURES:
@@ -74,7 +75,8 @@ def run_thermal(args, rec, settings=None) -> int:
     provenance = {"data_file": Path(args.recordings).name, "data_sha256": rec.sha256}
     if rec.comments:
         provenance["data_provenance"] = rec.comments[0]
-    model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source)
+    terms = None if args.terms == "auto" else (int(args.terms),)   # the hardware's size, when it must fit a part
+    model, choice = fit_thermal_auto(v, t, x, training=provenance, source=rec.source, terms=terms)
     if settings is not None:
         model = replace(model, conditioner=settings.to_dict())
     verdict = train_verdict(model, rec, choice.max_mm)

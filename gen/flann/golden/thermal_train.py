@@ -304,9 +304,11 @@ def select_thermal(results: list[ThermalCv], displacement_mm) -> tuple[ThermalCv
 
 
 def fit_thermal_auto(voltage_v, temperature_c, displacement_mm, *, training: dict | None = None,
-                     source: str = "recordings") -> tuple[ThermalModel, ThermalCv]:
-    """Structure by cross-validation (module docstring); the choice fitted on every row."""
-    run = cross_validate_thermal(voltage_v, temperature_c, displacement_mm, source=source)
+                     source: str = "recordings", terms=None) -> tuple[ThermalModel, ThermalCv]:
+    """Structure by cross-validation (module docstring); the choice fitted on every row.
+    ``terms``: the expansion sizes to choose among (default ``AUTO_TERMS``)."""
+    run = cross_validate_thermal(voltage_v, temperature_c, displacement_mm, source=source,
+                                 terms=AUTO_TERMS[1:] if terms is None else tuple(terms))
     choice, best, n_good = select_thermal(run.results, displacement_mm)
     info = {
         "selected_by": "cross-validation over held-out positions and temperatures; every "
