@@ -14,16 +14,27 @@ from flann.hardware.conditioner.render import render
 from flann.hardware.conditioner.verify import run_block
 
 
+def write_sources(texts: dict, src: Path) -> list[Path]:
+    """{file name: VHDL} written into ``src``; the paths in compile order (the dict's)."""
+    src.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, text in texts.items():
+        paths.append(src / name)
+        paths[-1].write_text(text)
+    return paths
+
+
 def render_and_run(spec, entity: str, bench: str, build_dir: Path, seed: int = 1, **config):
     """Render ``spec`` next to ``build_dir`` and run the cocotb module ``bench`` against ``entity``."""
     build_dir = Path(build_dir).resolve()
-    src = build_dir.parent / f"{build_dir.name}_hdl"
-    src.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for name, text in render(spec).items():   # every entity, in compile order: a top needs its blocks
-        paths.append(src / name)
-        paths[-1].write_text(text)
+    # every entity, in compile order: a top needs its blocks
+    paths = write_sources(render(spec), build_dir.parent / f"{build_dir.name}_hdl")
     return run_block(paths, spec, entity, bench, build_dir, seed=seed, **config)
+
+
+@pytest.fixture
+def sources():
+    return write_sources
 
 
 @pytest.fixture

@@ -2,8 +2,6 @@
 ratio's top bits into the FLANN and never wraps; a FLANN slower than the ratio is refused; under
 GHDL the chain matches its twin on a waveform through the divider's saturation, at its latency."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -65,15 +63,11 @@ def test_the_chain_top_lints(chain, tmp_path):
 
 
 @pytest.mark.sim
-def test_chain_top_matches_twin_under_ghdl(chain, stimulus, tmp_path):
+def test_chain_top_matches_twin_under_ghdl(chain, stimulus, sources, tmp_path):
     a, b, ref, _x = stimulus
-    texts = {**render(chain.conditioner), **fixed_render.render(chain.flann), **render_chain(chain)}
-    src = tmp_path / "hdl"
-    src.mkdir()
-    files = []
-    for name, text in texts.items():   # compile order: the conditioner's, the FLANN's, the chain
-        files.append(Path(src / name))
-        files[-1].write_text(text)
+    # compile order: the conditioner's, the FLANN's, the chain
+    files = sources({**render(chain.conditioner), **fixed_render.render(chain.flann), **render_chain(chain)},
+                    tmp_path / "hdl")
     r = run_chain_top(files, chain, a, b, ref, tmp_path / "sim", seed=3)
     assert r.ok, f"{r.failed_tests} (see {tmp_path / 'sim'})"
     rec = r.records["cond_chain"]

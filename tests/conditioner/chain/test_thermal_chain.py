@@ -4,8 +4,6 @@ checked from outside: changing any other strobe's code changes nothing); tempera
 given to a two-input chain and only to it; under GHDL the chain matches its twin with the
 temperature code changing on every strobe and crossing the calibrated range's clamp."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -92,15 +90,11 @@ def test_the_two_input_chain_top_lints(chain, tmp_path):
 
 
 @pytest.mark.sim
-def test_two_input_chain_top_matches_twin_under_ghdl(chain, stimulus, tmp_path):
+def test_two_input_chain_top_matches_twin_under_ghdl(chain, stimulus, sources, tmp_path):
     a, b, ref, temps = stimulus
-    texts = {**render(chain.conditioner), **thermal_render.render(chain.flann), **render_chain(chain)}
-    src = tmp_path / "hdl"
-    src.mkdir()
-    files = []
-    for name, text in texts.items():   # compile order: the conditioner's, the FLANN's, the chain
-        files.append(Path(src / name))
-        files[-1].write_text(text)
+    # compile order: the conditioner's, the FLANN's, the chain
+    files = sources({**render(chain.conditioner), **thermal_render.render(chain.flann), **render_chain(chain)},
+                    tmp_path / "hdl")
     r = run_chain_top(files, chain, a, b, ref, tmp_path / "sim", seed=5, temp_codes=temps)
     assert r.ok, f"{r.failed_tests} (see {tmp_path / 'sim'})"
     rec = r.records["cond_chain"]
