@@ -79,17 +79,18 @@ def main() -> int:
                  ("gen", ["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", a.output_lsb_mm]),
                  ("eval", ["eval", d / "model.json", d / "held_out.csv", "--design", d / "design", "--json",
                            "--quiet"])]
-        if a.hardware:
-            steps += hardware_steps(d / "design")
         print(f"{SENSOR}: trained at {TRAIN_C} degC, held out at {HELD_C} degC, {1e3 * a.noise_v:g} mV rms",
               flush=True)
         outs = run_steps(steps)
         if outs is None:
             return 1
+        # each hardware step on its own: a chain that does not fit a part still simulates
+        for step in hardware_steps(d / "design") if a.hardware else ():
+            outs += run_steps([step]) or []
         res = eval_result(outs)
         missed = drift_verdict(res)
         lin = res["linearity_pct_fs"]
-        judge(outs)   # every data-sheet figure, printed with its verdict
+        judge(outs)   # every data-sheet figure and the synth lines, printed with their verdicts
     missed += any(lin[c] is None or lin[c] > lin["reference_pct_fs"] for c in ("float", "hardware"))
     print(f"\n{'drift and linearity met' if not missed else 'missed: see above'}")
     return 1 if missed else 0
