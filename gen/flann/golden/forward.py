@@ -21,6 +21,7 @@ glitch, not data.  ``flann train --terms auto`` leaves such readings out
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -271,7 +272,7 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     Returns the smoother, its held-out predictions and its score."""
     scored = _scored(pos, slope, folds, monotonic)
     if robust:
-        sm, pred, e2 = min(scored, key=_robust_key(pos))
+        sm, pred, e2 = scored[_robust_order(pos, scored)[0]]
         return sm, pred, float(np.median(e2))
     best = min(scored, key=lambda t: float(np.mean(t[2])))
     pool = []
@@ -306,8 +307,18 @@ def _scored(pos: Positions, slope, folds, monotonic: bool) -> list:
     return scored
 
 
-def _robust_key(pos: Positions):
-    return lambda t: (float(np.median(t[2])), t[0].dof(pos))
+def _robust_order(pos: Positions, scored: list) -> list[int]:
+    """The indices of ``scored`` by median held-out error, then degrees of freedom, then
+    place; a candidate's degrees of freedom (a solve each) only asked where medians tie."""
+    med = [float(np.median(t[2])) for t in scored]
+    order = sorted(range(len(scored)), key=med.__getitem__)
+    out: list[int] = []
+    for _m, tied in itertools.groupby(order, key=med.__getitem__):
+        tied = list(tied)
+        if len(tied) > 1:
+            tied.sort(key=lambda i: (scored[i][0].dof(pos), i))
+        out += tied
+    return out
 
 
 def robust_pair(pos: Positions) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
@@ -316,11 +327,10 @@ def robust_pair(pos: Positions) -> tuple[Smoother, np.ndarray, np.ndarray | None
     there is none), from one scoring.  Near the ends of the stroke a high-degree polynomial's
     held-out prediction swings where a spline's does not (and the reverse can happen): a
     reading both miss by far is a glitch, one only a single family misses is that family's."""
-    key = _robust_key(pos)
-    keyed = sorted(((key(t), i, t) for i, t in enumerate(_scored(pos, None, None, False))),
-                   key=lambda k: (k[0], k[1]))
-    sm, pred, _e2 = keyed[0][2]
-    other = next((t[1] for _k, _i, t in keyed if t[0].kind != sm.kind), None)
+    scored = _scored(pos, None, None, False)
+    keyed = [scored[i] for i in _robust_order(pos, scored)]
+    sm, pred, _e2 = keyed[0]
+    other = next((t[1] for t in keyed if t[0].kind != sm.kind), None)
     return sm, pred, other
 
 
