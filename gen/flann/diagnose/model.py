@@ -140,6 +140,7 @@ class OddBasis:
         self.centres = self.half * np.arange(1, self.k + 1) / max(self.k, 1)
         self.width = self.half / max(self.k, 1)
         self._share = None
+        self._modes_seen = (None, None)   # the last positions' shape modes (see _known_at)
         if known is not None:
             u = np.linspace(-self.half, self.half, 401)
             self._share = np.linalg.lstsq(self._known_at(u), self._raw(u), rcond=RCOND)[0]
@@ -161,8 +162,13 @@ class OddBasis:
     def _known_at(self, core_mm: np.ndarray, shift_mm: float = 0.0) -> np.ndarray:
         grid, rows = self.known
         u = np.asarray(core_mm, float)
-        at = [u - shift_mm] + [u] * (len(rows) - 1)   # the output row first, then the modes
-        return np.stack([np.interp(a, grid, r) for a, r in zip(at, rows)], 1)
+        # the output row first (moved by the shift), then the modes, which do not move: a
+        # fit's every zero shift asks at the same positions, so the last ones are kept
+        seen, modes = self._modes_seen
+        if seen is None or seen.shape != u.shape or not np.array_equal(seen, u):
+            modes = [np.interp(u, grid, r) for r in rows[1:]]
+            self._modes_seen = (u.copy(), modes)
+        return np.stack([np.interp(u - shift_mm, grid, rows[0])] + modes, 1)
 
     def _raw(self, core_mm: np.ndarray) -> np.ndarray:
         u = np.asarray(core_mm, float)[:, None]
