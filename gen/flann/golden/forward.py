@@ -260,7 +260,7 @@ def strictly_monotone(y) -> bool:
 
 
 def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
-           robust: bool = False) -> tuple[Smoother, np.ndarray, float]:
+           robust: bool = False, scored: list | None = None) -> tuple[Smoother, np.ndarray, float]:
     """The simplest candidate (fewest degrees of freedom) whose held-out error is as small
     as the best one's within ``FORWARD_PAIRED_Z`` paired standard errors; only candidates
     monotonic over the stroke (else there is no inverse).  The held-out error is in x units
@@ -268,9 +268,11 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     slope is low.  The held-out readings carry the noise, the same for every candidate, so
     the candidates are told apart by the paired difference, not by the scores' spread.
     ``robust``: the smallest median held-out error instead (a gross outlier, not yet found,
-    must not decide the fit it is judged against).
+    must not decide the fit it is judged against).  ``scored``: :func:`_scored` of these
+    arguments, when the caller has it.
     Returns the smoother, its held-out predictions and its score."""
-    scored = _scored(pos, slope, folds, monotonic)
+    if scored is None:
+        scored = _scored(pos, slope, folds, monotonic)
     if robust:
         sm, pred, e2 = scored[_robust_order(pos, scored)[0]]
         return sm, pred, float(np.median(e2))
@@ -321,13 +323,15 @@ def _robust_order(pos: Positions, scored: list) -> list[int]:
     return out
 
 
-def robust_pair(pos: Positions) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
+def robust_pair(pos: Positions, scored: list | None = None) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
     """:func:`choose` ``robust`` (the smoother and its held-out predictions), and the held-out
     predictions of the best candidate of the other family (polynomial or spline; None when
     there is none), from one scoring.  Near the ends of the stroke a high-degree polynomial's
     held-out prediction swings where a spline's does not (and the reverse can happen): a
-    reading both miss by far is a glitch, one only a single family misses is that family's."""
-    scored = _scored(pos, None, None, False)
+    reading both miss by far is a glitch, one only a single family misses is that family's.
+    ``scored``: :func:`_scored` of ``pos`` (no slope, folds or monotonicity), when the caller has it."""
+    if scored is None:
+        scored = _scored(pos, None, None, False)
     keyed = [scored[i] for i in _robust_order(pos, scored)]
     sm, pred, _e2 = keyed[0]
     other = next((t[1] for t in keyed if t[0].kind != sm.kind), None)
@@ -418,9 +422,11 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
     floor = noise_floor_v(v, step_v)
     rep_sigma, pairs = repeat_noise_v(x, v, direction)
     outliers: dict[int, float] = {}
+    scored = None   # the last round's scores, while its positions are still the readings kept
     for _ in range(MAX_OUTLIER_ROUNDS):
         pos = _positions(x, v, keep)
-        sm, pred, other = robust_pair(pos)
+        scored = _scored(pos, None, None, False)
+        sm, pred, other = robust_pair(pos, scored)
         coef = sm.solve(pos)
         fitted = sm.predict(coef, pos.x)
         indexed = _with_index(pos, x, keep)
@@ -450,6 +456,7 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
         for i in np.flatnonzero(new):
             outliers[int(i)] = float(abs(r[i]))   # volts; in noise units once the noise is known
         keep &= ~new
+        scored = None
         if (~keep).sum() > max_share * x.size:
             break
     outliers = {i: r_v / sigma for i, r_v in outliers.items()}
@@ -458,7 +465,8 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
         worst = max(outliers, key=outliers.get)
         raise OutlierShareError(worst, outliers[worst], int((~keep).sum()), x.size, sigma)
     pos = _with_index(_positions(x, v, keep), x, keep)
-    sm, _pred, score = choose(pos, monotonic=False)
+    # without outliers found in the last round, the final choice scores what that round did
+    sm, _pred, score = choose(pos, monotonic=False, scored=scored)
     coef = sm.solve(pos)
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
 
