@@ -140,6 +140,7 @@ class OddBasis:
         self.centres = self.half * np.arange(1, self.k + 1) / max(self.k, 1)
         self.width = self.half / max(self.k, 1)
         self._share = None
+        self._modes_seen = (None, None)   # the last positions' shape modes (see _known_at)
         if known is not None:
             u = np.linspace(-self.half, self.half, 401)
             self._share = np.linalg.lstsq(self._known_at(u), self._raw(u), rcond=RCOND)[0]
@@ -161,8 +162,13 @@ class OddBasis:
     def _known_at(self, core_mm: np.ndarray, shift_mm: float = 0.0) -> np.ndarray:
         grid, rows = self.known
         u = np.asarray(core_mm, float)
-        at = [u - shift_mm] + [u] * (len(rows) - 1)   # the output row first, then the modes
-        return np.stack([np.interp(a, grid, r) for a, r in zip(at, rows)], 1)
+        # the output row first (moved by the shift), then the modes, which do not move: a
+        # fit's every zero shift asks at the same positions, so the last ones are kept
+        seen, modes = self._modes_seen
+        if seen is None or seen.shape != u.shape or not np.array_equal(seen, u):
+            modes = [np.interp(u, grid, r) for r in rows[1:]]
+            self._modes_seen = (u.copy(), modes)
+        return np.stack([np.interp(u - shift_mm, grid, rows[0])] + modes, 1)
 
     def _raw(self, core_mm: np.ndarray) -> np.ndarray:
         u = np.asarray(core_mm, float)[:, None]
@@ -183,6 +189,12 @@ class OddBasis:
         return (f"{self.k} odd Gaussian terms in core position (width {self.width:.3g} mm)"
                 f"{warp}, complexity chosen by 5-fold cross-validation with the named effects "
                 "in place")
+
+
+def _points_key(idx: np.ndarray, core: np.ndarray) -> tuple:
+    """The cache key of the points ``idx`` at the core positions ``core``: made once per
+    evaluation, which asks for its simulations, shape basis and modes row by row."""
+    return idx.size, hash(idx.tobytes()), hash(core.tobytes())
 
 
 def _shape_coef(ncols: int, B, pinv, y, target, lo, hi) -> np.ndarray:
@@ -360,20 +372,22 @@ class PhysicsFamily:
     _TURNS = {"leadscrew_periodic.phase_rad": EFFECTS["leadscrew_periodic"].bounds()["phase_rad"]}
 
     def _physical(self, theta: np.ndarray, names: list[str]) -> np.ndarray:
-        """Map unconstrained fit parameters to physical ones (non-negative, bounded)."""
+        """Map unconstrained fit parameters to physical ones (non-negative, bounded); a 2-D
+        ``theta`` maps each row (elementwise: the same numbers as row by row)."""
         th = np.array(theta, dtype=float)
         self._plan(names)
         _, _, one, two, bounds, turn = self._plans[tuple(names)]
         if one.size:
-            th[one] = np.abs(th[one])
+            th[..., one] = np.abs(th[..., one])
         if two.size:
-            th[two] = np.clip(th[two], bounds[:, 0], bounds[:, 1])
+            th[..., two] = np.clip(th[..., two], bounds[:, 0], bounds[:, 1])
         for i in turn:
             # a phase the fit wound past the catalogue's range (the simulator refuses it and
             # the whole diagnosis failed) is the same phase within one turn
             lo, hi = self._TURNS[names[i]]
-            if not lo <= th[i] <= hi:
-                th[i] = math.pi - (math.pi - th[i]) % (2 * math.pi)
+            for row in th.reshape(-1, th.shape[-1]):
+                if not lo <= row[i] <= hi:
+                    row[i] = math.pi - (math.pi - row[i]) % (2 * math.pi)
         return th
 
     @staticmethod
@@ -402,19 +416,20 @@ class PhysicsFamily:
         curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
         inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
         core = (d.x[idx] - self.origin0) * self.scale
+        at = _points_key(idx, core)
         # The core positions use the calibrated origin, so the simulator's magnetics cache
         # is hit whenever no position effect is on; a change of origin enters to first
         # order through the slope (it is ~1e-3 mm inside the effect fits).
-        y = self._simulate(gain, inner, idx, core)
+        y = self._simulate(gain, inner, idx, core, at)
         if curvature:
             # the imbalance's even part follows the sum of the secondaries, whose change
             # along the stroke the calibrated simulation knows only roughly: let it bend
             without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
-            y0 = self._simulate(gain, without, idx, core)
+            y0 = self._simulate(gain, without, idx, core, at)
             u = core / self._half_range()
             y = y + curvature * u ** 2 * (y - y0)
         if self.shape is not None:
-            modes = self._modes_at(idx, core)
+            modes = self._modes_at(idx, core, at)
             if origin != self.origin0:
                 y = y - gain * (origin - self.origin0) * self.scale * modes[0]
             if shape is not None:
@@ -430,7 +445,7 @@ class PhysicsFamily:
             # inside a fit (~1e-3 mm) would only move it by a negligible amount, and keeping
             # it fixed lets every evaluation reuse one factorisation of the basis
             shift = eff.get("zero_shift", {}).get("shift_mm", 0.0)
-            B, pinv = self._basis_at(basis, idx, core, shift)
+            B, pinv = self._basis_at(basis, idx, core, shift, at)
             if coef is None:
                 coef = _shape_coef(basis.ncols, B, pinv, y, target, lo, hi)
             y = y + B @ coef
@@ -450,17 +465,18 @@ class PhysicsFamily:
         m = len(thetas)
         d = self.data
         core = (d.x[idx] - self.origin0) * self.scale
-        rows = [self._unpack(self._physical(th, names), names) for th in thetas]
+        at = _points_key(idx, core)
+        rows = [self._unpack(th, names) for th in self._physical(thetas, names)]
         self.nfev += m
         sims, curv, y0 = [], np.zeros(m), {}
         for r, (gain, _origin, _shape, eff) in enumerate(rows):
             curvature = eff.get("secondary_imbalance", {}).pop(SUM_CURVATURE, 0.0)
             inner = {k: v for k, v in eff.items() if EFFECTS[k].stage != "output"}
-            sims.append(self._simulate(gain, inner, idx, core))
+            sims.append(self._simulate(gain, inner, idx, core, at))
             if curvature:
                 curv[r] = curvature
                 without = {k: v for k, v in inner.items() if k != "secondary_imbalance"}
-                y0[r] = self._simulate(gain, without, idx, core)
+                y0[r] = self._simulate(gain, without, idx, core, at)
         y = np.array(sims)
         if y0:
             bent = np.array(sorted(y0))
@@ -469,7 +485,7 @@ class PhysicsFamily:
         gains = [row[0] for row in rows]
         moved = [r for r, row in enumerate(rows) if row[1] != self.origin0]
         if self.shape is not None:
-            modes = self._modes_at(idx, core)
+            modes = self._modes_at(idx, core, at)
             if moved:
                 step = np.array([gains[r] * (rows[r][1] - self.origin0) * self.scale for r in moved])
                 y[moved] = y[moved] - step[:, None] * modes[0]
@@ -487,7 +503,7 @@ class PhysicsFamily:
         if basis is not None:
             for r, e in enumerate(effs):
                 shift = e.get("zero_shift", {}).get("shift_mm", 0.0)
-                B, pinv = self._basis_at(basis, idx, core, shift)
+                B, pinv = self._basis_at(basis, idx, core, shift, at)
                 c = coef
                 yr = y[r]
                 if c is None:
@@ -514,21 +530,24 @@ class PhysicsFamily:
             return [y - target for y in self._points(list(points), names, idx, target=target, basis=basis)]
         return columns
 
-    def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+    def _simulate(self, gain: float, inner: dict, idx: np.ndarray, core: np.ndarray,
+                  at: tuple | None = None) -> np.ndarray:
         """The simulated output with the simulator's own effects ``inner`` at the points
         ``idx``, cached on what it depends on: a finite-difference step of a parameter the
         simulator does not see (origin, shape, offset, the sum's bend, rails; the gain
         without a quadrature null) then costs no simulation.  Without a quadrature null the
         demodulator is ``gain x`` the same rotated e.m.f. (its quadrature term is 0), so the
-        output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``."""
+        output at unit gain times ``gain`` is the same numbers as a simulation at ``gain``.
+        ``at``: the points' key (:func:`_points_key`), when the caller has it."""
         linear = "quadrature_null" not in inner
         if gain not in self._gains_ok:   # checked as a simulation at this gain would be
             self.sensor.replace(demodulator_gain_ratio=gain)
             if len(self._gains_ok) >= 256:
                 self._gains_ok.clear()
             self._gains_ok.add(gain)
-        key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()),
-               idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        if at is None:
+            at = _points_key(idx, core)
+        key = (None if linear else gain, tuple((e, tuple(p.items())) for e, p in inner.items()), at)
         y = self._sim_cache.get(key)
         if y is None:
             d = self.data
@@ -542,12 +561,12 @@ class PhysicsFamily:
             self._sim_cache[key] = y
         return gain * y if linear else y
 
-    def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray, shift: float = 0.0):
+    def _basis_at(self, basis: OddBasis, idx: np.ndarray, core: np.ndarray, shift: float, at: tuple):
         """The shape basis at ``core`` and a function giving its pseudo-inverse, both cached:
         inside a fit the basis moves only with a zero shift, so the finite-difference
         steps of every other parameter reuse one factorisation (a least-squares solve per
         evaluation was most of the diagnosis' time on 2,000 points)."""
-        key = ("disc", basis.k, idx.size, hash(idx.tobytes()), hash(core.tobytes()), shift)
+        key = ("disc", basis.k, at, shift)
         hit = self._shape_cache.get(key)
         if hit is None:
             # bounded in bytes too: an entry (basis and pseudo-inverse) is 2 n K floats, and
@@ -569,10 +588,10 @@ class PhysicsFamily:
             self._shape_cache[key] = hit
         return hit
 
-    def _modes_at(self, idx: np.ndarray, core: np.ndarray) -> np.ndarray:
+    def _modes_at(self, idx: np.ndarray, core: np.ndarray, at: tuple) -> np.ndarray:
         """[slope, shape_1..K] at the points idx (per unit gain), cached per index set and
         positions."""
-        key = ("modes", idx.size, hash(idx.tobytes()), hash(core.tobytes()))
+        key = ("modes", at)
         hit = self._shape_cache.get(key)
         if hit is None:
             slope = np.interp(core, self.shape.grid_mm, self.shape.slope)

@@ -21,6 +21,7 @@ glitch, not data.  ``flann train --terms auto`` leaves such readings out
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -259,7 +260,7 @@ def strictly_monotone(y) -> bool:
 
 
 def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
-           robust: bool = False) -> tuple[Smoother, np.ndarray, float]:
+           robust: bool = False, scored: list | None = None) -> tuple[Smoother, np.ndarray, float]:
     """The simplest candidate (fewest degrees of freedom) whose held-out error is as small
     as the best one's within ``FORWARD_PAIRED_Z`` paired standard errors; only candidates
     monotonic over the stroke (else there is no inverse).  The held-out error is in x units
@@ -267,11 +268,13 @@ def choose(pos: Positions, slope=None, folds=None, monotonic: bool = True,
     slope is low.  The held-out readings carry the noise, the same for every candidate, so
     the candidates are told apart by the paired difference, not by the scores' spread.
     ``robust``: the smallest median held-out error instead (a gross outlier, not yet found,
-    must not decide the fit it is judged against).
+    must not decide the fit it is judged against).  ``scored``: :func:`_scored` of these
+    arguments, when the caller has it.
     Returns the smoother, its held-out predictions and its score."""
-    scored = _scored(pos, slope, folds, monotonic)
+    if scored is None:
+        scored = _scored(pos, slope, folds, monotonic)
     if robust:
-        sm, pred, e2 = min(scored, key=_robust_key(pos))
+        sm, pred, e2 = scored[_robust_order(pos, scored)[0]]
         return sm, pred, float(np.median(e2))
     best = min(scored, key=lambda t: float(np.mean(t[2])))
     pool = []
@@ -306,21 +309,32 @@ def _scored(pos: Positions, slope, folds, monotonic: bool) -> list:
     return scored
 
 
-def _robust_key(pos: Positions):
-    return lambda t: (float(np.median(t[2])), t[0].dof(pos))
+def _robust_order(pos: Positions, scored: list) -> list[int]:
+    """The indices of ``scored`` by median held-out error, then degrees of freedom, then
+    place; a candidate's degrees of freedom (a solve each) only asked where medians tie."""
+    med = [float(np.median(t[2])) for t in scored]
+    order = sorted(range(len(scored)), key=med.__getitem__)
+    out: list[int] = []
+    for _m, tied in itertools.groupby(order, key=med.__getitem__):
+        tied = list(tied)
+        if len(tied) > 1:
+            tied.sort(key=lambda i: (scored[i][0].dof(pos), i))
+        out += tied
+    return out
 
 
-def robust_pair(pos: Positions) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
+def robust_pair(pos: Positions, scored: list | None = None) -> tuple[Smoother, np.ndarray, np.ndarray | None]:
     """:func:`choose` ``robust`` (the smoother and its held-out predictions), and the held-out
     predictions of the best candidate of the other family (polynomial or spline; None when
     there is none), from one scoring.  Near the ends of the stroke a high-degree polynomial's
     held-out prediction swings where a spline's does not (and the reverse can happen): a
-    reading both miss by far is a glitch, one only a single family misses is that family's."""
-    key = _robust_key(pos)
-    keyed = sorted(((key(t), i, t) for i, t in enumerate(_scored(pos, None, None, False))),
-                   key=lambda k: (k[0], k[1]))
-    sm, pred, _e2 = keyed[0][2]
-    other = next((t[1] for _k, _i, t in keyed if t[0].kind != sm.kind), None)
+    reading both miss by far is a glitch, one only a single family misses is that family's.
+    ``scored``: :func:`_scored` of ``pos`` (no slope, folds or monotonicity), when the caller has it."""
+    if scored is None:
+        scored = _scored(pos, None, None, False)
+    keyed = [scored[i] for i in _robust_order(pos, scored)]
+    sm, pred, _e2 = keyed[0]
+    other = next((t[1] for t in keyed if t[0].kind != sm.kind), None)
     return sm, pred, other
 
 
@@ -408,9 +422,11 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
     floor = noise_floor_v(v, step_v)
     rep_sigma, pairs = repeat_noise_v(x, v, direction)
     outliers: dict[int, float] = {}
+    scored = None   # the last round's scores, while its positions are still the readings kept
     for _ in range(MAX_OUTLIER_ROUNDS):
         pos = _positions(x, v, keep)
-        sm, pred, other = robust_pair(pos)
+        scored = _scored(pos, None, None, False)
+        sm, pred, other = robust_pair(pos, scored)
         coef = sm.solve(pos)
         fitted = sm.predict(coef, pos.x)
         indexed = _with_index(pos, x, keep)
@@ -440,6 +456,7 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
         for i in np.flatnonzero(new):
             outliers[int(i)] = float(abs(r[i]))   # volts; in noise units once the noise is known
         keep &= ~new
+        scored = None
         if (~keep).sum() > max_share * x.size:
             break
     outliers = {i: r_v / sigma for i, r_v in outliers.items()}
@@ -448,7 +465,8 @@ def robust_forward(x, v, direction=None, step_v: float = 0.0,
         worst = max(outliers, key=outliers.get)
         raise OutlierShareError(worst, outliers[worst], int((~keep).sum()), x.size, sigma)
     pos = _with_index(_positions(x, v, keep), x, keep)
-    sm, _pred, score = choose(pos, monotonic=False)
+    # without outliers found in the last round, the final choice scores what that round did
+    sm, _pred, score = choose(pos, monotonic=False, scored=scored)
     coef = sm.solve(pos)
     return ForwardFit(sm, coef, pos, sigma, source, sorted(outliers.items()), keep, score)
 

@@ -292,7 +292,24 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
     if hit is not None:
         _INDUCTANCES.move_to_end(key)
         return hit
-    flat, inverse = np.unique(x.ravel(), return_inverse=True)
+    flat = x.ravel()
+    if TABLE_MIN_POINTS > flat.size > 1 and flat.min() < flat.max():
+        # exact at every position as given, without sorting out the distinct ones (a fit's
+        # many small calls): each position's solution is its own, the same numbers either
+        # way; a single distinct position stays one (its flux sums take another path)
+        out = tuple(r.reshape(x.shape) for r in _exact(s, flat, loop))
+    else:
+        out = _distinct(s, flat, loop, x.shape)
+    for arr in out:
+        arr.setflags(write=False)
+    _keep(key, out, x.nbytes + sum(a.nbytes for a in out))
+    return out
+
+
+def _distinct(s: Sensor, flat: np.ndarray, loop: bool, shape) -> tuple[np.ndarray, ...]:
+    """inductances_h on the distinct positions of ``flat``: exact, or interpolated from the
+    table when there are at least TABLE_MIN_POINTS of them."""
+    flat, inverse = np.unique(flat, return_inverse=True)
     if flat.size >= TABLE_MIN_POINTS:
         half = table_half_range_mm(s)
         inside = np.abs(flat) <= half
@@ -307,11 +324,7 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
             res = [r.real.copy() for r in res]
     else:
         res = _exact(s, flat, loop)
-    out = tuple(r[inverse].reshape(x.shape) for r in res)
-    for arr in out:
-        arr.setflags(write=False)
-    _keep(key, out, x.nbytes + sum(a.nbytes for a in out))
-    return out
+    return tuple(r[inverse].reshape(shape) for r in res)
 
 
 # Inductances kept: the most recent results up to this many and this many bytes (positions

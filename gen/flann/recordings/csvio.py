@@ -598,6 +598,8 @@ def parse_recordings(text: str, source: str = "<memory>",
     line_numbers: list[int] = []
     marks = _DecimalMarks()
     sensor_col, ids_seen = extras.sensor, {}
+    if sensor == _LIST and sensor_col is None:   # no sensor column: no IDs to list, no rows to read
+        _sensor_choice(source, header, sensor_col, ids_seen, sensor)
     # one pass, row by row (no list of split rows: ~100 bytes a row less at the peak)
     cut_candidate = not text.endswith(("\n", "\r")) and len(body) > 3
     shortest_last = None   # the shortest last cell of a full row so far (for a cut-off last line)
