@@ -33,7 +33,8 @@ def chain(tmp_path_factory, in_process, data_dir):
     # the expansion set (the structure search is the demodulated path's, tested there)
     rc, _out, err = in_process(["train", wave, "--temperature", "--terms", 11, "-o", d / "model.json"])
     assert rc == 0, err
-    rc, _out, err = in_process(["gen", d / "model.json", "-o", d / "design"])
+    # words fine enough to resolve the drift's change over the held-out temperatures
+    rc, _out, err = in_process(["gen", d / "model.json", "-o", d / "design", "--output-lsb-mm", 0.001])
     assert rc == 0, err
     return d
 
@@ -69,6 +70,22 @@ def test_eval_judges_the_drift_at_held_out_temperatures(chain, in_process, data_
     temps = [r["temperature_c"] for r in res["compensated"]["by_temperature"]]
     assert temps == [10.0, 40.0] and res["linearity_pct_fs"]["hardware"] is not None
     assert np.isfinite(res["excitation_rejection_ppm_fs_per_pct"]["value"])
+    # the design's drift is judged against the float chain's, as a demodulated design's is
+    judged = {c["name"]: c["ok"] for c in res["verdict"]["checks"]}
+    assert judged["hardware_vs_float_drift"] is True
+
+
+def test_a_drifting_temperature_column_keeps_its_dwells(in_process, data_dir, tmp_path):
+    # a slow ramp over the record (0.25 degC a window) is a drift, not a soak's step: every
+    # steady window is kept, one reading a dwell, as without a temperature column
+    rc, _out, err = in_process(["simulate", data_dir / "sensors" / SENSOR, "--waveforms", "-o", tmp_path / "ramp.csv",
+                                "--carrier-hz", 2500, "--sample-rate-hz", 80000, "--adc-bits", 12,
+                                "--adc-range-v", 2, "--from-mm", -25, "--to-mm", 25, "--step-mm", 5,
+                                "--trajectory", "steps:0.004", "--temperature-profile", "ramp:20:45"])
+    assert rc == 0, err
+    rc, _out, err = in_process(["train", tmp_path / "ramp.csv", "--terms", 7, "-o", tmp_path / "m.json"])
+    assert rc == 0, err
+    assert "11 positions, 21 dwells" in err and "(0 left out" in err
 
 
 def man_lsb(chain) -> float:

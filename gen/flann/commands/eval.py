@@ -21,6 +21,7 @@ from ..golden.thermal_metrics import temperature_report
 from ..hardware.accuracy import adc_codes, design_adc, design_spec, hardware_accuracy, plot_errors, temperature_codes
 from ..hardware.datapath import check_design_model
 from ..hardware.design import open_directory
+from ..hardware.conditioner.chain import window_temperatures
 from ..hardware.conditioner.verify import flann_design
 from ..hardware.fixed.twin import FlannTop
 from ..hardware.thermal.twin import FlannThermalTop
@@ -89,11 +90,12 @@ def eval_verdict(res: dict, figures=()):
     hw = res.get("hardware")
     if hw:
         checks.append(hardware_against_float(hw["max_error_mm"], res["compensated"]["max_error_mm"]))
-        drift = res.get("drift_ppm_fs_per_c") or {}
-        if drift.get("hardware") is not None and drift.get("float") is not None:
-            checks.append(hardware_against_float(drift["hardware"], drift["float"], "drift", "ppm FS/degC",
-                                                 "generate with more --input-bits and --temp-bits (flann gen "
-                                                 "warns with the widths that keep it)"))
+    # a two-input design's drift, a chain's as a demodulated design's
+    drift = res.get("drift_ppm_fs_per_c") or {}
+    if drift.get("hardware") is not None and drift.get("float") is not None:
+        checks.append(hardware_against_float(drift["hardware"], drift["float"], "drift", "ppm FS/degC",
+                                             "generate with more --input-bits and --temp-bits (flann gen "
+                                             "warns with the widths that keep it), or a finer --output-lsb-mm"))
     return combine(*checks)
 
 
@@ -116,8 +118,7 @@ def chain_window_mm(flann, settings, conditioned, wave) -> np.ndarray:
     codes = adc_codes(spec, conditioned.ratio, settings.ratio_converter)
     if not getattr(spec, "temp_bits", None):
         return FlannTop(spec).process(codes).out_data * spec.output_lsb_mm
-    m = settings.spec.window
-    temps = temperature_codes(spec, wave.temperature_c[m - 1::m][:codes.size])
+    temps = window_temperatures(temperature_codes(spec, wave.temperature_c), settings.spec.window, codes.size)
     return FlannThermalTop(spec).process(codes, temps).out_data * spec.output_lsb_mm
 
 

@@ -58,7 +58,8 @@ def _readings(args, wave, settings, conditioned, found: str):
     rec = dw.recordings
     positions = len(set(rec.displacement_mm.tolist()))
     info(args, f"{args.recordings}: waveforms{found}: {settings.line()}; {positions} positions, {len(rec)} dwells "
-               f"averaged over {dw.windows} windows ({dw.left_out} left out: moving or saturated)")
+               f"averaged over {dw.windows} windows ({dw.left_out} left out: moving, saturated or across a "
+               "temperature step)")
     return dw
 
 

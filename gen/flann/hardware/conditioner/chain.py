@@ -47,6 +47,12 @@ from .twin import ConditionerChain, FlannCondRatio
 CHAIN_TOP = "flann_chain_top"
 
 
+def window_temperatures(temp_codes, window: int, windows: int) -> np.ndarray:
+    """The temperature code each of ``windows`` windows of ``window`` strobes is computed at:
+    its last strobe's (the chain top's register, loaded by the strobes' count)."""
+    return np.asarray(temp_codes, dtype=np.int64)[window - 1::window][:windows]
+
+
 @dataclass(frozen=True)
 class ChainSpec:
     """The conditioner's spec and the FLANN's behind it (one input, or two with the
@@ -144,8 +150,7 @@ class FlannChainTop:
         if temp_codes is None:
             f = self.flann.process(code)
         else:
-            m = self.spec.conditioner.window
-            temp = np.asarray(temp_codes, dtype=np.int64)[m - 1::m][:code.size]
+            temp = window_temperatures(temp_codes, self.spec.conditioner.window, code.size)
             f = self.flann.process(code, temp)
         sat = (np.asarray(f.out_sat, dtype=bool) | (c.out_sat != 0)).astype(np.int64)
         return ChainTopOut(f.out_data, sat, c.out_ratio, c.out_sat, code, temp)
@@ -166,4 +171,4 @@ def render_chain(spec: ChainSpec, command: str = "flann gen", model_sha256: str 
         count_bits=count_bits, last_count=bits_literal(c.window - 1, count_bits, signed=False))}
 
 
-__all__ = ["CHAIN_TOP", "ChainSpec", "ChainTopOut", "FlannChainTop", "render_chain"]
+__all__ = ["CHAIN_TOP", "ChainSpec", "ChainTopOut", "FlannChainTop", "render_chain", "window_temperatures"]

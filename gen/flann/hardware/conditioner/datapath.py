@@ -20,6 +20,7 @@ the model records, is kept as ``waveform`` for ``flann sim``'s whole-chain run.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from pathlib import Path
 
 from ...errors import FlannError
@@ -34,6 +35,7 @@ from ..manifest import write_design
 from ..options import GenOptions
 from ..thermal import datapath as thermal_datapath
 from ..thermal import render as thermal_render
+from ..thermal.widths import widths_warning
 from .chain import CHAIN_TOP, ChainSpec, render_chain
 from .condition import adc_lsb_v
 from .render import ENTITIES, TOP, cycles_per_sample, render
@@ -102,12 +104,22 @@ def training_waveform(model_path, m) -> str | None:
     return None
 
 
+def flann_datapath(fman: dict) -> Datapath:
+    """The datapath of the FLANN behind a conditioner, by its manifest: the two-input one, or the
+    fixed one."""
+    return thermal_datapath.DATAPATH if fman.get("datapath") == thermal_datapath.DATAPATH.name else \
+        fixed_datapath.DATAPATH
+
+
 def _flann(model, m, opts: GenOptions):
     """(spec, {file: VHDL}, manifest, model sha256) of the FLANN behind the conditioner: the
     fixed datapath for a one-input model, the two-input one (its temperature port) for a model
     trained at several temperatures."""
     if isinstance(m, ThermalModel):
         tspec = thermal_render.derive(m, opts)
+        lost = widths_warning(tspec)
+        if lost:
+            warnings.warn(lost)   # said before the design is written
         sha = model_sha256(model)
         texts = thermal_render.render(tspec, sha)
         return tspec, texts, thermal_render.manifest(tspec, list(texts), sha), sha
@@ -157,8 +169,7 @@ def summary(man: dict) -> list[str]:
                      f"out_ratio({man['spec']['ratio_frac_bits']} downto {chain['dropped_ratio_bits']}) to its "
                      f"in_data; {man['output_bits']}-bit displacement code {man['latency_cycles']} clocks after a "
                      "window's last strobe")
-        lines += (thermal_datapath.summary(flann) if flann.get("datapath") == thermal_datapath.DATAPATH.name
-                  else fixed_datapath.summary(flann))
+        lines += flann_datapath(flann).summary(flann)
         lines.append("  flann sim's whole-chain run: " + (f"the training recording, kept as {man['waveform']}"
                      if man.get("waveform") else "the closed-form LVDT (the training recording was not found "
                      "beside the model under the name and sha256 it records)"))
@@ -173,4 +184,4 @@ DATAPATH = Datapath(
     model_field="", lacks=LACKS, ise=False, summary=summary, other_tops=(CHAIN_TOP,),
 )
 
-__all__ = ["DATAPATH", "write_conditioner", "manifest", "latency_cycles", "training_waveform", "WAVEFORM"]
+__all__ = ["DATAPATH", "flann_datapath", "write_conditioner", "manifest", "latency_cycles", "training_waveform", "WAVEFORM"]

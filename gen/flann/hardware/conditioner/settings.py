@@ -26,7 +26,6 @@ import numpy as np
 
 from ...errors import FlannError, ModelFileError
 from ...recordings import converter_of
-from ...recordings.checks import TEMPERATURE_RESOLUTION_C
 from ...recordings.csvio import Recordings
 from ...recordings.waveform import Waveforms, carrier_hz
 from ..adc import max_input_bits
@@ -35,6 +34,8 @@ from .condition import Conditioned, condition
 from .spec import ConditionerSpec, Reference, derive_conditioner, reference
 
 DEFAULT_OUTPUT_RATE_HZ = 500.0
+# a temperature change (degC) within a window, or between two, that is a soak's step, not a drift
+SOAK_STEP_C = 1.0
 # the carrier found may differ from fs / N by this fraction (the FFT's interpolation, a DAQ's
 # clock against the excitation's): beyond it the record is not a whole number of samples a period
 CARRIER_TOLERANCE = 0.005
@@ -251,10 +252,11 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
     keep = c.steady & (c.sat == 0)
     per = None
     if wave.temperature_c is not None:
-        # a soak's step within a window leaves it out, and starts a new dwell (a slow drift does neither)
+        # a soak's step within a window leaves it out, and starts a new dwell; a slow drift and a
+        # DAQ's noisy column (under SOAK_STEP_C a window) do neither
         temps = wave.temperature_c[: c.ratio.size * window].reshape(-1, window)
         per = temps.mean(axis=1)
-        keep &= np.ptp(temps, axis=1) <= TEMPERATURE_RESOLUTION_C
+        keep &= np.ptp(temps, axis=1) <= SOAK_STEP_C
     if not np.any(keep):
         raise FlannError(f"{wave.source}: no window of whole carrier periods dwells at one position unsaturated: "
                          "training needs dwell at stepped positions (flann simulate --waveforms --trajectory "
@@ -263,7 +265,7 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
     # a new dwell where a kept window does not follow the last, or the position changes
     new = (np.diff(idx) != 1) | (np.diff(c.displacement_mm[idx]) != 0)
     if per is not None:
-        new |= np.abs(np.diff(per[idx])) > TEMPERATURE_RESOLUTION_C
+        new |= np.abs(np.diff(per[idx])) > SOAK_STEP_C
     starts = np.flatnonzero(np.r_[True, new])
     groups = np.split(idx, starts[1:])
     x = np.array([c.displacement_mm[g[0]] for g in groups])

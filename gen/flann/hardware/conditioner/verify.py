@@ -34,9 +34,9 @@ from ...verify.runner import BenchResult, run_cocotb
 from ..accuracy import temperature_codes
 from ..design import Design
 from ..manifest import MANIFEST, Manifest
-from ..registry import FIXED, THERMAL, check_widths
+from ..registry import check_widths
 from .chain import CHAIN_TOP, ChainSpec, FlannChainTop
-from .datapath import FLANN
+from .datapath import FLANN, flann_datapath
 from .condition import adc_codes, calibrate_reference
 from .settings import of_model
 from .render import cycles_per_sample
@@ -183,7 +183,7 @@ def flann_design(design: Design) -> Design | None:
     where = design.directory / MANIFEST
     if not isinstance(fman, dict):
         raise FlannError(f"{where}: field {FLANN!r} must be an object (the FLANN design's manifest)")
-    dp = THERMAL if fman.get("datapath") == THERMAL.name else FIXED
+    dp = flann_datapath(fman)
     dp.check(fman, f"{where}: field {FLANN!r}")
     check_widths(fman, f"{where}: field {FLANN!r}")
     if not set(fman["files"]) <= set(design.manifest["files"]) or fman.get("model") != design.manifest.get("model"):
