@@ -52,7 +52,7 @@ import numpy as np
 from ..fileio import atomic_save_figure
 from ..golden.verdict import Check
 from ..hardware.conditioner.condition import adc_codes, adc_lsb_v, calibrate_reference, converted, window_sum_v
-from ..hardware.conditioner.settings import ConditionerSettings, DwellReadings
+from ..hardware.conditioner.settings import ConditionerSettings, DwellReadings, temperature_rows
 from ..hardware.conditioner.spec import (QUADRATURE_BUDGET, QUADRATURE_FRACTION, Reference, identity, reference,
                                          reference_phase)
 from ..hardware.conditioner.twin import ConditionerChain
@@ -114,8 +114,8 @@ class Figure:
 
 def window_temperature_c(wave: Waveforms, window: int) -> np.ndarray | None:
     """Each whole window's mean temperature (None for a recording without one)."""
-    t = wave.temperature_c
-    return None if t is None else t[: len(t) // window * window].reshape(-1, window).mean(axis=1)
+    rows = temperature_rows(wave, window)
+    return None if rows is None else rows.mean(axis=1)
 
 
 @dataclass(frozen=True)

@@ -247,12 +247,11 @@ def run(args) -> int:
                                                         / res["full_scale_mm"])
             # a dwell whose codes do not toggle is exact to within half of it: the figure's resolution
             res["linearity_pct_fs"]["hardware_lsb_pct_fs"] = 100 * chain.spec.output_lsb_mm / res["full_scale_mm"]
-        # a two-input model at each dwell's or window's temperature, else the recording's (median)
+        # a two-input model at each dwell's or window's temperature, else the recording's (median);
+        # a one-input model takes none
         median = None if rec.temperature_c is None else float(np.median(rec.temperature_c))
 
         def to_mm(ratio, temperature_c=None):
-            if len(model.inputs) < 2:
-                return predict_clamped(model, ratio)[0]
             return predict_clamped(model, ratio, median if temperature_c is None else temperature_c)[0]
 
         figures = chain_figures(settings, wave, dwells, to_mm, res["full_scale_mm"])

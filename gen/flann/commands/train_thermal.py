@@ -54,8 +54,7 @@ def train_verdict(model, rec, heldout_max_mm: float | None):
     line = float(np.max(np.abs(raw_output_mm(rec.voltage_v, rec.displacement_mm) - rec.displacement_mm)))
     if heldout_max_mm is not None:
         return combine(against_line(heldout_max_mm, line, "held-out max error"))
-    inputs = (rec.voltage_v,) if len(model.inputs) == 1 else (rec.voltage_v, rec.temperature_c)
-    own = float(np.max(np.abs(model.predict(*inputs) - rec.displacement_mm)))
+    own = float(np.max(np.abs(model.predict_at(rec.voltage_v, rec.temperature_c) - rec.displacement_mm)))
     return combine(against_line(own, line, "max error"))
 
 

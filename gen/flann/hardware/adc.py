@@ -34,6 +34,15 @@ def max_input_bits(model) -> int:
     if getattr(model, "conditioner", None) is None or len(model.inputs) > 1:
         return MAX_DESIGN_INPUT_BITS
     return CHAIN_INPUT_BITS
+
+
+def top_bits(model, bits: int, lsb: float) -> tuple[int, float, int]:
+    """(bits, value per code, low bits dropped) of a ``bits``-bit converter of ``lsb`` as a
+    design of ``model`` takes it: its top bits, at most :func:`max_input_bits`."""
+    dropped = max(0, bits - max_input_bits(model))
+    return bits - dropped, lsb * (1 << dropped), dropped
+
+
 MIN_TRAINED_CODES = 16       # fewer codes over the trained range cannot carry a calibration
 MIN_OUTPUT_CODES = 16        # the same floor on the output: codes over the trained stroke
 SMALL_FRACTION = 1 / 16      # the trained range uses less than this of the ADC: said (4 bits lost)
@@ -95,8 +104,7 @@ def plan_adc(model: FlannModel, input_bits, input_lsb_v=None, clamp: bool = True
             f"the trained range {vlo:.6g}..{vhi:.6g} V uses {100 * used:.2g} % of the ADC's "
             f"{lo_v:.6g}..{hi_v:.6g} V ({opts}): about {math.log2(1 / used):.1f} of its bits "
             "carry no signal; check the voltage unit or the conditioner's gain")
-    dropped = max(0, bits - max_input_bits(model))
-    eff_bits, eff_lsb = bits - dropped, lsb * (1 << dropped)
+    eff_bits, eff_lsb, dropped = top_bits(model, bits, lsb)
     if dropped and getattr(model, "conditioner", None) is not None:
         # the chain top wires the ratio's top bits itself: nothing for the user to wire
         notes.append(
@@ -247,4 +255,4 @@ def pathological_hint(model: FlannModel, output_lsb_mm: float) -> str:
 __all__ = ["ADC_BITS", "AdcPlan", "plan_adc", "check_converter", "check_output_step", "default_input_lsb",
            "default_lsb_for_range", "default_output_step_mm",
            "max_mm_per_v", "model_accuracy_mm", "wired_codes", "pathological_hint", "weight_range_text",
-           "CHAIN_INPUT_BITS", "WINDOW_NOISE", "MAX_DESIGN_INPUT_BITS", "max_input_bits", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]
+           "CHAIN_INPUT_BITS", "WINDOW_NOISE", "MAX_DESIGN_INPUT_BITS", "max_input_bits", "top_bits", "MIN_OUTPUT_CODES", "MIN_TRAINED_CODES"]

@@ -71,8 +71,9 @@ class ChainSpec:
             raise SpecError(f"a ratio every {self.ratio_clocks} clocks ({c.window} strobes of {cycles_per_sample(c)}), "
                             f"but the FLANN takes {f.cycles_per_sample} clocks a sample: lower the output rate "
                             "(flann train --output-rate-hz) or train fewer terms")
-        if self.temp_bits and ConditionerChain(c).latency >= self.ratio_clocks:
-            raise SpecError(f"a window's ratio comes {ConditionerChain(c).latency} clocks after its last strobe, "
+        ratio_latency = ConditionerChain(c).latency
+        if self.temp_bits and ratio_latency >= self.ratio_clocks:
+            raise SpecError(f"a window's ratio comes {ratio_latency} clocks after its last strobe, "
                             f"not within the next window's {self.ratio_clocks}: its temperature would not be held "
                             "for it; lower the output rate (flann train --output-rate-hz)")
 

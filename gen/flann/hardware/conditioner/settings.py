@@ -28,7 +28,7 @@ from ...errors import FlannError, ModelFileError
 from ...recordings import converter_of
 from ...recordings.csvio import Recordings
 from ...recordings.waveform import Waveforms, carrier_hz
-from ..adc import max_input_bits
+from ..adc import top_bits
 from ..options import GenOptions
 from .condition import Conditioned, condition
 from .spec import ConditionerSpec, Reference, derive_conditioner, reference
@@ -177,8 +177,7 @@ def flann_options(model, options: GenOptions, given=(), source: str = "model.jso
     bits, lsb = settings.ratio_converter
     if len(model.inputs) > 1:
         # a two-input design takes the ratio's top bits here, as a one-input one's converter plan does
-        drop = max(0, bits - max_input_bits(model))
-        bits, lsb = bits - drop, lsb * 2 ** drop
+        bits, lsb, _dropped = top_bits(model, bits, lsb)
     return replace(options, input_bits=bits, input_lsb_v=lsb)
 
 
@@ -246,15 +245,23 @@ class DwellReadings:
     groups: tuple = ()  # the windows of each dwell (index arrays), in the readings' order
 
 
+def temperature_rows(wave: Waveforms, window: int) -> np.ndarray | None:
+    """The temperature of each whole window of ``window`` samples, a row each (None for a
+    recording without one)."""
+    t = wave.temperature_c
+    return None if t is None else t[: len(t) // window * window].reshape(-1, window)
+
+
 def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "") -> DwellReadings:
     """The conditioned windows averaged per dwell (a run of steady windows at one position,
     unsaturated), as the DC path's readings: displacement_mm and voltage_v (the ratio)."""
     keep = c.steady & (c.sat == 0)
     per = None
-    if wave.temperature_c is not None:
+    temps = temperature_rows(wave, window)
+    if temps is not None:
         # a soak's step within a window leaves it out, and starts a new dwell; a slow drift and a
         # DAQ's noisy column (under SOAK_STEP_C a window) do neither
-        temps = wave.temperature_c[: c.ratio.size * window].reshape(-1, window)
+        temps = temps[: c.ratio.size]
         per = temps.mean(axis=1)
         keep &= np.ptp(temps, axis=1) <= SOAK_STEP_C
     if not np.any(keep):
@@ -277,4 +284,4 @@ def dwell_readings(c: Conditioned, wave: Waveforms, window: int, sha256: str = "
 
 
 __all__ = ["ConditionerSettings", "DwellReadings", "DEFAULT_OUTPUT_RATE_HZ", "calibrate", "condition_with", "dwell_readings",
-           "excitation_phase", "flann_options", "of_model"]
+           "excitation_phase", "flann_options", "of_model", "temperature_rows"]

@@ -93,9 +93,9 @@ def run_chain(files, spec: ConditionerSpec, build_dir, *, seed: int = 1) -> tupl
     return res, int(a.size)
 
 
-def kept_waveform(design: Design, spec: ConditionerSpec, flann_spec=None):
+def kept_waveform(design: Design, chain: ChainSpec):
     """(codes A, codes B, reference, what they are, temperature codes or None) of the training
-    recording the directory keeps (its temperature column as a two-input ``flann_spec`` receives it):
+    recording the directory keeps (its temperature column as the chain's two-input FLANN receives it):
     whole windows at a stride (each starts on a whole carrier period, so the NCO's phase runs on
     across the windows left out), at the model's reference turned by the record's excitation;
     None when it keeps none."""
@@ -111,17 +111,18 @@ def kept_waveform(design: Design, spec: ConditionerSpec, flann_spec=None):
                          "(missing or edited): regenerate the design with flann gen")
     wave = read_waveforms(path, announce=False)
     ref = settings.reference_for(wave)
+    spec = chain.conditioner
     windows = len(wave) // spec.window
     stride = -(-windows // max(1, CHAIN_SAMPLES // spec.window))   # at most CHAIN_SAMPLES, one window at least
     idx = (np.arange(windows)[::stride, None] * spec.window + np.arange(spec.window)).ravel()
     a = adc_codes(wave.sec_a_v, spec.adc_bits, settings.adc_range_v)[idx]
     b = adc_codes(wave.sec_b_v, spec.adc_bits, settings.adc_range_v)[idx]
     temps = None
-    if getattr(flann_spec, "temp_bits", None):
+    if chain.temp_bits:
         if wave.temperature_c is None:
             raise FlannError(f"{path}: no temperature_c column, but the FLANN behind the conditioner takes the "
                              "temperature: regenerate the design with flann gen")
-        temps = temperature_codes(flann_spec, wave.temperature_c[idx])
+        temps = temperature_codes(chain.flann, wave.temperature_c[idx])
     return a, b, ref, f"{name} (the training recording), one window in {stride}", temps
 
 
@@ -134,16 +135,17 @@ def swept_temperatures(flann_spec, n: int) -> np.ndarray:
     return np.clip(ramp, flann_spec.temp_code_min, flann_spec.temp_code_max)
 
 
-def chain_stimulus(design: Design, spec: ConditionerSpec, flann_spec=None):
+def chain_stimulus(design: Design, chain: ChainSpec):
     """(codes A, codes B, reference, what they are, temperature codes or None) of the
     whole-chain run: the kept training recording, else the closed-form LVDT calibrated as the
     hardware is (a two-input FLANN's temperature swept over its codes)."""
-    kept = kept_waveform(design, spec, flann_spec)
+    kept = kept_waveform(design, chain)
     if kept is not None:
         return kept
+    spec = chain.conditioner
     a, b, x = lvdt_codes(spec)
     ref, _phase = calibrate_reference(spec, ConditionerChain(spec).process(a, b, identity(spec)), x)
-    temps = swept_temperatures(flann_spec, a.size) if getattr(flann_spec, "temp_bits", None) else None
+    temps = swept_temperatures(chain.flann, a.size) if chain.temp_bits else None
     return a, b, ref, "the closed-form LVDT", temps
 
 
@@ -168,7 +170,7 @@ def run_whole_chain(design: Design, flann: Design, build_dir, *, seed: int = 1) 
     """A waveform through ``flann_chain_top`` against :class:`FlannChainTop`; (bench result, what
     was run)."""
     chain = ChainSpec(design.spec, flann.spec, flann.manifest["top"])
-    a, b, ref, source, temps = chain_stimulus(design, design.spec, flann.spec)
+    a, b, ref, source, temps = chain_stimulus(design, chain)
     res = run_chain_top(design.files, chain, a, b, ref, build_dir, seed=seed, temp_codes=temps)
     return res, {"samples": int(a.size), "source": source}
 
