@@ -1,4 +1,5 @@
-"""The diagnosis' fitting engine: its cached simulations are the simulator's own numbers, and a
+"""The diagnosis' fitting engine: its cached simulations are the simulator's own numbers (at its
+fixed geometry, through the magnetics table), and a
 lead-screw phase the fit winds past the catalogue's range is the same phase, not a failure."""
 
 import math
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 
 from flann.diagnose.model import Data, PhysicsFamily
+from flann.physics.lvdt import tabulated
 from flann.physics.sensor import default_sensor
 from flann.physics.simulate import simulate_output_v
 
@@ -32,8 +34,9 @@ def test_a_cached_simulation_is_the_simulators_own_at_every_gain(kind, inner):
     idx = np.arange(fam.data.x.size)
     core = fam.data.x[idx].copy()
     for gain in (2.0, -3.5, 2.0, 7.25):    # a repeated gain is answered from the cache
-        want = simulate_output_v(sensor.replace(demodulator_gain_ratio=gain, effects=inner), core,
-                                 direction=fam.data.direction)
+        with tabulated():
+            want = simulate_output_v(sensor.replace(demodulator_gain_ratio=gain, effects=inner), core,
+                                     direction=fam.data.direction)
         got = fam._simulate(gain, inner, idx, core)
         assert np.array_equal(got, want), (kind, gain, float(np.max(np.abs(got - want))))
 

@@ -225,3 +225,21 @@ def test_table_interpolation_matches_exact_solution():
     # beyond the table the exact solution is used
     far = np.concatenate([x, [500.0]])
     assert lvdt.ideal_output_v(s, far)[-1] == pytest.approx(lvdt.ideal_output_v(s, [500.0])[0], abs=1e-15)
+
+
+def test_tabulated_takes_the_table_at_any_number_of_positions():
+    # a fit's few positions asked inside tabulated(): the table's numbers, which a call with
+    # many positions interpolates too (the same function at every call), near the exact ones
+    s = default_sensor().replace(primary_length_mm=11.0)
+    x = np.random.default_rng(2).uniform(-70, 70, 3 * lvdt.TABLE_MIN_POINTS)
+    many = lvdt.ideal_output_v(s, x)
+    few = np.concatenate([lvdt.ideal_output_v(s, chunk) for chunk in np.array_split(x, 40)])
+    with lvdt.tabulated():
+        tab = np.concatenate([lvdt.ideal_output_v(s, chunk) for chunk in np.array_split(x, 40)])
+        one = lvdt.ideal_output_v(s, x[:1])
+        far = lvdt.ideal_output_v(s, np.array([x[0], 500.0]))
+    assert np.array_equal(tab, many) and one[0] == many[0]
+    assert not np.array_equal(tab, few) and np.abs(tab - few).max() < 1e-6 * np.abs(few).max()
+    # beyond the table, exact; and the context ends with its block
+    assert far[1] == pytest.approx(lvdt.ideal_output_v(s, [500.0])[0], abs=1e-15)
+    assert np.array_equal(np.concatenate([lvdt.ideal_output_v(s, c) for c in np.array_split(x, 40)]), few)

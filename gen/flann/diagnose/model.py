@@ -31,8 +31,18 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..physics.effects import EFFECTS
+from ..physics.lvdt import tabulated
 from ..physics.simulate import simulate_output_v
 from .select import Fit, make_folds
+
+
+def simulate_at_fixed_geometry(*args, **kwargs) -> np.ndarray:
+    """The simulator at a calibrated geometry, which a diagnosis evaluates thousands of
+    times: through the geometry's magnetics table (:func:`flann.physics.lvdt.tabulated`),
+    the same function at every call whatever its number of positions."""
+    with tabulated():
+        return simulate_output_v(*args, **kwargs)
+
 
 # candidate numbers of smooth shape terms (chosen by cross-validation).  The grid goes
 # on while it pays: a sensor whose geometry is a few % off the simulated one (a production
@@ -554,7 +564,7 @@ class PhysicsFamily:
             if len(self._sim_cache) >= SIM_CACHE:
                 self._sim_cache.clear()
             s = self.sensor.replace(demodulator_gain_ratio=1.0 if linear else gain, effects=inner)
-            y = simulate_output_v(
+            y = simulate_at_fixed_geometry(
                 s, core, direction=None if d.direction is None else d.direction[idx],
                 temperature_c=None if d.temperature_c is None else d.temperature_c[idx],
                 time_s=None if d.time_s is None else d.time_s[idx])
@@ -605,7 +615,7 @@ class PhysicsFamily:
         if hit is None:
             h = 0.01
             s1 = self.sensor.replace(demodulator_gain_ratio=1.0)
-            hit = (simulate_output_v(s1, core + h) - simulate_output_v(s1, core - h)) / (2 * h)
+            hit = (simulate_at_fixed_geometry(s1, core + h) - simulate_at_fixed_geometry(s1, core - h)) / (2 * h)
             self._shape_cache[key] = hit
         return hit
 
@@ -656,7 +666,7 @@ class PhysicsFamily:
         x = (d.x[idx] - origin) * self.scale
         h = 0.01
         s0 = self.sensor.replace(demodulator_gain_ratio=gain)
-        slope = (simulate_output_v(s0, x + h) - simulate_output_v(s0, x - h)) / (2 * h)
+        slope = (simulate_at_fixed_geometry(s0, x + h) - simulate_at_fixed_geometry(s0, x - h)) / (2 * h)
         g = {}
         g["null_offset.offset_v"] = float(np.mean(resid))
         g["quadrature_null.quadrature_v"] = max(float(np.min(np.abs(d.y[idx]))), 1e-4 * self.v_range)
@@ -775,10 +785,10 @@ class PhysicsFamily:
         grid = np.linspace(-1.5 * half_range_mm, 1.5 * half_range_mm, 601)
         s1 = self.sensor.replace(demodulator_gain_ratio=1.0)
         h = 1e-3 * max(half_range_mm, 1e-6)
-        slope = (simulate_output_v(s1, grid + h) - simulate_output_v(s1, grid - h)) / (2 * h)
+        slope = (simulate_at_fixed_geometry(s1, grid + h) - simulate_at_fixed_geometry(s1, grid - h)) / (2 * h)
         top = float(np.max(np.abs(slope)))
         warp = (grid, slope / top) if top > 0 and np.all(np.isfinite(slope)) else None
-        rows = [simulate_output_v(s1, grid)]
+        rows = [simulate_at_fixed_geometry(s1, grid)]
         if self.shape is not None:
             rows += list(self.shape.evaluate(grid))
         known = (grid, np.stack(rows)) if np.all(np.isfinite(rows)) else None
@@ -859,14 +869,8 @@ class PhysicsFamily:
                 f = start      # the chain found a worse minimum than the fit it came from
             if not f.ok:
                 continue
-            X = self._jacobian(f, idx)
-            err = 0.0
-            for test in folds:
-                train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
-                c = np.linalg.lstsq(X[train], f.resid[train], rcond=1e-10)[0]
-                e = f.resid[test] - X[test] @ c
-                err += float(e @ e)
-            table[k] = math.sqrt(err / idx.size)
+            e = self.fold_residuals(f, idx, folds)
+            table[k] = math.sqrt(sum(float(e[test] @ e[test]) for test in folds) / idx.size)
             stale = stale + 1 if len(table) > 1 and table[k] > 0.99 * min(
                 v for j, v in table.items() if j != k) else 0
             fits[k] = f
@@ -875,6 +879,24 @@ class PhysicsFamily:
         best = min(table.values())
         tied = sorted(k for k, v in table.items() if v <= best * 1.01)
         return tied[0], table, fits[tied[0]], tuple(tied)
+
+    def fold_residuals(self, fit: Fit, idx: np.ndarray, folds: list[np.ndarray]) -> np.ndarray:
+        """Out-of-fold residuals of ``fit``'s model (``folds``: positions in ``idx``): each
+        fold predicted by the model refitted on the other points, linearised about ``fit``
+        (every parameter and shape coefficient re-adjusts through its Jacobian column), so
+        a fold costs one small least squares instead of a nonlinear refit.  Kept on the fit."""
+        key = ("fold_residuals", idx.tobytes(), tuple(t.tobytes() for t in folds))
+        hit = fit.extra.get(key[0])
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        X = self._jacobian(fit, idx)
+        out = np.empty(idx.size)
+        for test in folds:
+            train = np.setdiff1d(np.arange(idx.size), test, assume_unique=True)
+            c = np.linalg.lstsq(X[train], fit.resid[train], rcond=1e-10)[0]
+            out[test] = fit.resid[test] - X[test] @ c
+        fit.extra[key[0]] = (key, out)
+        return out
 
     def implausible(self, candidate: str, fit: Fit, idx: np.ndarray) -> str:
         """Why ``fit`` does not show the physics ``candidate`` names ("" when it may).

@@ -13,6 +13,7 @@ earns its keep by both criteria:
 * **Cross-validation**: the same model with and without the effect is refitted on each
   of ``FOLDS`` training folds (fixed seed) and predicts the left-out fold; the paired
   out-of-fold squared errors must improve with a one-sided t statistic above ``CV_T``.
+  A family may refit a fold linearised about the fit on every point (``fold_residuals``).
 
 * **Equally good complexities**: a family with its own complexity (the shape term's number
   of terms) may have several that cross-validate equally well; the effect must lower BIC by
@@ -108,6 +109,11 @@ class Family(Protocol):
         """The weakest ΔBIC for ``candidate`` over the family's equally good complexities."""
         ...
 
+    def fold_residuals(self, fit: Fit, idx: np.ndarray, folds: list[np.ndarray]) -> np.ndarray:
+        """(Optional) out-of-fold residuals of ``fit``'s model, each fold refitted linearised
+        about ``fit`` (``folds``: positions in ``idx``)."""
+        ...
+
     def implausible(self, candidate: str, fit: Fit, idx: np.ndarray) -> str:
         """(Optional) why ``fit`` does not show what ``candidate`` names ("" if it may)."""
         ...
@@ -157,8 +163,13 @@ def make_folds(idx: np.ndarray, k: int = FOLDS, seed: int = CV_SEED) -> list[np.
 
 def oof_errors(family: Family, effects: Sequence[str], idx: np.ndarray,
                folds: list[np.ndarray], start: Fit) -> np.ndarray:
-    """Out-of-fold residuals (data - prediction) of a model, in the order of ``idx``."""
+    """Out-of-fold residuals (data - prediction) of a model, in the order of ``idx``:
+    ``start`` (the model fitted on every point) refitted without each fold, by the
+    family's own linearised refit where it has one (``fold_residuals``)."""
     pos = {int(i): k for k, i in enumerate(idx)}
+    linear = getattr(family, "fold_residuals", None)
+    if linear is not None and tuple(start.effects) == tuple(effects) and np.array_equal(start.idx, idx):
+        return linear(start, idx, [np.array([pos[int(i)] for i in test]) for test in folds])
     out = np.empty(idx.size)
     for test in folds:
         train = np.setdiff1d(idx, test, assume_unique=True)

@@ -48,6 +48,8 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
@@ -221,6 +223,21 @@ _TABLES: "OrderedDict[tuple, tuple]" = OrderedDict()
 # one consistent, C1-smooth function for its finite-difference Jacobians.
 TABLE_MIN_POINTS = 400
 TABLE_POINTS = 1601
+# A caller that evaluates one geometry thousands of times (the diagnosis' fits, after its
+# geometry is calibrated) takes the table at any number of positions: one table costs about
+# as much as a dozen small exact solves, and the table is the same function at every call.
+_TABULATED: ContextVar[bool] = ContextVar("tabulated", default=False)
+
+
+@contextmanager
+def tabulated():
+    """Inside, every call interpolates the per-geometry table, whatever its number of
+    positions (see TABLE_MIN_POINTS)."""
+    token = _TABULATED.set(True)
+    try:
+        yield
+    finally:
+        _TABULATED.reset(token)
 
 
 def _exact(s: Sensor, pos_mm: np.ndarray, loop: bool) -> list[np.ndarray]:
@@ -287,13 +304,16 @@ def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.n
     (see above).  Results are cached on geometry and positions, so a fit that varies only
     electrical parameters pays once."""
     x = np.asarray(core_position_mm, dtype=float)
-    key = (s.magnetics_key(), loop, x.shape, x.tobytes())
+    table = _TABULATED.get()
+    key = (s.magnetics_key(), loop, table, x.shape, x.tobytes())
     hit = _INDUCTANCES.get(key)
     if hit is not None:
         _INDUCTANCES.move_to_end(key)
         return hit
     flat = x.ravel()
-    if TABLE_MIN_POINTS > flat.size > 1 and flat.min() < flat.max():
+    if table and flat.size:
+        out = tuple(r.reshape(x.shape) for r in _tabulate(s, flat, loop))
+    elif TABLE_MIN_POINTS > flat.size > 1 and flat.min() < flat.max():
         # exact at every position as given, without sorting out the distinct ones (a fit's
         # many small calls): each position's solution is its own, the same numbers either
         # way; a single distinct position stays one (its flux sums take another path)
@@ -310,21 +330,24 @@ def _distinct(s: Sensor, flat: np.ndarray, loop: bool, shape) -> tuple[np.ndarra
     """inductances_h on the distinct positions of ``flat``: exact, or interpolated from the
     table when there are at least TABLE_MIN_POINTS of them."""
     flat, inverse = np.unique(flat, return_inverse=True)
-    if flat.size >= TABLE_MIN_POINTS:
-        half = table_half_range_mm(s)
-        inside = np.abs(flat) <= half
-        res = [np.empty(flat.size, dtype=complex) for _ in range(4 if loop else 3)]
-        interp = _interpolate(_table(s, loop), flat[inside])
-        exact = _exact(s, flat[~inside], loop) if (~inside).any() else None
-        for k in range(len(res)):
-            res[k][inside] = interp[k]
-            if exact is not None:
-                res[k][~inside] = exact[k]
-        if not any(np.iscomplexobj(v) for v in interp):
-            res = [r.real.copy() for r in res]
-    else:
-        res = _exact(s, flat, loop)
+    res = _tabulate(s, flat, loop) if flat.size >= TABLE_MIN_POINTS else _exact(s, flat, loop)
     return tuple(r[inverse].reshape(shape) for r in res)
+
+
+def _tabulate(s: Sensor, flat: np.ndarray, loop: bool) -> list[np.ndarray]:
+    """The table's interpolation at the positions it spans, exact beyond them."""
+    inside = np.abs(flat) <= table_half_range_mm(s)
+    interp = _interpolate(_table(s, loop), flat[inside] if not inside.all() else flat)
+    if inside.all():
+        return interp
+    res = [np.empty(flat.size, dtype=complex) for _ in range(4 if loop else 3)]
+    exact = _exact(s, flat[~inside], loop)
+    for k in range(len(res)):
+        res[k][inside] = interp[k]
+        res[k][~inside] = exact[k]
+    if not any(np.iscomplexobj(v) for v in interp):
+        res = [r.real.copy() for r in res]
+    return res
 
 
 # Inductances kept: the most recent results up to this many and this many bytes (positions
