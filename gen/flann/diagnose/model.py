@@ -62,9 +62,17 @@ RAIL_T = 3.0
 # simulated outputs a family keeps (a fit's Jacobian asks for a handful at a time)
 SIM_CACHE = 64
 # Levenberg-Marquardt stops when the relative change of the sum of squares (and of the
-# step) is below this: 1e-5 of the RSS moves BIC (n ln RSS) by 0.02 on 2,000 points, far
-# inside the 10 it must move by; tighter only wandered on (up to 4x the evaluations)
-TOL = 1e-5
+# step) would move BIC (n ln RSS) by less than this: far inside the 10 an effect must move
+# it by and the 2 of a tie; tighter only wandered on (up to 4x the evaluations).  On 2,000
+# points that is 1e-5 of the RSS, on a production line's 250 bin means 8e-5.
+TOL_BIC = 0.02
+TOL_MIN, TOL_MAX = 1e-8, 1e-4
+
+
+def fit_tolerance(points: int) -> float:
+    """The relative change of the sum of squares (and of the step) at which a fit on
+    ``points`` points stops: TOL_BIC of BIC."""
+    return float(np.clip(TOL_BIC / max(points, 1), TOL_MIN, TOL_MAX))
 
 # secondary_imbalance's extra, diagnosis-only parameter (not in the catalogue): how much
 # the sum of the secondaries bends along the stroke beyond the calibrated simulation's,
@@ -1042,10 +1050,11 @@ class PhysicsFamily:
                 t[ie], t[ic] = e, 0.0
                 starts.append(t)
         res = None
+        tol = fit_tolerance(idx.size)
         for t0 in starts:
             try:
                 r = least_squares(fun, t0, method="lm", x_scale="jac",
-                                  max_nfev=40 * (len(names) + 1), xtol=TOL, ftol=TOL,
+                                  max_nfev=40 * (len(names) + 1), xtol=tol, ftol=tol,
                                   workers=self._evaluator(names, idx, y, basis))
             except (ValueError, FloatingPointError, np.linalg.LinAlgError):
                 continue
