@@ -1002,16 +1002,17 @@ class PhysicsFamily:
         """``fit`` with the shape term's complexity chosen again now that ``effects`` are
         in the model (see :meth:`choose_terms`); the fit carries its number of terms, the
         cross-validation table and the equally good numbers of terms."""
-        _, table, f, tied = self.choose_terms(effects, idx, fit)
-        f.extra["cv_table"] = table
-        if tied:
-            f.extra["equivalent_terms"] = tied
-        return f
+        if fit.extra.get("chosen_for") == tuple(effects):
+            return fit      # re-chosen for these very effects when it was a candidate
+        return self.rechoose(effects, idx, fit)
 
     def rechoose(self, effects, idx: np.ndarray, fit: Fit) -> Fit:
         """``fit`` with the number of shape terms chosen for ``effects``."""
-        _, table, f, _ = self.choose_terms(effects, idx, fit)
+        _, table, f, tied = self.choose_terms(effects, idx, fit)
         f.extra["cv_table"] = table
+        f.extra["chosen_for"] = tuple(effects)
+        if tied:
+            f.extra["equivalent_terms"] = tied
         return f
 
     def _fit(self, effects, idx, start, clip_sides, k_shape) -> Fit:

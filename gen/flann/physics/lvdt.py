@@ -262,6 +262,8 @@ def table_half_range_mm(s: Sensor) -> float:
 
 
 def _table(s: Sensor, loop: bool):
+    """The geometry's table: its first position, its step, and per value and interval the
+    cubic Hermite polynomial's coefficients (values, 4, intervals)."""
     key = (s.magnetics_key(), loop)
     hit = _TABLES.get(key)
     if hit is not None:
@@ -269,13 +271,13 @@ def _table(s: Sensor, loop: bool):
         return hit
     half = table_half_range_mm(s)
     pos = np.linspace(-half, half, TABLE_POINTS)
-    values = _exact(s, pos, loop)
-    slopes = []
-    for y in values:
-        d = np.gradient(y)
-        d[2:-2] = (-y[4:] + 8 * y[3:-1] - 8 * y[1:-3] + y[:-4]) / 12
-        slopes.append(d)
-    hit = (pos, values, slopes)
+    y = np.stack(_exact(s, pos, loop))                     # (values, positions)
+    d = np.gradient(y, axis=1)
+    d[:, 2:-2] = (-y[:, 4:] + 8 * y[:, 3:-1] - 8 * y[:, 1:-3] + y[:, :-4]) / 12
+    y0, y1, d0, d1 = y[:, :-1], y[:, 1:], d[:, :-1], d[:, 1:]
+    # y(t) = y0 + d0 t + (3 (y1 - y0) - 2 d0 - d1) t^2 + (2 (y0 - y1) + d0 + d1) t^3
+    coef = np.stack([y0, d0, 3 * (y1 - y0) - 2 * d0 - d1, 2 * (y0 - y1) + d0 + d1], 1)
+    hit = (float(pos[0]), float(pos[1] - pos[0]), coef)
     _TABLES[key] = hit
     if len(_TABLES) > _CACHE_SIZE:
         _TABLES.popitem(last=False)
@@ -283,18 +285,12 @@ def _table(s: Sensor, loop: bool):
 
 
 def _interpolate(table, xq: np.ndarray) -> list[np.ndarray]:
-    pos, values, slopes = table
-    t = (xq - pos[0]) / (pos[1] - pos[0])
-    i = np.minimum(np.floor(t).astype(np.intp), pos.size - 2)
-    t -= i
-    t2 = t * t
-    t3 = t2 * t
-    h00 = 2 * t3 - 3 * t2 + 1
-    h10 = t3 - 2 * t2 + t
-    h01 = 3 * t2 - 2 * t3
-    h11 = t3 - t2
-    return [h00 * y[i] + h10 * d[i] + h01 * y[i + 1] + h11 * d[i + 1]
-            for y, d in zip(values, slopes)]
+    start, step, coef = table
+    t = (xq - start) / step
+    i = np.minimum(np.floor(t).astype(np.intp), coef.shape[2] - 1)
+    t = t - i
+    c = coef[:, :, i]                                      # (values, 4, positions)
+    return list(((c[:, 3] * t + c[:, 2]) * t + c[:, 1]) * t + c[:, 0])
 
 
 def inductances_h(s: Sensor, core_position_mm, loop: bool = False) -> tuple[np.ndarray, ...]:
