@@ -71,9 +71,10 @@ from .thermal import check_sensor_thermal
 from .traceability import Station, Traceability, traceability
 from .verdict import FAIL, Verdict, judge, rejected, require_positions, uncertainty
 
-# The diagnosis sees at most this many points (bin means).  For 2,000-point sweeps with the
-# nominal --sensor: ~1.2 s of CPU instead of ~1.9 s, the same effects named on the simulated
-# sensors tried (docs/production.md); fewer points save little, the fits dominate.
+# The diagnosis sees at most this many points (bin means).  On 2,000-point sweeps without a
+# sensor file, about a quarter of the CPU of every point (bench/bench_line_rate.py's sensors),
+# the same effects named on the simulated sensors tried (docs/production.md); fewer points save
+# little, the number of fits dominates.
 DIAGNOSIS_POINTS = 250
 SUMMARY = "summary.csv"
 SUMMARY_FIELDS = ("sensor", "status", "reason", "max_error_mm", "ratio_to_limit", "limit_mm",
