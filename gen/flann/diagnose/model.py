@@ -915,8 +915,10 @@ class PhysicsFamily:
         lowers BIC although the readings it clips still rise with the curve: not a
         converter's rail.  Judged by the slope of those readings against the unclipped
         model (0 on a rail, 1 on the curve), which the clipped readings must span well enough
-        to tell.
+        to tell.  A lead screw's fitted period must lie in its range (:meth:`_period_outside`).
         """
+        if candidate == "leadscrew_periodic":
+            return self._period_outside(fit)
         if candidate != "adc_clipping":
             return ""
         theta = fit.theta.copy()
@@ -942,6 +944,20 @@ class PhysicsFamily:
                 return (f"the readings beyond {where} still follow the curve ({slope:.0%} of its "
                         "rise): not a flat rail")
         return ""
+
+    def _period_outside(self, fit: Fit) -> str:
+        """Why a fitted lead-screw period is not one ("" when it is): the fit bounds it only
+        by its sign, and a period that ran beyond a few steps .. 1/8 of the stroke (see
+        :meth:`specs`) draws a smooth warp of the axis, the shape term's job, or aliases the
+        scatter of the readings."""
+        spec = self.specs_by_name(["leadscrew_periodic"])["leadscrew_periodic.period_mm"]
+        period = fit.value("leadscrew_periodic.period_mm")
+        if spec.lower <= period <= spec.upper:
+            return ""
+        k = 1.0 / self.scale      # recorded units
+        return (f"the fitted period {period * k:.3g} mm is outside {spec.lower * k:.3g}.."
+                f"{spec.upper * k:.3g} mm (three steps of one direction to 1/8 of the stroke): "
+                "not a lead screw's ripple")
 
     def shape_may_hide(self, candidate: str) -> bool:
         """Whether the shape term chosen without ``candidate`` may already draw it, so that
