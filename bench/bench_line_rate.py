@@ -2,6 +2,7 @@
 """Production line rate without a sensor file: sensors per minute of `flann calibrate`.
 
     PYTHONPATH=gen .venv/bin/python bench/bench_line_rate.py [--n 20] [--points 2000] [-j 2] [--runs 3]
+        [--span-mm 10] [--sharpness 2.5] [--start-at-zero] [--offset-v 0]
 
 Writes N closed-form S-curve sensors (the shape of tests/production/test_calibrate_closed_form.py:
 amplitude 2.9-3.2 V, asymmetry +-3 %, 2,000 points as one forward and one reverse sweep, a
@@ -11,7 +12,10 @@ times.  Prints, per run, sensors per minute (wall clock) beside the load average
 per sensor (this process and its workers), then the verdict against the line's 100 sensors per
 minute: on a machine shared with other work the wall-clock rate understates the tool, so the
 CPU seconds give what two idle cores make (2 x 60 / CPU s per sensor).  Exit 0 when every
-sensor got its certificate in every run.
+sensor got its certificate in every run.  The other options draw another family of the same
+closed form: its half-travel (the roll-off width 0.7 of it), the roll-off's sharpness, a travel
+from 0 mm with the null mid-way (the null's position is then calibration), and each sensor's
+null offset drawn within +-offset.
 """
 
 from __future__ import annotations
@@ -37,18 +41,20 @@ SPAN_MM, W_MM, SHARP = 10.0, 7.0, 2.5
 ADC_LSB_V = 2 * 3.6 / 2 ** 14
 
 
-def s_curve(x, amp_v, asym):
-    u = x / W_MM
-    return amp_v * np.where(u >= 0, 1 + asym, 1 - asym) * u / (1 + np.abs(u) ** SHARP) ** (1 / SHARP)
+def s_curve(x, amp_v, asym, w_mm=W_MM, sharp=SHARP):
+    u = x / w_mm
+    return amp_v * np.where(u >= 0, 1 + asym, 1 - asym) * u / (1 + np.abs(u) ** sharp) ** (1 / sharp)
 
 
-def sweep(amp_v: float, asym: float, seed: int, points: int) -> Recordings:
-    x = np.linspace(-SPAN_MM, SPAN_MM, points // 2)
+def sweep(amp_v: float, asym: float, seed: int, points: int, span_mm: float = SPAN_MM,
+          sharp: float = SHARP, start_at_zero: bool = False, offset_v: float = 0.0) -> Recordings:
+    x = np.linspace(-span_mm, span_mm, points // 2)
     xs = np.concatenate([x, x[::-1]])
     d = np.concatenate([np.ones(x.size), -np.ones(x.size)])
     noise = np.random.default_rng(seed).normal(0, 0.5e-3, xs.size)
-    v = np.round((s_curve(xs, amp_v, asym) + noise) / ADC_LSB_V) * ADC_LSB_V
-    return Recordings(displacement_mm=xs, voltage_v=v, direction=d)
+    w_mm = W_MM * span_mm / SPAN_MM
+    v = np.round((s_curve(xs, amp_v, asym, w_mm, sharp) + offset_v + noise) / ADC_LSB_V) * ADC_LSB_V
+    return Recordings(displacement_mm=xs + span_mm if start_at_zero else xs, voltage_v=v, direction=d)
 
 
 def _cpu_s() -> float:
@@ -62,14 +68,20 @@ def run() -> int:
     ap.add_argument("--points", type=int, default=2000)
     ap.add_argument("-j", type=int, default=2)
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--span-mm", type=float, default=SPAN_MM, help="half-travel")
+    ap.add_argument("--sharpness", type=float, default=SHARP, help="the roll-off's sharpness")
+    ap.add_argument("--start-at-zero", action="store_true", help="travel 0..2 x span, null mid-way")
+    ap.add_argument("--offset-v", type=float, default=0.0, help="null offsets drawn within +-this")
     a = ap.parse_args()
+    offsets = np.random.default_rng(2).uniform(-a.offset_v, a.offset_v, a.n)
     work = Path(tempfile.mkdtemp(prefix="flann-line-"))
     try:
         rng = np.random.default_rng(1)
         paths = []
         for k in range(a.n):
             p = work / f"sn{k:03d}.csv"
-            write_recordings(p, sweep(float(rng.uniform(2.9, 3.2)), float(rng.uniform(-0.03, 0.03)), k, a.points))
+            write_recordings(p, sweep(float(rng.uniform(2.9, 3.2)), float(rng.uniform(-0.03, 0.03)), k, a.points,
+                                      a.span_mm, a.sharpness, a.start_at_zero, float(offsets[k])))
             paths.append(str(p))
         if flann(["gen", "--family", *paths[:2], "-o", str(work / "design")]):
             return 1
